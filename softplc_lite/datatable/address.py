@@ -1,0 +1,380 @@
+"""Data table addresses: one parser, one canonical text form.
+
+Forms accepted (see docs/datatable.md for the full table)::
+
+    N7:0   N7:0/3   B3/17   B3:1/1   O:0/0   I:012/17   S:1/15
+    T4:0.ACC  T4:0/DN  T4:0.DN  C5:0/OV  R6:0.LEN  ST9:0  ST9:0.LEN  F8:2
+    #N7:0 (indexed by S:24)   N7:[N7:1]   N[N7:2]:0   N7:0/[N7:3] (indirect)
+
+``parse_address(text)`` returns an :class:`Address`; ``str(address)`` prints
+the canonical form, and ``parse_address(str(a)) == a`` for every address.
+Canonical choices: type letters and member names upper case; ``O:``/``I:``/
+``S:`` for the fixed files; I/O word and bit numbers in octal without leading
+zeros; status bits of T/C/R by name (``T4:0/DN``); direct B-file bits in the
+bit-number-across-file form (``B3/17``), as RSLogix 5 shows them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from enum import Enum
+from functools import lru_cache
+from typing import Union
+
+from .errors import AddressError
+from .filetypes import (
+    FILE_TYPES,
+    MAX_ELEMENTS,
+    MAX_FILE_NUMBER,
+    WORD_BITS,
+    FileType,
+)
+
+
+class ValueKind(Enum):
+    """What an address holds, as instruction operands care about it."""
+
+    BIT = "bit"
+    WORD = "word"  # a 16-bit signed integer word
+    FLOAT = "float"
+    STRING = "string"  # a whole ST element
+    TIMER = "timer"  # a whole T element
+    COUNTER = "counter"
+    CONTROL = "control"
+
+
+_STRUCT_KINDS = {"T": ValueKind.TIMER, "C": ValueKind.COUNTER, "R": ValueKind.CONTROL}
+
+Part = Union[int, "Address"]
+
+
+@dataclass(frozen=True)
+class Address:
+    """A parsed data table address.
+
+    ``file``, ``element`` and ``bit`` are numbers, or an ``Address`` of the
+    word that holds the number (indirect addressing). ``element`` is None only
+    for a B-file bit addressed across the file with an indirect bit number
+    (``B3/[N7:0]``). ``bit`` is a bit of the element's word (or of the member
+    word): status bits like DN are bits of word 0 and print by name.
+    """
+
+    type_letter: str
+    file: Part
+    element: Part | None
+    member: str | None = None  # word member: PRE ACC LEN POS
+    bit: Part | None = None
+    indexed: bool = False
+
+    # -- what it is -------------------------------------------------------
+    @property
+    def ftype(self) -> FileType:
+        return FILE_TYPES[self.type_letter]
+
+    @property
+    def is_direct(self) -> bool:
+        """True when no part comes from another word or the index register."""
+        return not self.indexed and not any(
+            isinstance(p, Address) for p in (self.file, self.element, self.bit)
+        )
+
+    @property
+    def kind(self) -> ValueKind:
+        ftype = self.ftype
+        if self.bit is not None:
+            return ValueKind.BIT
+        if self.member is not None:
+            return ValueKind.WORD
+        if ftype.is_string:
+            return ValueKind.STRING
+        if ftype.letter in _STRUCT_KINDS:
+            return _STRUCT_KINDS[ftype.letter]
+        if ftype.letter == "F":
+            return ValueKind.FLOAT
+        return ValueKind.WORD
+
+    def file_name(self) -> str:
+        """``N7`` for a direct file number; ``N[N7:2]`` for an indirect one."""
+        if isinstance(self.file, Address):
+            return f"{self.type_letter}[{self.file}]"
+        return f"{self.type_letter}{self.file}"
+
+    def with_element(self, element: int) -> "Address":
+        """The same address at another element (used for blocks and files)."""
+        return Address(self.type_letter, self.file, element, self.member, self.bit, self.indexed)
+
+    # -- canonical text -----------------------------------------------------
+    def __str__(self) -> str:
+        ftype = self.ftype
+        out = ["#"] if self.indexed else []
+        if isinstance(self.file, Address):
+            out.append(f"{self.type_letter}[{self.file}]")
+        elif ftype.fixed_number is not None:
+            out.append(self.type_letter)
+        else:
+            out.append(f"{self.type_letter}{self.file}")
+        if (
+            ftype.bits_across_file
+            and isinstance(self.element, int)
+            and isinstance(self.bit, int)
+        ):
+            out.append(f"/{self.element * WORD_BITS + self.bit}")
+            return "".join(out)
+        if self.element is not None:
+            out.append(":" + _number_text(self.element, ftype.octal))
+        if self.member is not None:
+            out.append("." + self.member)
+        if self.bit is not None:
+            name = None
+            if isinstance(self.bit, int) and self.member is None:
+                name = ftype.bit_name(self.bit)
+            out.append("/" + (name or _number_text(self.bit, ftype.octal)))
+        return "".join(out)
+
+    def __repr__(self) -> str:
+        return f"Address({str(self)!r})"
+
+
+def _number_text(part: Part, octal: bool) -> str:
+    if isinstance(part, Address):
+        return f"[{part}]"
+    return format(part, "o") if octal else str(part)
+
+
+# ---------------------------------------------------------------------------
+# Parser: a small recursive-descent scanner over the text; every error names
+# the offending position and what was expected there.
+
+
+class _Scanner:
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.pos = 0
+
+    def peek(self, n: int = 1) -> str:
+        return self.text[self.pos:self.pos + n]
+
+    def at_end(self) -> bool:
+        return self.pos >= len(self.text)
+
+    def error(self, reason: str, pos: int | None = None) -> AddressError:
+        return AddressError(self.text, self.pos if pos is None else pos, reason)
+
+    def found(self) -> str:
+        return f"'{self.text[self.pos]}'" if not self.at_end() else "the end"
+
+    def take(self, ch: str) -> bool:
+        if self.peek(len(ch)) == ch:
+            self.pos += len(ch)
+            return True
+        return False
+
+    def digits(self) -> str:
+        start = self.pos
+        while not self.at_end() and self.text[self.pos].isdigit() and self.text[self.pos].isascii():
+            self.pos += 1
+        return self.text[start:self.pos]
+
+    def name(self) -> str:
+        start = self.pos
+        while not self.at_end() and self.text[self.pos].isascii() and self.text[self.pos].isalpha():
+            self.pos += 1
+        return self.text[start:self.pos]
+
+
+def parse_address(text: str) -> Address:
+    """Parse address text; raise :class:`AddressError` saying what is wrong."""
+    if not isinstance(text, str):
+        raise TypeError(f"address text must be str, not {type(text).__name__}")
+    return _parse_cached(text)
+
+
+@lru_cache(maxsize=4096)
+def _parse_cached(text: str) -> Address:
+    sc = _Scanner(text)
+    if not text:
+        raise sc.error("empty address; expected something like N7:0")
+    addr = _parse(sc, nested=False)
+    if not sc.at_end():
+        raise sc.error(f"unexpected {sc.found()} after a complete address '{text[:sc.pos]}'")
+    return addr
+
+
+def _parse(sc: _Scanner, nested: bool) -> Address:
+    indexed = sc.take("#")
+    if indexed and nested:
+        raise sc.error("an indirect reference cannot be indexed", sc.pos - 1)
+    type_pos = sc.pos
+    letters = sc.name().upper()
+    ftype, rest = _file_type(letters)
+    if ftype is None:
+        raise sc.error(
+            f"unknown file type '{letters or sc.peek()}' (expected one of "
+            f"{' '.join(FILE_TYPES)})",
+            type_pos,
+        )
+    # A name like "N7" is split by name(); "ST" + digits likewise. Anything
+    # glued on after the type letters (e.g. "NX7") is not a file type.
+    if rest:
+        raise sc.error(
+            f"unknown file type '{letters}' (expected one of {' '.join(FILE_TYPES)})", type_pos
+        )
+    file_part = _file_number(sc, ftype)
+
+    element: Part | None = None
+    member: str | None = None
+    bit: Part | None = None
+
+    if sc.take(":"):
+        element = _element_number(sc, ftype)
+        if sc.take("."):
+            member, bit = _member(sc, ftype)
+        if sc.peek() == "/":
+            if bit is not None:
+                raise sc.error(f"'{ftype.letter}' element already names a status bit")
+            sc.take("/")
+            bit = _bit(sc, ftype, member)
+    elif sc.peek() == "/" and ftype.bits_across_file:
+        sc.take("/")
+        bit = _bit_across_file(sc)
+        if isinstance(bit, int):
+            element, bit = divmod(bit, WORD_BITS)
+    else:
+        example = "B3/17 or B3:1/1" if ftype.bits_across_file else f"{_example(ftype)}"
+        raise sc.error(f"expected ':' and an element number after the file, as in {example}")
+
+    addr = Address(ftype.letter, file_part, element, member, bit, indexed)
+    if nested and addr.kind is not ValueKind.WORD:
+        raise AddressError(
+            sc.text, type_pos,
+            f"an indirect reference must be a word address such as N7:1, not "
+            f"'{addr}' ({addr.kind.value})",
+        )
+    if nested and not addr.is_direct:
+        raise AddressError(sc.text, type_pos, "an indirect reference cannot itself be indirect")
+    return addr
+
+
+def _example(ftype: FileType) -> str:
+    if ftype.fixed_number is not None:
+        return f"{ftype.letter}:0"
+    return f"{ftype.letter}{ftype.default_number or 10}:0"
+
+
+def _file_type(letters: str) -> tuple[FileType | None, str]:
+    if letters.startswith("ST") and "ST" in FILE_TYPES:
+        return FILE_TYPES["ST"], letters[2:]
+    if letters[:1] in FILE_TYPES:
+        return FILE_TYPES[letters[:1]], letters[1:]
+    return None, letters
+
+
+def _file_number(sc: _Scanner, ftype: FileType) -> Part:
+    pos = sc.pos
+    if sc.peek() == "[":
+        if ftype.fixed_number is not None:
+            raise sc.error(f"the {ftype.title} file is always {ftype.letter}{ftype.fixed_number}")
+        return _indirect(sc)
+    digits = sc.digits()
+    if not digits:
+        if ftype.fixed_number is not None:
+            return ftype.fixed_number
+        raise sc.error(
+            f"{ftype.title} ({ftype.letter}) files need a file number 3..{MAX_FILE_NUMBER}, "
+            f"as in {_example(ftype)}"
+        )
+    number = int(digits)
+    if ftype.fixed_number is not None:
+        if number != ftype.fixed_number:
+            raise sc.error(
+                f"the {ftype.title} file is {ftype.letter}{ftype.fixed_number}, not "
+                f"{ftype.letter}{digits}", pos,
+            )
+        return number
+    if number < 3 or number > MAX_FILE_NUMBER:
+        raise sc.error(
+            f"file number {digits} out of range: {ftype.letter} files are numbered "
+            f"3..{MAX_FILE_NUMBER} (0, 1, 2 are O, I and S)", pos,
+        )
+    return number
+
+
+def _indirect(sc: _Scanner) -> "Address":
+    open_pos = sc.pos
+    sc.take("[")
+    inner = _parse(sc, nested=True)
+    if not sc.take("]"):
+        raise sc.error(f"expected ']' to close the indirect reference opened at column {open_pos + 1}")
+    return inner
+
+
+def _number(sc: _Scanner, what: str, octal: bool, limit: int) -> int:
+    """A decimal (or, for I/O, octal) number; ``what`` is a noun like
+    "element number"."""
+    pos = sc.pos
+    article = "an" if what[0] in "aeiou" else "a"
+    if sc.peek() == "-":
+        raise sc.error(f"{article} {what} cannot be negative")
+    digits = sc.digits()
+    if not digits:
+        raise sc.error(f"expected {article} {what} but found {sc.found()}")
+    if octal:
+        bad = next((d for d in digits if d in "89"), None)
+        if bad:
+            raise sc.error(f"I/O {what}s are octal; '{bad}' is not an octal digit in '{digits}'", pos)
+        value = int(digits, 8)
+    else:
+        value = int(digits)
+    if value > limit:
+        shown = f"{digits} (octal, = {value})" if octal else digits
+        top = format(limit, "o") if octal else str(limit)
+        raise sc.error(f"{what} {shown} out of range 0..{top}", pos)
+    return value
+
+
+def _element_number(sc: _Scanner, ftype: FileType) -> Part:
+    if sc.peek() == "[":
+        return _indirect(sc)
+    return _number(sc, "element number", ftype.octal, MAX_ELEMENTS - 1)
+
+
+def _member(sc: _Scanner, ftype: FileType) -> tuple[str | None, Part | None]:
+    pos = sc.pos
+    name = sc.name().upper()
+    if not ftype.is_structure:
+        raise sc.error(f"{ftype.title} ({ftype.letter}) elements have no members", pos - 1)
+    if not name:
+        raise sc.error(f"expected a member name ({ftype.member_names()}) after '.'")
+    member = ftype.members_by_name.get(name)
+    if member is None:
+        raise sc.error(
+            f"'{name}' is not a member of a {ftype.title} ({ftype.letter}) element; "
+            f"members are {ftype.member_names()}", pos,
+        )
+    if hasattr(member, "bit"):
+        return None, member.bit  # T4:0.DN is T4:0/DN
+    return member.name, None
+
+
+def _bit(sc: _Scanner, ftype: FileType, member: str | None) -> Part:
+    pos = sc.pos
+    if not ftype.has_bits:
+        raise sc.error(f"{ftype.title} ({ftype.letter}) elements have no bits", pos - 1)
+    if sc.peek() == "[":
+        return _indirect(sc)
+    if sc.peek().isalpha():
+        name = sc.name().upper()
+        m = ftype.members_by_name.get(name)
+        if member is None and m is not None and hasattr(m, "bit"):
+            return m.bit
+        named = " ".join(b.name for b in ftype.bit_members)
+        hint = f"; status bits are {named}" if named and member is None else ""
+        raise sc.error(f"'{name}' is not a bit of {ftype.title} ({ftype.letter}) elements{hint}", pos)
+    top = WORD_BITS - 1
+    return _number(sc, "bit number", ftype.octal, top)
+
+
+def _bit_across_file(sc: _Scanner) -> Part:
+    if sc.peek() == "[":
+        return _indirect(sc)
+    return _number(sc, "bit number", False, MAX_ELEMENTS * WORD_BITS - 1)

@@ -1,0 +1,147 @@
+"""The PLC-5/SoftPLC data file types and the layout of their elements.
+
+Every file type is described once here; the address parser, the storage
+classes, JSON import/export and the snapshot format all read these specs, so a
+member name or a bit position is written down in exactly one place.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import Enum
+
+#: Most elements one file may hold (PLC-5 and SoftPLC: 0..9999).
+MAX_ELEMENTS = 10_000
+#: Highest file number.
+MAX_FILE_NUMBER = 9999
+#: Characters in one ST element (SoftPLC: UCS-2, any 16-bit code unit).
+STRING_CHARS = 82
+#: Bits in a data table word.
+WORD_BITS = 16
+
+
+class Storage(Enum):
+    """How a file's elements are stored."""
+
+    WORD = "word"  # 16-bit words in array('h')
+    FLOAT = "float"  # IEEE float32 in array('f')
+
+
+@dataclass(frozen=True)
+class WordMember:
+    """A named 16-bit word inside a structured element (``T4:0.ACC``)."""
+
+    name: str
+    offset: int  # word offset inside the element
+
+
+@dataclass(frozen=True)
+class BitMember:
+    """A named status bit of a structured element (``T4:0/DN``), in word 0."""
+
+    name: str
+    bit: int
+    word: int = 0
+
+
+@dataclass(frozen=True)
+class FileType:
+    """One data file type: its letter, its element layout and its rules."""
+
+    letter: str
+    title: str
+    storage: Storage
+    words_per_element: int  # for FLOAT storage: floats per element (1)
+    word_members: tuple[WordMember, ...] = ()
+    bit_members: tuple[BitMember, ...] = ()
+    has_bits: bool = True  # /n bit addressing on the element word
+    fixed_number: int | None = None  # O is always 0, I 1, S 2
+    octal: bool = False  # I/O word and bit numbers are octal on PLC-5
+    default_number: int | None = None
+    default_size: int = 1
+    bits_across_file: bool = False  # B3/17 form
+    members_by_name: dict[str, WordMember | BitMember] = field(
+        init=False, repr=False, compare=False
+    )
+
+    def __post_init__(self) -> None:
+        table: dict[str, WordMember | BitMember] = {}
+        for m in self.word_members + self.bit_members:
+            table[m.name] = m
+        object.__setattr__(self, "members_by_name", table)
+
+    @property
+    def is_structure(self) -> bool:
+        return bool(self.word_members or self.bit_members)
+
+    @property
+    def is_string(self) -> bool:
+        return self.letter == "ST"
+
+    def bit_name(self, bit: int) -> str | None:
+        """The mnemonic of a status bit in word 0, if it has one."""
+        for m in self.bit_members:
+            if m.bit == bit:
+                return m.name
+        return None
+
+    def member_names(self) -> str:
+        return " ".join(m.name for m in self.bit_members + self.word_members)
+
+
+def _bits(*pairs: tuple[str, int]) -> tuple[BitMember, ...]:
+    return tuple(BitMember(name, bit) for name, bit in pairs)
+
+
+OUTPUT = FileType("O", "output image", Storage.WORD, 1, fixed_number=0, octal=True,
+                  default_number=0, default_size=32)
+INPUT = FileType("I", "input image", Storage.WORD, 1, fixed_number=1, octal=True,
+                 default_number=1, default_size=32)
+STATUS = FileType("S", "status", Storage.WORD, 1, fixed_number=2, default_number=2,
+                  default_size=128)
+BINARY = FileType("B", "binary", Storage.WORD, 1, default_number=3, bits_across_file=True)
+TIMER = FileType(
+    "T", "timer", Storage.WORD, 3,
+    word_members=(WordMember("PRE", 1), WordMember("ACC", 2)),
+    bit_members=_bits(("EN", 15), ("TT", 14), ("DN", 13)),
+    default_number=4,
+)
+COUNTER = FileType(
+    "C", "counter", Storage.WORD, 3,
+    word_members=(WordMember("PRE", 1), WordMember("ACC", 2)),
+    bit_members=_bits(("CU", 15), ("CD", 14), ("DN", 13), ("OV", 12), ("UN", 11)),
+    default_number=5,
+)
+CONTROL = FileType(
+    "R", "control", Storage.WORD, 3,
+    word_members=(WordMember("LEN", 1), WordMember("POS", 2)),
+    bit_members=_bits(("EN", 15), ("EU", 14), ("DN", 13), ("EM", 12), ("ER", 11),
+                      ("UL", 10), ("IN", 9), ("FD", 8)),
+    default_number=6,
+)
+INTEGER = FileType("N", "integer", Storage.WORD, 1, default_number=7)
+FLOAT = FileType("F", "float", Storage.FLOAT, 1, has_bits=False, default_number=8)
+# An ST element is its LEN word followed by 82 UCS-2 code units, one word each.
+STRING = FileType(
+    "ST", "string", Storage.WORD, 1 + STRING_CHARS,
+    word_members=(WordMember("LEN", 0),),
+    has_bits=False,
+)
+
+FILE_TYPES: dict[str, FileType] = {
+    t.letter: t
+    for t in (OUTPUT, INPUT, STATUS, BINARY, TIMER, COUNTER, CONTROL, INTEGER, FLOAT, STRING)
+}
+
+#: The files every data table starts with, in PLC-5 order.
+DEFAULT_FILES: tuple[tuple[FileType, int], ...] = tuple(
+    (t, t.default_number) for t in FILE_TYPES.values() if t.default_number is not None
+)
+
+
+def file_name(ftype: FileType, number: int) -> str:
+    """Canonical file name: ``N7``, ``ST9``, ``O0``."""
+    return f"{ftype.letter}{number}"
+
+#: Word of the status file holding the index register used by ``#`` addresses.
+INDEX_REGISTER_WORD = 24

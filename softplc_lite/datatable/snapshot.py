@@ -1,0 +1,167 @@
+"""Retentive snapshots: the whole data table on disk, saved atomically.
+
+File format (little-endian throughout)::
+
+    header  "SPLCSNAP"  u16 version=1  u16 reserved  u32 file count  u64 body length
+    body    per file:  2s type letter(s)  u16 number  u32 elements  <data bytes>
+    trailer u32 CRC-32 of header+body   "SPLCEND!"
+
+A short file, a wrong length, a bad CRC or a missing trailer is reported as
+:class:`SnapshotError`; nothing half-read is ever returned.
+
+Saving writes ``NAME.tmp``, fsyncs it, hard-links the current snapshot to
+``NAME.prev`` (the previous good one), renames the temp file over ``NAME``
+and fsyncs the directory. At every instant ``NAME`` is either the complete
+old snapshot or the complete new one, so a process killed during a save
+leaves a loadable snapshot.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+import zlib
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .errors import DataTableError, SnapshotError
+from .filetypes import FILE_TYPES
+from .table import DataTable
+
+MAGIC = b"SPLCSNAP"
+TRAILER_MAGIC = b"SPLCEND!"
+VERSION = 1
+_HEADER = struct.Struct("<8sHHIQ")
+_FILE = struct.Struct("<2sHI")
+_TRAILER = struct.Struct("<I8s")
+
+
+def encode(table: DataTable) -> bytes:
+    parts: list[bytes] = []
+    files = table.files()
+    for f in files:
+        parts.append(_FILE.pack(f.ftype.letter.encode("ascii").ljust(2), f.number, f.size))
+        parts.append(f.little_endian_bytes())
+    body = b"".join(parts)
+    header = _HEADER.pack(MAGIC, VERSION, 0, len(files), len(body))
+    crc = zlib.crc32(body, zlib.crc32(header))
+    return header + body + _TRAILER.pack(crc, TRAILER_MAGIC)
+
+
+def decode(raw: bytes, source: str = "<snapshot>") -> DataTable:
+    def bad(reason: str) -> SnapshotError:
+        return SnapshotError(f"{source}: not a usable snapshot: {reason}")
+
+    if len(raw) < _HEADER.size + _TRAILER.size:
+        raise bad(f"only {len(raw)} bytes (truncated)")
+    magic, version, _, count, body_len = _HEADER.unpack_from(raw, 0)
+    if magic != MAGIC:
+        raise bad("wrong magic number (not a softplc snapshot)")
+    if version != VERSION:
+        raise bad(f"format version {version}, this softplc reads version {VERSION}")
+    expected = _HEADER.size + body_len + _TRAILER.size
+    if len(raw) != expected:
+        raise bad(f"{len(raw)} bytes where the header promises {expected} (truncated or padded)")
+    crc, end_magic = _TRAILER.unpack_from(raw, _HEADER.size + body_len)
+    if end_magic != TRAILER_MAGIC:
+        raise bad("missing end marker")
+    actual = zlib.crc32(raw[_HEADER.size:_HEADER.size + body_len], zlib.crc32(raw[:_HEADER.size]))
+    if crc != actual:
+        raise bad(f"checksum mismatch (stored {crc:08x}, computed {actual:08x}): corrupted")
+    table = DataTable(defaults=False)
+    pos = _HEADER.size
+    end = _HEADER.size + body_len
+    try:
+        for _ in range(count):
+            letters, number, elements = _FILE.unpack_from(raw, pos)
+            pos += _FILE.size
+            ftype = FILE_TYPES.get(letters.decode("ascii").strip())
+            if ftype is None:
+                raise bad(f"unknown file type {letters!r}")
+            f = table.create_file(ftype.letter, number, 0)
+            nbytes = elements * ftype.words_per_element * f.data.itemsize
+            if pos + nbytes > end:
+                raise bad(f"{f.name} runs past the end of the body")
+            f.load_little_endian_bytes(raw[pos:pos + nbytes])
+            pos += nbytes
+    except (struct.error, UnicodeDecodeError, DataTableError) as e:
+        if isinstance(e, SnapshotError):
+            raise
+        raise bad(str(e)) from None
+    if pos != end:
+        raise bad(f"{end - pos} stray bytes after the last file")
+    return table
+
+
+def save(table: DataTable, path: str | os.PathLike[str]) -> None:
+    """Write ``table`` to ``path`` atomically, keeping the old one as .prev."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    prev = path.with_name(path.name + ".prev")
+    data = encode(table)
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+    try:
+        view = memoryview(data)
+        while view:
+            view = view[os.write(fd, view):]
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+    if path.exists():
+        # A hard link, not a rename: NAME must never be missing, even for an
+        # instant, or a kill right then would leave no current snapshot.
+        prev_tmp = path.with_name(path.name + ".prev.tmp")
+        prev_tmp.unlink(missing_ok=True)
+        os.link(path, prev_tmp)
+        os.replace(prev_tmp, prev)
+    os.replace(tmp, path)
+    _fsync_dir(path.parent)
+
+
+def _fsync_dir(directory: Path) -> None:
+    fd = os.open(directory, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def load(path: str | os.PathLike[str]) -> DataTable:
+    """Read one snapshot file; raise SnapshotError if it is missing or bad."""
+    try:
+        raw = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise SnapshotError(f"{path}: no snapshot") from None
+    except OSError as e:
+        raise SnapshotError(f"{path}: cannot read: {e.strerror}") from None
+    return decode(raw, str(path))
+
+
+@dataclass
+class Restored:
+    """What :func:`restore` found: the table (None when there was no
+    snapshot at all), which file it came from, and problems to report."""
+
+    table: DataTable | None
+    source: Path | None
+    problems: list[str] = field(default_factory=list)
+
+
+def restore(path: str | os.PathLike[str]) -> Restored:
+    """Load the snapshot at ``path``; if it is corrupt, report that and fall
+    back to ``path.prev``. Raises SnapshotError only when a snapshot exists
+    but neither it nor the previous one is usable."""
+    path = Path(path)
+    prev = path.with_name(path.name + ".prev")
+    if not path.exists() and not prev.exists():
+        return Restored(None, None)
+    problems: list[str] = []
+    for candidate in (path, prev):
+        if not candidate.exists():
+            continue
+        try:
+            return Restored(load(candidate), candidate, problems)
+        except SnapshotError as e:
+            problems.append(str(e))
+    raise SnapshotError("; ".join(problems) + "; no usable snapshot")

@@ -1,0 +1,1 @@
+"""The ladder language, its compiler and the scan engine (issue 3)."""

@@ -1,0 +1,1 @@
+"""Plug-in instruction modules (TLMs) (issue 4)."""

@@ -1,0 +1,1 @@
+"""The COMGENIUS TLM: format engine and serial instructions (issues 4 and 5)."""
