@@ -13,6 +13,7 @@ from typing import Sequence
 from . import __version__
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
+from .datatable.display import format_value
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT = 0, 1, 2, 3
 
@@ -43,7 +44,7 @@ def _cmd_datatable(args: argparse.Namespace) -> int:
             jsonio.load_into(table, jsonio.export_table(restored), path)
     for text in args.print:
         a = parse_address(text)
-        print(f"{a} = {table.read(a)!r}")
+        print(f"{a} = {format_value(table.read(a))}")
     if args.dump:
         sys.stdout.write(jsonio.dumps(table))
     if args.save:

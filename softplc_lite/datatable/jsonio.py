@@ -212,7 +212,7 @@ def _load_string(data: array, start: int, value: Any, name: str) -> None:
     from .table import write_string
 
     if isinstance(value, str):
-        write_string(data, start, value, name)
+        write_string(data, start, _utf16_units(value), name)
         return
     if not isinstance(value, dict):
         raise DataTableError(f"{name} is a string element; give a string or {{\"LEN\":..,\"CHARS\":..}}")
@@ -223,10 +223,29 @@ def _load_string(data: array, start: int, value: Any, name: str) -> None:
     if "CHARS" in value:
         chars = value["CHARS"]
         keep = data[start]
+        if isinstance(chars, str):
+            chars = _utf16_units(chars)
         write_string(data, start, chars, name)  # checks width and 16-bit range
         data[start] = keep
     if length is not None:
         data[start] = to_signed(_check_int(length, 0, RAW_MAX, f"{name}.LEN", "a raw word"))
+
+
+def _utf16_units(text: str) -> str:
+    """JSON strings are UTF-16: ``"\\ud83d\\ude00"`` (or a literal emoji) is two
+    code units, and json.loads joins such a pair into one character. Split it
+    back so every code unit is one ST character, as it was exported."""
+    if all(ord(c) <= 0xFFFF for c in text):
+        return text
+    out = []
+    for c in text:
+        code = ord(c)
+        if code > 0xFFFF:
+            code -= 0x10000
+            out.append(chr(0xD800 + (code >> 10)) + chr(0xDC00 + (code & 0x3FF)))
+        else:
+            out.append(c)
+    return "".join(out)
 
 
 def _load_struct(data: array, start: int, ftype: FileType, value: Any, name: str) -> None:

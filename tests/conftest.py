@@ -1,0 +1,36 @@
+"""Shared test helpers: random data tables built from raw contents."""
+
+from __future__ import annotations
+
+import math
+from array import array
+
+from hypothesis import strategies as st
+
+from softplc_lite.datatable import DataTable
+from softplc_lite.datatable.filetypes import FILE_TYPES
+
+
+@st.composite
+def random_tables(draw, max_elements: int = 12) -> DataTable:
+    """A table whose files hold arbitrary raw contents: any word pattern
+    (unnamed control bits, ST LEN above 82, characters past LEN) and any
+    non-NaN float32."""
+    table = DataTable()
+    numbers = draw(st.lists(st.integers(9, 60), unique=True, max_size=5))
+    for n in numbers:
+        table.create_file(draw(st.sampled_from(["B", "N", "T", "C", "R", "F", "ST"])), n, 0)
+    for f in table.files():
+        size = draw(st.integers(0 if f.number > 8 else f.size, max(f.size, max_elements)))
+        f.grow(size)
+        nbytes = len(f.data) * f.data.itemsize
+        # Raw bytes are far cheaper to draw than thousands of integers.
+        fresh = array(f.data.typecode, draw(st.binary(min_size=nbytes, max_size=nbytes)))
+        if not f.is_words:
+            # NaN payloads are not kept by JSON (documented); use plain values.
+            fresh = array("f", [0.0 if math.isnan(x) else x for x in fresh])
+        f.data[:] = fresh
+    return table
+
+
+FILE_LETTERS = list(FILE_TYPES)
