@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given, settings
 
 from conftest import random_tables
-from softplc_lite.datatable import DataTable, SnapshotError
+from softplc_lite.datatable import DataTable, DataTableError, SnapshotError
 from softplc_lite.datatable import snapshot
 
 
@@ -166,3 +166,53 @@ def test_kill_during_save_leaves_old_or_new(tmp_path):
         for leftover in tmp_path.iterdir():
             leftover.unlink()
     assert killed_mid_save >= 1, "no kill landed during a save; the test did not test anything"
+
+
+def _forged(entries: list[tuple[bytes, int, int, bytes]]) -> bytes:
+    """A snapshot with a valid checksum around hand-made file entries."""
+    import struct
+    import zlib
+
+    body = b"".join(struct.pack("<2sHI", l, n, e) + d for l, n, e, d in entries)
+    header = struct.pack("<8sHHIQ", b"SPLCSNAP", 1, 0, len(entries), len(body))
+    crc = zlib.crc32(body, zlib.crc32(header))
+    return header + body + struct.pack("<I8s", crc, b"SPLCEND!")
+
+
+def test_forged_entries_are_refused_even_with_a_good_checksum():
+    with pytest.raises(SnapshotError, match="claims 20000 elements"):
+        snapshot.decode(_forged([(b"N ", 7, 20000, bytes(40000))]))
+    with pytest.raises(SnapshotError, match="file number 7 appears twice"):
+        snapshot.decode(_forged([(b"N ", 7, 1, bytes(2)), (b"N ", 7, 1, bytes(2))]))
+    with pytest.raises(SnapshotError, match="unknown file type"):
+        snapshot.decode(_forged([(b"X ", 7, 1, bytes(2))]))
+    with pytest.raises(SnapshotError, match="runs past the end"):
+        snapshot.decode(_forged([(b"N ", 7, 5, bytes(2))]))
+
+
+def test_load_into_keeps_the_arrays_compiled_code_holds(tmp_path):
+    path = tmp_path / "datatable.snap"
+    saved = sample_table()
+    snapshot.save(saved, path)
+    live = DataTable()
+    live.reference("N7:20")  # the program references more than was saved
+    live.write("N7:20", 5)
+    live.reference("N30:0")  # a file the snapshot does not have
+    live.write("N30:0", 6)
+    data, i = live.word_ref("N7:9")
+    snapshot.load_into(live, path)
+    assert live.file("N7").data is data and data[i] == -7
+    assert live.file("N7").size == 21 and live.read("N7:20") == 0
+    assert live.read("N30:0") == 0
+    assert live.read("ST9:1") == "héllo" and live.read("T4:0/DN") == 1
+
+
+def test_load_into_refuses_a_type_clash_and_changes_nothing(tmp_path):
+    path = tmp_path / "datatable.snap"
+    snapshot.save(sample_table(), path)  # has ST9
+    live = DataTable()
+    live.reference("N9:0")
+    live.write("N9:0", 3)
+    with pytest.raises(DataTableError, match="cannot load ST9: file number 9 is N9 here"):
+        snapshot.load_into(live, path)
+    assert live.read("N9:0") == 3

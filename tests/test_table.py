@@ -318,6 +318,10 @@ def test_word_and_bit_refs_for_compiled_code(table):
         table.word_ref("N7:0/1")
     with pytest.raises(DataTableError, match="not a bit"):
         table.bit_ref("N7:0")
+    with pytest.raises(DataTableError, match="whole timer element"):
+        table.word_ref("T4:0")
+    with pytest.raises(DataTableError, match="whole string element"):
+        table.word_ref("ST9:0")
 
 
 def test_arrays_survive_growth(table):

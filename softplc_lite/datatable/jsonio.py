@@ -1,7 +1,8 @@
 """JSON import and export of a data table (format in docs/datatable.md).
 
-Keys are file names (``"N7"``, ``"ST9"``, ``"R6"``; ``"O"``, ``"I"``, ``"S"``
-for the fixed files); values are lists by element:
+Keys are file names (``"N7"``, ``"ST9"``, ``"R6"``, ``"O0"``; on import
+``"O"``, ``"I"``, ``"S"`` are accepted for the fixed files); values are lists
+by element:
 
 * O I S B N: signed 16-bit integers;
 * F: numbers (float32 values print exactly, e.g. 3.140000104904175);

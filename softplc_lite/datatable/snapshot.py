@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from .errors import DataTableError, SnapshotError
-from .filetypes import FILE_TYPES
+from .filetypes import FILE_TYPES, MAX_ELEMENTS
 from .table import DataTable
 
 MAGIC = b"SPLCSNAP"
@@ -71,6 +71,7 @@ def decode(raw: bytes, source: str = "<snapshot>") -> DataTable:
     table = DataTable(defaults=False)
     pos = _HEADER.size
     end = _HEADER.size + body_len
+    seen: set[int] = set()
     try:
         for _ in range(count):
             letters, number, elements = _FILE.unpack_from(raw, pos)
@@ -78,6 +79,11 @@ def decode(raw: bytes, source: str = "<snapshot>") -> DataTable:
             ftype = FILE_TYPES.get(letters.decode("ascii").strip())
             if ftype is None:
                 raise bad(f"unknown file type {letters!r}")
+            if elements > MAX_ELEMENTS:
+                raise bad(f"{ftype.letter}{number} claims {elements} elements (at most {MAX_ELEMENTS})")
+            if number in seen:
+                raise bad(f"file number {number} appears twice")
+            seen.add(number)
             f = table.create_file(ftype.letter, number, 0)
             nbytes = elements * ftype.words_per_element * f.data.itemsize
             if pos + nbytes > end:
@@ -125,6 +131,12 @@ def _fsync_dir(directory: Path) -> None:
         os.fsync(fd)
     finally:
         os.close(fd)
+
+
+def load_into(table: DataTable, path: str | os.PathLike[str]) -> None:
+    """Replace ``table``'s contents with the snapshot at ``path``, keeping
+    its array objects (compiled rungs hold references to them)."""
+    table.assign(load(path))
 
 
 def load(path: str | os.PathLike[str]) -> DataTable:

@@ -395,9 +395,11 @@ class DataTable:
         a = _as_address(addr)
         if not a.is_direct:
             raise DataTableError(f"{a} is indirect or indexed; resolve it each scan")
-        f, i, bit = self.resolve(a)
-        if bit is not None:
+        if a.kind is ValueKind.BIT:
             raise DataTableError(f"{a} is a bit; use bit_ref")
+        if a.kind not in (ValueKind.WORD, ValueKind.FLOAT):
+            raise DataTableError(f"{a} is a whole {a.kind.value} element, not a word or float")
+        f, i, _ = self.resolve(a)
         return f.data, i
 
     def bit_ref(self, addr: AddressLike) -> tuple[array, int, int]:
@@ -409,6 +411,31 @@ class DataTable:
         if bit is None:
             raise DataTableError(f"{a} is not a bit address")
         return f.data, i, bit_mask(bit)
+
+    def assign(self, other: "DataTable") -> None:
+        """Take ``other``'s values, keeping this table's arrays.
+
+        Restoring a snapshot into a running table must not break the
+        references compiled rungs hold, nor shrink files the program
+        references: every file is overwritten in place, grown if ``other``'s
+        is larger, and zero past the end of ``other``'s; files ``other`` lacks
+        are zeroed. A file number used with another type is refused before
+        anything changes."""
+        for number, theirs in other._files.items():
+            mine = self._files.get(number)
+            if mine is not None and mine.ftype is not theirs.ftype:
+                raise DataTableError(
+                    f"cannot load {theirs.name}: file number {number} is {mine.name} here"
+                )
+        for number, mine in self._files.items():
+            if number not in other._files:
+                mine.data[:] = array(mine.data.typecode, bytes(len(mine.data) * mine.data.itemsize))
+        for number, theirs in other._files.items():
+            mine = self.create_file(theirs.ftype.letter, number, 0)
+            extra = len(mine.data) - len(theirs.data)
+            mine.data[:] = theirs.data
+            if extra > 0:
+                mine.data.frombytes(bytes(extra * mine.data.itemsize))
 
     # -- comparison -------------------------------------------------------------
     def __eq__(self, other: object) -> bool:
