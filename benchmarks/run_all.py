@@ -1,0 +1,88 @@
+"""Run every data table benchmark, each in its own process, and summarize.
+
+    python benchmarks/run_all.py
+
+Each benchmark prints its own figures and writes benchmarks/results/NAME.json;
+this script then prints a summary from those files and writes
+benchmarks/results/run_all.json. Misses against a target are reported, not
+turned into a failing exit status; a benchmark that crashes is.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+
+import _common as C
+
+BENCHMARKS = ("bench_datatable_memory", "bench_snapshot", "bench_word_access")
+
+
+def main() -> int:
+    t_start = time.perf_counter()
+    failed: list[str] = []
+    wall: dict[str, float] = {}
+    for name in BENCHMARKS:
+        print(f"=== {name} " + "=" * (60 - len(name)), flush=True)
+        t0 = time.perf_counter()
+        proc = subprocess.run([sys.executable, str(C.HERE / f"{name}.py")], check=False)
+        wall[name] = time.perf_counter() - t0
+        if proc.returncode != 0:
+            failed.append(name)
+        print(flush=True)
+
+    def load(name: str) -> dict | None:
+        path = C.RESULTS / f"{name}.json"
+        if name in failed or not path.exists():
+            return None
+        return json.loads(path.read_text(encoding="utf-8"))
+
+    lines: list[str] = []
+    mem = load("bench_datatable_memory")
+    if mem:
+        t, p = mem["table"], mem["plain_lists"]
+        lines.append(
+            f"memory    {mem['verdict']}: retained {mem['retained_bytes_for_verdict'] / 1e6:.2f} MB "
+            f"(tracemalloc {t['tracemalloc_current'] / 1e6:.2f} MB, RSS {t['rss_delta_median'] / 1e6:.2f} MB) "
+            f"vs target {mem['target_bytes'] / 1e6:.0f} MB; plain lists "
+            f"{p['tracemalloc_current'] / 1e6:.2f} MB ({mem['ratio_plain_over_table_tracemalloc']:.1f}x)"
+        )
+    snap = load("bench_snapshot")
+    if snap:
+        m = snap["ms_median"]
+        lines.append(
+            f"snapshot  {snap['verdict']}: save {m['save']:.1f} ms + load {m['load']:.1f} ms = "
+            f"{m['total']:.1f} ms vs target {snap['target_ms']:.0f} ms; {snap['snapshot_bytes']} bytes; "
+            f"{snap['ratio_total_snapshot_over_pickle']:.2f}x pickle, "
+            f"{snap['ratio_total_snapshot_over_raw_io']:.2f}x raw I/O"
+        )
+    acc = load("bench_word_access")
+    if acc:
+        a = acc["access_ns"]
+        api = acc["typed_api_ns"]
+        lines.append(
+            "access    ns net, array (list): "
+            + ", ".join(
+                f"{op} {a[op]['array_ns']:.1f} ({a[op]['list_ns']:.1f})"
+                for op in ("read", "write", "bit_read", "bit_set")
+            )
+        )
+        read_ns = api["table.read('N7:5')"]["ns"]
+        write_ns = api["table.write('N7:5', v)"]["ns"]
+        lines.append(f"          typed API: read {read_ns:.0f} ns, write {write_ns:.0f} ns per call")
+
+    print("=== summary " + "=" * 53)
+    for line in lines:
+        print(line)
+    for name in failed:
+        print(f"FAILED: {name} exited non-zero")
+    total = time.perf_counter() - t_start
+    print(f"total wall time {total:.1f} s (" + ", ".join(f"{k} {v:.1f} s" for k, v in wall.items()) + ")")
+    C.write_results("run_all", {"summary": lines, "failed": failed, "wall_s": wall, "total_wall_s": total})
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
