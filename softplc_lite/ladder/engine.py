@@ -1,0 +1,339 @@
+"""Stage 4: the scan engine.
+
+One scan: input hooks, the ladder (main file 2 and the files it JSRs to),
+output hooks. Plug-in modules (TLMs) attach to exactly those points and to
+mode changes. Modes: PROGRAM (no ladder), RUN, TEST (ladder runs, outputs
+stay idle: output hooks are told outputs are disabled), FAULTED (after a
+major fault; clear it to go back to PROGRAM).
+
+Time is injectable: SimulatedClock advances a fixed number of ms per scan
+(deterministic, the default); RealClock reads the wall clock.
+"""
+
+from __future__ import annotations
+
+import enum
+import time
+import traceback
+from dataclasses import dataclass
+from typing import Callable
+
+from ..datatable import DataTable
+from ..datatable.table import to_signed
+from . import status as S
+from .ast import MAIN_FILE, AddressRef, Const, Instruction, Program, walk
+from .compiler import RET, TND, compile_file, describe
+from .interpreter import interpret_file
+from .semantics import BASE_MS, Machine, MajorFault, Settings
+
+
+class Mode(enum.Enum):
+    PROGRAM = 0
+    RUN = 1
+    TEST = 2
+    FAULTED = 3
+
+
+# Which mode changes an operator may ask for (FAULTED is entered by faults).
+TRANSITIONS = {
+    Mode.PROGRAM: {Mode.RUN, Mode.TEST},
+    Mode.RUN: {Mode.PROGRAM, Mode.TEST},
+    Mode.TEST: {Mode.PROGRAM, Mode.RUN},
+    Mode.FAULTED: {Mode.PROGRAM},  # clearing the fault
+}
+
+
+class ModeError(Exception):
+    pass
+
+
+class SimulatedClock:
+    """Each scan advances exactly ``scan_ms`` milliseconds."""
+
+    realtime = False
+
+    def __init__(self, scan_ms: int = 10) -> None:
+        self.scan_ms = scan_ms
+        self.now_ms = 0
+
+    def advance(self) -> int:
+        self.now_ms += self.scan_ms
+        return self.scan_ms
+
+
+class RealClock:
+    """Milliseconds of wall-clock time since the previous scan."""
+
+    realtime = True
+
+    def __init__(self) -> None:
+        self._last_ns = time.monotonic_ns()
+        self._carry_ns = 0
+        self.now_ms = 0
+
+    def advance(self) -> int:
+        now = time.monotonic_ns()
+        elapsed = now - self._last_ns + self._carry_ns
+        self._last_ns = now
+        ms, self._carry_ns = divmod(elapsed, 1_000_000)
+        self.now_ms += ms
+        return ms
+
+
+@dataclass
+class FaultInfo:
+    code: int
+    file: int | None
+    rung: int | None
+    instruction: str | None
+    message: str
+
+    def __str__(self) -> str:
+        where = ""
+        if self.file is not None:
+            where = f"program file {self.file}, rung {self.rung}"
+            if self.instruction:
+                where += f", {self.instruction}"
+            where += ": "
+        return f"major fault {self.code}: {where}{self.message}"
+
+
+class _EndScan(Exception):
+    """TND: end this scan now."""
+
+
+Hook = Callable[["Engine"], None]
+
+
+def reference_program(program: Program, table: DataTable) -> None:
+    """Grow the table to everything the program names (and COP/FLL blocks)."""
+    for decl in program.data:
+        letter = "ST" if decl.file.startswith("ST") else decl.file[:1]
+        table.create_file(letter, int(decl.file[len(letter):]), decl.size)
+    for pfile in program.files.values():
+        for rung in pfile.rungs:
+            for ins in walk(rung.elements):
+                for op in ins.operands:
+                    for ref in _address_refs(op):
+                        table.reference(ref.address)
+                if ins.mnemonic in ("COP", "FLL") and ins.operands[1].address.is_direct:
+                    n = ins.operands[2].value
+                    for ref in ins.operands[:2]:
+                        if isinstance(ref, AddressRef) and ref.address.is_direct:
+                            table.reference(ref.address.with_element(ref.address.element + n - 1))
+
+
+def _address_refs(op):
+    if isinstance(op, AddressRef):
+        yield op
+    for child in ("left", "right", "operand", "arg"):
+        sub = getattr(op, child, None)
+        if sub is not None:
+            yield from _address_refs(sub)
+
+
+def initial_values(program: Program, table: DataTable) -> None:
+    """What a download sets: DATA initial values, and the preset and
+    accumulator operands of TON/TOF/RTO/CTU/CTD (as RSLogix 5 does)."""
+    for decl in program.data:
+        letter = "ST" if decl.file.startswith("ST") else decl.file[:1]
+        for k, v in enumerate(decl.values):
+            addr = f"{decl.file}:{k}"
+            if isinstance(v, int) and letter != "F" and v > 32767:
+                table.write_word(addr, v)
+            else:
+                table.write(addr, v)
+    for pfile in program.files.values():
+        for rung in pfile.rungs:
+            for ins in walk(rung.elements):
+                if ins.mnemonic in ("TON", "TOF", "RTO", "CTU", "CTD") and ins.operands[0].address.is_direct:
+                    pre, acc = ins.operands[-2], ins.operands[-1]
+                    table.write(ins.operands[0].address, {"PRE": pre.value, "ACC": acc.value})
+
+
+class Engine:
+    def __init__(
+        self,
+        program: Program,
+        table: DataTable | None = None,
+        settings: Settings | None = None,
+        clock=None,
+        executor: str = "compiled",
+        fresh: bool = True,
+    ) -> None:
+        self.program = program
+        self.table = table if table is not None else DataTable()
+        self.settings = settings or Settings()
+        self.clock = clock or SimulatedClock(self.settings.scan_ms)
+        self.executor = executor
+        reference_program(program, self.table)
+        if fresh:
+            initial_values(program, self.table)
+        self.machine = Machine(self.table, self.settings)
+        self.s = self.machine.s
+        if self.s[S.WATCHDOG_MS] == 0:
+            self.s[S.WATCHDOG_MS] = self.settings.watchdog_ms
+        self.mode = Mode.PROGRAM
+        self.fault: FaultInfo | None = None
+        self.scans = 0
+        self.input_hooks: list[Hook] = []
+        self.output_hooks: list[Callable[["Engine", bool], None]] = []
+        self.mode_hooks: list[Callable[["Engine", Mode, Mode], None]] = []
+        self.last_scan_ms = 0.0
+        self.max_scan_ms = 0.0
+        self._first_pass = False
+        self._depth = 0
+        self._deadline = 0.0
+        self.files = {}
+        build = compile_file if executor == "compiled" else interpret_file
+        for number in sorted(program.files):
+            zone = [True]
+            self.files[number] = (build(program, number, self.table, self.machine, self._jsr, zone), zone)
+
+    # -- modes --------------------------------------------------------------------------
+    def set_mode(self, mode: Mode) -> None:
+        if mode is self.mode:
+            return
+        if mode not in TRANSITIONS[self.mode]:
+            raise ModeError(f"cannot go from {self.mode.name} to {mode.name}"
+                            + (" (clear the fault first: go to PROGRAM)" if self.mode is Mode.FAULTED else ""))
+        old = self.mode
+        if old is Mode.FAULTED:
+            self.fault = None
+            for w in (S.MAJOR_FAULT_BITS, S.MAJOR_FAULT_CODE, S.FAULT_FILE, S.FAULT_RUNG):
+                self.s[w] = 0
+        self.mode = mode
+        self.s[S.MODE_WORD] = mode.value
+        if mode in (Mode.RUN, Mode.TEST) and old is Mode.PROGRAM:
+            self._first_pass = True
+        for hook in self.mode_hooks:
+            hook(self, old, mode)
+
+    def run_mode(self) -> None:
+        self.set_mode(Mode.RUN)
+
+    # -- one scan ------------------------------------------------------------------------------
+    def scan(self) -> None:
+        m = self.machine
+        m.dt = self.clock.advance()
+        for hook in self.input_hooks:
+            hook(self)
+        if self.mode in (Mode.RUN, Mode.TEST):
+            self._ladder()
+        enabled = self.mode is Mode.RUN
+        for hook in self.output_hooks:
+            hook(self, enabled)
+
+    def _ladder(self) -> None:
+        s = self.s
+        if self._first_pass:
+            s[S.PROCESSOR_STATUS] |= -32768  # S:1/15 first pass
+        start = time.perf_counter()
+        watchdog_ms = s[S.WATCHDOG_MS] if s[S.WATCHDOG_MS] > 0 else self.settings.watchdog_ms
+        self._deadline = start + watchdog_ms / 1000
+        try:
+            self._depth = 0
+            self.run_file(MAIN_FILE)
+        except _EndScan:
+            pass
+        except MajorFault as fault:
+            self._major(fault)
+        except Exception as exc:  # a bug in softplc must not become a traceback for the user
+            self._major(MajorFault(S.FAULT_WATCHDOG + 55, f"internal error: {type(exc).__name__}: {exc}"), exc)
+        elapsed_ms = (time.perf_counter() - start) * 1000
+        self.last_scan_ms = elapsed_ms
+        self.max_scan_ms = max(self.max_scan_ms, elapsed_ms)
+        # S:8/S:9 hold the scan time in ms: simulated time per scan when the
+        # clock is simulated (so runs are reproducible), measured otherwise.
+        shown = elapsed_ms if self.clock.realtime else self.clock.scan_ms
+        s[S.LAST_SCAN_MS] = min(int(round(shown)), 32767)
+        s[S.MAX_SCAN_MS] = max(s[S.MAX_SCAN_MS], s[S.LAST_SCAN_MS])
+        self.scans += 1
+        s[S.SCAN_COUNT_LOW] = to_signed(self.scans & 0xFFFF)
+        s[S.SCAN_COUNT_HIGH] = to_signed((self.scans >> 16) & 0xFFFF)
+        if self._first_pass:
+            s[S.PROCESSOR_STATUS] &= 0x7FFF
+            self._first_pass = False
+        if self.mode is not Mode.FAULTED and elapsed_ms > watchdog_ms:
+            self._major(MajorFault(S.FAULT_WATCHDOG, f"scan took {elapsed_ms:.1f} ms, "
+                                   f"more than the watchdog setpoint S:28 = {watchdog_ms} ms"))
+
+    def run_file(self, number: int) -> None:
+        compiled, zone = self.files[number]
+        rungs = compiled.rungs
+        m = self.machine
+        saved_zone = zone[0]
+        zone[0] = True
+        i = 0
+        count = len(rungs)
+        try:
+            while i < count:
+                m.file = number
+                m.rung = i
+                r = rungs[i](zone[0])
+                if r is None:
+                    i += 1
+                elif r >= 0:
+                    if r <= i and time.perf_counter() > self._deadline:
+                        raise MajorFault(S.FAULT_WATCHDOG, "watchdog: the scan is stuck in a backward JMP loop "
+                                         f"(longer than S:28 = {self.s[S.WATCHDOG_MS]} ms)")
+                    i = r
+                elif r == RET:
+                    break
+                else:  # TND
+                    raise _EndScan
+        except MajorFault as fault:
+            if fault.file is None:
+                fault.file, fault.rung = number, i
+                if fault.instruction is None:
+                    fault.instruction = self._which_instruction(compiled, fault)
+            raise
+        except (_EndScan, RecursionError):
+            raise
+        except Exception as exc:
+            fault = MajorFault(S.FAULT_WATCHDOG + 55, f"internal error: {type(exc).__name__}: {exc}")
+            fault.file, fault.rung = number, i
+            fault.instruction = self._which_instruction(compiled, exc)
+            raise fault from exc
+        finally:
+            zone[0] = saved_zone
+
+    def _jsr(self, number: int) -> None:
+        self._depth += 1
+        try:
+            if self._depth > self.settings.jsr_depth:
+                raise MajorFault(S.FAULT_JSR_NESTING, f"JSR {number}: subroutines nested more than "
+                                 f"{self.settings.jsr_depth} deep")
+            if time.perf_counter() > self._deadline:
+                raise MajorFault(S.FAULT_WATCHDOG, "watchdog: scan time exceeded S:28 in subroutine calls")
+            self.run_file(number)
+        finally:
+            self._depth -= 1
+
+    @staticmethod
+    def _which_instruction(compiled, exc: BaseException) -> str | None:
+        """Map the generated source line where it failed back to its instruction."""
+        name = f"<ladder file {compiled.number}>"
+        found = None
+        for frame, lineno in traceback.walk_tb(exc.__traceback__):
+            if frame.f_code.co_filename == name and lineno in compiled.line_table:
+                found = compiled.line_table[lineno]
+        return describe(found) if found is not None else None
+
+    def _major(self, fault: MajorFault, cause: BaseException | None = None) -> None:
+        s = self.s
+        self.fault = FaultInfo(fault.code, fault.file, fault.rung, fault.instruction, fault.message)
+        bit = S.MAJOR_WATCHDOG_BIT if fault.code == S.FAULT_WATCHDOG else S.MAJOR_RUNTIME_BIT
+        s[S.MAJOR_FAULT_BITS] |= 1 << bit
+        s[S.MAJOR_FAULT_CODE] = fault.code
+        s[S.FAULT_FILE] = fault.file or 0
+        s[S.FAULT_RUNG] = fault.rung or 0
+        old = self.mode
+        self.mode = Mode.FAULTED
+        s[S.MODE_WORD] = Mode.FAULTED.value
+        for hook in self.mode_hooks:
+            hook(self, old, Mode.FAULTED)
+
+    def run(self, scans: int) -> None:
+        for _ in range(scans):
+            self.scan()

@@ -1,0 +1,152 @@
+"""Expressions of CPT and CMP: operators and functions, shared by the
+compiler (which turns an expression tree into Python source) and the
+reference interpreter (which walks the tree).
+
+Operators (PLC-5 CPT/CMP): ``+ - *``, ``|`` (divide; ``/`` with spaces
+around it is accepted too), ``MOD``, ``**``, ``AND OR XOR NOT`` (16-bit
+bitwise), unary ``-``, comparisons ``= <> < <= > >=`` (CMP only), and the
+functions in :data:`FUNCTIONS`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+from .ast import AddressRef, BinOp, Call, Const, UnaryOp
+
+
+def _int(v) -> int:
+    """Bitwise operators work on integers: floats are rounded first."""
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            return 0
+        return int(math.floor(abs(v) + 0.5)) * (1 if v >= 0 else -1)
+    return v
+
+
+def _safe(fn: Callable[[float], float]) -> Callable[[float], float]:
+    def wrapped(v):
+        try:
+            return fn(float(v))
+        except (ValueError, OverflowError):
+            return math.nan
+    return wrapped
+
+
+def _frd(v) -> int:
+    """BCD to integer (4 digits)."""
+    v = _int(v) & 0xFFFF
+    digits = [(v >> s) & 0xF for s in (12, 8, 4, 0)]
+    if any(d > 9 for d in digits):
+        return 0
+    return int("".join(map(str, digits)))
+
+
+def _tod(v) -> int:
+    """Integer 0..9999 to BCD."""
+    v = _int(v)
+    if not 0 <= v <= 9999:
+        return v
+    out = 0
+    for ch in f"{v:04d}":
+        out = (out << 4) | int(ch)
+    return out - 0x10000 if out & 0x8000 else out
+
+
+FUNCTIONS: dict[str, Callable] = {
+    "SQR": _safe(lambda v: math.sqrt(abs(v))),
+    "ABS": abs,
+    "NEG": lambda v: -v,
+    "FRD": _frd,
+    "TOD": _tod,
+    "LN": _safe(math.log),
+    "LOG": _safe(math.log10),
+    "SIN": _safe(math.sin),
+    "COS": _safe(math.cos),
+    "TAN": _safe(math.tan),
+    "ASN": _safe(math.asin),
+    "ACS": _safe(math.acos),
+    "ATN": _safe(math.atan),
+    "DEG": _safe(math.degrees),
+    "RAD": _safe(math.radians),
+}
+
+PY_COMPARE = {"=": "==", "<>": "!=", "<": "<", "<=": "<=", ">": ">", ">=": ">="}
+
+
+def to_python(node, operand_code: Callable[[AddressRef], str]) -> str:
+    """Python source for an expression. Names used: ``_div``, ``_mod``,
+    ``_pow``, ``_int``, ``_fn_<NAME>``; ``operand_code`` gives the source of
+    each address read. Only validated tokens reach the text: numbers are
+    printed by repr(), operators come from fixed tables."""
+    if isinstance(node, Const):
+        return repr(node.value)
+    if isinstance(node, AddressRef):
+        return operand_code(node)
+    if isinstance(node, UnaryOp):
+        inner = to_python(node.operand, operand_code)
+        return f"(-{inner})" if node.op == "NEG" else f"(~_int({inner}))"
+    if isinstance(node, Call):
+        assert node.func in FUNCTIONS
+        return f"_fn_{node.func}({to_python(node.arg, operand_code)})"
+    assert isinstance(node, BinOp)
+    a, b = to_python(node.left, operand_code), to_python(node.right, operand_code)
+    op = node.op
+    if op in ("+", "-", "*"):
+        return f"({a} {op} {b})"
+    if op == "|":
+        return f"_div({a}, {b})"
+    if op == "MOD":
+        return f"_mod({a}, {b})"
+    if op == "**":
+        return f"_pow({a}, {b})"
+    if op in ("AND", "OR", "XOR"):
+        sym = {"AND": "&", "OR": "|", "XOR": "^"}[op]
+        return f"(_int({a}) {sym} _int({b}))"
+    if op in PY_COMPARE:
+        return f"({a} {PY_COMPARE[op]} {b})"
+    raise ValueError(f"unknown operator {op!r}")  # the grammar has no others
+
+
+def evaluate(node, read: Callable[[AddressRef], int | float], machine):
+    """Walk an expression tree (the reference interpreter's way)."""
+    if isinstance(node, Const):
+        return node.value
+    if isinstance(node, AddressRef):
+        return read(node)
+    if isinstance(node, UnaryOp):
+        v = evaluate(node.operand, read, machine)
+        return -v if node.op == "NEG" else ~_int(v)
+    if isinstance(node, Call):
+        return FUNCTIONS[node.func](evaluate(node.arg, read, machine))
+    a = evaluate(node.left, read, machine)
+    b = evaluate(node.right, read, machine)
+    op = node.op
+    if op == "+":
+        return a + b
+    if op == "-":
+        return a - b
+    if op == "*":
+        return a * b
+    if op == "|":
+        return machine.divide(a, b)
+    if op == "MOD":
+        return machine.modulo(a, b)
+    if op == "**":
+        return machine.power(a, b)
+    if op == "AND":
+        return _int(a) & _int(b)
+    if op == "OR":
+        return _int(a) | _int(b)
+    if op == "XOR":
+        return _int(a) ^ _int(b)
+    return {"=": a == b, "<>": a != b, "<": a < b, "<=": a <= b, ">": a > b, ">=": a >= b}[op]
+
+
+def namespace(machine) -> dict[str, object]:
+    """The helper names compiled expressions use."""
+    ns: dict[str, object] = {"_div": machine.divide, "_mod": machine.modulo, "_pow": machine.power, "_int": _int}
+    for name, fn in FUNCTIONS.items():
+        ns[f"_fn_{name}"] = fn
+    return ns

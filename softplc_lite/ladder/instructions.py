@@ -1,0 +1,165 @@
+"""The instruction table: every mnemonic, its operands and their kinds.
+
+The validator checks operands against these specs, the parser uses the
+mnemonic set to group mnemonic-form rungs, and ``fmt`` prints operands in
+this order. Plug-in modules (TLMs) add their instructions with
+:func:`register`.
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass
+from enum import Enum
+
+
+class K(Enum):
+    """Operand kinds."""
+
+    BIT = "bit address"
+    SOURCE = "number or word/float address"  # read-only numeric operand
+    DEST = "word or float address"  # numeric destination
+    INT_SOURCE = "integer or word address"
+    WORD = "word address"
+    TIMER = "timer element (T)"
+    COUNTER = "counter element (C)"
+    CONTROL = "control element (R)"
+    RESETTABLE = "timer, counter or control element"
+    TIMEBASE = "time base 1.0 or 0.01"
+    PRESET = "integer constant"
+    LABEL = "label number 0..999"
+    PROGRAM_FILE = "program file number 3..999"
+    EXPRESSION = "expression"
+    FILE = "file address (#N7:0)"
+    FILE_SOURCE = "number, or file address (#N7:0)"
+    LENGTH = "length 1..1000"
+    STRING = "string element (ST)"
+    BIT_NUMBER = "bit number 0..15"
+    ANY = "operand"  # TLM parameters: validated by the TLM
+
+
+@dataclass(frozen=True)
+class OperandSpec:
+    name: str
+    kind: K
+
+
+@dataclass(frozen=True)
+class InstructionSpec:
+    mnemonic: str
+    title: str
+    operands: tuple[OperandSpec, ...]
+    output: bool  # output instructions are last in a series (informational)
+    optional: int = 0  # how many trailing operands may be left out
+    module: str | None = None  # the TLM that provides it; None = built in
+
+    @property
+    def min_operands(self) -> int:
+        return len(self.operands) - self.optional
+
+    def signature(self) -> str:
+        names = [o.name if i < self.min_operands else f"[{o.name}]" for i, o in enumerate(self.operands)]
+        return f"{self.mnemonic} {' '.join(names)}".strip()
+
+
+def _spec(mnemonic: str, title: str, output: bool, *operands: tuple[str, K], optional: int = 0) -> InstructionSpec:
+    return InstructionSpec(mnemonic, title, tuple(OperandSpec(n, k) for n, k in operands), output, optional)
+
+
+_BUILTIN = [
+    # bit
+    _spec("XIC", "examine if closed", False, ("bit", K.BIT)),
+    _spec("XIO", "examine if open", False, ("bit", K.BIT)),
+    _spec("OTE", "output energize", True, ("bit", K.BIT)),
+    _spec("OTL", "output latch", True, ("bit", K.BIT)),
+    _spec("OTU", "output unlatch", True, ("bit", K.BIT)),
+    _spec("ONS", "one shot", False, ("storage", K.BIT)),
+    _spec("OSR", "one shot rising", True, ("storage", K.BIT), ("output", K.BIT)),
+    _spec("OSF", "one shot falling", True, ("storage", K.BIT), ("output", K.BIT)),
+    # timers and counters
+    _spec("TON", "timer on delay", True, ("timer", K.TIMER), ("base", K.TIMEBASE), ("preset", K.PRESET), ("accum", K.PRESET)),
+    _spec("TOF", "timer off delay", True, ("timer", K.TIMER), ("base", K.TIMEBASE), ("preset", K.PRESET), ("accum", K.PRESET)),
+    _spec("RTO", "retentive timer on", True, ("timer", K.TIMER), ("base", K.TIMEBASE), ("preset", K.PRESET), ("accum", K.PRESET)),
+    _spec("CTU", "count up", True, ("counter", K.COUNTER), ("preset", K.PRESET), ("accum", K.PRESET)),
+    _spec("CTD", "count down", True, ("counter", K.COUNTER), ("preset", K.PRESET), ("accum", K.PRESET)),
+    _spec("RES", "reset", True, ("element", K.RESETTABLE)),
+    # compare
+    *[_spec(m, t, False, ("a", K.SOURCE), ("b", K.SOURCE)) for m, t in (
+        ("EQU", "equal"), ("NEQ", "not equal"), ("LES", "less than"), ("LEQ", "less than or equal"),
+        ("GRT", "greater than"), ("GEQ", "greater than or equal"))],
+    _spec("LIM", "limit test", False, ("low", K.SOURCE), ("test", K.SOURCE), ("high", K.SOURCE)),
+    _spec("MEQ", "masked equal", False, ("source", K.INT_SOURCE), ("mask", K.INT_SOURCE), ("compare", K.INT_SOURCE)),
+    _spec("CMP", "compare expression", False, ("expression", K.EXPRESSION)),
+    # math
+    *[_spec(m, t, True, ("a", K.SOURCE), ("b", K.SOURCE), ("dest", K.DEST)) for m, t in (
+        ("ADD", "add"), ("SUB", "subtract"), ("MUL", "multiply"), ("DIV", "divide"), ("MOD", "modulo"))],
+    *[_spec(m, t, True, ("source", K.SOURCE), ("dest", K.DEST)) for m, t in (
+        ("NEG", "negate"), ("ABS", "absolute value"), ("SQR", "square root"))],
+    _spec("CPT", "compute", True, ("dest", K.DEST), ("expression", K.EXPRESSION)),
+    _spec("CLR", "clear", True, ("dest", K.DEST)),
+    *[_spec(m, t, True, ("a", K.INT_SOURCE), ("b", K.INT_SOURCE), ("dest", K.WORD)) for m, t in (
+        ("AND", "bitwise and"), ("OR", "bitwise or"), ("XOR", "bitwise exclusive or"))],
+    _spec("NOT", "bitwise not", True, ("source", K.INT_SOURCE), ("dest", K.WORD)),
+    # move and file
+    _spec("MOV", "move", True, ("source", K.SOURCE), ("dest", K.DEST)),
+    _spec("MVM", "masked move", True, ("source", K.INT_SOURCE), ("mask", K.INT_SOURCE), ("dest", K.WORD)),
+    _spec("COP", "file copy", True, ("source", K.FILE), ("dest", K.FILE), ("length", K.LENGTH)),
+    _spec("FLL", "file fill", True, ("source", K.FILE_SOURCE), ("dest", K.FILE), ("length", K.LENGTH)),
+    _spec("BTD", "bit field distribute", True, ("source", K.INT_SOURCE), ("source_bit", K.BIT_NUMBER),
+          ("dest", K.WORD), ("dest_bit", K.BIT_NUMBER), ("length", K.BIT_NUMBER)),
+    # program control
+    _spec("JMP", "jump to label", True, ("label", K.LABEL)),
+    _spec("LBL", "label", False, ("label", K.LABEL)),
+    _spec("JSR", "jump to subroutine", True, ("file", K.PROGRAM_FILE)),
+    _spec("SBR", "subroutine", False),
+    _spec("RET", "return", True),
+    _spec("MCR", "master control reset", True),
+    _spec("AFI", "always false", False),
+    _spec("TND", "temporary end", True),
+    # strings
+    _spec("ACI", "string to integer", True, ("source", K.STRING), ("dest", K.DEST)),
+    _spec("AIC", "integer to string", True, ("source", K.INT_SOURCE), ("dest", K.STRING)),
+    _spec("ACN", "string concatenate", True, ("a", K.STRING), ("b", K.STRING), ("dest", K.STRING)),
+    _spec("AEX", "string extract", True, ("source", K.STRING), ("index", K.INT_SOURCE),
+          ("count", K.INT_SOURCE), ("dest", K.STRING)),
+    _spec("ASC", "string search", True, ("source", K.STRING), ("index", K.INT_SOURCE),
+          ("search", K.STRING), ("result", K.WORD)),
+    _spec("ASR", "string compare", False, ("a", K.STRING), ("b", K.STRING)),
+]
+
+# Instructions with a fixed role in the language itself (not operand-driven).
+BRANCH_KEYWORDS = ("BST", "NXB", "BND", "SOR", "EOR")
+
+_TABLE: dict[str, InstructionSpec] = {s.mnemonic: s for s in _BUILTIN}
+
+
+def lookup(mnemonic: str) -> InstructionSpec | None:
+    return _TABLE.get(mnemonic.upper())
+
+
+def is_mnemonic(name: str) -> bool:
+    return name.upper() in _TABLE
+
+
+def all_specs() -> list[InstructionSpec]:
+    return list(_TABLE.values())
+
+
+def suggest(name: str) -> str | None:
+    """The closest known mnemonic, for "did you mean" hints."""
+    close = difflib.get_close_matches(name.upper(), list(_TABLE), n=1, cutoff=0.5)
+    return close[0] if close else None
+
+
+def register(spec: InstructionSpec) -> None:
+    """Add a plug-in instruction; two modules may not claim one mnemonic."""
+    existing = _TABLE.get(spec.mnemonic)
+    if existing is not None and existing != spec:
+        owner = existing.module or "the built-in instruction set"
+        raise ValueError(f"{spec.mnemonic} from {spec.module} is already defined by {owner}")
+    _TABLE[spec.mnemonic] = spec
+
+
+def unregister_module(module: str) -> None:
+    for m in [m for m, s in _TABLE.items() if s.module == module]:
+        del _TABLE[m]

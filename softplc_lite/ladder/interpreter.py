@@ -1,0 +1,265 @@
+"""Stage 3 (reference): a plain tree-walking interpreter over the AST.
+
+Slow and obvious on purpose: every operand is resolved through
+``DataTable.resolve`` each time it is used, every rung walks its elements.
+The differential tests run random programs through this and the compiler
+and require identical data tables. Kernels with real logic (timers,
+counters, math stores, strings) are shared from semantics.py; contacts,
+coils, branches, compares, operand access, expressions and control flow are
+written here a second time.
+"""
+
+from __future__ import annotations
+
+from ..datatable import DataTable, bit_mask
+from ..datatable.errors import AddressRangeError
+from .ast import AddressRef, Branch, Const, Instruction, Program, Rung
+from .compiler import RET, TND, address_fault, labels_of
+from .expr import evaluate
+from .semantics import BASE_MS, Machine, MajorFault, lim
+from . import status as S
+
+# Instructions whose operands are only touched when the rung is true (the
+# compiled path resolves them inside its "if c:").
+_WHEN_TRUE = {
+    "CMP", "ADD", "SUB", "MUL", "DIV", "MOD", "NEG", "ABS", "SQR", "MOV", "CPT", "CLR", "AND",
+    "OR", "XOR", "NOT", "MVM", "COP", "FLL", "BTD", "RES", "ACI", "AIC", "ACN", "AEX", "ASC", "ASR",
+}
+
+
+class _Jump(Exception):
+    def __init__(self, target: int) -> None:
+        self.target = target
+
+
+class ReferenceFile:
+    """One program file as rung callables, like a CompiledFile."""
+
+    def __init__(self, interp: "Interpreter", number: int, rungs: list[Rung]) -> None:
+        self.number = number
+        self.labels = labels_of(rungs)
+        self.has_mcr = any(
+            isinstance(el, Instruction) and el.mnemonic == "MCR" for r in rungs for el in r.elements
+        )
+        self.rungs = [self._callable(interp, r) for r in rungs]
+        self.line_table: dict = {}
+
+    def _callable(self, interp: "Interpreter", rung: Rung):
+        def run(c: bool):
+            try:
+                interp.series(rung.elements, c, rung, self)
+            except _Jump as j:
+                return j.target
+            return None
+        return run
+
+
+class Interpreter:
+    def __init__(self, table: DataTable, machine: Machine, jsr, zone: list) -> None:
+        self.table = table
+        self.m = machine
+        self.jsr = jsr
+        self.zone = zone
+
+    # -- operands -----------------------------------------------------------------
+    def loc(self, ref: AddressRef):
+        try:
+            f, index, bit = self.table.resolve(ref.address)
+        except AddressRangeError as e:
+            raise address_fault(ref.address, e) from None
+        return f.data, index, bit
+
+    def read(self, operand):
+        if isinstance(operand, Const):
+            return operand.value
+        d, i, bit = self.loc(operand)
+        if bit is not None:
+            return (d[i] >> bit) & 1
+        return d[i]
+
+    def bit(self, ref) -> bool:
+        d, i, bit = self.loc(ref)
+        return bool((d[i] >> bit) & 1)
+
+    def set_bit(self, ref, on: bool) -> None:
+        d, i, bit = self.loc(ref)
+        mask = bit_mask(bit)
+        d[i] = (d[i] | mask) if on else (d[i] & ~mask)
+
+    def expr(self, node):
+        return evaluate(node, self.read, self.m)
+
+    # -- rungs ----------------------------------------------------------------------------
+    def series(self, elements, c: bool, rung: Rung, pfile: ReferenceFile) -> bool:
+        for el in elements:
+            if isinstance(el, Branch):
+                out = False
+                for leg in el.legs:
+                    out = self.series(leg, c, rung, pfile) or out
+                c = out
+            else:
+                try:
+                    c = self.instruction(el, c, rung, pfile)
+                except MajorFault as fault:
+                    if fault.instruction is None:
+                        from .compiler import describe
+
+                        fault.instruction = describe(el)
+                    raise
+        return c
+
+    def instruction(self, ins: Instruction, c: bool, rung: Rung, pfile: ReferenceFile) -> bool:
+        m, ops, mc = ins.mnemonic, ins.operands, self.m
+        if m in _WHEN_TRUE and not c:
+            return c
+        if m == "XIC":
+            on = self.bit(ops[0])  # resolved even on a false rung, as compiled code does
+            return c and on
+        if m == "XIO":
+            on = self.bit(ops[0])
+            return c and not on
+        if m == "OTE":
+            self.set_bit(ops[0], c)
+        elif m == "OTL":
+            if c:
+                self.set_bit(ops[0], True)
+        elif m == "OTU":
+            if c:
+                self.set_bit(ops[0], False)
+        elif m == "ONS":
+            stored = self.bit(ops[0])
+            self.set_bit(ops[0], c)
+            return c and not stored
+        elif m in ("OSR", "OSF"):
+            stored = self.bit(ops[0])
+            self.bit(ops[1])  # resolve in the same order as the compiled code
+            fire = (c and not stored) if m == "OSR" else (not c and stored)
+            self.set_bit(ops[1], fire)
+            self.set_bit(ops[0], c)
+        elif m in ("TON", "TOF", "RTO"):
+            d, i, _ = self.loc(ops[0])
+            getattr(mc, m.lower())(d, i, c, BASE_MS[ops[1].value])
+        elif m in ("CTU", "CTD"):
+            d, i, _ = self.loc(ops[0])
+            getattr(mc, m.lower())(d, i, c)
+        elif m == "RES":
+            d, i, _ = self.loc(ops[0])
+            mc.res(d, i)
+        elif m in ("EQU", "NEQ", "LES", "LEQ", "GRT", "GEQ"):
+            a, b = self.read(ops[0]), self.read(ops[1])
+            result = {"EQU": a == b, "NEQ": a != b, "LES": a < b, "LEQ": a <= b,
+                      "GRT": a > b, "GEQ": a >= b}[m]
+            return c and result
+        elif m == "LIM":
+            lo, t, hi = (self.read(o) for o in ops)
+            return c and lim(lo, t, hi)
+        elif m == "MEQ":
+            s, mask, cmp_ = (self.read(o) for o in ops)
+            return c and (s & mask) == (cmp_ & mask)
+        elif m == "CMP":
+            return bool(self.expr(ops[0]))
+        elif m in ("ADD", "SUB", "DIV", "MOD"):
+            a, b = self.read(ops[0]), self.read(ops[1])
+            d, i, _ = self.loc(ops[2])
+            getattr(mc, m.lower())(a, b, d, i)
+        elif m == "MUL":
+            a, b = self.read(ops[0]), self.read(ops[1])
+            d, i, _ = self.loc(ops[2])
+            mc.store(a * b, d, i)
+        elif m in ("NEG", "ABS", "MOV"):
+            v = self.read(ops[0])
+            d, i, _ = self.loc(ops[1])
+            mc.store(-v if m == "NEG" else abs(v) if m == "ABS" else v, d, i)
+        elif m == "SQR":
+            v = self.read(ops[0])
+            d, i, _ = self.loc(ops[1])
+            mc.sqr(v, d, i)
+        elif m == "CPT":
+            v = self.expr(ops[1])
+            d, i, _ = self.loc(ops[0])
+            mc.store(v, d, i)
+        elif m == "CLR":
+            d, i, _ = self.loc(ops[0])
+            mc.clear(d, i)
+        elif m in ("AND", "OR", "XOR"):
+            a, b = self.read(ops[0]), self.read(ops[1])
+            d, i, _ = self.loc(ops[2])
+            mc.logic(a & b if m == "AND" else a | b if m == "OR" else a ^ b, d, i)
+        elif m == "NOT":
+            v = self.read(ops[0])
+            d, i, _ = self.loc(ops[1])
+            mc.logic(~v, d, i)
+        elif m == "MVM":
+            s, mask = self.read(ops[0]), self.read(ops[1])
+            d, i, _ = self.loc(ops[2])
+            mc.logic((d[i] & ~mask) | (s & mask), d, i)
+        elif m in ("COP", "FLL"):
+            n = ops[2].value * ops[1].address.ftype.words_per_element
+            if m == "COP":
+                sd, si = self._block(ops[0], n)
+                dd, di = self._block(ops[1], n)
+                mc.cop(sd, si, dd, di, n)
+            else:
+                v = self.read(ops[0])
+                dd, di = self._block(ops[1], n)
+                mc.fll(v, dd, di, n)
+        elif m == "BTD":
+            src = self.read(ops[0])
+            d, i, _ = self.loc(ops[2])
+            mc.btd(src, ops[1].value, d, i, ops[3].value, ops[4].value)
+        elif m == "JMP":
+            if c:
+                raise _Jump(pfile.labels[ops[0].value])
+        elif m == "JSR":
+            if c:
+                self.jsr(ops[0].value)
+        elif m == "RET":
+            if c:
+                raise _Jump(RET)
+        elif m == "TND":
+            if c:
+                raise _Jump(TND)
+        elif m == "MCR":
+            self.zone[0] = c if rung.elements[0] is not ins else True
+        elif m == "AFI":
+            return False
+        elif m in ("LBL", "SBR"):
+            pass
+        elif m == "ACI":
+            sd, si, _ = self.loc(ops[0])
+            d, i, _ = self.loc(ops[1])
+            mc.aci(sd, si, d, i)
+        elif m == "AIC":
+            v = self.read(ops[0])
+            d, i, _ = self.loc(ops[1])
+            mc.aic(v, d, i)
+        elif m == "ACN":
+            (ad, ai, _), (bd, bi, _), (d, i, _) = (self.loc(o) for o in ops)
+            mc.acn(ad, ai, bd, bi, d, i)
+        elif m == "AEX":
+            sd, si, _ = self.loc(ops[0])
+            index, count = self.read(ops[1]), self.read(ops[2])
+            d, i, _ = self.loc(ops[3])
+            mc.aex(sd, si, index, count, d, i)
+        elif m == "ASC":
+            sd, si, _ = self.loc(ops[0])
+            index = self.read(ops[1])
+            (qd, qi, _), (d, i, _) = self.loc(ops[2]), self.loc(ops[3])
+            mc.asc(sd, si, index, qd, qi, d, i)
+        elif m == "ASR":
+            (ad, ai, _), (bd, bi, _) = self.loc(ops[0]), self.loc(ops[1])
+            return mc.asr(ad, ai, bd, bi)
+        else:
+            raise NotImplementedError(f"the reference interpreter has no rule for {m}")
+        return c
+
+    def _block(self, ref, n):
+        d, i, _ = self.loc(ref)
+        if i + n > len(d):
+            raise MajorFault(S.FAULT_BLOCK_RANGE,
+                             f"{n} words from {ref.address} run past the end of the file ({len(d)} words)")
+        return d, i
+
+
+def interpret_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list) -> ReferenceFile:
+    return ReferenceFile(Interpreter(table, machine, jsr, zone), number, program.files[number].rungs)

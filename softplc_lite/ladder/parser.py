@@ -1,0 +1,526 @@
+"""Stage 1: program text -> typed AST (``Program``).
+
+The grammar is ``ladder.lark`` (LALR, contextual lexer). A small post-lexer
+lets neutral-text rungs and SOR...EOR rungs span lines. Mnemonic rungs are
+parsed as flat token runs and grouped into instructions here, because only
+the instruction table knows where one instruction's operands end: a name
+that is a known mnemonic starts a new instruction, any other name is a
+symbol operand.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Callable, Iterable, Iterator
+
+from lark import Lark, Token, Transformer, v_args
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
+
+from ..datatable import AddressError, parse_address
+from .ast import (
+    MAIN_FILE,
+    AddressRef,
+    BinOp,
+    Branch,
+    Call,
+    Const,
+    DataDecl,
+    Element,
+    Instruction,
+    Operand,
+    Pos,
+    Program,
+    ProgramFile,
+    Rung,
+    SymbolDecl,
+    SymbolRef,
+    Text,
+    UnaryOp,
+)
+from .errors import LadderError
+
+# -- the post-lexer ---------------------------------------------------------------
+
+
+class LadderPostLex:
+    """Drop newlines and comments inside multi-line rungs.
+
+    A neutral-text rung opens at its first "(" or "[" and closes at ";"; a
+    mnemonic rung may be wrapped in SOR ... EOR. Inside either, line ends
+    carry no meaning (and comments inside a rung are not rung comments).
+    """
+
+    always_accept = ("_NL", "COMMENT")
+
+    def process(self, stream: Iterator[Token]) -> Iterator[Token]:
+        neutral = False
+        wrapped = False
+        for tok in stream:
+            kind = tok.type
+            if kind in ("LPAR", "LSQB"):
+                neutral = True
+            elif kind == "SEMICOLON":
+                neutral = False
+            elif kind == "SOR":
+                wrapped = True
+            elif kind == "EOR":
+                wrapped = False
+            elif kind in ("_NL", "COMMENT") and (neutral or wrapped):
+                continue
+            yield tok
+
+
+@lru_cache(maxsize=1)
+def get_parser() -> Lark:
+    return Lark.open_from_package(
+        "softplc_lite.ladder",
+        "ladder.lark",
+        parser="lalr",
+        lexer="contextual",
+        postlex=LadderPostLex(),
+        propagate_positions=True,
+        maybe_placeholders=False,
+        start=["start", "expr"],
+    )
+
+
+# -- transformer --------------------------------------------------------------------
+
+# Markers for mnemonic-form branch keywords inside a flat token run.
+BST, NXB, BND = "BST", "NXB", "BND"
+
+
+@dataclass
+class _Name:
+    text: str
+    pos: Pos
+
+
+@dataclass
+class _Marker:
+    kind: str
+    pos: Pos
+
+
+@dataclass
+class _Comment:
+    text: str
+    line: int
+
+
+@dataclass
+class _Header:
+    number: int
+    name: str | None
+    pos: Pos
+
+
+@dataclass
+class _RungDraft:
+    pos: Pos
+    elements: list[Element] | None = None  # neutral: already structured
+    tokens: list | None = None  # mnemonic: flat, grouped later
+    comment: str | None = None  # trailing // comment on the rung's line
+    last_line: int = 0
+
+
+def _number(tok: Token) -> int | float:
+    if tok.type == "HEX":
+        return int(tok, 16)
+    if tok.type == "INT":
+        return int(tok)
+    return float(tok)
+
+
+_CALLS = ("SQR", "ABS", "NEG", "FRD", "TOD", "LN", "LOG", "SIN", "COS", "TAN", "ASN", "ACS", "ATN", "DEG", "RAD")
+
+
+class _ToAst(Transformer):
+    def __init__(self, source: str, line_offset: int = 0, column_offset: int = 0) -> None:
+        super().__init__()
+        self.source = source
+        self.line_offset = line_offset
+        self.column_offset = column_offset
+
+    def _pos(self, item) -> Pos:
+        line = getattr(item, "line", None)
+        column = getattr(item, "column", None)
+        if line is None:  # a Tree's meta
+            line, column = item.line, item.column
+        if line == 1:
+            column += self.column_offset
+        return Pos(self.source, line + self.line_offset, column)
+
+    # operands ------------------------------------------------------------------
+    def _address(self, tok: Token) -> AddressRef:
+        try:
+            return AddressRef(parse_address(str(tok)), self._pos(tok))
+        except AddressError as e:
+            p = self._pos(tok)
+            raise LadderError(Pos(p.source, p.line, p.column + e.position), e.reason) from None
+
+    @v_args(inline=True)
+    def address(self, tok):
+        return self._address(tok)
+
+    @v_args(inline=True)
+    def symbol(self, tok):
+        return SymbolRef(str(tok), self._pos(tok))
+
+    @v_args(inline=True)
+    def signed_number(self, tok):
+        return Const(_number(tok), self._pos(tok))
+
+    @v_args(meta=True, inline=True)
+    def negative_number(self, meta, tok):
+        return Const(-_number(tok), self._pos(meta))
+
+    def INT(self, tok):
+        return tok
+
+    @v_args(inline=True)
+    def call(self, name, arg):
+        func = str(name).upper()
+        if func not in _CALLS:
+            raise LadderError(self._pos(name), f"unknown function {name}() in an expression; "
+                              f"functions are {' '.join(_CALLS)}")
+        return Call(func, arg, self._pos(name))
+
+    @v_args(meta=True, inline=True)
+    def negate(self, meta, operand):
+        if isinstance(operand, Const):
+            return Const(-operand.value, self._pos(meta))
+        return UnaryOp("NEG", operand, self._pos(meta))
+
+    @v_args(meta=True, inline=True)
+    def bit_not(self, meta, operand):
+        return UnaryOp("NOT", operand, self._pos(meta))
+
+    def _chain(self, meta, items, op=None):
+        items = [i if not (isinstance(i, Token) and i.type in ("INT", "FLOAT", "HEX")) else Const(_number(i), self._pos(i)) for i in items]
+        result = items[0]
+        i = 1
+        while i < len(items):
+            if op is None:
+                operator, right = str(items[i]).upper(), items[i + 1]
+                i += 2
+            else:
+                operator, right = op, items[i]
+                i += 1
+            if operator == "/":
+                operator = "|"  # PLC-5 writes division as |
+            result = BinOp(operator, result, right, self._pos(meta))
+        return result
+
+    @v_args(meta=True)
+    def or_chain(self, meta, items):
+        return self._chain(meta, items, "OR")
+
+    @v_args(meta=True)
+    def xor_chain(self, meta, items):
+        return self._chain(meta, items, "XOR")
+
+    @v_args(meta=True)
+    def and_chain(self, meta, items):
+        return self._chain(meta, items, "AND")
+
+    @v_args(meta=True)
+    def sum_chain(self, meta, items):
+        return self._chain(meta, items)
+
+    @v_args(meta=True)
+    def product_chain(self, meta, items):
+        return self._chain(meta, items)
+
+    @v_args(meta=True)
+    def power_op(self, meta, items):
+        return self._chain(meta, items, "**")
+
+    @v_args(meta=True)
+    def compare(self, meta, items):
+        return self._chain(meta, items)
+
+    def _atomize(self, item):
+        if isinstance(item, Token) and item.type in ("INT", "FLOAT", "HEX"):
+            return Const(_number(item), self._pos(item))
+        return item
+
+    # neutral text -----------------------------------------------------------------
+    @v_args(meta=True)
+    def nt_instruction(self, meta, items):
+        name = items[0]
+        operands = [self._atomize(i) for i in items[1:]]
+        return Instruction(str(name).upper(), operands, self._pos(name))
+
+    @v_args(meta=True)
+    def nt_branch(self, meta, legs):
+        return Branch(list(legs), self._pos(meta))
+
+    def nt_series(self, items):
+        return list(items)
+
+    @v_args(meta=True)
+    def neutral_rung(self, meta, items):
+        series = items[0]
+        comment = str(items[1])[2:].strip() if len(items) > 1 else None
+        return _RungDraft(self._pos(meta), elements=series, comment=comment, last_line=meta.end_line)
+
+    # mnemonic --------------------------------------------------------------------------
+    @v_args(inline=True)
+    def mn_name(self, tok):
+        return _Name(str(tok), self._pos(tok))
+
+    @v_args(inline=True)
+    def mn_address(self, tok):
+        return self._address(tok)
+
+    @v_args(inline=True)
+    def mn_string(self, tok):
+        return Text(_unquote(str(tok)), self._pos(tok))
+
+    @v_args(meta=True)
+    def mn_bst(self, meta, _):
+        return _Marker(BST, self._pos(meta))
+
+    @v_args(meta=True)
+    def mn_nxb(self, meta, _):
+        return _Marker(NXB, self._pos(meta))
+
+    @v_args(meta=True)
+    def mn_bnd(self, meta, _):
+        return _Marker(BND, self._pos(meta))
+
+    @v_args(meta=True)
+    def mnemonic_rung(self, meta, items):
+        comment = None
+        if items and isinstance(items[-1], Token) and items[-1].type == "COMMENT":
+            comment = str(items[-1])[2:].strip()
+            items = items[:-1]
+        return _RungDraft(self._pos(meta), tokens=list(items), comment=comment, last_line=meta.end_line)
+
+    # directives and comments -------------------------------------------------------------
+    @v_args(meta=True)
+    def comment(self, meta, items):
+        return _Comment(str(items[0])[2:].strip(), meta.line + self.line_offset)
+
+    @v_args(meta=True)
+    def file_header(self, meta, items):
+        number = int(items[0])
+        name = str(items[1]) if len(items) > 1 and items[1].type == "NAME" else None
+        return _Header(number, name, self._pos(meta))
+
+    @v_args(meta=True)
+    def data_decl(self, meta, items):
+        name, size = items[0], items[1]
+        values = []
+        for v in items[2:]:
+            if isinstance(v, Token) and v.type == "COMMENT":
+                continue
+            if isinstance(v, Token) and v.type == "STRING":
+                values.append(_unquote(str(v)))
+            else:
+                values.append(v.value)
+        return DataDecl(str(name).upper(), int(size), values, self._pos(meta))
+
+    @v_args(meta=True)
+    def symbol_decl(self, meta, items):
+        name, addr = items[0], items[1]
+        return SymbolDecl(str(name), self._address(addr).address, self._pos(name))
+
+    def start(self, items):
+        return list(items)
+
+
+def _unquote(text: str) -> str:
+    body = text[1:-1]
+    return body.replace('\\"', '"').replace("\\\\", "\\")
+
+
+# -- errors ---------------------------------------------------------------------------
+
+_FRIENDLY = {
+    "_NL": "end of line", "$END": "end of file", "SEMICOLON": "';'", "COMMA": "','",
+    "LPAR": "'('", "RPAR": "')'", "LSQB": "'['", "RSQB": "']'", "NAME": "an instruction or name",
+    "ADDRESS": "an address", "INT": "a number", "FLOAT": "a number", "HEX": "a number",
+    "STRING": "a quoted string", "COMMENT": "a comment", "BND": "BND", "NXB": "NXB",
+    "BST": "BST", "EOR": "EOR", "SOR": "SOR", "MINUS": "'-'", "EQUAL": "'='",
+    "COMPARE_OP": "a comparison", "ADD_OP": "'+' or '-'", "MUL_OP": "'*', '|' or MOD",
+}
+
+
+def _describe(names: Iterable[str]) -> str:
+    shown = sorted({_FRIENDLY.get(n, n) for n in names})
+    return ", ".join(shown) if shown else "nothing"
+
+
+def _syntax_error(e: UnexpectedInput, text: str, source: str, line_offset: int, column_offset: int) -> LadderError:
+    line = getattr(e, "line", None) or 1
+    column = getattr(e, "column", None) or 1
+    if line == 1:
+        column += column_offset
+    pos = Pos(source, line + line_offset, column)
+    try:
+        context = e.get_context(text)
+    except Exception:  # pragma: no cover - lark cannot always slice context at EOF
+        context = None
+    if isinstance(e, UnexpectedCharacters):
+        ch = text[e.pos_in_stream] if e.pos_in_stream < len(text) else "end of file"
+        message = f"unexpected character {ch!r}"
+    elif isinstance(e, UnexpectedEOF):
+        message = f"unexpected end of file; expected {_describe(e.expected)}"
+    else:
+        assert isinstance(e, UnexpectedToken)
+        tok = e.token
+        found = "end of file" if tok.type == "$END" else (
+            "end of line" if tok.type == "_NL" else repr(str(tok)))
+        message = f"unexpected {found}; expected {_describe(e.expected)}"
+        if tok.type == "$END" and "SEMICOLON" in e.expected:
+            message += " (a neutral-text rung must end with ';')"
+        elif tok.type == "$END" and "EOR" in e.expected:
+            message += " (SOR without EOR)"
+    return LadderError(pos, message, context)
+
+
+def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column_offset: int = 0):
+    try:
+        tree = get_parser().parse(text, start=start)
+    except UnexpectedInput as e:
+        raise _syntax_error(e, text, source, line_offset, column_offset) from None
+    try:
+        return _ToAst(source, line_offset, column_offset).transform(tree)
+    except VisitError as e:
+        if isinstance(e.orig_exc, LadderError):
+            raise e.orig_exc from None
+        raise
+
+
+def parse_expression(text: str, pos: Pos) -> Operand:
+    """Parse a CPT/CMP expression given as a quoted mnemonic operand; errors
+    point into the original file (``pos`` is where the text starts)."""
+    return _parse_tree(text, pos.source, "expr", pos.line - 1, pos.column)
+
+
+# -- assembling the program ------------------------------------------------------------
+
+
+def parse_program(
+    text: str,
+    source: str = "<program>",
+    is_mnemonic: Callable[[str], bool] | None = None,
+    program: Program | None = None,
+) -> Program:
+    """Parse one .lad text into ``program`` (a new one by default).
+
+    ``is_mnemonic`` tells instruction names from symbol names in mnemonic
+    rungs; by default the built-in instruction table (plus loaded TLMs).
+    """
+    if is_mnemonic is None:
+        from .instructions import is_mnemonic as default
+
+        is_mnemonic = default
+    if text and not text.endswith("\n"):
+        text += "\n"
+    items = _parse_tree(text, source, "start")
+    program = program if program is not None else Program()
+    current: ProgramFile | None = None
+    comments: list[_Comment] = []
+
+    def file_for_rungs(pos: Pos) -> ProgramFile:
+        nonlocal current
+        if current is None:
+            current = _add_file(program, MAIN_FILE, None, Pos(source, pos.line, 1))
+        return current
+
+    for item in items:
+        if isinstance(item, _Comment):
+            comments.append(item)
+            continue
+        if isinstance(item, _Header):
+            current = _add_file(program, item.number, item.name, item.pos)
+        elif isinstance(item, DataDecl):
+            program.data.append(item)
+        elif isinstance(item, SymbolDecl):
+            if item.name in program.symbols:
+                raise LadderError(item.pos, f"symbol {item.name} is declared twice "
+                                  f"(first at {program.symbols[item.name].pos})")
+            program.symbols[item.name] = item
+        elif isinstance(item, _RungDraft):
+            rung_comment = _comment_above(comments, item.pos.line)
+            if item.comment:
+                rung_comment = f"{rung_comment}\n{item.comment}" if rung_comment else item.comment
+            elements = item.elements if item.elements is not None else _group(item.tokens, is_mnemonic, item.pos)
+            file_for_rungs(item.pos).rungs.append(Rung(elements, rung_comment, item.pos))
+        comments = []
+    return program
+
+
+def _add_file(program: Program, number: int, name: str | None, pos: Pos) -> ProgramFile:
+    if not 2 <= number <= 999:
+        raise LadderError(pos, f"program file number {number} out of range: the main file is 2, "
+                          "subroutine files are 3..999")
+    if number in program.files:
+        raise LadderError(pos, f"program file {number} is defined twice (first at {program.files[number].pos})")
+    f = program.files[number] = ProgramFile(number, name, [], pos)
+    return f
+
+
+def _comment_above(comments: list[_Comment], rung_line: int) -> str | None:
+    """The comment lines that end on the line just above the rung."""
+    lines: list[str] = []
+    expected = rung_line - 1
+    for c in reversed(comments):
+        if c.line != expected:
+            break
+        lines.append(c.text)
+        expected -= 1
+    return "\n".join(reversed(lines)) if lines else None
+
+
+def _group(tokens: list, is_mnemonic: Callable[[str], bool], rung_pos: Pos) -> list[Element]:
+    """Turn a flat mnemonic token run into instructions and branches."""
+    root: list[Element] = []
+    stack: list[tuple[list[Element], Branch]] = []  # (series to return to, open branch)
+    series = root
+    current: Instruction | None = None
+    for tok in tokens:
+        if isinstance(tok, _Marker):
+            current = None
+            if tok.kind == BST:
+                branch = Branch([[]], tok.pos)
+                series.append(branch)
+                stack.append((series, branch))
+                series = branch.legs[0]
+            elif not stack:
+                raise LadderError(tok.pos, f"{tok.kind} without a BST to open the branch")
+            elif tok.kind == NXB:
+                branch = stack[-1][1]
+                branch.legs.append([])
+                series = branch.legs[-1]
+            else:  # BND
+                series, _ = stack.pop()
+            continue
+        if isinstance(tok, _Name) and is_mnemonic(tok.text.upper()):
+            current = Instruction(tok.text.upper(), [], tok.pos)
+            series.append(current)
+            continue
+        operand = SymbolRef(tok.text, tok.pos) if isinstance(tok, _Name) else tok
+        if current is None:
+            if isinstance(tok, _Name):
+                raise LadderError(tok.pos, f"unknown instruction {tok.text!r}{_did_you_mean(tok.text)}")
+            raise LadderError(_operand_pos(operand), "an operand with no instruction before it")
+        current.operands.append(operand)
+    if stack:
+        raise LadderError(stack[-1][1].pos, "BST without a matching BND (unclosed branch)")
+    return root
+
+
+def _operand_pos(operand) -> Pos:
+    return getattr(operand, "pos", None) or Pos("<program>", 0, 0)
+
+
+def _did_you_mean(name: str) -> str:
+    from .instructions import suggest
+
+    hint = suggest(name)
+    return f" (did you mean {hint}?)" if hint else ""

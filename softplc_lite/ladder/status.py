@@ -1,0 +1,50 @@
+"""The status file (S2): PLC-5 layout where PLC-5 has one, softplc
+additions in words PLC-5 leaves free. docs/engine.md has the table."""
+
+# PLC-5 layout
+ARITH_FLAGS = 0  # S:0  bit 0 carry, 1 overflow, 2 zero, 3 sign
+CARRY, OVERFLOW, ZERO, SIGN = 0, 1, 2, 3
+PROCESSOR_STATUS = 1  # S:1
+FIRST_PASS_BIT = 15  # S:1/15
+LAST_SCAN_MS = 8  # S:8
+MAX_SCAN_MS = 9  # S:9
+MAJOR_FAULT_BITS = 11  # S:11
+MAJOR_FAULT_CODE = 12  # S:12
+FAULT_FILE = 13  # S:13 program file where the major fault happened
+FAULT_RUNG = 14  # S:14 rung where it happened
+MINOR_FAULT_BITS = 17  # S:17 (softplc assignments of its bits below)
+INDEX_REGISTER = 24  # S:24
+WATCHDOG_MS = 28  # S:28
+
+# S:11 major fault word bits (PLC-5 meanings)
+MAJOR_RUNTIME_BIT = 2  # "programming error" (run-time ladder error)
+MAJOR_WATCHDOG_BIT = 8  # watchdog timeout
+
+# S:17 minor fault bits (softplc assignments)
+MINOR_OVERFLOW_BIT = 0  # math overflow (also S:0/1)
+MINOR_DIV_ZERO_BIT = 1  # division by zero
+MINOR_STRING_BIT = 2  # string instruction error (length, index)
+
+# softplc additions (words 100..109)
+SCAN_COUNT_LOW = 100  # S:100/S:101 scans since RUN, 32-bit, low word first
+SCAN_COUNT_HIGH = 101
+MINOR_FAULT_CODE = 102  # last minor fault code
+MINOR_FAULT_FILE = 103
+MINOR_FAULT_RUNG = 104
+MODE_WORD = 105  # 0 PROGRAM, 1 RUN, 2 TEST, 3 FAULTED
+
+DEFAULT_WATCHDOG_MS = 500
+
+# Major fault codes (S:12), PLC-5 numbering where PLC-5 has the fault.
+FAULT_INDIRECT_RANGE = 20  # indirect/indexed address outside its file
+FAULT_INDIRECT_FILE = 24  # indirect file number names no file of that type
+FAULT_JSR_NESTING = 30  # subroutines nested too deep
+FAULT_NEGATIVE_TIMER = 34  # negative timer preset or accumulator
+FAULT_WATCHDOG = 200  # softplc: scan longer than S:28
+FAULT_DIV_ZERO = 201  # softplc: division by zero with divide_by_zero = "fault"
+FAULT_BLOCK_RANGE = 202  # softplc: COP/FLL block past the end of its file
+
+# Minor fault codes (S:102)
+MINOR_CODE_OVERFLOW = 1
+MINOR_CODE_DIV_ZERO = 2
+MINOR_CODE_STRING = 3

@@ -1,0 +1,337 @@
+"""Stage 2: check a parsed program and resolve names.
+
+Finds every problem it can (``softplc check`` lists them all), each with
+file:line:col: unknown instructions (with a did-you-mean), wrong operand
+counts and kinds, unknown symbols, JMPs to missing labels, JSRs to missing
+files, bad data declarations. Symbols are replaced by their addresses and
+quoted CPT/CMP expressions are parsed, so later stages see only addresses,
+constants and expression trees.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ..datatable import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, Address, AddressError, ValueKind, parse_address
+from .ast import (
+    MAIN_FILE,
+    AddressRef,
+    BinOp,
+    Branch,
+    Call,
+    Const,
+    Element,
+    Instruction,
+    Operand,
+    Program,
+    Rung,
+    SymbolRef,
+    Text,
+    UnaryOp,
+    walk,
+)
+from .errors import LadderError, ProgramErrors
+from .instructions import K, lookup, suggest
+from .parser import parse_expression
+
+_NUMERIC = (ValueKind.WORD, ValueKind.FLOAT)
+COMPARISONS = ("=", "<>", "<", "<=", ">", ">=")
+
+
+class _Checker:
+    def __init__(self, program: Program) -> None:
+        self.program = program
+        self.errors: list[LadderError] = []
+
+    def error(self, pos, message: str) -> None:
+        self.errors.append(LadderError(pos, message))
+
+    # -- operands -------------------------------------------------------------------
+    def resolve(self, operand: Operand) -> Operand | None:
+        """Symbols -> addresses, recursively through expressions."""
+        if isinstance(operand, SymbolRef):
+            decl = self.program.symbols.get(operand.name)
+            if decl is None:
+                hint = suggest(operand.name)
+                extra = f" (is {operand.name} a misspelt instruction? did you mean {hint}?)" if hint else ""
+                self.error(operand.pos, f"unknown symbol {operand.name!r}{extra}")
+                return None
+            return AddressRef(decl.address, operand.pos)
+        if isinstance(operand, BinOp):
+            left, right = self.resolve(operand.left), self.resolve(operand.right)
+            return None if left is None or right is None else replace(operand, left=left, right=right)
+        if isinstance(operand, UnaryOp):
+            inner = self.resolve(operand.operand)
+            return None if inner is None else replace(operand, operand=inner)
+        if isinstance(operand, Call):
+            inner = self.resolve(operand.arg)
+            return None if inner is None else replace(operand, arg=inner)
+        return operand
+
+    def expression(self, operand: Operand, mnemonic: str) -> Operand | None:
+        if isinstance(operand, Text):
+            try:
+                operand = parse_expression(operand.value, operand.pos)
+            except LadderError as e:
+                self.errors.append(e)
+                return None
+        operand = self.resolve(operand)
+        if operand is None:
+            return None
+        ok = True
+        for leaf in _leaves(operand):
+            if isinstance(leaf, AddressRef) and leaf.address.kind not in _NUMERIC:
+                self.error(leaf.pos, f"{leaf.address} is a {leaf.address.kind.value}; expressions "
+                           "take words, floats and numbers")
+                ok = False
+        top_is_compare = isinstance(operand, BinOp) and operand.op in COMPARISONS
+        if mnemonic == "CMP" and not top_is_compare:
+            self.error(_pos(operand), "CMP needs a comparison (=, <>, <, <=, >, >=) at the top of its expression")
+            ok = False
+        if mnemonic != "CMP" and _has_compare(operand):
+            self.error(_pos(operand), f"{mnemonic} computes a value; comparisons belong in CMP")
+            ok = False
+        return operand if ok else None
+
+    def operand(self, instr: Instruction, index: int, kind: K, operand: Operand) -> Operand | None:
+        if kind is K.EXPRESSION:
+            return self.expression(operand, instr.mnemonic)
+        if kind is K.ANY:
+            return self.resolve(operand)
+        resolved = self.resolve(operand)
+        if resolved is None:
+            return None
+        spec_name = lookup(instr.mnemonic).operands[index].name
+        where = f"{instr.mnemonic} operand {index + 1} ({spec_name})"
+
+        def bad(expected: str) -> None:
+            self.error(_pos(resolved), f"{where} must be {expected}, not {_describe(resolved)}")
+
+        if kind in (K.TIMEBASE, K.PRESET, K.LABEL, K.PROGRAM_FILE, K.LENGTH, K.BIT_NUMBER):
+            if not isinstance(resolved, Const):
+                bad(f"a constant ({kind.value})")
+                return None
+            v = resolved.value
+            if kind is K.TIMEBASE:
+                if v not in (1.0, 0.01):
+                    bad("the time base 1.0 or 0.01")
+                    return None
+                return resolved
+            if isinstance(v, float):
+                bad(f"an integer ({kind.value})")
+                return None
+            lo, hi = {K.PRESET: (-32768, 32767), K.LABEL: (0, 999), K.PROGRAM_FILE: (3, 999),
+                      K.LENGTH: (1, 1000), K.BIT_NUMBER: (0, 15)}[kind]
+            if kind is K.BIT_NUMBER and instr.mnemonic == "BTD" and index == 4:
+                lo, hi = 1, 16
+            if not lo <= v <= hi:
+                bad(f"in {lo}..{hi}")
+                return None
+            return resolved
+        if isinstance(resolved, Const):
+            if kind in (K.SOURCE, K.FILE_SOURCE):
+                return _word_constant(resolved) if isinstance(resolved.value, int) else resolved
+            if kind is K.INT_SOURCE and isinstance(resolved.value, int):
+                return self._int_constant(resolved, where)
+            bad(kind.value)
+            return None
+        if not isinstance(resolved, AddressRef):
+            bad(kind.value)
+            return None
+        a = resolved.address
+        want = {
+            K.BIT: (ValueKind.BIT,), K.SOURCE: _NUMERIC, K.DEST: _NUMERIC, K.FILE: _NUMERIC,
+            K.FILE_SOURCE: _NUMERIC, K.INT_SOURCE: (ValueKind.WORD,), K.WORD: (ValueKind.WORD,),
+            K.TIMER: (ValueKind.TIMER,), K.COUNTER: (ValueKind.COUNTER,), K.CONTROL: (ValueKind.CONTROL,),
+            K.RESETTABLE: (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL),
+            K.STRING: (ValueKind.STRING,),
+        }[kind]
+        if a.kind not in want:
+            bad(kind.value)
+            return None
+        if kind in (K.DEST, K.WORD) and a.type_letter in ("I",) and False:  # inputs are writable on PLC-5
+            return None
+        if kind in (K.FILE, K.FILE_SOURCE) and a.indexed:
+            # '#' marks a file operand here (PLC-5 file instructions), not indexing.
+            return AddressRef(Address(a.type_letter, a.file, a.element, a.member, a.bit, False), resolved.pos)
+        return resolved
+
+    def _int_constant(self, const: Const, where: str) -> Const | None:
+        v = const.value
+        if -32768 <= v <= 0xFFFF:
+            return _word_constant(const)
+        self.error(const.pos, f"{where}: {v} does not fit a 16-bit word")
+        return None
+
+    # -- instructions and rungs ---------------------------------------------------------
+    def instruction(self, instr: Instruction, file_number: int, labels: set[int], first: bool) -> Instruction:
+        spec = lookup(instr.mnemonic)
+        if spec is None:
+            hint = suggest(instr.mnemonic)
+            self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}" + (f" (did you mean {hint}?)" if hint else ""))
+            return instr
+        n = len(instr.operands)
+        if not spec.min_operands <= n <= len(spec.operands):
+            extras = instr.operands[len(spec.operands):]
+            stray = next((o for o in extras if isinstance(o, SymbolRef) and o.name not in self.program.symbols), None)
+            if stray is not None:
+                hint = suggest(stray.name)
+                self.error(stray.pos, f"unknown instruction {stray.name!r}" + (f" (did you mean {hint}?)" if hint else ""))
+                return instr
+            want = (f"{spec.min_operands}..{len(spec.operands)}" if spec.optional else str(len(spec.operands)))
+            plural = "" if want == "1" else "s"
+            self.error(instr.pos, f"{spec.mnemonic} takes {want} operand{plural} ({spec.signature()}), got {n}")
+            return instr
+        operands = []
+        for i, op in enumerate(instr.operands):
+            checked = self.operand(instr, i, spec.operands[i].kind, op)
+            operands.append(checked if checked is not None else op)
+        if spec.mnemonic == "LBL" and not first:
+            self.error(instr.pos, "LBL must be the first instruction of its rung")
+        if spec.mnemonic == "JSR" and operands and isinstance(operands[0], Const):
+            target = operands[0].value
+            if target not in self.program.files:
+                self.error(_pos(operands[0]), f"JSR to program file {target}, which does not exist"
+                           f" (files: {', '.join(map(str, sorted(self.program.files)))})")
+        if spec.mnemonic == "JMP" and operands and isinstance(operands[0], Const):
+            if operands[0].value not in labels:
+                self.error(_pos(operands[0]), f"JMP to label {operands[0].value}, which is not in program file {file_number}")
+        return Instruction(instr.mnemonic, operands, instr.pos)
+
+    def series(self, elements: list[Element], file_number: int, labels: set[int], first: bool) -> list[Element]:
+        out: list[Element] = []
+        for el in elements:
+            if isinstance(el, Branch):
+                if len(el.legs) < 2:
+                    self.error(el.pos, "a branch needs at least two legs (BST ... NXB ... BND)")
+                legs = [self.series(leg, file_number, labels, False) for leg in el.legs]
+                for leg in el.legs:
+                    if not leg:
+                        self.error(el.pos, "empty branch leg")
+                out.append(Branch(legs, el.pos))
+            else:
+                out.append(self.instruction(el, file_number, labels, first and not out))
+        return out
+
+    def run(self) -> Program:
+        prog = self.program
+        for name, decl in prog.symbols.items():
+            if lookup(name) is not None:
+                self.error(decl.pos, f"symbol {name} has the name of an instruction")
+        for decl in prog.data:
+            self.data(decl)
+        if prog.files and MAIN_FILE not in prog.files:
+            first = min(prog.files.values(), key=lambda f: f.number)
+            self.error(first.pos, "the program has no main file 2 (rungs before any FILE header go there)")
+        resolved = Program(data=prog.data, symbols=prog.symbols)
+        for number, pfile in prog.files.items():
+            labels: dict[int, Rung] = {}
+            for rung in pfile.rungs:
+                if rung.elements and isinstance(rung.elements[0], Instruction) and rung.elements[0].mnemonic == "LBL":
+                    ops = rung.elements[0].operands
+                    if len(ops) == 1 and isinstance(ops[0], Const) and isinstance(ops[0].value, int):
+                        if ops[0].value in labels:
+                            self.error(rung.pos, f"label {ops[0].value} is defined twice in file {number} "
+                                       f"(first at {labels[ops[0].value].pos})")
+                        labels[ops[0].value] = rung
+            rungs = []
+            for rung in pfile.rungs:
+                if not rung.elements:
+                    self.error(rung.pos, "empty rung")
+                rungs.append(Rung(self.series(rung.elements, number, set(labels), True), rung.comment, rung.pos))
+            resolved.files[number] = replace(pfile, rungs=rungs)
+        return resolved
+
+    def data(self, decl) -> None:
+        text = decl.file
+        letter = "ST" if text.startswith("ST") else text[:1]
+        ftype = FILE_TYPES.get(letter)
+        digits = text[len(letter):]
+        if ftype is None or not digits.isdigit():
+            self.error(decl.pos, f"DATA {text}: expected a data file name such as N10, F11 or ST12")
+            return
+        try:
+            parse_address(f"{text}:0")
+        except AddressError as e:
+            self.error(decl.pos, f"DATA {text}: {e.reason}")
+            return
+        if not 1 <= decl.size <= MAX_ELEMENTS:
+            self.error(decl.pos, f"DATA {text}: size {decl.size} out of range 1..{MAX_ELEMENTS}")
+        if len(decl.values) > decl.size:
+            self.error(decl.pos, f"DATA {text}: {len(decl.values)} values for {decl.size} elements")
+        for v in decl.values:
+            if ftype.is_string:
+                if not isinstance(v, str) or len(v) > STRING_CHARS:
+                    self.error(decl.pos, f"DATA {text}: string files take quoted strings of at most {STRING_CHARS} characters")
+                    return
+            elif ftype.letter == "F":
+                if isinstance(v, str):
+                    self.error(decl.pos, f"DATA {text}: float files take numbers")
+                    return
+            elif ftype.letter in ("N", "B", "O", "I", "S"):
+                if not isinstance(v, int) or not -32768 <= v <= 0xFFFF:
+                    self.error(decl.pos, f"DATA {text}: {v!r} does not fit a 16-bit word")
+                    return
+            else:
+                self.error(decl.pos, f"DATA {text}: initial values are for N, B, F and ST files")
+                return
+
+
+def _word_constant(const: Const) -> Const:
+    """Hex constants above 0x7FFF are bit patterns: 0xFFFF is -1."""
+    v = const.value
+    if isinstance(v, int) and 0x8000 <= v <= 0xFFFF:
+        return Const(v - 0x10000, const.pos)
+    return const
+
+
+def _leaves(expr):
+    if isinstance(expr, BinOp):
+        yield from _leaves(expr.left)
+        yield from _leaves(expr.right)
+    elif isinstance(expr, UnaryOp):
+        yield from _leaves(expr.operand)
+    elif isinstance(expr, Call):
+        yield from _leaves(expr.arg)
+    else:
+        yield expr
+
+
+def _has_compare(expr) -> bool:
+    if isinstance(expr, BinOp):
+        return expr.op in COMPARISONS or _has_compare(expr.left) or _has_compare(expr.right)
+    if isinstance(expr, UnaryOp):
+        return _has_compare(expr.operand)
+    if isinstance(expr, Call):
+        return _has_compare(expr.arg)
+    return False
+
+
+def _pos(operand):
+    return getattr(operand, "pos")
+
+
+def _describe(operand: Operand) -> str:
+    if isinstance(operand, AddressRef):
+        return f"{operand.address} (a {operand.address.kind.value})"
+    if isinstance(operand, Const):
+        return f"the constant {operand.value}"
+    if isinstance(operand, Text):
+        return f'the string "{operand.value}"'
+    return "an expression"
+
+
+def check(program: Program) -> tuple[Program, list[LadderError]]:
+    """Validate; return the resolved program and every problem found."""
+    checker = _Checker(program)
+    resolved = checker.run()
+    checker.errors.sort(key=lambda e: (e.pos.source, e.pos.line, e.pos.column))
+    return resolved, checker.errors
+
+
+def validate(program: Program) -> Program:
+    """Validate and resolve, raising ProgramErrors if anything is wrong."""
+    resolved, errors = check(program)
+    if errors:
+        raise ProgramErrors(errors)
+    return resolved
