@@ -76,8 +76,8 @@ PY_COMPARE = {"=": "==", "<>": "!=", "<": "<", "<=": "<=", ">": ">", ">=": ">="}
 
 
 def to_python(node, operand_code: Callable[[AddressRef], str]) -> str:
-    """Python source for an expression. Names used: ``_div``, ``_mod``,
-    ``_pow``, ``_int``, ``_fn_<NAME>``; ``operand_code`` gives the source of
+    """Python source for an expression. Names used: ``_x_div``, ``_x_mod``,
+    ``_x_pow``, ``_int``, ``_fn_<NAME>``; ``operand_code`` gives the source of
     each address read. Only validated tokens reach the text: numbers are
     printed by repr(), operators come from fixed tables."""
     if isinstance(node, Const):
@@ -96,11 +96,11 @@ def to_python(node, operand_code: Callable[[AddressRef], str]) -> str:
     if op in ("+", "-", "*"):
         return f"({a} {op} {b})"
     if op == "|":
-        return f"_div({a}, {b})"
+        return f"_x_div({a}, {b})"
     if op == "MOD":
-        return f"_mod({a}, {b})"
+        return f"_x_mod({a}, {b})"
     if op == "**":
-        return f"_pow({a}, {b})"
+        return f"_x_pow({a}, {b})"
     if op in ("AND", "OR", "XOR"):
         sym = {"AND": "&", "OR": "|", "XOR": "^"}[op]
         return f"(_int({a}) {sym} _int({b}))"
@@ -146,7 +146,7 @@ def evaluate(node, read: Callable[[AddressRef], int | float], machine):
 
 def namespace(machine) -> dict[str, object]:
     """The helper names compiled expressions use."""
-    ns: dict[str, object] = {"_div": machine.divide, "_mod": machine.modulo, "_pow": machine.power, "_int": _int}
+    ns: dict[str, object] = {"_x_div": machine.divide, "_x_mod": machine.modulo, "_x_pow": machine.power, "_int": _int}
     for name, fn in FUNCTIONS.items():
         ns[f"_fn_{name}"] = fn
     return ns

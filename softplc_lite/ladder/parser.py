@@ -173,14 +173,16 @@ class _ToAst(Transformer):
         return Const(_number(tok), self._pos(tok))
 
     @v_args(meta=True, inline=True)
-    def negative_number(self, meta, tok):
-        return Const(-_number(tok), self._pos(meta))
+    def negative_number(self, meta, sign, tok):
+        value = _number(tok)
+        return Const(-value if str(sign) == "-" else value, self._pos(meta))
 
     def INT(self, tok):
         return tok
 
     @v_args(inline=True)
     def call(self, name, arg):
+        arg = self._atomize(arg)
         func = str(name).upper()
         if func not in _CALLS:
             raise LadderError(self._pos(name), f"unknown function {name}() in an expression; "
@@ -188,58 +190,25 @@ class _ToAst(Transformer):
         return Call(func, arg, self._pos(name))
 
     @v_args(meta=True, inline=True)
-    def negate(self, meta, operand):
+    def negate(self, meta, sign, operand):
+        operand = self._atomize(operand)
+        if str(sign) == "+":
+            return operand
         if isinstance(operand, Const):
             return Const(-operand.value, self._pos(meta))
         return UnaryOp("NEG", operand, self._pos(meta))
 
     @v_args(meta=True, inline=True)
     def bit_not(self, meta, operand):
+        operand = self._atomize(operand)
         return UnaryOp("NOT", operand, self._pos(meta))
 
-    def _chain(self, meta, items, op=None):
-        items = [i if not (isinstance(i, Token) and i.type in ("INT", "FLOAT", "HEX")) else Const(_number(i), self._pos(i)) for i in items]
-        result = items[0]
-        i = 1
-        while i < len(items):
-            if op is None:
-                operator, right = str(items[i]).upper(), items[i + 1]
-                i += 2
-            else:
-                operator, right = op, items[i]
-                i += 1
-            if operator == "/":
-                operator = "|"  # PLC-5 writes division as |
-            result = BinOp(operator, result, right, self._pos(meta))
-        return result
-
-    @v_args(meta=True)
-    def or_chain(self, meta, items):
-        return self._chain(meta, items, "OR")
-
-    @v_args(meta=True)
-    def xor_chain(self, meta, items):
-        return self._chain(meta, items, "XOR")
-
-    @v_args(meta=True)
-    def and_chain(self, meta, items):
-        return self._chain(meta, items, "AND")
-
-    @v_args(meta=True)
-    def sum_chain(self, meta, items):
-        return self._chain(meta, items)
-
-    @v_args(meta=True)
-    def product_chain(self, meta, items):
-        return self._chain(meta, items)
-
-    @v_args(meta=True)
-    def power_op(self, meta, items):
-        return self._chain(meta, items, "**")
-
-    @v_args(meta=True)
-    def compare(self, meta, items):
-        return self._chain(meta, items)
+    @v_args(meta=True, inline=True)
+    def binop(self, meta, left, op, right):
+        operator = str(op).upper()
+        if operator == "/":
+            operator = "|"  # PLC-5 writes division as |
+        return BinOp(operator, self._atomize(left), self._atomize(right), self._pos(meta))
 
     def _atomize(self, item):
         if isinstance(item, Token) and item.type in ("INT", "FLOAT", "HEX"):
@@ -388,7 +357,11 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
     except UnexpectedInput as e:
         raise _syntax_error(e, text, source, line_offset, column_offset) from None
     try:
-        return _ToAst(source, line_offset, column_offset).transform(tree)
+        result = _ToAst(source, line_offset, column_offset).transform(tree)
+        if isinstance(result, Token):  # a bare number as a whole expression
+            p = Pos(source, result.line + line_offset, result.column + (column_offset if result.line == 1 else 0))
+            return Const(_number(result), p)
+        return result
     except VisitError as e:
         if isinstance(e.orig_exc, LadderError):
             raise e.orig_exc from None
@@ -505,6 +478,10 @@ def _group(tokens: list, is_mnemonic: Callable[[str], bool], rung_pos: Pos) -> l
             series.append(current)
             continue
         operand = SymbolRef(tok.text, tok.pos) if isinstance(tok, _Name) else tok
+        if isinstance(operand, Text) and current is not None and _takes_expression(current):
+            # CPT "N7:1 + 5": the quoted text is an expression; parse it now
+            # so both rung syntaxes give the same tree.
+            operand = parse_expression(operand.value, operand.pos)
         if current is None:
             if isinstance(tok, _Name):
                 raise LadderError(tok.pos, f"unknown instruction {tok.text!r}{_did_you_mean(tok.text)}")
@@ -513,6 +490,14 @@ def _group(tokens: list, is_mnemonic: Callable[[str], bool], rung_pos: Pos) -> l
     if stack:
         raise LadderError(stack[-1][1].pos, "BST without a matching BND (unclosed branch)")
     return root
+
+
+def _takes_expression(instr: Instruction) -> bool:
+    from .instructions import K, lookup
+
+    spec = lookup(instr.mnemonic)
+    index = len(instr.operands)
+    return spec is not None and index < len(spec.operands) and spec.operands[index].kind is K.EXPRESSION
 
 
 def _operand_pos(operand) -> Pos:

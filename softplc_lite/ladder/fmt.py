@@ -1,0 +1,145 @@
+"""Print a program canonically, in mnemonic or neutral-text style.
+
+Parsing what this prints gives back an equal AST (positions aside): the
+tests check it on every program in programs/ and on generated programs.
+"""
+
+from __future__ import annotations
+
+from .ast import (
+    MAIN_FILE,
+    AddressRef,
+    BinOp,
+    Branch,
+    Call,
+    Const,
+    Element,
+    Instruction,
+    Program,
+    Rung,
+    SymbolRef,
+    Text,
+    UnaryOp,
+)
+
+STYLES = ("mnemonic", "neutral")
+
+# Binding strength of expression operators (higher binds tighter), as in ladder.lark.
+_PREC = {"=": 1, "<>": 1, "<": 1, "<=": 1, ">": 1, ">=": 1, "OR": 2, "XOR": 3, "AND": 4,
+         "+": 5, "-": 5, "*": 6, "|": 6, "MOD": 6, "**": 7}
+_UNARY, _ATOM = 8, 9
+
+
+def _number(v: int | float) -> str:
+    return repr(v) if isinstance(v, float) else str(v)
+
+
+def _prec(node) -> int:
+    if isinstance(node, BinOp):
+        return _PREC[node.op]
+    if isinstance(node, UnaryOp):
+        return _UNARY
+    if isinstance(node, Const) and node.value < 0:
+        return _UNARY  # printed with a leading '-'
+    return _ATOM
+
+
+def format_expression(node) -> str:
+    if isinstance(node, Const):
+        return _number(node.value)
+    if isinstance(node, AddressRef):
+        return str(node.address)
+    if isinstance(node, SymbolRef):
+        return node.name
+    if isinstance(node, Call):
+        return f"{node.func}({format_expression(node.arg)})"
+    if isinstance(node, UnaryOp):
+        inner = format_expression(node.operand)
+        if _prec(node.operand) < _UNARY:
+            inner = f"({inner})"
+        return f"-{inner}" if node.op == "NEG" else f"NOT {inner}"
+    assert isinstance(node, BinOp)
+    p = _PREC[node.op]
+    left, right = format_expression(node.left), format_expression(node.right)
+    if node.op == "**":
+        # power takes unary operands on both sides and does not chain
+        if _prec(node.left) < _UNARY:
+            left = f"({left})"
+        if _prec(node.right) < _UNARY:
+            right = f"({right})"
+    else:
+        if _prec(node.left) < p or (p == 1 and _prec(node.left) == 1):
+            left = f"({left})"
+        if _prec(node.right) <= p:
+            right = f"({right})"
+    return f"{left} {node.op} {right}"
+
+
+def format_operand(op, style: str, file_operand: bool = False) -> str:
+    if isinstance(op, (BinOp, UnaryOp, Call)):
+        text = format_expression(op)
+        return f'"{text}"' if style == "mnemonic" else text
+    if isinstance(op, Const):
+        return _number(op.value)
+    if isinstance(op, AddressRef):
+        return str(op.address)
+    if isinstance(op, SymbolRef):
+        return op.name
+    if isinstance(op, Text):
+        escaped = op.value.replace("\\", "\\\\").replace('"', '\\"')
+        return f'"{escaped}"'
+    raise TypeError(f"cannot print operand {op!r}")
+
+
+def format_instruction(ins: Instruction, style: str = "mnemonic") -> str:
+    operands = [format_operand(o, style) for o in ins.operands]
+    if style == "neutral":
+        return f"{ins.mnemonic}({','.join(operands)})"
+    return " ".join([ins.mnemonic, *operands])
+
+
+def format_series(elements: list[Element], style: str) -> str:
+    parts = []
+    for el in elements:
+        if isinstance(el, Branch):
+            legs = [format_series(leg, style) for leg in el.legs]
+            if style == "neutral":
+                parts.append("[" + ",".join(legs) + "]")
+            else:
+                parts.append("BST " + " NXB ".join(legs) + " BND")
+        else:
+            parts.append(format_instruction(el, style))
+    return ("" if style == "neutral" else " ").join(parts)
+
+
+def format_rung(rung: Rung, style: str = "mnemonic") -> str:
+    lines = [f"// {line}".rstrip() for line in (rung.comment or "").split("\n")] if rung.comment else []
+    body = format_series(rung.elements, style)
+    lines.append(body + ";" if style == "neutral" else body)
+    return "\n".join(lines)
+
+
+def _data_value(v) -> str:
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    return _number(v)
+
+
+def format_program(program: Program, style: str = "mnemonic") -> str:
+    if style not in STYLES:
+        raise ValueError(f"style must be one of {', '.join(STYLES)}")
+    out: list[str] = []
+    for decl in program.symbols.values():
+        out.append(f"SYMBOL {decl.name} {decl.address}")
+    for decl in program.data:
+        values = " ".join(_data_value(v) for v in decl.values)
+        out.append(f"DATA {decl.file} {decl.size}" + (f" = {values}" if decl.values else ""))
+    for number in sorted(program.files):
+        pfile = program.files[number]
+        if out:
+            out.append("")
+        if number != MAIN_FILE or pfile.name:
+            out.append(f"FILE {number}" + (f" {pfile.name}" if pfile.name else ""))
+        for rung in pfile.rungs:
+            out.append(format_rung(rung, style))
+    return "\n".join(out) + "\n"
