@@ -1,19 +1,25 @@
 """The ``softplc`` command.
 
-Exit codes: 0 ok, 1 a program/config/data error (reported, no traceback),
-2 usage error (argparse), 3 a PLC fault (scan engine, later issues).
+Exit codes: 0 ok; 1 a program, config or data error (reported with
+file:line:col, no traceback); 2 usage error; 3 the PLC faulted.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 from typing import Sequence
 
 from . import __version__
+from .app import AppError, lad_files, load_app, parse_files
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
 from .datatable.display import format_value
+from .ladder.engine import Mode
+from .ladder.errors import LadderError
+from .ladder.fmt import STYLES, format_program
+from .runner import RunOptions, Runner
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT = 0, 1, 2, 3
 
@@ -40,15 +46,74 @@ def _cmd_datatable(args: argparse.Namespace) -> int:
         if path.endswith(".json"):
             jsonio.load_file(table, path)
         else:
-            restored = snapshot.load(path)
-            jsonio.load_into(table, jsonio.export_table(restored), path)
-    for text in args.print:
-        a = parse_address(text)
-        print(f"{a} = {format_value(table.read(a))}")
+            table.assign(snapshot.load(path))
+    _print_values(table, args.print)
     if args.dump:
         sys.stdout.write(jsonio.dumps(table))
     if args.save:
         snapshot.save(table, args.save)
+    return EXIT_OK
+
+
+def _print_values(table: DataTable, addresses: list[str], symbols=None) -> None:
+    for text in addresses:
+        name = text
+        if symbols and text in symbols:
+            a = symbols[text].address
+            name = f"{text} ({a})"
+        else:
+            a = parse_address(text)
+            name = str(a)
+        print(f"{name} = {format_value(table.read(a))}")
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    if args.scans is not None and args.scans < 0:
+        raise SystemExit("softplc run: error: --scans must be 0 or more")
+    app = load_app(args.app, args.state)
+    options = RunOptions(
+        scan_ms=args.scan_ms, realtime=args.realtime, fresh=args.fresh,
+        load=tuple(args.load or ()), sets=tuple(args.set), executor=args.executor,
+    )
+    runner = Runner(app, options)
+    runner.run(args.scans)
+    engine = runner.engine
+    runner.save()
+    if args.dump:
+        Path(args.dump).write_text(jsonio.dumps(runner.table), encoding="utf-8")
+    _print_values(runner.table, args.print, app.program.symbols)
+    if engine.mode is Mode.FAULTED:
+        print(f"softplc: {app.name}: {engine.fault}", file=sys.stderr)
+        return EXIT_FAULT
+    return EXIT_OK
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    try:
+        app = load_app(args.app)
+    except AppError as e:
+        print(str(e), file=sys.stderr)
+        count = len(e.errors) or 1
+        print(f"{count} problem{'s' if count != 1 else ''} found", file=sys.stderr)
+        return EXIT_ERROR
+    rungs = sum(len(f.rungs) for f in app.program.files.values())
+    print(f"{app.name}: ok ({len(app.program.files)} program file{'s' if len(app.program.files) != 1 else ''}, "
+          f"{rungs} rung{'s' if rungs != 1 else ''})")
+    return EXIT_OK
+
+
+def _cmd_fmt(args: argparse.Namespace) -> int:
+    path = Path(args.path)
+    if not path.exists():
+        raise AppError(f"{path}: no such file or directory")
+    files = lad_files(path)
+    for k, f in enumerate(files):
+        program, errors = parse_files([f], path)
+        if errors:
+            raise AppError(errors)
+        if len(files) > 1:
+            print(("\n" if k else "") + f"// ==> {f.name} <==")
+        sys.stdout.write(format_program(program, args.style))
     return EXIT_OK
 
 
@@ -59,6 +124,31 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"softplc_lite {__version__}")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
+
+    r = sub.add_parser("run", help="run an app (directory or .lad file) in RUN mode")
+    r.add_argument("app", metavar="APP", help="app directory or .lad file")
+    r.add_argument("--scans", type=int, metavar="N", help="stop after N scans (default: run until Ctrl-C)")
+    r.add_argument("--scan-ms", type=int, metavar="MS",
+                   help="simulated ms per scan (default 10), or with --realtime the scan period (0 = free-running)")
+    r.add_argument("--realtime", action="store_true", help="use the wall clock instead of simulated time")
+    r.add_argument("--state", metavar="DIR", help="keep the retentive snapshot in DIR (default APP/.softplc)")
+    r.add_argument("--fresh", action="store_true", help="ignore the retentive snapshot")
+    r.add_argument("--load", action="append", metavar="FILE.json", help="load data table values at start")
+    r.add_argument("--dump", metavar="FILE.json", help="write the data table as JSON at the end")
+    r.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE", help="set a value at start")
+    r.add_argument("--print", action="append", default=[], metavar="ADDR", help="print a value at the end")
+    r.add_argument("--executor", choices=("compiled", "reference"), default="compiled",
+                   help="compiled fast path (default) or the reference interpreter")
+    r.set_defaults(func=_cmd_run)
+
+    c = sub.add_parser("check", help="parse and validate an app; list every problem")
+    c.add_argument("app", metavar="APP")
+    c.set_defaults(func=_cmd_check)
+
+    f = sub.add_parser("fmt", help="print a program canonically")
+    f.add_argument("path", metavar="PATH", help=".lad file or app directory")
+    f.add_argument("--style", choices=STYLES, default="mnemonic")
+    f.set_defaults(func=_cmd_fmt)
 
     a = sub.add_parser("address", help="parse data table addresses and print their canonical form")
     a.add_argument("text", nargs="+", metavar="ADDR", help="address text such as N7:0/3 or I:012/17")
@@ -81,7 +171,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_OK
     try:
         return args.func(args)
-    except DataTableError as e:
+    except (DataTableError, AppError, LadderError) as e:
+        text = e.report() if isinstance(e, LadderError) else str(e)
+        print(f"error: {text}" if not isinstance(e, AppError) else text, file=sys.stderr)
+        return EXIT_ERROR
+    except OSError as e:
         print(f"error: {e}", file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
