@@ -239,7 +239,7 @@ class Engine:
         except MajorFault as fault:
             self._major(fault)
         except Exception as exc:  # a bug in softplc must not become a traceback for the user
-            self._major(MajorFault(S.FAULT_WATCHDOG + 55, f"internal error: {type(exc).__name__}: {exc}"), exc)
+            self._major(MajorFault(S.FAULT_INTERNAL, f"internal error: {type(exc).__name__}: {exc}"), exc)
         elapsed_ms = (time.perf_counter() - start) * 1000
         self.last_scan_ms = elapsed_ms
         self.max_scan_ms = max(self.max_scan_ms, elapsed_ms)
@@ -291,7 +291,7 @@ class Engine:
         except (_EndScan, RecursionError):
             raise
         except Exception as exc:
-            fault = MajorFault(S.FAULT_WATCHDOG + 55, f"internal error: {type(exc).__name__}: {exc}")
+            fault = MajorFault(S.FAULT_INTERNAL, f"internal error: {type(exc).__name__}: {exc}")
             fault.file, fault.rung = number, i
             fault.instruction = self._which_instruction(compiled, exc)
             raise fault from exc

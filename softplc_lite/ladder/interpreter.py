@@ -14,7 +14,7 @@ from __future__ import annotations
 from ..datatable import DataTable, bit_mask
 from ..datatable.errors import AddressRangeError
 from .ast import AddressRef, Branch, Const, Instruction, Program, Rung
-from .compiler import RET, TND, address_fault, labels_of
+from .compiler import RET, TND, address_fault, describe, labels_of
 from .expr import evaluate
 from .semantics import BASE_MS, Machine, MajorFault, lim
 from . import status as S
@@ -100,12 +100,16 @@ class Interpreter:
             else:
                 try:
                     c = self.instruction(el, c, rung, pfile)
+                except _Jump:
+                    raise
                 except MajorFault as fault:
                     if fault.instruction is None:
-                        from .compiler import describe
-
                         fault.instruction = describe(el)
                     raise
+                except Exception as exc:  # a bug: contained as a fault naming the instruction
+                    fault = MajorFault(S.FAULT_INTERNAL, f"internal error: {type(exc).__name__}: {exc}")
+                    fault.instruction = describe(el)
+                    raise fault from exc
         return c
 
     def instruction(self, ins: Instruction, c: bool, rung: Rung, pfile: ReferenceFile) -> bool:

@@ -43,6 +43,7 @@ FAULT_NEGATIVE_TIMER = 34  # negative timer preset or accumulator
 FAULT_WATCHDOG = 200  # softplc: scan longer than S:28
 FAULT_DIV_ZERO = 201  # softplc: division by zero with divide_by_zero = "fault"
 FAULT_BLOCK_RANGE = 202  # softplc: COP/FLL block past the end of its file
+FAULT_INTERNAL = 255  # softplc: an internal error (a bug), contained as a fault
 
 # Minor fault codes (S:102)
 MINOR_CODE_OVERFLOW = 1

@@ -1,0 +1,129 @@
+"""softplc run / check / fmt as a user runs them (real processes)."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def softplc(*args: str, cwd: Path = ROOT, timeout: float = 60) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=cwd,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.fixture
+def app(tmp_path: Path) -> Path:
+    d = tmp_path / "counter"
+    d.mkdir()
+    (d / "main.lad").write_text("// count scans\nADD N7:0 1 N7:0\nXIC S:1/15 MOV 7 N7:1\n")
+    return d
+
+
+def test_run_counts_scans_and_keeps_retentive_memory(app):
+    p = softplc("run", str(app), "--scans", "25", "--print", "N7:0")
+    assert p.returncode == 0, p.stderr
+    assert p.stdout == "N7:0 = 25\n"
+    assert (app / ".softplc" / "datatable.snap").exists()
+    p = softplc("run", str(app), "--scans", "5", "--print", "N7:0")
+    assert p.stdout == "N7:0 = 30\n"  # restored from the snapshot
+    p = softplc("run", str(app), "--scans", "5", "--fresh", "--print", "N7:0")
+    assert p.stdout == "N7:0 = 5\n"
+
+
+def test_datatable_json_then_load_then_set(app, tmp_path):
+    (app / "datatable.json").write_text('{"N7": [100, 0, 0, 0]}')
+    extra = tmp_path / "extra.json"
+    extra.write_text('{"N7": [null, null, 3]}')
+    dump = tmp_path / "out.json"
+    p = softplc("run", str(app), "--fresh", "--scans", "1", "--load", str(extra), "--set", "N7:3=9",
+                "--set", "F8:0=2.5", "--dump", str(dump), "--print", "N7:0", "--print", "N7:2", "--print", "N7:3")
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.splitlines() == ["N7:0 = 101", "N7:2 = 3", "N7:3 = 9"]
+    doc = json.loads(dump.read_text())
+    assert doc["N7"][:4] == [101, 7, 3, 9] and doc["F8"] == [2.5]
+
+
+def test_single_lad_file_has_no_state_unless_asked(app, tmp_path):
+    lad = app / "main.lad"
+    p = softplc("run", str(lad), "--scans", "3", "--print", "N7:0")
+    assert p.stdout == "N7:0 = 3\n" and not (app / ".softplc").exists()
+    state = tmp_path / "state"
+    softplc("run", str(lad), "--scans", "3", "--state", str(state))
+    p = softplc("run", str(lad), "--scans", "3", "--state", str(state), "--print", "N7:0")
+    assert p.stdout == "N7:0 = 6\n"
+
+
+def test_fault_exits_3_with_the_fault_in_words(tmp_path):
+    lad = tmp_path / "bad.lad"
+    lad.write_text("MOV 40 N7:1\nMOV N7:[N7:1] N7:0\n")
+    p = softplc("run", str(lad), "--scans", "5")
+    assert p.returncode == 3
+    assert "major fault 20: program file 2, rung 1, MOV N7:[N7:1] N7:0" in p.stderr
+    assert "Traceback" not in p.stderr
+
+
+def test_check_lists_every_problem_and_exits_1(tmp_path):
+    d = tmp_path / "broken"
+    d.mkdir()
+    (d / "a.lad").write_text("XIC B3/0 XIX B3/1\nJMP 4\n")
+    (d / "b.lad").write_text("FILE 3\nXIC(B3/0;\n")
+    p = softplc("check", str(d))
+    assert p.returncode == 1
+    lines = p.stderr.splitlines()
+    assert any(line.endswith("a.lad:1:10: unknown instruction 'XIX' (did you mean XIO?)") for line in lines)
+    assert any("a.lad:2:5: JMP to label 4" in line for line in lines)
+    assert any("b.lad:2:" in line for line in lines)
+    assert lines[-1] == "3 problems found"
+    assert "Traceback" not in p.stderr
+
+
+def test_check_ok(app):
+    p = softplc("check", str(app))
+    assert p.returncode == 0 and p.stdout == "counter: ok (1 program file, 2 rungs)\n"
+
+
+def test_fmt_both_styles(app):
+    p = softplc("fmt", str(app / "main.lad"), "--style", "neutral")
+    assert p.returncode == 0
+    assert p.stdout == "// count scans\nADD(N7:0,1,N7:0);\nXIC(S:1/15)MOV(7,N7:1);\n"
+    p = softplc("fmt", str(app / "main.lad"))
+    assert p.stdout == "// count scans\nADD N7:0 1 N7:0\nXIC S:1/15 MOV 7 N7:1\n"
+
+
+def test_bad_settings_and_usage(app, tmp_path):
+    (app / "softplc.toml").write_text("[math]\noverflow = 'saturate'\n")
+    p = softplc("run", str(app), "--scans", "1")
+    assert p.returncode == 1 and "overflow = 'saturate'; expected one of 'clamp', 'wrap'" in p.stderr
+    (app / "softplc.toml").write_text("[math\n")
+    p = softplc("run", str(app), "--scans", "1")
+    assert p.returncode == 1 and "softplc.toml" in p.stderr and "line 1" in p.stderr
+    assert softplc("run").returncode == 2
+    p = softplc("run", str(tmp_path / "nope"))
+    assert p.returncode == 1 and "no such app directory" in p.stderr
+    p = softplc("run", str(app / "main.lad"), "--scans", "1", "--set", "N7:0=99999")
+    assert p.returncode == 1 and "99999 does not fit N7:0" in p.stderr
+
+
+def test_without_scans_it_runs_until_ctrl_c_then_saves(app):
+    proc = subprocess.Popen([sys.executable, "-m", "softplc_lite", "run", str(app), "--realtime",
+                             "--scan-ms", "5", "--print", "N7:0"], cwd=ROOT, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(1.0)
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=20)
+    finally:
+        proc.kill()
+    assert proc.returncode == 0, err
+    scans = int(out.split("=")[1])
+    assert 20 < scans < 400  # about 5 ms per scan for about a second
+    p = softplc("run", str(app), "--scans", "1", "--print", "N7:0")
+    assert p.stdout == f"N7:0 = {scans + 1}\n"
