@@ -1,0 +1,73 @@
+"""The compiler's generated code: only validated tokens reach it, and its
+line table maps faults back to instructions."""
+
+from __future__ import annotations
+
+import ast
+import re
+
+from softplc_lite.ladder import Engine, load_text
+
+# Every name generated code may use: data arrays, temporaries, rung
+# functions, bound kernels and expression helpers.
+ALLOWED = re.compile(
+    r"^(f\d+|_d\d+|_i\d+|_m\d+|b\d+|o\d+|r\d+|c|_env|_factory|_loc\d+|_jsr|_zone|_x_div|_x_mod|_x_pow|_int|"
+    r"_fn_[A-Z]+|_[a-z]+|abs|bool)$"
+)
+
+HOSTILE = r'''
+SYMBOL __import__ N7:0
+SYMBOL os B3/0
+SYMBOL exec_ N7:1
+DATA ST12 1 = "\"); import os; os.system(\"echo pwned"
+XIC os MOV __import__ exec_
+CPT N7:2 "__import__ + exec_ * 2"
+CMP "exec_ > 0" OTE B3/1
+'''
+
+
+def _names(source: str) -> set[str]:
+    tree = ast.parse(source)
+    names = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
+    names |= {n.name for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)}
+    names |= {a.arg for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) for a in n.args.args}
+    return names
+
+
+def test_program_text_never_reaches_generated_code():
+    engine = Engine(load_text(HOSTILE, "hostile.lad"))
+    source = engine.files[2][0].source
+    names = _names(source)
+    assert all(ALLOWED.match(n) for n in names), sorted(n for n in names if not ALLOWED.match(n))
+    assert "__import__" not in source and "os" not in names and "pwned" not in source
+    # Strings in generated code are only subscript keys of the bindings table.
+    strings = {n.value for n in ast.walk(ast.parse(source)) if isinstance(n, ast.Constant) and isinstance(n.value, str)}
+    assert strings <= {n for n in names}
+
+
+def test_every_example_program_compiles_to_allowed_names():
+    from pathlib import Path
+
+    from softplc_lite.app import load_app
+
+    for app_dir in sorted((Path(__file__).resolve().parent.parent / "programs").iterdir()):
+        if not any(app_dir.glob("*.lad")):
+            continue
+        engine = Engine(load_app(app_dir).program)
+        for compiled, _ in engine.files.values():
+            assert all(ALLOWED.match(n) for n in _names(compiled.source)), app_dir
+
+
+def test_line_table_names_the_failing_instruction():
+    from softplc_lite.ladder import Mode
+
+    text = "MOV 9 N7:0\nBST XIC B3/0 NXB XIO B3/0 BND ADD 1 2 N7:2 MOV N7:[N7:0] N7:1 OTE B3/1\n"
+    engine = Engine(load_text(text, "t.lad"))
+    compiled = engine.files[2][0]
+    assert {ins.mnemonic for ins in compiled.line_table.values()} == {"MOV", "XIC", "XIO", "ADD", "OTE"}
+    engine.set_mode(Mode.RUN)
+    engine.scan()
+    fault = engine.fault
+    assert fault is not None and (fault.file, fault.rung) == (2, 1)
+    assert fault.instruction == "MOV N7:[N7:0] N7:1 at t.lad:2:44"
+    assert engine.table.read("N7:2") == 3  # the instruction before it ran; the data is kept
