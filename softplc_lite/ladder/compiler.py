@@ -16,6 +16,7 @@ each generated line back to its instruction for fault messages.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 from ..datatable import Address, DataTable, ValueKind, bit_mask
@@ -24,10 +25,15 @@ from . import status as S
 from .ast import AddressRef, Branch, Const, Instruction, Program, Rung, walk
 from .expr import namespace as expr_namespace
 from .expr import to_python
-from .semantics import BASE_MS, Machine, MajorFault, lim
+from .semantics import BASE_MS, Machine, MajorFault, lim, source_units
 
 RET = -1
 TND = -2
+
+
+class EndScan(Exception):
+    """TND: end this scan now. Control flow, not an error: it passes up
+    through JSR calls (both executors) to the engine."""
 
 
 @dataclass
@@ -51,8 +57,10 @@ def address_fault(addr: Address, error: AddressRangeError) -> MajorFault:
 
 
 class _FileCompiler:
-    def __init__(self, table: DataTable, machine: Machine, number: int, labels: dict[int, int]) -> None:
+    def __init__(self, table: DataTable, machine: Machine, number: int, labels: dict[int, int], zone: list) -> None:
         self.table = table
+        self.zone = zone  # the file's MCR zone cell, shared with the engine's runner
+        self.rung_elements: list = []
         self.machine = machine
         self.number = number
         self.labels = labels
@@ -309,11 +317,13 @@ class _FileCompiler:
 
     def _block(self, ind, ref: AddressRef, length: int, dest_ref: AddressRef) -> tuple[str, str, str]:
         """A block operand of a file instruction: array, start, word count.
-        The element count comes from the destination's element size."""
+        The element count comes from the destination's element size; a COP
+        source of another storage (F vs words) spans the same bytes."""
         wpe = dest_ref.address.ftype.words_per_element
+        needed = source_units(length * wpe, ref.address.ftype, dest_ref.address.ftype)
         d, i, _ = self.location(ind, ref)
         check = self.bind("_block_check", _block_check)
-        self.emit(ind, f"{check}({d}, {i}, {length * wpe!r}, {str(ref.address)!r})")
+        self.emit(ind, f"{check}({d}, {i}, {needed!r}, {str(ref.address)!r})")
         return d, i, repr(length * wpe)
 
     def i_COP(self, ind, ops):
@@ -357,7 +367,8 @@ class _FileCompiler:
 
     def i_MCR(self, ind, ops):
         self.has_mcr = True
-        conditional = not (self._rung_elements and self._rung_elements[0] is self.current)
+        # An MCR alone on its rung ends the zone; with conditions before it, it starts one.
+        conditional = self.rung_elements[0] is not self.current
         self.emit(ind, f"_zone[0] = {'c' if conditional else 'True'}")
 
     def i_AFI(self, ind, ops):
@@ -396,27 +407,51 @@ class _FileCompiler:
         self.emit(ind + 1, f"c = {self.bind('_asr', self.machine.asr)}({ad}, {ai}, {bd}, {bi})")
 
     # -- the whole file -----------------------------------------------------------------------------
-    _rung_elements: list = []
-
     def compile(self, rungs: list[Rung], jsr) -> CompiledFile:
         self.lines = ["def _factory(_env):"]
         header_at = len(self.lines)
         for k, rung in enumerate(rungs):
-            self._rung_elements = rung.elements
+            self.rung_elements = rung.elements
             self.rung(k, rung)
         self.lines.append(f"    return [{', '.join(f'r{k}' for k in range(len(rungs)))}]")
         self.env["_jsr"] = jsr
-        self.env["_zone"] = self.machine_zone
+        self.env["_zone"] = self.zone
         self.env.update(expr_namespace(self.machine))
         bindings = [f"    {name} = _env[{name!r}]" for name in sorted(self.env)]
-        self.lines[header_at:header_at] = bindings
         shift = len(bindings)
         line_table = {line + shift: ins for line, ins in self.line_instr.items()}
+        functions = self._compile_chunks(len(rungs), shift)
+        self.lines[header_at:header_at] = bindings
         source = "\n".join(self.lines) + "\n"
-        code = compile(source, f"<ladder file {self.number}>", "exec")
-        scope: dict[str, object] = {}
-        exec(code, scope)  # noqa: S102 - source built only from validated tokens
-        return CompiledFile(self.number, scope["_factory"](self.env), self.has_mcr, source, line_table)
+        return CompiledFile(self.number, functions, self.has_mcr, source, line_table)
+
+    def _compile_chunks(self, count: int, shift: int) -> list:
+        """Compile the rung functions CHUNK_RUNGS at a time, each chunk its own
+        factory binding only the names it uses: CPython compiles one huge
+        function body several times slower than the same code in small
+        ones. Blank lines in front of each chunk keep every line at its
+        number in the whole file's source (``source``, ``line_table``)."""
+        starts = [i for i, line in enumerate(self.lines) if line.startswith("    def r")]
+        starts.append(len(self.lines) - 1)  # the whole file's return line
+        name = f"<ladder file {self.number}>"
+        functions: list = []
+        for a in range(0, count, CHUNK_RUNGS):
+            b = min(a + CHUNK_RUNGS, count)
+            body = self.lines[starts[a]:starts[b]]
+            used = set(_IDENTIFIER.findall("\n".join(body)))
+            bindings = [f"    {n} = _env[{n!r}]" for n in sorted(self.env) if n in used]
+            pad = starts[a] + shift - 1 - len(bindings)
+            text = "\n".join(["\n" * pad + "def _factory(_env):", *bindings, *body,
+                              f"    return [{', '.join(f'r{k}' for k in range(a, b))}]"]) + "\n"
+            scope: dict[str, object] = {}
+            exec(compile(text, name, "exec"), scope)  # noqa: S102 - source built only from validated tokens
+            functions += scope["_factory"](self.env)
+        return functions
+
+
+# Rungs per compiled chunk (see _FileCompiler._compile_chunks).
+CHUNK_RUNGS = 200
+_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
 def _resolver(table: DataTable, addr: Address):
@@ -451,6 +486,5 @@ def labels_of(rungs: list[Rung]) -> dict[int, int]:
 
 def compile_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list) -> CompiledFile:
     pfile = program.files[number]
-    fc = _FileCompiler(table, machine, number, labels_of(pfile.rungs))
-    fc.machine_zone = zone
+    fc = _FileCompiler(table, machine, number, labels_of(pfile.rungs), zone)
     return fc.compile(pfile.rungs, jsr)

@@ -22,9 +22,9 @@ from ..datatable import DataTable
 from ..datatable.table import to_signed
 from . import status as S
 from .ast import MAIN_FILE, AddressRef, Const, Instruction, Program, walk
-from .compiler import RET, TND, compile_file, describe
+from .compiler import RET, TND, EndScan, compile_file, describe
 from .interpreter import interpret_file
-from .semantics import BASE_MS, Machine, MajorFault, Settings
+from .semantics import BASE_MS, Machine, MajorFault, Settings, source_units
 
 
 class Mode(enum.Enum):
@@ -98,8 +98,7 @@ class FaultInfo:
         return f"major fault {self.code}: {where}{self.message}"
 
 
-class _EndScan(Exception):
-    """TND: end this scan now."""
+_EndScan = EndScan  # TND: end this scan now (defined with RET/TND so both executors let it through)
 
 
 Hook = Callable[["Engine"], None]
@@ -118,9 +117,12 @@ def reference_program(program: Program, table: DataTable) -> None:
                         table.reference(ref.address)
                 if ins.mnemonic in ("COP", "FLL") and ins.operands[1].address.is_direct:
                     n = ins.operands[2].value
+                    dest = ins.operands[1].address
                     for ref in ins.operands[:2]:
                         if isinstance(ref, AddressRef) and ref.address.is_direct:
-                            table.reference(ref.address.with_element(ref.address.element + n - 1))
+                            # a COP source in another storage (F vs words) spans the same bytes
+                            count = source_units(n, ref.address.ftype, dest.ftype)
+                            table.reference(ref.address.with_element(ref.address.element + count - 1))
 
 
 def _address_refs(op):

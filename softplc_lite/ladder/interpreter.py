@@ -14,9 +14,9 @@ from __future__ import annotations
 from ..datatable import DataTable, bit_mask
 from ..datatable.errors import AddressRangeError
 from .ast import AddressRef, Branch, Const, Instruction, Program, Rung
-from .compiler import RET, TND, address_fault, describe, labels_of
+from .compiler import RET, TND, EndScan, address_fault, describe, labels_of
 from .expr import evaluate
-from .semantics import BASE_MS, Machine, MajorFault, lim
+from .semantics import BASE_MS, Machine, MajorFault, lim, source_units
 from . import status as S
 
 # Instructions whose operands are only touched when the rung is true (the
@@ -87,7 +87,21 @@ class Interpreter:
         d[i] = (d[i] | mask) if on else (d[i] & ~mask)
 
     def expr(self, node):
-        return evaluate(node, self.read, self.m)
+        return self.prepare(node)()
+
+    def prepare(self, node):
+        """Resolve every address of an expression now, in tree order, and
+        return a thunk that computes it. Compiled code resolves all indirect
+        addresses before it computes (and before a CPT's destination), so an
+        address fault comes before any minor fault (division by zero) the
+        computation would set, and a minor fault cannot move an address."""
+        locs = {id(leaf): self.loc(leaf) for leaf in _address_leaves(node)}
+
+        def read(ref):
+            d, i, bit = locs[id(ref)]
+            return d[i] if bit is None else (d[i] >> bit) & 1
+
+        return lambda: evaluate(node, read, self.m)
 
     # -- rungs ----------------------------------------------------------------------------
     def series(self, elements, c: bool, rung: Rung, pfile: ReferenceFile) -> bool:
@@ -100,7 +114,7 @@ class Interpreter:
             else:
                 try:
                     c = self.instruction(el, c, rung, pfile)
-                except _Jump:
+                except (_Jump, EndScan):  # control flow (EndScan: a TND inside a JSR)
                     raise
                 except MajorFault as fault:
                     if fault.instruction is None:
@@ -124,22 +138,25 @@ class Interpreter:
             return c and not on
         if m == "OTE":
             self.set_bit(ops[0], c)
-        elif m == "OTL":
+        elif m in ("OTL", "OTU"):
+            d, i, bit = self.loc(ops[0])  # resolved even on a false rung, as compiled code does
             if c:
-                self.set_bit(ops[0], True)
-        elif m == "OTU":
-            if c:
-                self.set_bit(ops[0], False)
+                mask = bit_mask(bit)
+                d[i] = (d[i] | mask) if m == "OTL" else (d[i] & ~mask)
         elif m == "ONS":
             stored = self.bit(ops[0])
             self.set_bit(ops[0], c)
             return c and not stored
         elif m in ("OSR", "OSF"):
-            stored = self.bit(ops[0])
-            self.bit(ops[1])  # resolve in the same order as the compiled code
+            # Resolve both once, storage first, as compiled code does: writing
+            # the output bit may change a word the storage address goes through.
+            sd, si, sbit = self.loc(ops[0])
+            od, oi, obit = self.loc(ops[1])
+            stored = (sd[si] >> sbit) & 1
             fire = (c and not stored) if m == "OSR" else (not c and stored)
-            self.set_bit(ops[1], fire)
-            self.set_bit(ops[0], c)
+            omask, smask = bit_mask(obit), bit_mask(sbit)
+            od[oi] = (od[oi] | omask) if fire else (od[oi] & ~omask)
+            sd[si] = (sd[si] | smask) if c else (sd[si] & ~smask)
         elif m in ("TON", "TOF", "RTO"):
             d, i, _ = self.loc(ops[0])
             getattr(mc, m.lower())(d, i, c, BASE_MS[ops[1].value])
@@ -179,9 +196,9 @@ class Interpreter:
             d, i, _ = self.loc(ops[1])
             mc.sqr(v, d, i)
         elif m == "CPT":
-            v = self.expr(ops[1])
+            compute = self.prepare(ops[1])
             d, i, _ = self.loc(ops[0])
-            mc.store(v, d, i)
+            mc.store(compute(), d, i)
         elif m == "CLR":
             d, i, _ = self.loc(ops[0])
             mc.clear(d, i)
@@ -200,7 +217,7 @@ class Interpreter:
         elif m in ("COP", "FLL"):
             n = ops[2].value * ops[1].address.ftype.words_per_element
             if m == "COP":
-                sd, si = self._block(ops[0], n)
+                sd, si = self._block(ops[0], source_units(n, ops[0].address.ftype, ops[1].address.ftype))
                 dd, di = self._block(ops[1], n)
                 mc.cop(sd, si, dd, di, n)
             else:
@@ -267,3 +284,13 @@ class Interpreter:
 
 def interpret_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list) -> ReferenceFile:
     return ReferenceFile(Interpreter(table, machine, jsr, zone), number, program.files[number].rungs)
+
+
+def _address_leaves(node):
+    """The address operands of an expression, left to right."""
+    if isinstance(node, AddressRef):
+        yield node
+    for child in ("left", "right", "operand", "arg"):
+        sub = getattr(node, child, None)
+        if sub is not None:
+            yield from _address_leaves(sub)

@@ -16,6 +16,7 @@ from array import array
 from dataclasses import dataclass
 
 from ..datatable import DataTable
+from ..datatable.filetypes import Storage
 from ..datatable.table import STRING_CHARS, read_string
 from . import status as S
 
@@ -105,23 +106,26 @@ class Machine:
                 over = True
             d[i] = v
             stored = d[i]
-            if over or (math.isinf(stored) and math.isfinite(v)):
+            # A result that is not a finite float32 (too large, division by zero, NaN) is an overflow.
+            if over or not math.isfinite(stored):
                 self.minor(S.MINOR_OVERFLOW_BIT, S.MINOR_CODE_OVERFLOW)
                 over = True
             self.flags(False, over, stored == 0, stored < 0)
             return
+        over = False
         if isinstance(value, float):
             if math.isnan(value):
-                value = 0
-                over = True
+                value, over = 0, True
             elif math.isinf(value):
-                value = 32767 if value > 0 else -32768
+                # No low 16 bits to keep: the extreme of its sign whatever the overflow setting.
+                value, over = (32767 if value > 0 else -32768), True
             else:
                 value = int(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
-        over = not -32768 <= value <= 32767
+        if not -32768 <= value <= 32767:
+            over = True
+            value = (32767 if value > 0 else -32768) if self.clamp else signed16(value)
         if over:
             self.minor(S.MINOR_OVERFLOW_BIT, S.MINOR_CODE_OVERFLOW)
-            value = (32767 if value > 0 else -32768) if self.clamp else signed16(value)
         d[i] = value
         self.flags(carry, over, value == 0, value < 0)
 
@@ -130,9 +134,9 @@ class Machine:
         if self.settings.divide_by_zero == "fault":
             raise MajorFault(S.FAULT_DIV_ZERO, "division by zero")
         self.minor(S.MINOR_DIV_ZERO_BIT, S.MINOR_CODE_DIV_ZERO)
-        if isinstance(a, float):
-            return math.copysign(math.inf, a) if a != 0 else math.inf
-        return 32768 if a >= 0 else -32769  # out of range: store() sets overflow
+        # Infinity with the dividend's sign: store() sets overflow and stores
+        # 32767/-32768 (in both overflow modes) or +-inf in a float.
+        return math.copysign(math.inf, a) if a != 0 else math.inf
 
     # -- math kernels -----------------------------------------------------------------------
     def add(self, a, b, d: array, i: int) -> None:
@@ -170,7 +174,10 @@ class Machine:
         if isinstance(a, int) and isinstance(b, int):
             r = abs(a) % abs(b)
             return r if a >= 0 else -r
-        return math.fmod(a, b)
+        try:
+            return math.fmod(a, b)
+        except ValueError:  # fmod(inf, b): no remainder
+            return math.nan
 
     def sqr(self, v, d: array, i: int) -> None:
         self.store(math.sqrt(abs(v)), d, i)
@@ -187,11 +194,13 @@ class Machine:
 
     def power(self, a, b):
         try:
-            return float(a) ** float(b)
+            r = float(a) ** float(b)
         except (OverflowError, ZeroDivisionError):
             return math.inf
         except ValueError:
             return math.nan
+        # a negative base with a fractional exponent has no real result (Python gives a complex)
+        return r if isinstance(r, float) else math.nan
 
     # -- timers and counters ------------------------------------------------------------------
     def _check_timer(self, d: array, i: int) -> None:
@@ -214,14 +223,16 @@ class Machine:
         self._check_timer(d, i)
         w = d[i]
         if c:
-            if w & EN and not w & DN:
+            # DN is ACC >= PRE, evaluated each scan: a done timer whose preset is
+            # raised times on again (it does not test its own DN bit).
+            if w & EN and d[i + 2] < d[i + 1]:
                 w = self._accumulate(d, i, w, base_ms)
             # The scan the rung goes true starts the timer; time counts from the next one.
             w |= EN
             if d[i + 2] >= d[i + 1]:
                 w = (w | DN) & ~TT & ~FRACTION
             else:
-                w |= TT
+                w = (w | TT) & ~DN
         else:
             w &= ~(EN | TT | DN | FRACTION)
             d[i + 2] = 0
@@ -248,13 +259,13 @@ class Machine:
         self._check_timer(d, i)
         w = d[i]
         if c:
-            if w & EN and not w & DN:
+            if w & EN and d[i + 2] < d[i + 1]:
                 w = self._accumulate(d, i, w, base_ms)
             w |= EN
             if d[i + 2] >= d[i + 1]:
                 w = (w | DN) & ~TT & ~FRACTION
             else:
-                w |= TT
+                w = (w | TT) & ~DN
         else:
             w &= ~(EN | TT)  # ACC and DN are retained until RES
         d[i] = w
@@ -290,14 +301,30 @@ class Machine:
     # -- files ------------------------------------------------------------------------------
     def cop(self, sd: array, si: int, dd: array, di: int, n: int) -> None:
         # Overlapping copies behave like memmove, as on the PLC (source first read whole).
-        dd[di:di + n] = sd[si:si + n]
+        if sd.typecode == dd.typecode:
+            dd[di:di + n] = sd[si:si + n]
+            return
+        # F <-> word file: PLC-5 COP copies memory without conversion. n counts
+        # destination units; the source gives the same number of bytes (a float
+        # is two words, low word first).
+        nbytes = n * dd.itemsize
+        m = -(-nbytes // sd.itemsize)
+        if si + m > len(sd):
+            raise MajorFault(S.FAULT_BLOCK_RANGE, f"{m} source elements from index {si} run past the end "
+                             f"of the file ({len(sd)})")
+        dd[di:di + n] = array(dd.typecode, sd[si:si + m].tobytes()[:nbytes])
 
     def fll(self, value, dd: array, di: int, n: int) -> None:
         if dd.typecode == "f":
             dd[di:di + n] = array("f", [float(value)]) * n
         else:
             if isinstance(value, float):
-                value = int(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
+                if math.isnan(value):
+                    value = 0  # no integer value (as store())
+                elif math.isinf(value):
+                    value = 32767 if value > 0 else -32768
+                else:
+                    value = int(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
             value = max(-32768, min(32767, value)) if self.clamp else signed16(value)
             dd[di:di + n] = array("h", [value]) * n
 
@@ -366,6 +393,13 @@ class Machine:
 
     def asr(self, ad: array, ai: int, bd: array, bi: int) -> bool:
         return read_string(ad, ai) == read_string(bd, bi)
+
+
+def source_units(count: int, src_ftype, dest_ftype) -> int:
+    """COP between a float file and a word file copies memory: the number
+    of source array units holding as many bytes as ``count`` destination units."""
+    sb, db = (4 if f.storage is Storage.FLOAT else 2 for f in (src_ftype, dest_ftype))
+    return count if sb == db else -(-count * db // sb)
 
 
 def lim(low, test, high) -> bool:
