@@ -1,4 +1,4 @@
-"""Run every data table benchmark, each in its own process, and summarize.
+"""Run every benchmark (data table and ladder engine), each in its own process, and summarize.
 
     python benchmarks/run_all.py
 
@@ -17,7 +17,7 @@ import time
 
 import _common as C
 
-BENCHMARKS = ("bench_datatable_memory", "bench_snapshot", "bench_word_access")
+BENCHMARKS = ("bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder")
 
 
 def main() -> int:
@@ -72,6 +72,18 @@ def main() -> int:
         read_ns = api["table.read('N7:5')"]["ns"]
         write_ns = api["table.write('N7:5', v)"]["ns"]
         lines.append(f"          typed API: read {read_ns:.0f} ns, write {write_ns:.0f} ns per call")
+
+    lad = load("bench_ladder")
+    if lad:
+        for kind in ("boolean", "mixed"):
+            r = lad[kind]
+            v = r["verdicts"]
+            lines.append(
+                f"ladder    {kind}: compiled {r['compiled_scan_ns']['per_instruction']:.0f} ns/instruction "
+                f"[{v['ns_per_instruction']} <= {r['targets']['ns_per_instruction']:.0f}], "
+                f"{r['ratio_reference_over_compiled']:.1f}x the reference [{v['ratio']}], load "
+                f"{r['load']['parse_validate_compile_s']:.2f} s [{v['load']} <= {r['targets']['load_s']:.0f} s]"
+            )
 
     print("=== summary " + "=" * 53)
     for line in lines:
