@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import Enum
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from typing import Union
 
 from .errors import AddressError
@@ -71,14 +71,14 @@ class Address:
     def ftype(self) -> FileType:
         return FILE_TYPES[self.type_letter]
 
-    @property
+    @cached_property  # asked for every operand at load; an Address never changes
     def is_direct(self) -> bool:
         """True when no part comes from another word or the index register."""
         return not self.indexed and not any(
             isinstance(p, Address) for p in (self.file, self.element, self.bit)
         )
 
-    @property
+    @cached_property
     def kind(self) -> ValueKind:
         ftype = self.ftype
         if self.bit is not None:

@@ -10,6 +10,8 @@ symbol operand.
 
 from __future__ import annotations
 
+from ..gcpause import gc_paused
+
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Callable, Iterable, Iterator
@@ -73,15 +75,31 @@ class LadderPostLex:
 
 @lru_cache(maxsize=1)
 def get_parser() -> Lark:
+    """The grammar, for tools (lark's own parse trees, error contexts)."""
+    return _lark(None)
+
+
+@lru_cache(maxsize=1)
+def _ast_parser() -> Lark:
+    """The grammar with the AST built during the parse: Lark calls
+    ``_ToAst``'s methods as LALR reduces each rule, so no parse tree is built
+    and walked a second time (that halved the load of a 10,000-rung
+    program). Positions come from tokens (see the "!" rules in the grammar);
+    the source name and line offset of each parse are ``_ToAst.context``."""
+    return _lark(_ToAst())
+
+
+def _lark(transformer) -> Lark:
     return Lark.open_from_package(
         "softplc_lite.ladder",
         "ladder.lark",
         parser="lalr",
         lexer="contextual",
         postlex=LadderPostLex(),
-        propagate_positions=True,
+        propagate_positions=False,
         maybe_placeholders=False,
         start=["start", "expr"],
+        transformer=transformer,
     )
 
 
@@ -122,7 +140,6 @@ class _RungDraft:
     elements: list[Element] | None = None  # neutral: already structured
     tokens: list | None = None  # mnemonic: flat, grouped later
     comment: str | None = None  # trailing // comment on the rung's line
-    last_line: int = 0
 
 
 def _number(tok: Token) -> int | float:
@@ -136,21 +153,31 @@ def _number(tok: Token) -> int | float:
 _CALLS = ("SQR", "ABS", "NEG", "FRD", "TOD", "LN", "LOG", "SIN", "COS", "TAN", "ASN", "ACS", "ATN", "DEG", "RAD")
 
 
+def _tokens(items, *kinds):
+    return [t for t in items if isinstance(t, Token) and t.type in kinds]
+
+
 class _ToAst(Transformer):
-    def __init__(self, source: str, line_offset: int = 0, column_offset: int = 0) -> None:
+    """Parse-tree rules to AST nodes, called by Lark during the LALR parse.
+
+    One instance serves every parse; ``context`` holds the current parse's
+    source name and offsets (an expression inside a quoted mnemonic operand
+    is parsed on its own and its positions shifted into the file). Parsing
+    is single-threaded, as Lark's parser objects are.
+    """
+
+    def __init__(self) -> None:
         super().__init__()
-        self.source = source
-        self.line_offset = line_offset
-        self.column_offset = column_offset
+        self.context = ("<program>", 0, 0)
 
     def _pos(self, item) -> Pos:
-        line = getattr(item, "line", None)
-        column = getattr(item, "column", None)
-        if line is None:  # a Tree's meta
-            line, column = item.line, item.column
-        if line == 1:
-            column += self.column_offset
-        return Pos(self.source, line + self.line_offset, column)
+        """The position of a token, or of an AST node already built."""
+        if not isinstance(item, Token):
+            return item.pos
+        source, line_offset, column_offset = self.context
+        line = item.line
+        column = item.column + column_offset if line == 1 else item.column
+        return Pos(source, line + line_offset, column)
 
     # operands ------------------------------------------------------------------
     def _address(self, tok: Token) -> AddressRef:
@@ -172,13 +199,10 @@ class _ToAst(Transformer):
     def signed_number(self, tok):
         return Const(_number(tok), self._pos(tok))
 
-    @v_args(meta=True, inline=True)
-    def negative_number(self, meta, sign, tok):
+    @v_args(inline=True)
+    def negative_number(self, sign, tok):
         value = _number(tok)
-        return Const(-value if str(sign) == "-" else value, self._pos(meta))
-
-    def INT(self, tok):
-        return tok
+        return Const(-value if str(sign) == "-" else value, self._pos(sign))
 
     @v_args(inline=True)
     def call(self, name, arg):
@@ -189,26 +213,27 @@ class _ToAst(Transformer):
                               f"functions are {' '.join(_CALLS)}")
         return Call(func, arg, self._pos(name))
 
-    @v_args(meta=True, inline=True)
-    def negate(self, meta, sign, operand):
+    @v_args(inline=True)
+    def negate(self, sign, operand):
         operand = self._atomize(operand)
         if str(sign) == "+":
             return operand
         if isinstance(operand, Const):
-            return Const(-operand.value, self._pos(meta))
-        return UnaryOp("NEG", operand, self._pos(meta))
+            return Const(-operand.value, self._pos(sign))
+        return UnaryOp("NEG", operand, self._pos(sign))
 
-    @v_args(meta=True, inline=True)
-    def bit_not(self, meta, operand):
+    @v_args(inline=True)
+    def bit_not(self, keyword, operand):
         operand = self._atomize(operand)
-        return UnaryOp("NOT", operand, self._pos(meta))
+        return UnaryOp("NOT", operand, self._pos(keyword))
 
-    @v_args(meta=True, inline=True)
-    def binop(self, meta, left, op, right):
+    @v_args(inline=True)
+    def binop(self, left, op, right):
         operator = str(op).upper()
         if operator == "/":
             operator = "|"  # PLC-5 writes division as |
-        return BinOp(operator, self._atomize(left), self._atomize(right), self._pos(meta))
+        left = self._atomize(left)
+        return BinOp(operator, left, self._atomize(right), left.pos)
 
     def _atomize(self, item):
         if isinstance(item, Token) and item.type in ("INT", "FLOAT", "HEX"):
@@ -216,24 +241,23 @@ class _ToAst(Transformer):
         return item
 
     # neutral text -----------------------------------------------------------------
-    @v_args(meta=True)
-    def nt_instruction(self, meta, items):
+    def nt_instruction(self, items):
         name = items[0]
         operands = [self._atomize(i) for i in items[1:]]
         return Instruction(str(name).upper(), operands, self._pos(name))
 
-    @v_args(meta=True)
-    def nt_branch(self, meta, legs):
-        return Branch(list(legs), self._pos(meta))
+    def nt_branch(self, items):
+        legs = [i for i in items if not isinstance(i, Token)]
+        return Branch(legs, self._pos(items[0]))
 
     def nt_series(self, items):
         return list(items)
 
-    @v_args(meta=True)
-    def neutral_rung(self, meta, items):
+    def neutral_rung(self, items):
         series = items[0]
-        comment = str(items[1])[2:].strip() if len(items) > 1 else None
-        return _RungDraft(self._pos(meta), elements=series, comment=comment, last_line=meta.end_line)
+        comment = _tokens(items, "COMMENT")
+        at = series[0] if series else items[1]  # an empty rung: its ";"
+        return _RungDraft(self._pos(at), elements=series, comment=comment[0][2:].strip() if comment else None)
 
     # mnemonic --------------------------------------------------------------------------
     @v_args(inline=True)
@@ -248,53 +272,47 @@ class _ToAst(Transformer):
     def mn_string(self, tok):
         return Text(_unquote(str(tok)), self._pos(tok))
 
-    @v_args(meta=True)
-    def mn_bst(self, meta, _):
-        return _Marker(BST, self._pos(meta))
+    @v_args(inline=True)
+    def mn_bst(self, tok):
+        return _Marker(BST, self._pos(tok))
 
-    @v_args(meta=True)
-    def mn_nxb(self, meta, _):
-        return _Marker(NXB, self._pos(meta))
+    @v_args(inline=True)
+    def mn_nxb(self, tok):
+        return _Marker(NXB, self._pos(tok))
 
-    @v_args(meta=True)
-    def mn_bnd(self, meta, _):
-        return _Marker(BND, self._pos(meta))
+    @v_args(inline=True)
+    def mn_bnd(self, tok):
+        return _Marker(BND, self._pos(tok))
 
-    @v_args(meta=True)
-    def mnemonic_rung(self, meta, items):
-        comment = None
-        if items and isinstance(items[-1], Token) and items[-1].type == "COMMENT":
-            comment = str(items[-1])[2:].strip()
-            items = items[:-1]
-        return _RungDraft(self._pos(meta), tokens=list(items), comment=comment, last_line=meta.end_line)
+    def mnemonic_rung(self, items):
+        pos = self._pos(items[0])  # the first token, or SOR
+        comment = _tokens(items, "COMMENT")
+        tokens = [i for i in items if not isinstance(i, Token)]
+        return _RungDraft(pos, tokens=tokens, comment=comment[0][2:].strip() if comment else None)
 
     # directives and comments -------------------------------------------------------------
-    @v_args(meta=True)
-    def comment(self, meta, items):
-        return _Comment(str(items[0])[2:].strip(), meta.line + self.line_offset)
+    @v_args(inline=True)
+    def comment(self, tok):
+        return _Comment(str(tok)[2:].strip(), self._pos(tok).line)
 
-    @v_args(meta=True)
-    def file_header(self, meta, items):
-        number = int(items[0])
-        name = str(items[1]) if len(items) > 1 and items[1].type == "NAME" else None
-        return _Header(number, name, self._pos(meta))
+    def file_header(self, items):
+        number = _tokens(items, "INT")[0]
+        name = _tokens(items, "NAME")
+        return _Header(int(number), str(name[0]) if name else None, self._pos(items[0]))
 
-    @v_args(meta=True)
-    def data_decl(self, meta, items):
-        name, size = items[0], items[1]
+    def data_decl(self, items):
+        name, size = _tokens(items, "NAME", "INT")[:2]
         values = []
-        for v in items[2:]:
-            if isinstance(v, Token) and v.type == "COMMENT":
-                continue
-            if isinstance(v, Token) and v.type == "STRING":
-                values.append(_unquote(str(v)))
+        for v in items[3:]:
+            if isinstance(v, Token):
+                if v.type == "STRING":
+                    values.append(_unquote(str(v)))
             else:
                 values.append(v.value)
-        return DataDecl(str(name).upper(), int(size), values, self._pos(meta))
+        return DataDecl(str(name).upper(), int(size), values, self._pos(items[0]))
 
-    @v_args(meta=True)
-    def symbol_decl(self, meta, items):
-        name, addr = items[0], items[1]
+    @v_args(inline=True)
+    def symbol_decl(self, name, addr, *_comment_nl):
         return SymbolDecl(str(name), self._address(addr).address, self._pos(name))
 
     def start(self, items):
@@ -352,20 +370,23 @@ def _syntax_error(e: UnexpectedInput, text: str, source: str, line_offset: int, 
 
 
 def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column_offset: int = 0):
+    parser = _ast_parser()
+    builder = parser.options.transformer
+    saved = builder.context  # an expression parse happens inside a program parse
+    builder.context = (source, line_offset, column_offset)
     try:
-        tree = get_parser().parse(text, start=start)
+        result = parser.parse(text, start=start)
     except UnexpectedInput as e:
         raise _syntax_error(e, text, source, line_offset, column_offset) from None
-    try:
-        result = _ToAst(source, line_offset, column_offset).transform(tree)
-        if isinstance(result, Token):  # a bare number as a whole expression
-            p = Pos(source, result.line + line_offset, result.column + (column_offset if result.line == 1 else 0))
-            return Const(_number(result), p)
-        return result
     except VisitError as e:
         if isinstance(e.orig_exc, LadderError):
             raise e.orig_exc from None
         raise
+    finally:
+        builder.context = saved
+    if isinstance(result, Token):  # a bare number as a whole expression
+        return builder._atomize(result)
+    return result
 
 
 def parse_expression(text: str, pos: Pos) -> Operand:
@@ -377,11 +398,13 @@ def parse_expression(text: str, pos: Pos) -> Operand:
 # -- assembling the program ------------------------------------------------------------
 
 
+@gc_paused
 def parse_program(
     text: str,
     source: str = "<program>",
     is_mnemonic: Callable[[str], bool] | None = None,
     program: Program | None = None,
+    line_offset: int = 0,
 ) -> Program:
     """Parse one .lad text into ``program`` (a new one by default).
 
@@ -394,7 +417,7 @@ def parse_program(
         is_mnemonic = default
     if text and not text.endswith("\n"):
         text += "\n"
-    items = _parse_tree(text, source, "start")
+    items = _parse_tree(text, source, "start", line_offset)
     program = program if program is not None else Program()
     current: ProgramFile | None = None
     comments: list[_Comment] = []

@@ -10,6 +10,8 @@ constants and expression trees.
 
 from __future__ import annotations
 
+from ..gcpause import gc_paused
+
 from dataclasses import replace
 
 from ..datatable import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, Address, AddressError, ValueKind, parse_address
@@ -37,6 +39,18 @@ from .parser import parse_expression
 _NUMERIC = (ValueKind.WORD, ValueKind.FLOAT)
 COMPARISONS = ("=", "<>", "<", "<=", ">", ">=")
 
+
+
+# Operand kinds that must be constants, and the value kinds each address
+# operand kind accepts (built once: validate() asks for every operand).
+_CONSTANT_KINDS = frozenset({K.TIMEBASE, K.PRESET, K.LABEL, K.PROGRAM_FILE, K.LENGTH, K.BIT_NUMBER})
+_WANT = {
+    K.BIT: (ValueKind.BIT,), K.SOURCE: _NUMERIC, K.DEST: _NUMERIC, K.FILE: _NUMERIC,
+    K.FILE_SOURCE: _NUMERIC, K.INT_SOURCE: (ValueKind.WORD,), K.WORD: (ValueKind.WORD,),
+    K.TIMER: (ValueKind.TIMER,), K.COUNTER: (ValueKind.COUNTER,), K.CONTROL: (ValueKind.CONTROL,),
+    K.RESETTABLE: (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL),
+    K.STRING: (ValueKind.STRING,),
+}
 
 class _Checker:
     def __init__(self, program: Program) -> None:
@@ -101,13 +115,13 @@ class _Checker:
         resolved = self.resolve(operand)
         if resolved is None:
             return None
-        spec_name = lookup(instr.mnemonic).operands[index].name
-        where = f"{instr.mnemonic} operand {index + 1} ({spec_name})"
+        def where() -> str:
+            return f"{instr.mnemonic} operand {index + 1} ({lookup(instr.mnemonic).operands[index].name})"
 
         def bad(expected: str) -> None:
-            self.error(_pos(resolved), f"{where} must be {expected}, not {_describe(resolved)}")
+            self.error(_pos(resolved), f"{where()} must be {expected}, not {_describe(resolved)}")
 
-        if kind in (K.TIMEBASE, K.PRESET, K.LABEL, K.PROGRAM_FILE, K.LENGTH, K.BIT_NUMBER):
+        if kind in _CONSTANT_KINDS:
             if not isinstance(resolved, Const):
                 bad(f"a constant ({kind.value})")
                 return None
@@ -132,24 +146,16 @@ class _Checker:
             if kind in (K.SOURCE, K.FILE_SOURCE):
                 return _word_constant(resolved) if isinstance(resolved.value, int) else resolved
             if kind is K.INT_SOURCE and isinstance(resolved.value, int):
-                return self._int_constant(resolved, where)
+                return self._int_constant(resolved, where())
             bad(kind.value)
             return None
         if not isinstance(resolved, AddressRef):
             bad(kind.value)
             return None
         a = resolved.address
-        want = {
-            K.BIT: (ValueKind.BIT,), K.SOURCE: _NUMERIC, K.DEST: _NUMERIC, K.FILE: _NUMERIC,
-            K.FILE_SOURCE: _NUMERIC, K.INT_SOURCE: (ValueKind.WORD,), K.WORD: (ValueKind.WORD,),
-            K.TIMER: (ValueKind.TIMER,), K.COUNTER: (ValueKind.COUNTER,), K.CONTROL: (ValueKind.CONTROL,),
-            K.RESETTABLE: (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL),
-            K.STRING: (ValueKind.STRING,),
-        }[kind]
+        want = _WANT[kind]
         if a.kind not in want:
             bad(kind.value)
-            return None
-        if kind in (K.DEST, K.WORD) and a.type_letter in ("I",) and False:  # inputs are writable on PLC-5
             return None
         if kind in (K.FILE, K.FILE_SOURCE) and a.indexed:
             # '#' marks a file operand here (PLC-5 file instructions), not indexing.
@@ -329,6 +335,7 @@ def check(program: Program) -> tuple[Program, list[LadderError]]:
     return resolved, checker.errors
 
 
+@gc_paused
 def validate(program: Program) -> Program:
     """Validate and resolve, raising ProgramErrors if anything is wrong."""
     resolved, errors = check(program)
