@@ -18,7 +18,7 @@ from pathlib import Path
 
 from .ladder.ast import Pos, Program
 from .ladder.errors import LadderError, ProgramErrors
-from .ladder.parser import parse_program
+from .ladder.parser import parse_program, syntax_problems
 from .ladder.semantics import Settings
 from .ladder.validate import check
 
@@ -65,7 +65,8 @@ def lad_files(path: Path) -> list[Path]:
 
 
 def parse_files(files: list[Path], base: Path) -> tuple[Program, list[LadderError]]:
-    """Parse every file; a syntax error stops only its own file."""
+    """Parse every file. A file with a syntax error adds nothing to the
+    program, but the problems after it in the file are listed too."""
     program = Program()
     errors: list[LadderError] = []
     for f in files:
@@ -77,7 +78,7 @@ def parse_files(files: list[Path], base: Path) -> tuple[Program, list[LadderErro
         try:
             parse_program(text, _display(f, base), program=program)
         except LadderError as e:
-            errors.append(e)
+            errors.extend(syntax_problems(text, _display(f, base)) or [e])
     return program, errors
 
 

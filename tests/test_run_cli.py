@@ -85,6 +85,24 @@ def test_check_lists_every_problem_and_exits_1(tmp_path):
     assert "Traceback" not in p.stderr
 
 
+def test_check_lists_the_problems_around_a_syntax_error(tmp_path):
+    # Parsing resumes after a syntax error, and the lines before it are
+    # checked on their own, so every problem in the file is listed.
+    f = tmp_path / "broken.lad"
+    f.write_text("XIX B3/0 OTE O:0/0\n"
+                 "XIC B3/1 OTE O:0/1\n"
+                 "XIC(B3/0)[XIO(B3/2)OTE(O:0/0);\n"
+                 "XIC B3/1 BND OTE O:0/1\n"
+                 "SOR XIC B3/0\n"
+                 " OTE O:0/0\n")
+    p = softplc("check", str(f))
+    assert p.returncode == 1
+    where = [line.split(": ", 1)[0].rsplit(".lad:", 1)[1] for line in p.stderr.splitlines() if ".lad:" in line]
+    assert where == ["1:1", "3:30", "4:10", "6:6"]
+    assert "BND without a BST" in p.stderr and "SOR without EOR" in p.stderr
+    assert p.stderr.splitlines()[-1] == "4 problems found"
+
+
 def test_check_ok(app):
     p = softplc("check", str(app))
     assert p.returncode == 0 and p.stdout == "counter: ok (1 program file, 2 rungs)\n"

@@ -451,6 +451,40 @@ def parse_program(
     return program
 
 
+def syntax_problems(text: str, source: str, limit: int = 50) -> list[LadderError]:
+    """Every problem ``parse_program`` finds in a file, in source order, not
+    just the first, so that ``check`` lists them all. After a problem,
+    parsing resumes on the next line; the lines before a syntax error are
+    parsed on their own too, because the problems found only after the
+    parse (an unknown instruction) would otherwise be hidden behind it.
+    Resuming inside a rung that spans lines can report a problem that is
+    only a consequence of the one before, as compilers do."""
+    lines = text.splitlines(keepends=True)
+    found: list[LadderError] = []
+
+    def scan(start: int, end: int, cut: bool) -> None:
+        # lines[start:end]; ``cut``: the range ends where a later problem is,
+        # so a rung may be cut short there (not a problem of its own).
+        while start < end and len(found) < limit:
+            try:
+                parse_program("".join(lines[start:end]), source, program=Program(), line_offset=start)
+                return
+            except LadderError as e:
+                line = e.pos.line
+                if cut and e.message.startswith("unexpected end of file"):
+                    end -= 1  # a rung cut short at the range's end: check the range without it
+                    continue
+                if line <= start or line > end:
+                    return
+                if line - 1 > start:
+                    scan(start, line - 1, True)
+                found.append(e)
+                start = line
+
+    scan(0, len(lines), False)
+    return found[:limit]
+
+
 def _add_file(program: Program, number: int, name: str | None, pos: Pos) -> ProgramFile:
     if not 2 <= number <= 999:
         raise LadderError(pos, f"program file number {number} out of range: the main file is 2, "
