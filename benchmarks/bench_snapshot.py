@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import os
 import pickle
-import statistics
 import tempfile
 import time
 from pathlib import Path

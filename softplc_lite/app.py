@@ -17,7 +17,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from .ladder.ast import Pos, Program
-from .ladder.errors import LadderError, ProgramErrors
+from .ladder.errors import LadderError
 from .ladder.parser import parse_program, syntax_problems
 from .ladder.semantics import Settings
 from .ladder.validate import check

@@ -29,7 +29,6 @@ from .filetypes import (
     STRING_CHARS,
     WORD_BITS,
     FileType,
-    Storage,
 )
 
 AddressLike = Union[str, Address]

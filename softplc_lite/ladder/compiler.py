@@ -16,15 +16,15 @@ each generated line back to its instruction for fault messages.
 
 from __future__ import annotations
 
-from ..gcpause import gc_paused
-
 import re
 from dataclasses import dataclass, field
 
+from ..gcpause import gc_paused
 from ..datatable import Address, DataTable, ValueKind, bit_mask
 from ..datatable.errors import AddressRangeError
+from ..datatable.filetypes import Storage
 from . import status as S
-from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, walk
+from .ast import AddressRef, BinOp, Branch, Const, Element, Instruction, Program, Rung, UnaryOp, walk
 from .expr import namespace as expr_namespace
 from .expr import to_python
 from .semantics import BASE_MS, Machine, MajorFault, lim, source_units
@@ -280,8 +280,10 @@ class _FileCompiler:
         self.emit(ind, "if c:")
         self.emit(ind + 1, f"c = bool({self.expression(ind + 1, ops[0])})")
 
-    def _store(self, ind, dest, value_code: str, kernel: str = "store"):
+    def _store(self, ind, dest, value_code: str, kernel: str = "store", value=None):
         d, i, _ = self.location(ind + 1, dest)
+        if kernel == "store" and value is not None and _is_word(dest) and _word_valued(value):
+            kernel = "store_word"
         fn = self.bind(f"_{kernel}", getattr(self.machine, kernel))
         self.emit(ind + 1, f"{fn}({value_code}, {d}, {i})")
 
@@ -289,6 +291,8 @@ class _FileCompiler:
         self.emit(ind, "if c:")
         a, b = self.value(ind + 1, ops[0]), self.value(ind + 1, ops[1])
         d, i, _ = self.location(ind + 1, ops[2])
+        if kernel in ("add", "sub") and all(_is_word(op) for op in ops):
+            kernel += "_words"
         fn = self.bind(f"_{kernel}", getattr(self.machine, kernel))
         self.emit(ind + 1, f"{fn}({a}, {b}, {d}, {i})")
 
@@ -325,11 +329,11 @@ class _FileCompiler:
 
     def i_MOV(self, ind, ops):
         self.emit(ind, "if c:")
-        self._store(ind, ops[1], self.value(ind + 1, ops[0]))
+        self._store(ind, ops[1], self.value(ind + 1, ops[0]), value=ops[0])
 
     def i_CPT(self, ind, ops):
         self.emit(ind, "if c:")
-        self._store(ind, ops[0], self.expression(ind + 1, ops[1]))
+        self._store(ind, ops[0], self.expression(ind + 1, ops[1]), value=ops[1])
 
     def i_CLR(self, ind, ops):
         self.emit(ind, "if c:")
@@ -492,6 +496,24 @@ class _FileCompiler:
             exec(compile(text, name, "exec"), scope)  # noqa: S102 - source built only from validated tokens
             functions += scope["_factory"](self.env)
         return functions
+
+
+def _is_word(operand) -> bool:
+    """A 16-bit word at run time, known at load: an integer constant in word
+    range, or an address in a word file (its type letter never changes, even
+    when its file or element number is indirect)."""
+    if isinstance(operand, Const):
+        return isinstance(operand.value, int) and -32768 <= operand.value <= 32767
+    return isinstance(operand, AddressRef) and operand.address.ftype.storage is not Storage.FLOAT
+
+
+def _word_valued(node) -> bool:
+    """An integer whatever the data: words combined by + - * and negation."""
+    if isinstance(node, BinOp):
+        return node.op in ("+", "-", "*") and _word_valued(node.left) and _word_valued(node.right)
+    if isinstance(node, UnaryOp):
+        return node.op == "NEG" and _word_valued(node.operand)
+    return _is_word(node)
 
 
 # Outputs: they leave the rung condition as they found it.

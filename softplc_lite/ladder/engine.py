@@ -21,10 +21,10 @@ from typing import Callable
 from ..datatable import DataTable
 from ..datatable.table import to_signed
 from . import status as S
-from .ast import MAIN_FILE, AddressRef, Const, Instruction, Program, walk
-from .compiler import RET, TND, EndScan, compile_file, describe
+from .ast import MAIN_FILE, AddressRef, Program, walk
+from .compiler import RET, EndScan, compile_file, describe
 from .interpreter import interpret_file
-from .semantics import BASE_MS, Machine, MajorFault, Settings, source_units
+from .semantics import Machine, MajorFault, Settings, source_units
 
 
 class Mode(enum.Enum):

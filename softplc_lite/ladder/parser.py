@@ -10,8 +10,6 @@ symbol operand.
 
 from __future__ import annotations
 
-from ..gcpause import gc_paused
-
 from dataclasses import dataclass
 from functools import lru_cache
 from typing import Callable, Iterable, Iterator
@@ -19,6 +17,7 @@ from typing import Callable, Iterable, Iterator
 from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
 
+from ..gcpause import gc_paused
 from ..datatable import AddressError, parse_address
 from .ast import (
     MAIN_FILE,

@@ -129,6 +129,37 @@ class Machine:
         d[i] = value
         self.flags(carry, over, value == 0, value < 0)
 
+    # -- word fast paths (compiled code only) ---------------------------------------------
+    # The compiler calls these when it can prove at load time that every
+    # operand and the destination are 16-bit words: no float cases to test.
+    # Out of range, they hand over to the general kernel, so the result and
+    # the flags are those of store(); the differential test holds them to it.
+    def store_word(self, v: int, d: array, i: int) -> None:
+        if -32768 <= v <= 32767:
+            d[i] = v
+            s = self.s
+            s[0] = (s[0] & -16) | ((v == 0) << 2) | ((v < 0) << 3)
+        else:
+            self.store(v, d, i)
+
+    def add_words(self, a: int, b: int, d: array, i: int) -> None:
+        v = a + b
+        if -32768 <= v <= 32767:
+            d[i] = v
+            s = self.s
+            s[0] = (s[0] & -16) | ((a & 0xFFFF) + (b & 0xFFFF) > 0xFFFF) | ((v == 0) << 2) | ((v < 0) << 3)
+        else:
+            self.add(a, b, d, i)
+
+    def sub_words(self, a: int, b: int, d: array, i: int) -> None:
+        v = a - b
+        if -32768 <= v <= 32767:
+            d[i] = v
+            s = self.s
+            s[0] = (s[0] & -16) | ((a & 0xFFFF) < (b & 0xFFFF)) | ((v == 0) << 2) | ((v < 0) << 3)
+        else:
+            self.sub(a, b, d, i)
+
     def div_zero(self, a: int | float) -> int | float:
         """Division by zero: a major fault, or overflow with the largest result."""
         if self.settings.divide_by_zero == "fault":

@@ -10,10 +10,9 @@ constants and expression trees.
 
 from __future__ import annotations
 
-from ..gcpause import gc_paused
-
 from dataclasses import replace
 
+from ..gcpause import gc_paused
 from ..datatable import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, Address, AddressError, ValueKind, parse_address
 from .ast import (
     MAIN_FILE,
@@ -30,7 +29,6 @@ from .ast import (
     SymbolRef,
     Text,
     UnaryOp,
-    walk,
 )
 from .errors import LadderError, ProgramErrors
 from .instructions import K, lookup, suggest
