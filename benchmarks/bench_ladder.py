@@ -48,7 +48,7 @@ RUNGS = 10_000
 SEED = 20240503
 WARMUP_SCANS = 3
 COMPILED_SCANS = 30
-REFERENCE_SCANS = 5
+REFERENCE_SCANS = 9
 
 TARGET_NS = {"boolean": 100.0, "mixed": 400.0}
 TARGET_RATIO = 10.0
@@ -304,20 +304,24 @@ def bench(kind: str, text: str) -> dict:
     # The same scans on both: warm-up (first pass, timers starting), then measured.
     time_scans(compiled, WARMUP_SCANS)
     time_scans(reference, WARMUP_SCANS)
-    comp = time_scans(compiled, REFERENCE_SCANS)
-    ref = time_scans(reference, REFERENCE_SCANS)
+    # Interleaved, scan k of one executor right after scan k of the other, and
+    # the ratio is the median of the per-scan ratios: the machine is shared,
+    # and a slow spell then lands on both sides of a ratio, not on one.
+    comp, ref = [], []
+    for _ in range(REFERENCE_SCANS):
+        comp += time_scans(compiled, 1)
+        ref += time_scans(reference, 1)
     same = compiled.table == reference.table
+    ratio = statistics.median(r / c for r, c in zip(ref, comp))
+    c_window = statistics.median(comp)
     comp += time_scans(compiled, COMPILED_SCANS - REFERENCE_SCANS)
     c_med, r_med = statistics.median(comp), statistics.median(ref)
     c_ns, r_ns = c_med / instructions, r_med / instructions
-    # The ratio compares the same scans (the window both executors ran).
-    c_window = statistics.median(comp[:REFERENCE_SCANS])
-    ratio = r_med / c_window
     target = TARGET_NS[kind]
     print(f"scan, compiled:  median {c_med / 1e6:8.2f} ms  best {min(comp) / 1e6:8.2f} ms  "
           f"{c_ns:7.1f} ns/instruction  [{'PASS' if c_ns <= target else 'MISS'} <= {target:.0f}]")
     print(f"scan, reference: median {r_med / 1e6:8.2f} ms  best {min(ref) / 1e6:8.2f} ms  {r_ns:7.1f} ns/instruction")
-    print(f"reference / compiled (same {REFERENCE_SCANS} scans, compiled median {c_window / 1e6:.2f} ms there): {ratio:.1f}x  [{'PASS' if ratio >= TARGET_RATIO else 'MISS'} >= {TARGET_RATIO:.0f}x]; "
+    print(f"reference / compiled (median of {REFERENCE_SCANS} interleaved scan pairs; compiled median {c_window / 1e6:.2f} ms there): {ratio:.1f}x  [{'PASS' if ratio >= TARGET_RATIO else 'MISS'} >= {TARGET_RATIO:.0f}x]; "
           f"tables equal after the same {WARMUP_SCANS + REFERENCE_SCANS} scans: {same}")
 
     split = loop_split(compiled)
