@@ -165,3 +165,22 @@ def walk(elements: list[Element]):
                 yield from walk(leg)
         else:
             yield el
+
+
+def leaves(operand):
+    """The leaves of an operand or expression (constants, addresses,
+    symbols, text), left to right."""
+    if isinstance(operand, BinOp):
+        yield from leaves(operand.left)
+        yield from leaves(operand.right)
+    elif isinstance(operand, UnaryOp):
+        yield from leaves(operand.operand)
+    elif isinstance(operand, Call):
+        yield from leaves(operand.arg)
+    else:
+        yield operand
+
+
+def address_refs(operand):
+    """The addresses an operand or expression reads, left to right."""
+    return (leaf for leaf in leaves(operand) if isinstance(leaf, AddressRef))

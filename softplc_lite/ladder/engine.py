@@ -21,7 +21,7 @@ from typing import Callable
 from ..datatable import DataTable
 from ..datatable.table import to_signed
 from . import status as S
-from .ast import MAIN_FILE, AddressRef, Program, walk
+from .ast import MAIN_FILE, AddressRef, Program, address_refs, walk
 from .compiler import RET, EndScan, compile_file, describe
 from .interpreter import interpret_file
 from .semantics import Machine, MajorFault, Settings, source_units
@@ -113,7 +113,7 @@ def reference_program(program: Program, table: DataTable) -> None:
         for rung in pfile.rungs:
             for ins in walk(rung.elements):
                 for op in ins.operands:
-                    for ref in _address_refs(op):
+                    for ref in address_refs(op):
                         table.reference(ref.address)
                 if ins.mnemonic in ("COP", "FLL") and ins.operands[1].address.is_direct:
                     n = ins.operands[2].value
@@ -123,15 +123,6 @@ def reference_program(program: Program, table: DataTable) -> None:
                             # a COP source in another storage (F vs words) spans the same bytes
                             count = source_units(n, ref.address.ftype, dest.ftype)
                             table.reference(ref.address.with_element(ref.address.element + count - 1))
-
-
-def _address_refs(op):
-    if isinstance(op, AddressRef):
-        yield op
-    for child in ("left", "right", "operand", "arg"):
-        sub = getattr(op, child, None)
-        if sub is not None:
-            yield from _address_refs(sub)
 
 
 def initial_values(program: Program, table: DataTable) -> None:

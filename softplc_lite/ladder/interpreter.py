@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from ..datatable import DataTable, bit_mask
 from ..datatable.errors import AddressRangeError
-from .ast import AddressRef, Branch, Const, Instruction, Program, Rung
+from .ast import AddressRef, Branch, Const, Instruction, Program, Rung, address_refs
 from .compiler import RET, TND, EndScan, address_fault, describe, labels_of
 from .expr import evaluate
 from .semantics import BASE_MS, Machine, MajorFault, lim, source_units
@@ -95,7 +95,7 @@ class Interpreter:
         addresses before it computes (and before a CPT's destination), so an
         address fault comes before any minor fault (division by zero) the
         computation would set, and a minor fault cannot move an address."""
-        locs = {id(leaf): self.loc(leaf) for leaf in _address_leaves(node)}
+        locs = {id(leaf): self.loc(leaf) for leaf in address_refs(node)}
 
         def read(ref):
             d, i, bit = locs[id(ref)]
@@ -285,12 +285,3 @@ class Interpreter:
 def interpret_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list) -> ReferenceFile:
     return ReferenceFile(Interpreter(table, machine, jsr, zone), number, program.files[number].rungs)
 
-
-def _address_leaves(node):
-    """The address operands of an expression, left to right."""
-    if isinstance(node, AddressRef):
-        yield node
-    for child in ("left", "right", "operand", "arg"):
-        sub = getattr(node, child, None)
-        if sub is not None:
-            yield from _address_leaves(sub)

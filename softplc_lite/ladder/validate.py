@@ -29,6 +29,7 @@ from .ast import (
     SymbolRef,
     Text,
     UnaryOp,
+    leaves,
 )
 from .errors import LadderError, ProgramErrors
 from .instructions import K, lookup, suggest
@@ -91,7 +92,7 @@ class _Checker:
         if operand is None:
             return None
         ok = True
-        for leaf in _leaves(operand):
+        for leaf in leaves(operand):
             if isinstance(leaf, AddressRef) and leaf.address.kind not in _NUMERIC:
                 self.error(leaf.pos, f"{leaf.address} is a {leaf.address.kind.value}; expressions "
                            "take words, floats and numbers")
@@ -287,18 +288,6 @@ def _word_constant(const: Const) -> Const:
     if isinstance(v, int) and 0x8000 <= v <= 0xFFFF:
         return Const(v - 0x10000, const.pos)
     return const
-
-
-def _leaves(expr):
-    if isinstance(expr, BinOp):
-        yield from _leaves(expr.left)
-        yield from _leaves(expr.right)
-    elif isinstance(expr, UnaryOp):
-        yield from _leaves(expr.operand)
-    elif isinstance(expr, Call):
-        yield from _leaves(expr.arg)
-    else:
-        yield expr
 
 
 def _has_compare(expr) -> bool:
