@@ -34,13 +34,17 @@ def _table() -> list[int]:
 _CRC_TABLE = _table()
 
 
+def low_bytes(chars: str) -> bytes:
+    """The low 8 bits of each character, as bytes."""
+    try:
+        return chars.encode("latin-1")
+    except UnicodeEncodeError:
+        return bytes(ord(c) & 0xFF for c in chars)
+
+
 def crc16(chars: str, preload: int = 0) -> int:
     """CRC-16 (poly 0xA001, reflected) of the low bytes of ``chars``."""
-    crc = preload
-    table = _CRC_TABLE
-    for ch in chars:
-        crc = (crc >> 8) ^ table[(crc ^ ord(ch)) & 0xFF]
-    return crc
+    return crc16_bytes(low_bytes(chars), preload)
 
 
 def crc16_bytes(data: bytes | Iterable[int], preload: int = 0) -> int:
@@ -55,9 +59,7 @@ def crc16_bytes(data: bytes | Iterable[int], preload: int = 0) -> int:
 def sum16(chars: str, negate: bool = False, one_byte: bool = False) -> int:
     """The sum of the low bytes of ``chars``: 16 bits, or 8 with ``one_byte``;
     its two's complement with ``negate``."""
-    total = 0
-    for ch in chars:
-        total += ord(ch) & 0xFF
+    total = sum(low_bytes(chars))
     if negate:
         total = -total
     return total & (0xFF if one_byte else 0xFFFF)

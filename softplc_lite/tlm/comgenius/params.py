@@ -65,6 +65,10 @@ class Param:
     def set_word(self, value: int, k: int = 0) -> None:
         raise ParamError(f"{self.name} is a {self.kind.value} param, not an integer")
 
+    def set_words(self, words: array, k: int = 0) -> None:
+        """Store a run of words from word ``k`` on (``%.250C`` fills 125)."""
+        raise ParamError(f"{self.name} is a {self.kind.value} param, not an integer")
+
     def float(self) -> float:
         raise ParamError(f"{self.name} is a {self.kind.value} param, not a float")
 
@@ -115,6 +119,15 @@ class ValueParam(Param):
             raise ParamError(f"{self.name}: word {k} past the end of the param ({len(self.value)} words)")
         self.value[k] = to_signed(value & 0xFFFF)
 
+    def set_words(self, words: array, k: int = 0) -> None:
+        if self.kind is not ParamKind.INTEGER:
+            return super().set_words(words, k)
+        self._check_write()
+        if k + len(words) > len(self.value):
+            raise ParamError(f"{self.name}: {len(words)} words from word {k} run past the end of the param "
+                             f"({len(self.value)} words)")
+        self.value[k:k + len(words)] = list(words)
+
     def float(self) -> float:
         if self.kind is not ParamKind.FLOAT:
             return super().float()
@@ -163,6 +176,14 @@ class TableParam(Param):
         if self.kind is not ParamKind.INTEGER:
             return super().set_word(value, k)
         self.data[self._at(k)] = to_signed(value & 0xFFFF)
+
+    def set_words(self, words: array, k: int = 0) -> None:
+        if self.kind is not ParamKind.INTEGER:
+            return super().set_words(words, k)
+        i = self.index + k
+        if i + len(words) > len(self.data):
+            raise ParamError(f"{self.name}: {len(words)} words from it run past the end of its file")
+        self.data[i:i + len(words)] = words
 
     def float(self) -> float:
         if self.kind is not ParamKind.FLOAT:

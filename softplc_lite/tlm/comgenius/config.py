@@ -1,0 +1,176 @@
+"""COMGENIUS.LST: the module's one configuration file (manual chapter 3).
+
+Three sections, each opened by a line ``[DRIVER]``, ``[PORTS]`` or
+``[STRINGS]`` (any case):
+
+- ``[DRIVER]``: ``DEBUG=0``, ``1`` or ``2``.
+- ``[PORTS]``: one port a line, 8 comma-separated fields: logical port
+  (0-35), physical port, encoding, baud, data bits (5-8), parity (N/E/O),
+  stop bits (1/2), timeout in ms. The physical port is ``COMn``, a bare
+  number ``n`` (the manual's first sample: physical port 0 is COM1), a
+  device path, or a pyserial URL; a URL may itself hold commas, so the
+  fields are counted from both ends.
+- ``[STRINGS]``: see strings.py. Blank lines there take no number; any other
+  line does (a line without quotes is the empty string).
+
+``;`` starts a comment everywhere except in ``[STRINGS]``, where every
+non-blank line is a string (a warning points out a ``;`` line there,
+because it becomes an empty string rather than a comment).
+
+Errors name the file, the line (and column where it helps) and the reason.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..api import find_file
+from ..errors import ModuleError
+from .strings import MAX_LENGTH, MAX_STRINGS, EscapeError, StringTable, decode_escapes
+
+CONFIG_FILE = "COMGENIUS.LST"
+MAX_PORT = 35
+ENCODINGS = {name.upper(): name for name in ("ISO-8859-1", "US-ASCII", "UTF-8", "UTF-16BE", "UTF-16LE")}
+SECTIONS = ("DRIVER", "PORTS", "STRINGS")
+_SECTION = re.compile(r"^\s*\[([A-Za-z_]+)\]\s*$")
+
+
+@dataclass(frozen=True)
+class PortConfig:
+    """One ``[PORTS]`` line."""
+
+    logical: int
+    physical: str
+    encoding: str  # canonical name, e.g. "ISO-8859-1"
+    baud: int
+    data_bits: int
+    parity: str  # "N", "E" or "O"
+    stop_bits: int
+    timeout_ms: int
+    line: int = 0
+
+    def describe(self) -> str:
+        return (f"{self.logical}, {self.physical}, {self.encoding}, {self.baud}, {self.data_bits}, "
+                f"{self.parity}, {self.stop_bits}, {self.timeout_ms}")
+
+
+@dataclass
+class ComGeniusConfig:
+    path: str = CONFIG_FILE
+    debug: int = 0
+    ports: dict[int, PortConfig] = field(default_factory=dict)
+    strings: StringTable = field(default_factory=StringTable)
+    warnings: list[str] = field(default_factory=list)
+
+
+def _int_field(text: str, name: str, lo: int, hi: int | None, err) -> int:
+    text = text.strip()
+    if not re.fullmatch(r"[0-9]+", text):
+        raise err(f"{name} must be a number, not {text!r}")
+    value = int(text)
+    if value < lo or (hi is not None and value > hi):
+        raise err(f"{name} {value} is out of range ({lo}..{hi})" if hi is not None
+                  else f"{name} must be at least {lo}, not {value}")
+    return value
+
+
+def _port_line(text: str, line: int, path: str) -> PortConfig:
+    def err(message: str) -> ModuleError:
+        return ModuleError(f"[PORTS]: {message}", path, line)
+
+    parts = text.split(",")
+    if len(parts) < 8:
+        raise err(f"expected 8 comma-separated fields (logical port, physical port, encoding, baud, "
+                  f"data bits, parity, stop bits, timeout ms), found {len(parts)}")
+    logical = _int_field(parts[0], "logical port", 0, MAX_PORT, err)
+    physical = ",".join(parts[1:-6]).strip()
+    if not physical:
+        raise err("the physical port is empty (COM1, a device path such as /dev/ttyUSB0, or a URL such as loop://)")
+    enc_text, baud_t, bits_t, parity_t, stop_t, timeout_t = (p.strip() for p in parts[-6:])
+    encoding = ENCODINGS.get(enc_text.upper())
+    if encoding is None:
+        raise err(f"unknown encoding {enc_text!r} (encodings: {', '.join(ENCODINGS.values())})")
+    baud = _int_field(baud_t, "baud rate", 1, None, err)
+    data_bits = _int_field(bits_t, "data bits", 5, 8, err)
+    parity = parity_t.upper()
+    if parity not in ("N", "E", "O"):
+        raise err(f"parity must be N, E or O, not {parity_t!r}")
+    stop_bits = _int_field(stop_t, "stop bits", 1, 2, err)
+    timeout = _int_field(timeout_t, "timeout", 0, None, err)
+    return PortConfig(logical, physical, encoding, baud, data_bits, parity, stop_bits, timeout, line)
+
+
+def _string_line(raw: str, line: int, path: str, table: StringTable) -> None:
+    first, last = raw.find('"'), raw.rfind('"')
+    if first >= 0 and first == last:
+        raise ModuleError("[STRINGS]: only one double quote; a string goes between an opening and a closing "
+                          '" (write \\" for a quote inside it)', path, line, first + 1)
+    text = raw[first + 1:last] if first >= 0 else ""
+    try:
+        value = decode_escapes(text)
+    except EscapeError as e:
+        raise ModuleError(f"[STRINGS]: {e.message}", path, line, first + 2 + e.offset) from None
+    if len(value) > MAX_LENGTH:
+        raise ModuleError(f"[STRINGS]: string {len(table)} has {len(value)} characters; "
+                          f"at most {MAX_LENGTH} are allowed", path, line, first + 1)
+    if len(table) > MAX_STRINGS:
+        raise ModuleError(f"[STRINGS]: more than {MAX_STRINGS} strings", path, line)
+    table.add(value, line)
+
+
+def parse_config(text: str, path: str = CONFIG_FILE) -> ComGeniusConfig:
+    """Read COMGENIUS.LST text; ModuleError on the first problem."""
+    config = ComGeniusConfig(path=path)
+    section: str | None = None
+    for number, raw in enumerate(text.splitlines(), start=1):
+        header = _SECTION.match(raw)
+        if header:
+            name = header.group(1).upper()
+            if name not in SECTIONS:
+                raise ModuleError(f"unknown section [{header.group(1)}] (sections: "
+                                  f"{', '.join(f'[{s}]' for s in SECTIONS)})", path, number)
+            section = name
+            continue
+        if section == "STRINGS":
+            if not raw.strip():
+                continue
+            _string_line(raw, number, path, config.strings)
+            if raw.lstrip().startswith(";") and '"' not in raw:
+                config.warnings.append(f"{path}:{number}: ';' does not start a comment in [STRINGS]: this line "
+                                       f"is string {len(config.strings) - 1}, the empty string")
+            continue
+        content = raw.split(";", 1)[0].strip()
+        if not content:
+            continue
+        if section is None:
+            raise ModuleError(f"{content!r} is outside any section (start with [DRIVER], [PORTS] or [STRINGS])",
+                              path, number)
+        if section == "DRIVER":
+            key, eq, value = content.partition("=")
+            if not eq or key.strip().upper() != "DEBUG":
+                raise ModuleError(f"[DRIVER]: expected DEBUG=0, 1 or 2, found {content!r}", path, number)
+            if value.strip() not in ("0", "1", "2"):
+                raise ModuleError(f"[DRIVER]: DEBUG must be 0, 1 or 2, not {value.strip()!r}", path, number)
+            config.debug = int(value)
+        else:
+            port = _port_line(content, number, path)
+            if port.logical in config.ports:
+                raise ModuleError(f"[PORTS]: logical port {port.logical} is defined twice (first on line "
+                                  f"{config.ports[port.logical].line})", path, number)
+            config.ports[port.logical] = port
+    return config
+
+
+def load_config(app_dir: Path) -> ComGeniusConfig:
+    """COMGENIUS.LST from the app directory (the name in any case)."""
+    path = find_file(app_dir, CONFIG_FILE)
+    if path is None:
+        raise ModuleError(f"COMGENIUS is enabled in MODULES.LST but {app_dir / CONFIG_FILE} does not exist "
+                          "(it holds the [DRIVER], [PORTS] and [STRINGS] sections)")
+    try:
+        text = path.read_text(encoding="latin-1")
+    except OSError as e:
+        raise ModuleError(f"cannot read: {e.strerror}", str(path)) from None
+    return parse_config(text, str(path))
