@@ -20,9 +20,12 @@ from .semantics import MajorFault, Settings
 from .validate import check, validate
 
 
-def load_text(text: str, source: str = "<program>") -> Program:
-    """Parse and validate one program text; raises ProgramErrors/LadderError."""
-    return validate(parse_program(text, source))
+def load_text(text: str, source: str = "<program>", instructions=None) -> Program:
+    """Parse and validate one program text; raises ProgramErrors/LadderError.
+    ``instructions``: an InstructionSet with module (TLM) instructions."""
+    if instructions is None:
+        from .instructions import BUILTIN as instructions
+    return validate(parse_program(text, source, instructions), instructions)
 
 
 def run_text(
@@ -33,10 +36,18 @@ def run_text(
     settings: Settings | None = None,
     table: DataTable | None = None,
     values: dict[str, object] | None = None,
+    modules=(),
 ) -> Engine:
     """Load a program, write ``values`` (address -> value), put it in RUN and
-    run ``scans`` scans on simulated time. Returns the engine."""
-    engine = Engine(load_text(text), table=table, settings=settings, executor=executor)
+    run ``scans`` scans on simulated time. Returns the engine. ``modules``:
+    configured TLM instances whose instructions the program may use."""
+    instructions = None
+    if modules:
+        from ..tlm.registry import instruction_set
+
+        instructions = instruction_set(list(modules))
+    engine = Engine(load_text(text, instructions=instructions), table=table, settings=settings,
+                    executor=executor, modules=modules)
     for addr, value in (values or {}).items():
         engine.table.write(addr, value)
     engine.set_mode(Mode.RUN)

@@ -59,8 +59,10 @@ def address_fault(addr: Address, error: AddressRangeError) -> MajorFault:
 
 
 class _FileCompiler:
-    def __init__(self, table: DataTable, machine: Machine, number: int, labels: dict[int, int], zone: list) -> None:
+    def __init__(self, table: DataTable, machine: Machine, number: int, labels: dict[int, int], zone: list,
+                 module_instance=None) -> None:
         self.table = table
+        self.module_instance = module_instance  # TLM instructions: Instruction -> callable(c) -> c
         self.zone = zone  # the file's MCR zone cell, shared with the engine's runner
         self.rung_elements: list = []
         self.machine = machine
@@ -194,6 +196,11 @@ class _FileCompiler:
         if m in _COMPARE:
             a, b = self.value(ind, ops[0]), self.value(ind, ops[1])
             self.emit(ind, f"c = c and {a} {_COMPARE[m]} {b}")
+            return
+        instance = self.module_instance(ins) if self.module_instance is not None else None
+        if instance is not None:
+            # A module (TLM) instruction: its instance takes the rung-in and gives the rung-out.
+            self.emit(ind, f"c = {self.bind(f'_tli{len(self.env)}', instance)}(c)")
             return
         raise NotImplementedError(f"no compiler template for {m}")  # validated programs never get here
 
@@ -555,7 +562,8 @@ def labels_of(rungs: list[Rung]) -> dict[int, int]:
 
 
 @gc_paused
-def compile_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list) -> CompiledFile:
+def compile_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list,
+                 module_instance=None) -> CompiledFile:
     pfile = program.files[number]
-    fc = _FileCompiler(table, machine, number, labels_of(pfile.rungs), zone)
+    fc = _FileCompiler(table, machine, number, labels_of(pfile.rungs), zone, module_instance)
     return fc.compile(pfile.rungs, jsr)

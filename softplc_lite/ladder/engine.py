@@ -153,8 +153,10 @@ class Engine:
         clock=None,
         executor: str = "compiled",
         fresh: bool = True,
+        modules=(),
     ) -> None:
         self.program = program
+        self.modules = list(modules)  # enabled TLMs (softplc_lite.tlm.TLM)
         self.table = table if table is not None else DataTable()
         self.settings = settings or Settings()
         self.clock = clock or SimulatedClock(self.settings.scan_ms)
@@ -177,11 +179,41 @@ class Engine:
         self._first_pass = False
         self._depth = 0
         self._deadline = 0.0
+        self._owner = {spec.mnemonic: m for m in self.modules for spec in m.instructions()}
+        self._attach_hooks()
         self.files = {}
         build = compile_file if executor == "compiled" else interpret_file
         for number in sorted(program.files):
             zone = [True]
-            self.files[number] = (build(program, number, self.table, self.machine, self._jsr, zone), zone)
+            self.files[number] = (build(program, number, self.table, self.machine, self._jsr, zone,
+                                        self._module_instance), zone)
+
+    # -- plug-in modules (TLMs) --------------------------------------------------------
+    def _attach_hooks(self) -> None:
+        from ..tlm.api import overrides
+
+        for m in self.modules:
+            if overrides(m, "on_input"):
+                self.input_hooks.append(m.on_input)
+            if overrides(m, "on_output"):
+                self.output_hooks.append(m.on_output)
+            if overrides(m, "on_mode"):
+                self.mode_hooks.append(m.on_mode)
+
+    def _module_instance(self, ins):
+        """The run-time instance of a module instruction (called once per
+        instruction by either executor), or None for a built-in one."""
+        module = self._owner.get(ins.mnemonic)
+        if module is None:
+            return None
+        from ..tlm.api import InstructionContext
+
+        return module.create(ins, InstructionContext(self, ins))
+
+    def close(self) -> None:
+        """End of the run: modules release what they hold (ports, files)."""
+        for m in self.modules:
+            m.close()
 
     # -- modes --------------------------------------------------------------------------
     def set_mode(self, mode: Mode) -> None:

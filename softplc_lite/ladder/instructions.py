@@ -2,8 +2,8 @@
 
 The validator checks operands against these specs, the parser uses the
 mnemonic set to group mnemonic-form rungs, and ``fmt`` prints operands in
-this order. Plug-in modules (TLMs) add their instructions with
-:func:`register`.
+this order. Plug-in modules (TLMs) add their instructions through an
+:class:`InstructionSet` built for the app that enables them.
 """
 
 from __future__ import annotations
@@ -36,6 +36,11 @@ class K(Enum):
     STRING = "string element (ST)"
     BIT_NUMBER = "bit number 0..15"
     ANY = "operand"  # TLM parameters: validated by the TLM
+    # TLM parameter kinds (COMGENIUS and third-party modules)
+    PORT = "port number 0..35 or word address"
+    FORMAT = "format index (integer or word address)"
+    PARAM = "number, or word, float or STRING element"  # read by a conversion
+    PARAM_OUT = "word, float or STRING element"  # written by a conversion
 
 
 @dataclass(frozen=True)
@@ -130,36 +135,65 @@ _BUILTIN = [
 # Instructions with a fixed role in the language itself (not operand-driven).
 BRANCH_KEYWORDS = ("BST", "NXB", "BND", "SOR", "EOR")
 
-_TABLE: dict[str, InstructionSpec] = {s.mnemonic: s for s in _BUILTIN}
+
+class InstructionSet:
+    """The mnemonics a program may use: the built-in instructions plus those
+    of the plug-in modules (TLMs) an app enables. The parser asks it which
+    names are instructions, the validator for operand specs.
+
+    ``unavailable`` maps mnemonics of installed but not enabled modules to
+    their module name, so an unknown-instruction error can say what to add
+    to MODULES.LST."""
+
+    def __init__(self, extra=(), unavailable: dict[str, str] | None = None) -> None:
+        self.table: dict[str, InstructionSpec] = dict(_BUILTIN_TABLE)
+        self.unavailable = dict(unavailable or {})
+        for spec in extra:
+            existing = self.table.get(spec.mnemonic)
+            if existing is not None and existing != spec:
+                owner = f"module {existing.module}" if existing.module else "the built-in instruction set"
+                raise ValueError(f"{spec.mnemonic} of module {spec.module} is already an instruction of {owner}")
+            self.table[spec.mnemonic] = spec
+
+    def lookup(self, mnemonic: str) -> InstructionSpec | None:
+        return self.table.get(mnemonic.upper())
+
+    def is_mnemonic(self, name: str) -> bool:
+        return name.upper() in self.table
+
+    def all_specs(self) -> list[InstructionSpec]:
+        return list(self.table.values())
+
+    def suggest(self, name: str) -> str | None:
+        """The closest known mnemonic, for "did you mean" hints."""
+        close = difflib.get_close_matches(name.upper(), list(self.table), n=1, cutoff=0.5)
+        return close[0] if close else None
+
+    def hint(self, name: str) -> str:
+        """What to say after "unknown instruction NAME"."""
+        module = self.unavailable.get(name.upper())
+        if module is not None:
+            return f" ({name.upper()} is an instruction of the {module} module: add {module} to the app's MODULES.LST)"
+        close = self.suggest(name)
+        return f" (did you mean {close}?)" if close else ""
+
+
+_BUILTIN_TABLE: dict[str, InstructionSpec] = {s.mnemonic: s for s in _BUILTIN}
+BUILTIN = InstructionSet()
 
 
 def lookup(mnemonic: str) -> InstructionSpec | None:
-    return _TABLE.get(mnemonic.upper())
+    return BUILTIN.lookup(mnemonic)
 
 
 def is_mnemonic(name: str) -> bool:
-    return name.upper() in _TABLE
+    return BUILTIN.is_mnemonic(name)
 
 
 def all_specs() -> list[InstructionSpec]:
-    return list(_TABLE.values())
+    return BUILTIN.all_specs()
 
 
 def suggest(name: str) -> str | None:
-    """The closest known mnemonic, for "did you mean" hints."""
-    close = difflib.get_close_matches(name.upper(), list(_TABLE), n=1, cutoff=0.5)
-    return close[0] if close else None
-
-
-def register(spec: InstructionSpec) -> None:
-    """Add a plug-in instruction; two modules may not claim one mnemonic."""
-    existing = _TABLE.get(spec.mnemonic)
-    if existing is not None and existing != spec:
-        owner = existing.module or "the built-in instruction set"
-        raise ValueError(f"{spec.mnemonic} from {spec.module} is already defined by {owner}")
-    _TABLE[spec.mnemonic] = spec
-
-
-def unregister_module(module: str) -> None:
-    for m in [m for m, s in _TABLE.items() if s.module == module]:
-        del _TABLE[m]
+    """The closest built-in mnemonic, for "did you mean" hints."""
+    return BUILTIN.suggest(name)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from ..datatable import DataTable, bit_mask
 from ..datatable.errors import AddressRangeError
-from .ast import AddressRef, Branch, Const, Instruction, Program, Rung, address_refs
+from .ast import AddressRef, Branch, Const, Instruction, Program, Rung, address_refs, walk
 from .compiler import RET, TND, EndScan, address_fault, describe, labels_of
 from .expr import evaluate
 from .semantics import BASE_MS, Machine, MajorFault, lim, source_units
@@ -56,6 +56,7 @@ class ReferenceFile:
 
 class Interpreter:
     def __init__(self, table: DataTable, machine: Machine, jsr, zone: list) -> None:
+        self.modules: dict[int, object] = {}  # id(Instruction) -> module (TLM) instance
         self.table = table
         self.m = machine
         self.jsr = jsr
@@ -270,6 +271,8 @@ class Interpreter:
         elif m == "ASR":
             (ad, ai, _), (bd, bi, _) = self.loc(ops[0]), self.loc(ops[1])
             return mc.asr(ad, ai, bd, bi)
+        elif id(ins) in self.modules:
+            return self.modules[id(ins)](c)
         else:
             raise NotImplementedError(f"the reference interpreter has no rule for {m}")
         return c
@@ -282,6 +285,15 @@ class Interpreter:
         return d, i
 
 
-def interpret_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list) -> ReferenceFile:
-    return ReferenceFile(Interpreter(table, machine, jsr, zone), number, program.files[number].rungs)
+def interpret_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list,
+                   module_instance=None) -> ReferenceFile:
+    interp = Interpreter(table, machine, jsr, zone)
+    rungs = program.files[number].rungs
+    if module_instance is not None:
+        for rung in rungs:
+            for ins in walk(rung.elements):
+                instance = module_instance(ins)
+                if instance is not None:
+                    interp.modules[id(ins)] = instance
+    return ReferenceFile(interp, number, rungs)
 

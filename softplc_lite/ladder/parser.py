@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Callable, Iterable, Iterator
+from typing import Iterable, Iterator
 
 from lark import Lark, Token, Transformer, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
@@ -401,19 +401,18 @@ def parse_expression(text: str, pos: Pos) -> Operand:
 def parse_program(
     text: str,
     source: str = "<program>",
-    is_mnemonic: Callable[[str], bool] | None = None,
+    instructions=None,
     program: Program | None = None,
     line_offset: int = 0,
 ) -> Program:
     """Parse one .lad text into ``program`` (a new one by default).
 
-    ``is_mnemonic`` tells instruction names from symbol names in mnemonic
-    rungs; by default the built-in instruction table (plus loaded TLMs).
+    ``instructions`` (an InstructionSet) tells instruction names from symbol
+    names in mnemonic rungs: by default the built-in instructions; an app
+    passes the set that includes its modules' (TLM) instructions.
     """
-    if is_mnemonic is None:
-        from .instructions import is_mnemonic as default
-
-        is_mnemonic = default
+    if instructions is None:
+        from .instructions import BUILTIN as instructions
     if text and not text.endswith("\n"):
         text += "\n"
     items = _parse_tree(text, source, "start", line_offset)
@@ -444,13 +443,13 @@ def parse_program(
             rung_comment = _comment_above(comments, item.pos.line)
             if item.comment:
                 rung_comment = f"{rung_comment}\n{item.comment}" if rung_comment else item.comment
-            elements = item.elements if item.elements is not None else _group(item.tokens, is_mnemonic, item.pos)
+            elements = item.elements if item.elements is not None else _group(item.tokens, instructions, item.pos)
             file_for_rungs(item.pos).rungs.append(Rung(elements, rung_comment, item.pos))
         comments = []
     return program
 
 
-def syntax_problems(text: str, source: str, limit: int = 50) -> list[LadderError]:
+def syntax_problems(text: str, source: str, limit: int = 50, instructions=None) -> list[LadderError]:
     """Every problem ``parse_program`` finds in a file, in source order, not
     just the first, so that ``check`` lists them all. After a problem,
     parsing resumes on the next line; the lines before a syntax error are
@@ -466,7 +465,7 @@ def syntax_problems(text: str, source: str, limit: int = 50) -> list[LadderError
         # so a rung may be cut short there (not a problem of its own).
         while start < end and len(found) < limit:
             try:
-                parse_program("".join(lines[start:end]), source, program=Program(), line_offset=start)
+                parse_program("".join(lines[start:end]), source, instructions, program=Program(), line_offset=start)
                 return
             except LadderError as e:
                 line = e.pos.line
@@ -506,7 +505,7 @@ def _comment_above(comments: list[_Comment], rung_line: int) -> str | None:
     return "\n".join(reversed(lines)) if lines else None
 
 
-def _group(tokens: list, is_mnemonic: Callable[[str], bool], rung_pos: Pos) -> list[Element]:
+def _group(tokens: list, instructions, rung_pos: Pos) -> list[Element]:
     """Turn a flat mnemonic token run into instructions and branches."""
     root: list[Element] = []
     stack: list[tuple[list[Element], Branch]] = []  # (series to return to, open branch)
@@ -529,18 +528,18 @@ def _group(tokens: list, is_mnemonic: Callable[[str], bool], rung_pos: Pos) -> l
             else:  # BND
                 series, _ = stack.pop()
             continue
-        if isinstance(tok, _Name) and is_mnemonic(tok.text.upper()):
+        if isinstance(tok, _Name) and instructions.is_mnemonic(tok.text):
             current = Instruction(tok.text.upper(), [], tok.pos)
             series.append(current)
             continue
         operand = SymbolRef(tok.text, tok.pos) if isinstance(tok, _Name) else tok
-        if isinstance(operand, Text) and current is not None and _takes_expression(current):
+        if isinstance(operand, Text) and current is not None and _takes_expression(current, instructions):
             # CPT "N7:1 + 5": the quoted text is an expression; parse it now
             # so both rung syntaxes give the same tree.
             operand = parse_expression(operand.value, operand.pos)
         if current is None:
             if isinstance(tok, _Name):
-                raise LadderError(tok.pos, f"unknown instruction {tok.text!r}{_did_you_mean(tok.text)}")
+                raise LadderError(tok.pos, f"unknown instruction {tok.text!r}{instructions.hint(tok.text)}")
             raise LadderError(_operand_pos(operand), "an operand with no instruction before it")
         current.operands.append(operand)
     if stack:
@@ -548,20 +547,13 @@ def _group(tokens: list, is_mnemonic: Callable[[str], bool], rung_pos: Pos) -> l
     return root
 
 
-def _takes_expression(instr: Instruction) -> bool:
-    from .instructions import K, lookup
+def _takes_expression(instr: Instruction, instructions) -> bool:
+    from .instructions import K
 
-    spec = lookup(instr.mnemonic)
+    spec = instructions.lookup(instr.mnemonic)
     index = len(instr.operands)
     return spec is not None and index < len(spec.operands) and spec.operands[index].kind is K.EXPRESSION
 
 
 def _operand_pos(operand) -> Pos:
     return getattr(operand, "pos", None) or Pos("<program>", 0, 0)
-
-
-def _did_you_mean(name: str) -> str:
-    from .instructions import suggest
-
-    hint = suggest(name)
-    return f" (did you mean {hint}?)" if hint else ""

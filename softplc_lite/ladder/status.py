@@ -24,6 +24,7 @@ MAJOR_WATCHDOG_BIT = 8  # watchdog timeout
 MINOR_OVERFLOW_BIT = 0  # math overflow (also S:0/1)
 MINOR_DIV_ZERO_BIT = 1  # division by zero
 MINOR_STRING_BIT = 2  # string instruction error (length, index)
+MINOR_MODULE_BIT = 3  # a module (TLM) instruction without a CONTROL failed (STRPRINT)
 
 # softplc additions (words 100..109)
 SCAN_COUNT_LOW = 100  # S:100/S:101 scans since RUN, 32-bit, low word first
@@ -49,3 +50,6 @@ FAULT_INTERNAL = 255  # softplc: an internal error (a bug), contained as a fault
 MINOR_CODE_OVERFLOW = 1
 MINOR_CODE_DIV_ZERO = 2
 MINOR_CODE_STRING = 3
+MINOR_CODE_FORMAT_INDEX = 4  # a format index with no string in the table
+MINOR_CODE_FORMAT = 5  # an illegal format string (e.g. %k)
+MINOR_CODE_PARAM = 6  # a Param missing, of the wrong kind, or past the end of its file

@@ -32,7 +32,7 @@ from .ast import (
     leaves,
 )
 from .errors import LadderError, ProgramErrors
-from .instructions import K, lookup, suggest
+from .instructions import BUILTIN, InstructionSet, K
 from .parser import parse_expression
 
 _NUMERIC = (ValueKind.WORD, ValueKind.FLOAT)
@@ -49,11 +49,17 @@ _WANT = {
     K.TIMER: (ValueKind.TIMER,), K.COUNTER: (ValueKind.COUNTER,), K.CONTROL: (ValueKind.CONTROL,),
     K.RESETTABLE: (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL),
     K.STRING: (ValueKind.STRING,),
+    K.PORT: (ValueKind.WORD,), K.FORMAT: (ValueKind.WORD,),
+    K.PARAM: (ValueKind.WORD, ValueKind.FLOAT, ValueKind.STRING),
+    K.PARAM_OUT: (ValueKind.WORD, ValueKind.FLOAT, ValueKind.STRING),
 }
+# Integer constants allowed where an operand may be a constant or a word.
+_CONSTANT_RANGE = {K.PORT: (0, 35), K.FORMAT: (0, 32000)}
 
 class _Checker:
-    def __init__(self, program: Program) -> None:
+    def __init__(self, program: Program, instructions: InstructionSet = BUILTIN) -> None:
         self.program = program
+        self.instructions = instructions
         self.errors: list[LadderError] = []
 
     def error(self, pos, message: str) -> None:
@@ -65,7 +71,7 @@ class _Checker:
         if isinstance(operand, SymbolRef):
             decl = self.program.symbols.get(operand.name)
             if decl is None:
-                hint = suggest(operand.name)
+                hint = self.instructions.suggest(operand.name)
                 extra = f" (is {operand.name} a misspelt instruction? did you mean {hint}?)" if hint else ""
                 self.error(operand.pos, f"unknown symbol {operand.name!r}{extra}")
                 return None
@@ -115,7 +121,7 @@ class _Checker:
         if resolved is None:
             return None
         def where() -> str:
-            return f"{instr.mnemonic} operand {index + 1} ({lookup(instr.mnemonic).operands[index].name})"
+            return f"{instr.mnemonic} operand {index + 1} ({self.instructions.lookup(instr.mnemonic).operands[index].name})"
 
         def bad(expected: str) -> None:
             self.error(_pos(resolved), f"{where()} must be {expected}, not {_describe(resolved)}")
@@ -142,6 +148,14 @@ class _Checker:
                 return None
             return resolved
         if isinstance(resolved, Const):
+            if kind in _CONSTANT_RANGE:
+                lo, hi = _CONSTANT_RANGE[kind]
+                if isinstance(resolved.value, int) and lo <= resolved.value <= hi:
+                    return resolved
+                bad(f"a {kind.value.split(' or ')[0]} in {lo}..{hi}, or a word address")
+                return None
+            if kind is K.PARAM:
+                return self._int_constant(resolved, where()) if isinstance(resolved.value, int) else resolved
             if kind in (K.SOURCE, K.FILE_SOURCE):
                 return _word_constant(resolved) if isinstance(resolved.value, int) else resolved
             if kind is K.INT_SOURCE and isinstance(resolved.value, int):
@@ -170,18 +184,16 @@ class _Checker:
 
     # -- instructions and rungs ---------------------------------------------------------
     def instruction(self, instr: Instruction, file_number: int, labels: set[int], first: bool) -> Instruction:
-        spec = lookup(instr.mnemonic)
+        spec = self.instructions.lookup(instr.mnemonic)
         if spec is None:
-            hint = suggest(instr.mnemonic)
-            self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}" + (f" (did you mean {hint}?)" if hint else ""))
+            self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}{self.instructions.hint(instr.mnemonic)}")
             return instr
         n = len(instr.operands)
         if not spec.min_operands <= n <= len(spec.operands):
             extras = instr.operands[len(spec.operands):]
             stray = next((o for o in extras if isinstance(o, SymbolRef) and o.name not in self.program.symbols), None)
             if stray is not None:
-                hint = suggest(stray.name)
-                self.error(stray.pos, f"unknown instruction {stray.name!r}" + (f" (did you mean {hint}?)" if hint else ""))
+                self.error(stray.pos, f"unknown instruction {stray.name!r}{self.instructions.hint(stray.name)}")
                 return instr
             want = (f"{spec.min_operands}..{len(spec.operands)}" if spec.optional else str(len(spec.operands)))
             plural = "" if want == "1" else "s"
@@ -221,7 +233,7 @@ class _Checker:
     def run(self) -> Program:
         prog = self.program
         for name, decl in prog.symbols.items():
-            if lookup(name) is not None:
+            if self.instructions.lookup(name) is not None:
                 self.error(decl.pos, f"symbol {name} has the name of an instruction")
         for decl in prog.data:
             self.data(decl)
@@ -314,18 +326,18 @@ def _describe(operand: Operand) -> str:
     return "an expression"
 
 
-def check(program: Program) -> tuple[Program, list[LadderError]]:
+def check(program: Program, instructions: InstructionSet = BUILTIN) -> tuple[Program, list[LadderError]]:
     """Validate; return the resolved program and every problem found."""
-    checker = _Checker(program)
+    checker = _Checker(program, instructions)
     resolved = checker.run()
     checker.errors.sort(key=lambda e: (e.pos.source, e.pos.line, e.pos.column))
     return resolved, checker.errors
 
 
 @gc_paused
-def validate(program: Program) -> Program:
+def validate(program: Program, instructions: InstructionSet = BUILTIN) -> Program:
     """Validate and resolve, raising ProgramErrors if anything is wrong."""
-    resolved, errors = check(program)
+    resolved, errors = check(program, instructions)
     if errors:
         raise ProgramErrors(errors)
     return resolved

@@ -1,0 +1,268 @@
+"""What a plug-in module (TLM) implements, and the helpers it gets.
+
+A TLM is a class registered in the entry-point group ``softplc_lite.tlms``
+(see registry.py). An app enables it by naming it in its MODULES.LST. Then,
+for that app:
+
+1. ``configure(app_dir)`` reads the module's own config file (its
+   ``config_file``, e.g. COMGENIUS.LST) and returns warnings;
+2. ``instructions()`` declares its instructions (InstructionSpec, with
+   operand kinds from ``ladder.instructions.K``); both rung syntaxes, the
+   validator and ``fmt`` then know them like built-in ones;
+3. ``check(instr)`` may return warnings about a use the module can judge
+   before running (``softplc check`` prints them with their location);
+4. ``create(instr, ctx)`` makes one instance per instruction in the
+   program. Each scan the engine calls the instance with the rung-in
+   condition and takes its return value as the rung-out condition;
+5. the driver hooks ``on_input``/``on_output`` run every scan at the
+   engine's input and output points, ``on_mode`` on each mode change, and
+   ``close`` when the run ends.
+
+The engine has no special case for any module; COMGENIUS uses exactly this.
+"""
+
+from __future__ import annotations
+
+import sys
+from array import array
+from pathlib import Path
+from typing import TYPE_CHECKING, Callable
+
+from ..datatable.errors import AddressRangeError
+from ..ladder.ast import AddressRef, Const, Instruction
+from ..ladder.compiler import address_fault
+from ..ladder.errors import LadderError
+from ..ladder.instructions import InstructionSpec
+from ..ladder.semantics import R_DN, R_EM, R_EN, R_ER, Machine
+
+if TYPE_CHECKING:  # pragma: no cover
+    from ..datatable import DataTable
+    from ..ladder.engine import Engine, Mode
+
+Instance = Callable[[bool], bool]
+
+
+class TLM:
+    """Base class of a plug-in module. Subclasses set ``name`` (as written
+    in MODULES.LST) and override what they need."""
+
+    name: str = ""
+    title: str = ""
+    config_file: str | None = None  # read from the app directory by configure()
+
+    def configure(self, app_dir: Path | None) -> list[str]:
+        """Read the module's config from ``app_dir``; return warnings. Raise
+        tlm.errors.ModuleError (with path, line, column) for a bad config."""
+        return []
+
+    def instructions(self) -> list[InstructionSpec]:
+        return []
+
+    def check(self, instr: Instruction) -> list[LadderError]:
+        """Warnings about one (validated) instruction of this module."""
+        return []
+
+    def create(self, instr: Instruction, ctx: "InstructionContext") -> Instance:
+        raise NotImplementedError(f"module {self.name} cannot run {instr.mnemonic}")
+
+    # driver hooks: no-ops unless overridden
+    def on_input(self, engine: "Engine") -> None:
+        pass
+
+    def on_output(self, engine: "Engine", outputs_enabled: bool) -> None:
+        pass
+
+    def on_mode(self, engine: "Engine", old: "Mode", new: "Mode") -> None:
+        pass
+
+    def close(self) -> None:
+        pass
+
+    def log(self, message: str) -> None:
+        """Diagnostics (a module's DEBUG output): standard error by default."""
+        print(f"{self.name}: {message}", file=sys.stderr)
+
+
+def find_file(directory: Path, name: str) -> Path | None:
+    """``name`` in ``directory``, matched without regard to case (SoftPLC
+    config names are upper case; files copied from elsewhere may not be)."""
+    exact = directory / name
+    if exact.is_file():
+        return exact
+    if directory.is_dir():
+        for p in sorted(directory.iterdir()):
+            if p.name.upper() == name.upper() and p.is_file():
+                return p
+    return None
+
+
+def overrides(module: TLM, hook: str) -> bool:
+    """Does ``module`` implement ``hook`` (so the engine must call it)?"""
+    return getattr(type(module), hook) is not getattr(TLM, hook)
+
+
+# -- operands --------------------------------------------------------------------------
+
+class BoundOperand:
+    """One operand of a TLM instruction, bound to the data table.
+
+    A direct address is resolved once; an indirect or indexed one each time
+    it is used (a bad one raises the same major fault as built-in
+    instructions do)."""
+
+    def __init__(self, table: "DataTable", operand) -> None:
+        self.operand = operand
+        self.table = table
+        self.constant = operand.value if isinstance(operand, Const) else None
+        self.address = operand.address if isinstance(operand, AddressRef) else None
+        self._location = None
+        if self.address is not None and self.address.is_direct:
+            self._location = self._resolve()
+
+    def _resolve(self):
+        try:
+            f, index, bit = self.table.resolve(self.address)
+        except AddressRangeError as e:
+            raise address_fault(self.address, e) from None
+        return f.data, index, bit
+
+    @property
+    def text(self) -> str:
+        return str(self.address) if self.address is not None else repr(self.constant)
+
+    def location(self) -> tuple[array, int, int | None]:
+        """(array, index, bit) of an address operand."""
+        return self._location if self._location is not None else self._resolve()
+
+    def value(self) -> int | float:
+        """A constant's value, or what the address holds (a word, a float,
+        or 0/1 for a bit)."""
+        if self.address is None:
+            return self.constant
+        d, i, bit = self.location()
+        return d[i] if bit is None else (d[i] >> bit) & 1
+
+
+class InstructionContext:
+    """What ``TLM.create`` gets: the instruction, its bound operands and the
+    run-time machine (data table, status file, clock)."""
+
+    def __init__(self, engine: "Engine", instr: Instruction) -> None:
+        self.engine = engine
+        self.instr = instr
+        self.table = engine.table
+        self.machine: Machine = engine.machine
+        self.operands = [BoundOperand(engine.table, op) for op in instr.operands]
+
+    @property
+    def now_ms(self) -> int:
+        """The engine's clock (simulated or real), in ms."""
+        return self.engine.clock.now_ms
+
+    def where(self) -> str:
+        from ..ladder.fmt import format_instruction
+
+        return f"{format_instruction(self.instr)} at {self.instr.pos}"
+
+
+# -- the CONTROL element pattern ---------------------------------------------------------
+
+
+class ControlElement:
+    """An R element seen by an instruction: status bits of word 0, LEN and
+    POS. Bit masks are those of signed 16-bit words."""
+
+    __slots__ = ("d", "i")
+
+    def __init__(self, d: array, i: int) -> None:
+        self.d = d
+        self.i = i
+
+    def _bit(self, mask: int) -> bool:
+        return bool(self.d[self.i] & mask)
+
+    en = property(lambda self: self._bit(R_EN))
+    dn = property(lambda self: self._bit(R_DN))
+    er = property(lambda self: self._bit(R_ER))
+    em = property(lambda self: self._bit(R_EM))
+
+    @property
+    def len(self) -> int:
+        return self.d[self.i + 1]
+
+    @len.setter
+    def len(self, value: int) -> None:
+        self.d[self.i + 1] = _word(value)
+
+    @property
+    def pos(self) -> int:
+        return self.d[self.i + 2]
+
+    @pos.setter
+    def pos(self, value: int) -> None:
+        self.d[self.i + 2] = _word(value)
+
+    def finish(self, error: bool = False, empty: bool = False) -> None:
+        """Completion: DN, with ER on error and EM when ``empty`` (a timeout)."""
+        w = (self.d[self.i] | R_DN) & ~(R_ER | R_EM)
+        if error:
+            w |= R_ER
+        if empty:
+            w |= R_EM
+        self.d[self.i] = w
+
+
+def _word(value: int) -> int:
+    value &= 0xFFFF
+    return value - 0x10000 if value & 0x8000 else value
+
+
+class ControlledInstruction:
+    """The manual's pattern for instructions with a CONTROL operand.
+
+    - Rung true with EN off (a false-to-true transition): EN on, DN ER EM
+      off, ``start(ctl)``; from then on ``step(ctl)`` each true scan until it
+      returns True (it calls ``ctl.finish`` to set DN/ER/EM).
+    - Rung true and not started again: nothing, DN and ER stay as they are
+      until the rung goes false ("allow the rung to go false").
+    - Rung false: EN, DN, ER and EM off; an unfinished operation is dropped
+      (``cancel()``): no completion.
+
+    The EN bit is the memory of the previous rung state, as in PLC-5 file
+    and message instructions, so the data table alone says what happens on
+    the next scan. Subclasses implement ``start`` and ``step`` (``start``
+    may finish at once and return True)."""
+
+    def __init__(self, control: BoundOperand) -> None:
+        self.control = control
+        self.busy = False
+
+    def __call__(self, c: bool) -> bool:
+        d, i, _ = self.control.location()
+        w = d[i]
+        if not c:
+            if self.busy:
+                self.busy = False
+                self.cancel()
+            if w & (R_EN | R_DN | R_ER | R_EM):
+                d[i] = w & ~(R_EN | R_DN | R_ER | R_EM)
+            return c
+        ctl = None
+        if not w & R_EN:
+            d[i] = (w | R_EN) & ~(R_DN | R_ER | R_EM)
+            ctl = ControlElement(d, i)
+            self.busy = not self.start(ctl)
+        elif self.busy:
+            ctl = ControlElement(d, i)
+            self.busy = not self.step(ctl)
+        return c
+
+    def start(self, ctl: ControlElement) -> bool:
+        """Begin; return True when already finished."""
+        return self.step(ctl)
+
+    def step(self, ctl: ControlElement) -> bool:
+        raise NotImplementedError
+
+    def cancel(self) -> None:
+        pass

@@ -1,0 +1,144 @@
+"""Finding, enabling and loading plug-in modules (TLMs).
+
+Installed modules are the entry points of the group ``softplc_lite.tlms``:
+the entry point's name is the module's name (``COMGENIUS``), its object a
+``TLM`` subclass. A package adds one in its ``pyproject.toml``::
+
+    [project.entry-points."softplc_lite.tlms"]
+    MYTLM = "my_package.tlm:MyTLM"
+
+softplc_lite registers COMGENIUS the same way; the engine has no special
+case for it.
+
+An app enables modules explicitly, as SoftPLC's MODULES.LST does: a file
+``MODULES.LST`` in the app directory names one module a line, in any case;
+``;`` starts a comment. Naming a module that is not installed is an error
+that lists the installed ones; so are two modules claiming one mnemonic.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from importlib.metadata import EntryPoint, entry_points
+from pathlib import Path
+
+from ..ladder.instructions import InstructionSet
+from .api import TLM, find_file
+from .errors import ModuleError
+
+GROUP = "softplc_lite.tlms"
+MODULES_FILE = "MODULES.LST"
+
+
+def installed() -> dict[str, EntryPoint]:
+    """Installed modules by upper-case name, in sorted order."""
+    found: dict[str, EntryPoint] = {}
+    for ep in sorted(entry_points(group=GROUP), key=lambda e: (e.name.upper(), e.value)):
+        found.setdefault(ep.name.upper(), ep)
+    return found
+
+
+def _package(ep: EntryPoint) -> str:
+    dist = getattr(ep, "dist", None)
+    return f"package {dist.name}" if dist is not None else f"entry point {ep.value}"
+
+
+def load_module(name: str, available: dict[str, EntryPoint] | None = None) -> TLM:
+    """A new instance of the installed module ``name`` (any case)."""
+    available = installed() if available is None else available
+    ep = available.get(name.upper())
+    if ep is None:
+        names = ", ".join(available) or "none"
+        raise ModuleError(f"no module named {name!r} is installed (installed modules: {names})")
+    try:
+        factory = ep.load()
+    except Exception as e:  # any import failure of third-party code
+        raise ModuleError(f"module {ep.name} ({_package(ep)}) failed to load: {type(e).__name__}: {e}") from None
+    try:
+        module = factory()
+    except Exception as e:
+        raise ModuleError(f"module {ep.name} ({_package(ep)}) failed to start: {type(e).__name__}: {e}") from None
+    if not isinstance(module, TLM):
+        raise ModuleError(f"module {ep.name} ({_package(ep)}): {ep.value} is not a softplc_lite.tlm.TLM")
+    module.name = ep.name.upper()
+    return module
+
+
+@dataclass(frozen=True)
+class Enabled:
+    name: str  # upper case
+    line: int
+
+
+def read_modules_lst(app_dir: Path) -> tuple[Path | None, list[Enabled]]:
+    """The modules an app enables, from its MODULES.LST (none if absent)."""
+    path = find_file(app_dir, MODULES_FILE)
+    if path is None:
+        return None, []
+    try:
+        text = path.read_text(encoding="latin-1")
+    except OSError as e:
+        raise ModuleError(f"cannot read: {e.strerror}", str(path)) from None
+    out: list[Enabled] = []
+    seen: dict[str, int] = {}
+    for number, raw in enumerate(text.splitlines(), start=1):
+        content = raw.split(";", 1)[0].strip()
+        if not content:
+            continue
+        if len(content.split()) != 1:
+            raise ModuleError(f"expected one module name on the line, found {content!r}", str(path), number)
+        name = content.upper()
+        if name in seen:
+            raise ModuleError(f"module {name} is named twice (first on line {seen[name]})", str(path), number)
+        seen[name] = number
+        out.append(Enabled(name, number))
+    return path, out
+
+
+def load_modules(app_dir: Path | None, configure: bool = True) -> tuple[list[TLM], list[str]]:
+    """Load (and configure) the modules an app enables; returns them and the
+    warnings their configs gave. ModuleError for any problem."""
+    if app_dir is None:
+        return [], []
+    path, enabled = read_modules_lst(app_dir)
+    available = installed() if enabled else {}
+    modules: list[TLM] = []
+    warnings: list[str] = []
+    for entry in enabled:
+        if entry.name not in available:
+            names = ", ".join(available) or "none"
+            raise ModuleError(f"module {entry.name} is not installed (installed modules: {names})",
+                              str(path), entry.line)
+        modules.append(load_module(entry.name, available))
+    instruction_set(modules)  # two modules claiming one mnemonic: an error now, not at run time
+    if configure:
+        for module in modules:
+            warnings += module.configure(app_dir)
+    return modules, warnings
+
+
+def instruction_set(modules: list[TLM], hints: bool = False) -> InstructionSet:
+    """Built-in instructions plus those of ``modules``. With ``hints``, the
+    mnemonics of installed modules that are not enabled are remembered, so
+    an unknown instruction can be told which module to enable."""
+    extra = []
+    for module in modules:
+        for spec in module.instructions():
+            if spec.module != module.name:
+                raise ModuleError(f"module {module.name} declares {spec.mnemonic} as belonging to {spec.module}")
+            extra.append(spec)
+    unavailable: dict[str, str] = {}
+    if hints:
+        enabled = {m.name for m in modules}
+        for name in installed():
+            if name in enabled:
+                continue
+            try:
+                other = load_module(name)
+                unavailable.update({s.mnemonic: name for s in other.instructions()})
+            except ModuleError:
+                continue  # a broken module that is not enabled gives no hint
+    try:
+        return InstructionSet(extra, unavailable)
+    except ValueError as e:
+        raise ModuleError(str(e)) from None
