@@ -5,8 +5,8 @@ An app directory holds:
 * ``*.lad``: program files (read in name order; FILE headers number them);
 * ``softplc.toml``: optional app settings (see docs/engine.md);
 * ``datatable.json``: optional initial data table values;
-* module config files such as ``MODULES.LST`` and ``COMGENIUS.LST``
-  (read by the plug-in modules);
+* ``MODULES.LST``: the plug-in modules (TLMs) the app enables, and their
+  config files such as ``COMGENIUS.LST`` (read by the modules);
 * ``.softplc/``: the retentive snapshot, kept between runs.
 """
 
@@ -16,11 +16,15 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from .ladder.ast import Pos, Program
+from .ladder.ast import Pos, Program, walk
 from .ladder.errors import LadderError
+from .ladder.instructions import BUILTIN, InstructionSet
 from .ladder.parser import parse_program, syntax_problems
 from .ladder.semantics import Settings
 from .ladder.validate import check
+from .tlm.api import TLM, find_file
+from .tlm.errors import ModuleError
+from .tlm.registry import installed, instruction_set, load_module, load_modules
 
 SETTINGS_FILE = "softplc.toml"
 DATATABLE_FILE = "datatable.json"
@@ -48,6 +52,9 @@ class App:
     datatable_json: Path | None = None
     state_dir: Path | None = None
     problems: list[LadderError] = field(default_factory=list)
+    modules: list[TLM] = field(default_factory=list)  # enabled and configured
+    instructions: InstructionSet = BUILTIN
+    warnings: list[str] = field(default_factory=list)  # from module configs and checks
 
     @property
     def name(self) -> str:
@@ -64,7 +71,7 @@ def lad_files(path: Path) -> list[Path]:
     return [path]
 
 
-def parse_files(files: list[Path], base: Path) -> tuple[Program, list[LadderError]]:
+def parse_files(files: list[Path], base: Path, instructions: InstructionSet = BUILTIN) -> tuple[Program, list[LadderError]]:
     """Parse every file. A file with a syntax error adds nothing to the
     program, but the problems after it in the file are listed too."""
     program = Program()
@@ -76,9 +83,9 @@ def parse_files(files: list[Path], base: Path) -> tuple[Program, list[LadderErro
             errors.append(LadderError(Pos(str(f), 1, 1), f"cannot read: {e}"))
             continue
         try:
-            parse_program(text, _display(f, base), program=program)
+            parse_program(text, _display(f, base), instructions, program=program)
         except LadderError as e:
-            errors.extend(syntax_problems(text, _display(f, base)) or [e])
+            errors.extend(syntax_problems(text, _display(f, base), instructions=instructions) or [e])
     return program, errors
 
 
@@ -131,15 +138,66 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
         raise AppError(f"{path}: the app directory has no .lad program files")
     if not is_dir and path.suffix.lower() != ".lad":
         raise AppError(f"{path}: expected an app directory or a .lad file")
-    parsed, errors = parse_files(files, path)
-    resolved, problems = check(parsed)
+    module_dir = path if is_dir else path.parent
+    try:
+        modules, warnings = load_modules(module_dir)
+        instructions = instruction_set(modules, hints=True)
+    except ModuleError as e:
+        raise AppError(e.report()) from None
+    warnings += _unused_configs(module_dir, modules)
+    parsed, errors = parse_files(files, path, instructions)
+    resolved, problems = check(parsed, instructions)
     errors += problems
     if errors:
         raise AppError(sorted(errors, key=lambda e: (e.pos.source, e.pos.line, e.pos.column)))
+    warnings += [w.report() for w in _module_checks(resolved, modules)]
     settings = load_settings(path / SETTINGS_FILE) if is_dir else Settings()
     table_json = path / DATATABLE_FILE if is_dir and (path / DATATABLE_FILE).exists() else None
     if state_dir is not None:
         state = Path(state_dir)
     else:
         state = path / STATE_DIR if is_dir else None
-    return App(path, is_dir, files, resolved, settings, parsed, table_json, state)
+    return App(path, is_dir, files, resolved, settings, parsed, table_json, state,
+               modules=modules, instructions=instructions, warnings=warnings)
+
+
+def app_instructions(path: Path) -> InstructionSet:
+    """The instruction set of the app at ``path`` (a directory, or the
+    directory of a .lad file): built-in plus its enabled modules'. Module
+    configs are not read (for fmt)."""
+    try:
+        modules, _ = load_modules(path if path.is_dir() else path.parent, configure=False)
+        return instruction_set(modules, hints=True)
+    except ModuleError as e:
+        raise AppError(e.report()) from None
+
+
+def _module_checks(program: Program, modules: list[TLM]) -> list[LadderError]:
+    """Each module's warnings about its own instructions (softplc check)."""
+    owner = {spec.mnemonic: m for m in modules for spec in m.instructions()}
+    found: list[LadderError] = []
+    for pfile in program.files.values():
+        for rung in pfile.rungs:
+            for ins in walk(rung.elements):
+                module = owner.get(ins.mnemonic)
+                if module is not None:
+                    found += module.check(ins)
+    return sorted(found, key=lambda e: (e.pos.source, e.pos.line, e.pos.column))
+
+
+def _unused_configs(app_dir: Path, modules: list[TLM]) -> list[str]:
+    """A module config file in the app directory whose module MODULES.LST
+    does not enable: likely a forgotten line."""
+    enabled = {m.name for m in modules}
+    out = []
+    for name in installed():
+        if name in enabled:
+            continue
+        try:
+            config = load_module(name).config_file
+        except ModuleError:
+            continue
+        found = find_file(app_dir, config) if config else None
+        if found is not None:
+            out.append(f"{found}: {name} is not enabled (add {name} to MODULES.LST), so this file is not read")
+    return out

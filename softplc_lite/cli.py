@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Sequence
 
 from . import __version__
-from .app import AppError, lad_files, load_app, parse_files
+from .app import AppError, app_instructions, lad_files, load_app, parse_files
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
 from .datatable.display import format_value
@@ -71,12 +71,16 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if args.scans is not None and args.scans < 0:
         raise SystemExit("softplc run: error: --scans must be 0 or more")
     app = load_app(args.app, args.state)
+    _print_warnings(app.warnings)
     options = RunOptions(
         scan_ms=args.scan_ms, realtime=args.realtime, fresh=args.fresh,
         load=tuple(args.load or ()), sets=tuple(args.set), executor=args.executor,
     )
     runner = Runner(app, options)
-    runner.run(args.scans)
+    try:
+        runner.run(args.scans)
+    finally:
+        runner.engine.close()
     engine = runner.engine
     runner.save()
     if args.dump:
@@ -96,10 +100,19 @@ def _cmd_check(args: argparse.Namespace) -> int:
         count = len(e.errors) or 1
         print(f"{count} problem{'s' if count != 1 else ''} found", file=sys.stderr)
         return EXIT_ERROR
+    _print_warnings(app.warnings)
     rungs = sum(len(f.rungs) for f in app.program.files.values())
+    extra = "".join(f", module {m.name}" for m in app.modules)
+    if app.warnings:
+        extra += f", {len(app.warnings)} warning{'s' if len(app.warnings) != 1 else ''}"
     print(f"{app.name}: ok ({len(app.program.files)} program file{'s' if len(app.program.files) != 1 else ''}, "
-          f"{rungs} rung{'s' if rungs != 1 else ''})")
+          f"{rungs} rung{'s' if rungs != 1 else ''}{extra})")
     return EXIT_OK
+
+
+def _print_warnings(warnings: list[str]) -> None:
+    for w in warnings:
+        print(f"warning: {w}", file=sys.stderr)
 
 
 def _cmd_fmt(args: argparse.Namespace) -> int:
@@ -107,8 +120,9 @@ def _cmd_fmt(args: argparse.Namespace) -> int:
     if not path.exists():
         raise AppError(f"{path}: no such file or directory")
     files = lad_files(path)
+    instructions = app_instructions(path)
     for k, f in enumerate(files):
-        program, errors = parse_files([f], path)
+        program, errors = parse_files([f], path, instructions)
         if errors:
             raise AppError(errors)
         if len(files) > 1:

@@ -58,7 +58,8 @@ class Runner:
             settings.scan_ms = options.scan_ms
         clock = RealClock() if options.realtime else SimulatedClock(settings.scan_ms)
         self.table = DataTable()
-        self.engine = Engine(app.program, self.table, settings, clock, executor=options.executor)
+        self.engine = Engine(app.program, self.table, settings, clock, executor=options.executor,
+                             modules=app.modules)
         self.restored_from: Path | None = None
         path = app.snapshot_path
         if path is not None and not options.fresh:

@@ -93,11 +93,13 @@ class StrPrint:
         self.params = param_sources(ops[2:])
         self.where = ctx.where()
         self.log = log
-        self.last: str | None = None
+        self.last: str | None = None  # the last output or problem logged (each is logged once, not every scan)
 
     def _fail(self, code: int, message: str) -> None:
         self.machine.minor(S.MINOR_MODULE_BIT, code)
-        self.log(1, f"{self.where}: {message}; the STRING is left as it was (minor fault S:17/3, code {code})")
+        if message != self.last:
+            self.last = message
+            self.log(1, f"{self.where}: {message}; the STRING is left as it was (minor fault S:17/3, code {code})")
 
     def __call__(self, c: bool) -> bool:
         if not c:
