@@ -27,6 +27,7 @@ such as the manual's example 1 costs one ``%`` operation.
 
 from __future__ import annotations
 
+import math
 from functools import lru_cache
 from typing import Callable, Sequence
 
@@ -111,7 +112,10 @@ def _pad(prefix: str, body: str, flags: str, width: int | None, zero_ok: bool) -
 
 def c_float(value: float, conv: str, flags: str, width: int | None, precision: int | None) -> str:
     """One float conversion: Python's ``%`` follows C here (``#``, ``0``,
-    inf and nan included)."""
+    inf and nan included), except that C99 pads an infinity or NaN with
+    spaces even under the ``0`` flag (Python pads it with zeros)."""
+    if "0" in flags and not math.isfinite(value):
+        flags = flags.replace("0", "")
     fmt = "%" + flags + ("" if width is None else str(width)) + ("" if precision is None else f".{precision}") + conv
     return fmt % value
 
@@ -140,7 +144,7 @@ def _python_compatible(spec: Spec) -> bool:
     if spec.width == STAR or spec.precision == STAR:
         return False
     if c in FLOAT_CONVERSIONS:
-        return True
+        return "0" not in flags  # 0: an infinity or NaN is space padded
     if c == "s":
         return "0" not in flags
     if c in "diuoxX":

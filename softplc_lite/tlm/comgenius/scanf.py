@@ -39,6 +39,7 @@ Rules, per the manual where it speaks and C's scanf where it does not:
 
 from __future__ import annotations
 
+import re
 from array import array
 from functools import lru_cache
 from typing import NamedTuple, Sequence
@@ -224,6 +225,14 @@ def _float_end(data: str, pos: int, n: int) -> int:
     return j
 
 
+# Input that more characters could still turn into a longer float: a whole
+# number so far ("1.5"), or one cut short ("-", ".", "1e", "1e+", "in", "na").
+_FLOAT_PREFIX = re.compile(
+    r"[+-]?(?:\d*\.?\d*|(?:\d+\.?\d*|\.\d+)e[+-]?\d*"
+    r"|i(?:n(?:f(?:i(?:n(?:i(?:ty?)?)?)?)?)?)?|n(?:an?)?)",
+    re.IGNORECASE | re.ASCII)
+
+
 def _float(spec: Spec):
     store = not spec.suppressed
 
@@ -232,9 +241,9 @@ def _float(spec: Spec):
         pos = st.skip_ws(pos)
         if pos >= n:
             st.end(pos)
+        if not st.final and _FLOAT_PREFIX.fullmatch(data, pos):
+            st.end(n)  # the number may go on, or has not yet begun
         end = _float_end(data, pos, n)
-        if end >= n and not st.final:
-            st.end(n)  # the number may go on
         if end == pos:
             raise _Stop(pos, False)
         value = float(data[pos:end])
