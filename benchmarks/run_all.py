@@ -1,4 +1,4 @@
-"""Run every benchmark (data table and ladder engine), each in its own process, and summarize.
+"""Run every benchmark (data table, ladder engine, COMGENIUS format engine), each in its own process, and summarize.
 
     python benchmarks/run_all.py
 
@@ -17,7 +17,9 @@ import time
 
 import _common as C
 
-BENCHMARKS = ("bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder")
+BENCHMARKS = (
+    "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_comgenius_format",
+)
 
 
 def main() -> int:
@@ -84,6 +86,21 @@ def main() -> int:
                 f"{r['ratio_reference_over_compiled']:.1f}x the reference [{v['ratio']}], load "
                 f"{r['load']['parse_validate_compile_s']:.2f} s [{v['load']} <= {r['targets']['load_s']:.0f} s]"
             )
+
+    fmt = load("bench_comgenius_format")
+    if fmt:
+        p, sc, d = fmt["strprint_example1"], fmt["strscan_strings_7_8"], fmt["decode_example4"]
+        crc = fmt["crc16"]["4 KiB"]
+        lines.append(
+            f"comgenius STRPRINT ex. 1 {p['fast_us']:.2f} us [{p['verdict']} <= {p['target_us']:.0f}], "
+            f"{p['ratio_naive_over_fast']:.1f}x naive, {p['ratio_fast_over_floor']:.1f}x Python %; "
+            f"STRSCAN 7/8 {sc['fast_us']:.1f} us, {sc['ratio_naive_over_fast']:.1f}x naive"
+        )
+        lines.append(
+            f"          decode ex. 4 {d['fast_us']:.1f} us [{d['verdict']} <= {d['target_us']:.0f}], "
+            f"{d['ratio_naive_over_fast']:.1f}x naive; CRC-16 {crc['bytes_per_s']['crc16'] / 1e6:.1f} MB/s, "
+            f"{crc['ratio_naive_over_table']:.1f}x bitwise"
+        )
 
     print("=== summary " + "=" * 53)
     for line in lines:
