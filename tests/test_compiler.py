@@ -9,9 +9,10 @@ import re
 from softplc_lite.ladder import Engine, load_text
 
 # Every name generated code may use: data arrays, temporaries, rung
-# functions, bound kernels and expression helpers.
+# functions, bound kernels, module (TLM) instruction instances and
+# expression helpers.
 ALLOWED = re.compile(
-    r"^(f\d+|_d\d+|_i\d+|_m\d+|b\d+|o\d+|r\d+|c|_env|_factory|_loc\d+|_jsr|_zone|_x_div|_x_mod|_x_pow|_int|"
+    r"^(f\d+|_d\d+|_i\d+|_m\d+|b\d+|o\d+|r\d+|c|_env|_factory|_loc\d+|_tli\d+|_jsr|_zone|_x_div|_x_mod|_x_pow|_int|"
     r"_fn_[A-Z]+|_[a-z]+(?:_[a-z]+)*|abs|bool)$"
 )
 
@@ -53,7 +54,8 @@ def test_every_example_program_compiles_to_allowed_names():
     for app_dir in sorted((Path(__file__).resolve().parent.parent / "programs").iterdir()):
         if not any(app_dir.glob("*.lad")):
             continue
-        engine = Engine(load_app(app_dir).program)
+        app = load_app(app_dir)
+        engine = Engine(app.program, modules=app.modules)
         for compiled, _ in engine.files.values():
             assert all(ALLOWED.match(n) for n in _names(compiled.source)), app_dir
 

@@ -30,7 +30,9 @@ from ladder_strategies import ADDRESS_SPACE, F8_FLOATS, N7_WORDS, input_seeds, i
 from softplc_lite.datatable import DataTable, to_signed
 from softplc_lite.ladder import Engine, Mode, compiler, validate
 from softplc_lite.ladder.fmt import format_program
+from softplc_lite.app import app_instructions, load_app
 from softplc_lite.ladder.parser import parse_program
+from softplc_lite.tlm import load_modules
 
 SCANS = 50
 REPO = Path(__file__).resolve().parent.parent
@@ -63,15 +65,16 @@ def fault_of(engine):
     return None if f is None else (f.code, f.file, f.rung, f.instruction, f.message)
 
 
-def run_pair(program, initial: dict, words: list[tuple[int, int | None]], space=ADDRESS_SPACE):
+def run_pair(program, initial: dict, words: list[tuple[int, int | None]], space=ADDRESS_SPACE, modules=lambda: ()):
     """Both executors side by side; yields (scan, compiled, reference).
-    ``words``: per scan, the raw I:0 word and B3:0 word (None: leave B3:0)."""
+    ``words``: per scan, the raw I:0 word and B3:0 word (None: leave B3:0).
+    ``modules``: makes each engine its own plug-in modules (TLMs)."""
     engines = []
     for executor in ("compiled", "reference"):
         table = DataTable()
         for addr in [*space, *initial]:
             table.reference(addr)
-        engine = Engine(program, table=table, executor=executor)
+        engine = Engine(program, table=table, executor=executor, modules=modules())
         for addr, value in initial.items():
             engine.table.write(addr, value)
         scan = iter(words)
@@ -132,11 +135,14 @@ def test_fmt_round_trip_random_programs(prog):
 
 
 def _round_trip(path: Path) -> None:
-    program = parse_program(path.read_text(encoding="utf-8"), str(path))
+    # The app's instruction set: the built-in instructions and those of the
+    # modules its MODULES.LST enables.
+    instructions = app_instructions(path)
+    program = parse_program(path.read_text(encoding="utf-8"), str(path), instructions)
     for style in ("mnemonic", "neutral"):
         text = format_program(program, style)
-        assert parse_program(text, f"<{style} of {path.name}>") == program, style
-        assert format_program(parse_program(text), style) == text, style
+        assert parse_program(text, f"<{style} of {path.name}>", instructions) == program, style
+        assert format_program(parse_program(text, instructions=instructions), style) == text, style
 
 
 @pytest.mark.parametrize("path", LAD_FILES or [None], ids=lambda p: str(p.relative_to(REPO)) if p else "none")
@@ -151,9 +157,10 @@ def test_programs_dir_executors_agree(path):
     """Each stand-alone .lad under programs/ runs the same on both executors."""
     if path is None:
         pytest.skip("no .lad files under programs/ yet")
-    program = validate(parse_program(path.read_text(encoding="utf-8"), str(path)))
+    app = load_app(path)
     words = [((k * 40503) & 0xFFFF, None) for k in range(SCANS)]
-    for k, compiled, reference in run_pair(program, {}, words, space=()):
+    modules = lambda: load_modules(path.parent)[0]  # noqa: E731 - fresh modules for each engine
+    for k, compiled, reference in run_pair(app.program, {}, words, space=(), modules=modules):
         assert fault_of(compiled) == fault_of(reference), f"scan {k}"
         assert compiled.table == reference.table, f"scan {k}\n" + table_diff(compiled.table, reference.table)
 
