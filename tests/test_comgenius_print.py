@@ -34,6 +34,8 @@ from softplc_lite.tlm.comgenius.formats import FormatError, params_needed, parse
 from softplc_lite.tlm.comgenius.params import Param, ParamError, ParamKind, TableParam, ValueParam
 from softplc_lite.tlm.comgenius.printf import c_integer, compile_print, format_text
 
+from reference_checks import crc16_modbus_ref
+
 INF = float("inf")
 NAN = float("nan")
 
@@ -50,16 +52,6 @@ def param(v) -> Param:
 def pr(fmt: str, *values) -> str:
     """``format_text`` with plain values as Params."""
     return format_text(fmt, [param(v) for v in values])
-
-
-def crc16_modbus_ref(data: bytes, preload: int) -> int:
-    """CRC-16 bit by bit (poly 0xA001 reflected), independent of checksum.py."""
-    crc = preload
-    for byte in data:
-        crc ^= byte
-        for _ in range(8):
-            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
-    return crc
 
 
 def le2(value: int) -> str:

@@ -32,21 +32,13 @@ from softplc_lite.tlm.comgenius.printf import format_text
 from softplc_lite.tlm.comgenius.scanf import (MATCHED, MISMATCH, NEED_MORE, ScanResult, compile_scan,
                                               scan_text)
 
+from reference_checks import crc16_modbus_ref
+
 WS = " \t\n\r\v\f"
 
 
 def f32(x: float) -> float:
     return struct.unpack("<f", struct.pack("<f", x))[0]
-
-
-def crc16_modbus_ref(data: bytes, preload: int) -> int:
-    """CRC-16 bit by bit (poly 0xA001 reflected), independent of checksum.py."""
-    crc = preload
-    for byte in data:
-        crc ^= byte
-        for _ in range(8):
-            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
-    return crc
 
 
 def chars(data: bytes) -> str:
