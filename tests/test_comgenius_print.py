@@ -522,6 +522,9 @@ def test_check_star_width_and_precision_take_integer_params():
     assert out == "ABCD" + le2(crc16_modbus_ref(b"BC", 0)) + "9"
     assert pr("ABC%*.*S", 0, 1) == "ABC" + le2(sum_ref(b"ABC"))
     assert pr("ABC%.*S", -1) == "ABC" + le2(sum_ref(b"ABC"))  # negative: the default 1
+    # a negative * start offset starts at the first character, not at |offset|
+    assert pr("ABCD%*R", -2) == "ABCD" + le2(crc16_modbus_ref(b"ABCD", 0))
+    assert pr("ABCD%*S", -2) == "ABCD" + le2(sum_ref(b"ABCD"))
 
 
 def test_checksum_helpers():

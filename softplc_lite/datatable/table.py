@@ -480,6 +480,13 @@ def write_string(data: array, start: int, text: Any, where: str) -> None:
         raise ValueRangeError(
             f"U+{wide:X} does not fit {where}: ST characters are UCS-2 (16-bit code units)"
         )
+    store_units(data, start, units)
+
+
+def store_units(data: array, start: int, units: list[int]) -> None:
+    """Store at most STRING_CHARS 16-bit code units into the ST element whose
+    LEN word is ``data[start]``, zeroing the unused rest (one slice write)."""
+    units = units[:STRING_CHARS]
     padded = array("H", units + [0] * (STRING_CHARS - len(units)))
     data[start] = len(units)
     data[start + 1:start + 1 + STRING_CHARS] = array("h", padded.tobytes())

@@ -78,6 +78,24 @@ def _digits(fmt: str, i: int) -> tuple[int | None, int]:
     return (int(fmt[i:j]) if j > i else None), j
 
 
+def _length_and_conversion(fmt: str, start: int, i: int, lengths: str, conversions: str,
+                           listing: str) -> tuple[str, str, int]:
+    """The optional length modifier and the conversion character that end
+    the specification begun at ``start``; both parsers share this tail."""
+    n = len(fmt)
+    length = ""
+    if i < n and fmt[i] in lengths:
+        length = fmt[i]
+        i += 1
+    if i >= n:
+        raise FormatError(start, f"the format ends inside the conversion {fmt[start:]!r}")
+    conv = fmt[i]
+    i += 1
+    if conv not in conversions:
+        raise FormatError(start, f"{fmt[start:i]!r} has no conversion character {conv!r} ({listing})")
+    return length, conv, i
+
+
 def parse_print(fmt: str) -> list[str | Spec]:
     """Literal runs and Specs of a print format, in order."""
     items: list[str | Spec] = []
@@ -110,17 +128,8 @@ def parse_print(fmt: str) -> list[str | Spec]:
             else:
                 precision, i = _digits(fmt, i)
                 precision = precision or 0
-        length = ""
-        if i < n and fmt[i] in "lLh":
-            length = fmt[i]
-            i += 1
-        if i >= n:
-            raise FormatError(start, f"the format ends inside the conversion {fmt[start:]!r}")
-        conv = fmt[i]
-        i += 1
-        if conv not in PRINT_CONVERSIONS:
-            raise FormatError(start, f"{fmt[start:i]!r} has no conversion character {conv!r} "
-                              f"(print conversions: {' '.join(PRINT_CONVERSIONS)})")
+        length, conv, i = _length_and_conversion(fmt, start, i, "lLh", PRINT_CONVERSIONS,
+                                                 f"print conversions: {' '.join(PRINT_CONVERSIONS)}")
         if conv == "%" and i - start == 2:
             literal.append("%")
             continue
@@ -176,17 +185,9 @@ def parse_scan(fmt: str) -> list[str | Spec]:
                 raise FormatError(i, "a scan width or precision may not be '*'")
             precision, i = _digits(fmt, i)
             precision = precision or 0
-        length = ""
-        if i < n and fmt[i] in "lLhH":
-            length = fmt[i]
-            i += 1
-        if i >= n:
-            raise FormatError(start, f"the format ends inside the conversion {fmt[start:]!r}")
-        conv = fmt[i]
-        i += 1
-        if conv not in SCAN_CONVERSIONS:
-            raise FormatError(start, f"{fmt[start:i]!r} has no conversion character {conv!r} "
-                              f"(scan conversions: {' '.join(SCAN_CONVERSIONS)}, %%, % and a space)")
+        length, conv, i = _length_and_conversion(
+            fmt, start, i, "lLhH", SCAN_CONVERSIONS,
+            f"scan conversions: {' '.join(SCAN_CONVERSIONS)}, %%, % and a space")
         items.append(Spec(conv, flags, width, precision, length, start, fmt[start:i]))
     return items
 

@@ -22,7 +22,7 @@ import math
 import struct
 from array import array
 
-from ...datatable.table import STRING_CHARS, read_string, to_signed
+from ...datatable.table import STRING_CHARS, read_string, store_units, to_signed
 
 
 class ParamKind(enum.Enum):
@@ -205,10 +205,4 @@ class TableParam(Param):
             return super().set_string(text)
         # Every 16-bit character is kept (the manual: "all 16 bits of each
         # character"); at most 82 of them fit an ST element.
-        units = [ord(c) & 0xFFFF for c in text[:STRING_CHARS]]
-        d, i = self.data, self.index
-        d[i] = len(units)
-        for k, u in enumerate(units):
-            d[i + 1 + k] = to_signed(u)
-        for k in range(len(units), STRING_CHARS):
-            d[i + 1 + k] = 0
+        store_units(self.data, self.index, [ord(c) & 0xFFFF for c in text[:STRING_CHARS]])

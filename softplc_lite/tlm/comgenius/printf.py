@@ -219,7 +219,9 @@ class PrintFormat:
                 width = _take(params, j, spec).word(0)
                 j += 1
                 if width < 0:
-                    flags, width = flags + "-", -width
+                    # For S and R the width is a start offset, not a field
+                    # width: a negative one starts at the beginning.
+                    flags, width = (flags, 0) if c in "SR" else (flags + "-", -width)
             if star_p:
                 precision = _take(params, j, spec).word(0)
                 j += 1

@@ -40,6 +40,7 @@ Rules, per the manual where it speaks and C's scanf where it does not:
 from __future__ import annotations
 
 import re
+import sys
 from array import array
 from functools import lru_cache
 from typing import NamedTuple, Sequence
@@ -106,6 +107,14 @@ class _Scan:
             pos += 1
         return pos
 
+    def field_start(self, pos: int) -> int:
+        """Skip leading whitespace before a numeric field; the field cannot
+        be decided while the input ends there."""
+        pos = self.skip_ws(pos)
+        if pos >= self.n:
+            self.end(pos)
+        return pos
+
 
 def _literal(text: str):
     size = len(text)
@@ -145,9 +154,7 @@ def _integer(spec: Spec):
 
     def op(st: _Scan, pos: int) -> int:
         data, n = st.data, st.n
-        pos = st.skip_ws(pos)
-        if pos >= n:
-            st.end(pos)
+        pos = st.field_start(pos)
         negative = False
         if data[pos] in "+-":
             negative = data[pos] == "-"
@@ -238,9 +245,7 @@ def _float(spec: Spec):
 
     def op(st: _Scan, pos: int) -> int:
         data, n = st.data, st.n
-        pos = st.skip_ws(pos)
-        if pos >= n:
-            st.end(pos)
+        pos = st.field_start(pos)
         if not st.final and _FLOAT_PREFIX.fullmatch(data, pos):
             st.end(n)  # the number may go on, or has not yet begun
         end = _float_end(data, pos, n)
@@ -275,7 +280,9 @@ def _string(spec: Spec):
 
 def _chars(spec: Spec):
     count = 1 if spec.precision is None else spec.precision
-    big = spec.conv == "C"
+    # Words hold the bytes little endian (c) or big endian (C), whatever
+    # the host's own order: array("h") uses the native one.
+    swap = (spec.conv == "C") != (sys.byteorder == "big")
     store = not spec.suppressed
 
     def op(st: _Scan, pos: int) -> int:
@@ -287,7 +294,7 @@ def _chars(spec: Spec):
             if count & 1:
                 raw += b"\0"
             words = array("h", raw)
-            if big:
+            if swap:
                 words.byteswap()
             st.param(spec).set_words(words)
         return end
