@@ -349,3 +349,19 @@ def test_max_elements_per_file():
     assert t.file("N7").size == 10_000
     with pytest.raises(DataTableError, match="at most 10000"):
         t.file("N7").grow(10_001)
+
+
+@pytest.mark.parametrize("text", [
+    "", "A_STRing", "x" * 82, "y" * 100,        # empty, short, full, truncated to 82
+    "\u0141\u0242\uffff", "\ud800lone",          # all 16 bits, a lone surrogate kept as a unit
+    "a\U0001F600b",                              # above U+FFFF: its low 16 bits
+])
+def test_store_text_keeps_82_units_and_zeroes_the_rest(text):
+    from softplc_lite.datatable.table import STRING_CHARS, read_string, store_text
+    data = array("h", [-1] * (2 + STRING_CHARS))  # garbage before the store
+    store_text(data, 1, text)
+    units = [ord(c) & 0xFFFF for c in text[:STRING_CHARS]]
+    assert data[1] == len(units)
+    assert [w & 0xFFFF for w in data[2:2 + STRING_CHARS]] == units + [0] * (STRING_CHARS - len(units))
+    assert data[0] == -1  # the word before is untouched
+    assert read_string(data, 1) == "".join(map(chr, units))

@@ -15,6 +15,7 @@ PLC rules, not Python ones:
 from __future__ import annotations
 
 import struct
+import sys
 from array import array
 from typing import Any, Iterator, NamedTuple, Union
 
@@ -480,13 +481,20 @@ def write_string(data: array, start: int, text: Any, where: str) -> None:
         raise ValueRangeError(
             f"U+{wide:X} does not fit {where}: ST characters are UCS-2 (16-bit code units)"
         )
-    store_units(data, start, units)
+    store_text(data, start, text)
 
 
-def store_units(data: array, start: int, units: list[int]) -> None:
-    """Store at most STRING_CHARS 16-bit code units into the ST element whose
-    LEN word is ``data[start]``, zeroing the unused rest (one slice write)."""
-    units = units[:STRING_CHARS]
-    padded = array("H", units + [0] * (STRING_CHARS - len(units)))
-    data[start] = len(units)
-    data[start + 1:start + 1 + STRING_CHARS] = array("h", padded.tobytes())
+_NATIVE_UTF16 = "utf-16-le" if sys.byteorder == "little" else "utf-16-be"
+_ZERO_UNITS = bytes(2 * STRING_CHARS)
+
+
+def store_text(data: array, start: int, text: str) -> None:
+    """Store the first STRING_CHARS characters of ``text`` into the ST element
+    whose LEN word is ``data[start]`` and zero the rest, in one slice write.
+    A character above U+FFFF keeps its low 16 bits (ST is UCS-2)."""
+    text = text[:STRING_CHARS]
+    raw = text.encode(_NATIVE_UTF16, "surrogatepass")
+    if len(raw) != 2 * len(text):  # a character above U+FFFF took two units
+        raw = array("H", [ord(c) & RAW_MAX for c in text]).tobytes()
+    data[start] = len(text)
+    data[start + 1:start + 1 + STRING_CHARS] = array("h", raw + _ZERO_UNITS[len(raw):])

@@ -22,7 +22,7 @@ import math
 import struct
 from array import array
 
-from ...datatable.table import STRING_CHARS, read_string, store_units, to_signed
+from ...datatable.table import STRING_CHARS, read_string, store_text, to_signed
 
 
 class ParamKind(enum.Enum):
@@ -205,4 +205,4 @@ class TableParam(Param):
             return super().set_string(text)
         # Every 16-bit character is kept (the manual: "all 16 bits of each
         # character"); at most 82 of them fit an ST element.
-        store_units(self.data, self.index, [ord(c) & 0xFFFF for c in text[:STRING_CHARS]])
+        store_text(self.data, self.index, text)
