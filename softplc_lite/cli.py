@@ -20,6 +20,7 @@ from .ladder.engine import Mode
 from .ladder.errors import LadderError
 from .ladder.fmt import STYLES, format_program
 from .runner import RunOptions, Runner
+from .tlm.errors import ModuleError
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT = 0, 1, 2, 3
 
@@ -75,6 +76,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     options = RunOptions(
         scan_ms=args.scan_ms, realtime=args.realtime, fresh=args.fresh,
         load=tuple(args.load or ()), sets=tuple(args.set), executor=args.executor,
+        ports=tuple(args.port), record=args.record, replay=args.replay,
     )
     runner = Runner(app, options)
     try:
@@ -153,6 +155,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--print", action="append", default=[], metavar="ADDR", help="print a value at the end")
     r.add_argument("--executor", choices=("compiled", "reference"), default="compiled",
                    help="compiled fast path (default) or the reference interpreter")
+    r.add_argument("--port", action="append", default=[], metavar="N=DEVICE",
+                   help="open logical port N on DEVICE (a device path or pyserial URL) instead of its [PORTS] field")
+    r.add_argument("--record", metavar="TRACE", help="record every port's traffic to the TRACE file")
+    r.add_argument("--replay", metavar="TRACE", help="play every port back from a recorded TRACE file")
     r.set_defaults(func=_cmd_run)
 
     c = sub.add_parser("check", help="parse and validate an app; list every problem")
@@ -185,8 +191,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_OK
     try:
         return args.func(args)
-    except (DataTableError, AppError, LadderError) as e:
-        text = e.report() if isinstance(e, LadderError) else str(e)
+    except (DataTableError, AppError, LadderError, ModuleError) as e:
+        text = e.report() if isinstance(e, (LadderError, ModuleError)) else str(e)
         print(f"error: {text}" if not isinstance(e, AppError) else text, file=sys.stderr)
         return EXIT_ERROR
     except OSError as e:

@@ -116,7 +116,13 @@ def _error(text: str) -> ModuleError:
     ("DEBUG=1\n", "C.LST:1: 'DEBUG=1' is outside any section (start with [DRIVER], [PORTS] or [STRINGS])"),
     ("[DRIVERS]\n", "C.LST:1: unknown section [DRIVERS] (sections: [DRIVER], [PORTS], [STRINGS])"),
     ("[DRIVER]\nDEBUG=3\n", "C.LST:2: [DRIVER]: DEBUG must be 0, 1 or 2, not '3'"),
-    ("[DRIVER]\nVERBOSE=1\n", "C.LST:2: [DRIVER]: expected DEBUG=0, 1 or 2, found 'VERBOSE=1'"),
+    ("[DRIVER]\nVERBOSE=1\n", "C.LST:2: [DRIVER]: unknown setting 'VERBOSE' (settings: DEBUG, PORT_ERRORS, "
+                                "RETRY_MS, COM1..COM99)"),
+    ("[DRIVER]\nDEBUG\n", "C.LST:2: [DRIVER]: expected KEY=VALUE (DEBUG=0, 1 or 2), found 'DEBUG'"),
+    ("[DRIVER]\nPORT_ERRORS=maybe\n", "C.LST:2: [DRIVER]: PORT_ERRORS must be STOP (a port that cannot be "
+                                       "opened stops the run) or RETRY (run on, retrying it), not 'maybe'"),
+    ("[DRIVER]\nRETRY_MS=5\n", "C.LST:2: [DRIVER]: RETRY_MS must be at least 10, not 5"),
+    ("[DRIVER]\nCOM3=\n", "C.LST:2: [DRIVER]: COM3= needs a device (e.g. COM3=/dev/ttyUSB0) or a URL"),
     ("[PORTS]\n0, COM1, ISO-8859-1, 38400, 8, N, 1\n",
      "C.LST:2: [PORTS]: expected 8 comma-separated fields (logical port, physical port, encoding, baud, "
      "data bits, parity, stop bits, timeout ms), found 7"),
@@ -151,3 +157,12 @@ def test_at_most_32000_strings():
     ok = "[STRINGS]\n" + '"s"\n' * 32000
     assert len(parse_config(ok).strings) == 32001
     assert _error(ok + '"one too many"\n').report() == "C.LST:32002: [STRINGS]: more than 32000 strings"
+
+
+def test_driver_extensions_port_errors_retry_and_com_devices():
+    config = parse_config("[DRIVER]\nDEBUG=1\nport_errors = retry\nRETRY_MS=250\ncom1=/dev/ttyUSB0\n"
+                          "COM12 = socket://127.0.0.1:5020 ; a TCP bridge\n")
+    assert (config.debug, config.port_errors, config.retry_ms) == (1, "RETRY", 250)
+    assert config.com_devices == {1: "/dev/ttyUSB0", 12: "socket://127.0.0.1:5020"}
+    defaults = parse_config("[DRIVER]\nDEBUG=0\n")
+    assert (defaults.port_errors, defaults.retry_ms, defaults.com_devices) == ("STOP", 1000, {})

@@ -154,6 +154,7 @@ class Engine:
         executor: str = "compiled",
         fresh: bool = True,
         modules=(),
+        module_options=None,
     ) -> None:
         self.program = program
         self.modules = list(modules)  # enabled TLMs (softplc_lite.tlm.TLM)
@@ -180,6 +181,8 @@ class Engine:
         self._depth = 0
         self._deadline = 0.0
         self._owner = {spec.mnemonic: m for m in self.modules for spec in m.instructions()}
+        self.module_warnings: list[str] = []
+        self._attach_modules(module_options or {})
         self._attach_hooks()
         self.files = {}
         build = compile_file if executor == "compiled" else interpret_file
@@ -189,6 +192,17 @@ class Engine:
                                         self._module_instance), zone)
 
     # -- plug-in modules (TLMs) --------------------------------------------------------
+    def _attach_modules(self, options) -> None:
+        attached = []
+        try:
+            for m in self.modules:
+                self.module_warnings += m.attach(self, options)
+                attached.append(m)
+        except BaseException:
+            for m in attached:  # a module refused to start: release what the others opened
+                m.close()
+            raise
+
     def _attach_hooks(self) -> None:
         from ..tlm.api import overrides
 

@@ -53,3 +53,4 @@ MINOR_CODE_STRING = 3
 MINOR_CODE_FORMAT_INDEX = 4  # a format index with no string in the table
 MINOR_CODE_FORMAT = 5  # an illegal format string (e.g. %k)
 MINOR_CODE_PARAM = 6  # a Param missing, of the wrong kind, or past the end of its file
+MINOR_CODE_PORT = 7  # a module instruction names a port that is not configured or is down

@@ -11,10 +11,15 @@ for that app:
    validator and ``fmt`` then know them like built-in ones;
 3. ``check(instr)`` may return warnings about a use the module can judge
    before running (``softplc check`` prints them with their location);
-4. ``create(instr, ctx)`` makes one instance per instruction in the
+4. ``attach(engine, options)`` is called once when an engine takes the
+   module, before the first scan: open what it drives (ports). ``options``
+   holds the run's module options (``softplc run --port/--record/--replay``:
+   keys "ports", "record", "replay"); a module ignores keys it does not use.
+   Raise ModuleError to refuse to start;
+5. ``create(instr, ctx)`` makes one instance per instruction in the
    program. Each scan the engine calls the instance with the rung-in
    condition and takes its return value as the rung-out condition;
-5. the driver hooks ``on_input``/``on_output`` run every scan at the
+6. the driver hooks ``on_input``/``on_output`` run every scan at the
    engine's input and output points, ``on_mode`` on each mode change, and
    ``close`` when the run ends.
 
@@ -26,7 +31,7 @@ from __future__ import annotations
 import sys
 from array import array
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING, Callable, Mapping
 
 from ..datatable.errors import AddressRangeError
 from ..ladder.ast import AddressRef, Const, Instruction
@@ -64,6 +69,10 @@ class TLM:
 
     def create(self, instr: Instruction, ctx: "InstructionContext") -> Instance:
         raise NotImplementedError(f"module {self.name} cannot run {instr.mnemonic}")
+
+    def attach(self, engine: "Engine", options: Mapping[str, object]) -> list[str]:
+        """An engine takes the module (before its first scan); return warnings."""
+        return []
 
     # driver hooks: no-ops unless overridden
     def on_input(self, engine: "Engine") -> None:

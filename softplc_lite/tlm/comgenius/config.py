@@ -62,6 +62,9 @@ class ComGeniusConfig:
     debug: int = 0
     ports: dict[int, PortConfig] = field(default_factory=dict)
     strings: StringTable = field(default_factory=StringTable)
+    port_errors: str = "STOP"  # or "RETRY": what a port that cannot be opened at start does
+    retry_ms: int = 1000  # how often a port that is down is tried again
+    com_devices: dict[int, str] = field(default_factory=dict)  # COMn=device overrides
     warnings: list[str] = field(default_factory=list)
 
 
@@ -120,6 +123,37 @@ def _string_line(raw: str, line: int, path: str, table: StringTable) -> None:
     table.add(value, line)
 
 
+_COM = re.compile(r"COM([1-9][0-9]?)", re.IGNORECASE)
+
+
+def _driver_line(content: str, line: int, path: str, config: "ComGeniusConfig") -> None:
+    """``KEY=VALUE`` in [DRIVER]. The manual has DEBUG only; the other keys
+    are softplc_lite's (docs/serial.md): PORT_ERRORS, RETRY_MS and COMn."""
+    key, eq, value = (part.strip() for part in content.partition("="))
+    name = key.upper()
+    if not eq:
+        raise ModuleError(f"[DRIVER]: expected KEY=VALUE (DEBUG=0, 1 or 2), found {content!r}", path, line)
+    if name == "DEBUG":
+        if value not in ("0", "1", "2"):
+            raise ModuleError(f"[DRIVER]: DEBUG must be 0, 1 or 2, not {value!r}", path, line)
+        config.debug = int(value)
+    elif name == "PORT_ERRORS":
+        if value.upper() not in ("STOP", "RETRY"):
+            raise ModuleError(f"[DRIVER]: PORT_ERRORS must be STOP (a port that cannot be opened stops the run) "
+                              f"or RETRY (run on, retrying it), not {value!r}", path, line)
+        config.port_errors = value.upper()
+    elif name == "RETRY_MS":
+        config.retry_ms = _int_field(value, "RETRY_MS", 10, None,
+                                     lambda m: ModuleError(f"[DRIVER]: {m}", path, line))
+    elif _COM.fullmatch(name):
+        if not value:
+            raise ModuleError(f"[DRIVER]: {key}= needs a device (e.g. {key}=/dev/ttyUSB0) or a URL", path, line)
+        config.com_devices[int(_COM.fullmatch(name).group(1))] = value
+    else:
+        raise ModuleError(f"[DRIVER]: unknown setting {key!r} (settings: DEBUG, PORT_ERRORS, RETRY_MS, "
+                          f"COM1..COM99)", path, line)
+
+
 def parse_config(text: str, path: str = CONFIG_FILE) -> ComGeniusConfig:
     """Read COMGENIUS.LST text; ModuleError on the first problem."""
     config = ComGeniusConfig(path=path)
@@ -148,12 +182,7 @@ def parse_config(text: str, path: str = CONFIG_FILE) -> ComGeniusConfig:
             raise ModuleError(f"{content!r} is outside any section (start with [DRIVER], [PORTS] or [STRINGS])",
                               path, number)
         if section == "DRIVER":
-            key, eq, value = content.partition("=")
-            if not eq or key.strip().upper() != "DEBUG":
-                raise ModuleError(f"[DRIVER]: expected DEBUG=0, 1 or 2, found {content!r}", path, number)
-            if value.strip() not in ("0", "1", "2"):
-                raise ModuleError(f"[DRIVER]: DEBUG must be 0, 1 or 2, not {value.strip()!r}", path, number)
-            config.debug = int(value)
+            _driver_line(content, number, path, config)
         else:
             port = _port_line(content, number, path)
             if port.logical in config.ports:

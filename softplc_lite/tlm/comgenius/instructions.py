@@ -69,6 +69,19 @@ def _param(op: BoundOperand) -> Param:
     return TableParam(_KINDS.get(op.address.kind, ParamKind.INTEGER), d, i, op.text)
 
 
+def param_problem(items, params: Sequence[Param], scan: bool) -> str | None:
+    """Too few Params, or one of the wrong kind, for a parsed format: what
+    COMSCAN reports at its start, before any input could hide it."""
+    needed = params_needed(items, scan)
+    if len(needed) > len(params):
+        return (f"too few Params: the format needs {len(needed)}, "
+                f"{len(params)} {'was' if len(params) == 1 else 'were'} given")
+    for k, ((item, kind), p) in enumerate(zip(needed, params), start=1):
+        if p.kind.value != kind:
+            return f"Param {k} ({p.name}) is a {p.kind.value} param; {item.text} needs a {kind}"
+    return None
+
+
 class FormatSource:
     """The format operand: a string table index, constant or from a word."""
 

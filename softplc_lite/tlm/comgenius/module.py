@@ -10,13 +10,18 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
+from typing import Mapping
 
-from ...ladder.ast import Instruction
+from ...ladder.ast import Const, Instruction
 from ...ladder.errors import LadderError
 from ...ladder.instructions import InstructionSpec
 from ..api import TLM, InstructionContext, Instance
+from ..errors import ModuleError
 from .config import CONFIG_FILE, ComGeniusConfig, load_config
+from .com import (COMPRINT, COMRCVCLEAR, COMRCVSTS, COMSCAN, COMXMITCLEAR, ComPrint, ComRcvClear, ComRcvSts,
+                  ComScan, ComXmitClear)
 from .instructions import STRPRINT, STRSCAN, StrPrint, StrScan, check_format_use
+from .ports import PortSet
 
 
 class ComGenius(TLM):
@@ -26,6 +31,10 @@ class ComGenius(TLM):
 
     def __init__(self, config: ComGeniusConfig | None = None) -> None:
         self.config = config or ComGeniusConfig()
+        self.ports: PortSet | None = None
+        self.engine = None
+        self.recorder = None
+        self.replays: list = []
 
     def configure(self, app_dir: Path | None) -> list[str]:
         if app_dir is not None:
@@ -33,23 +42,125 @@ class ComGenius(TLM):
         return list(self.config.warnings)
 
     def instructions(self) -> list[InstructionSpec]:
-        return [STRPRINT, STRSCAN]
+        return [COMPRINT, COMSCAN, COMRCVCLEAR, COMXMITCLEAR, COMRCVSTS, STRPRINT, STRSCAN]
 
     def check(self, instr: Instruction) -> list[LadderError]:
-        if instr.mnemonic == "STRPRINT":
-            return check_format_use(instr, self.config.strings, 1, scan=False)
-        if instr.mnemonic == "STRSCAN":
-            return check_format_use(instr, self.config.strings, 2, scan=True)
-        return []
+        m = instr.mnemonic
+        found = []
+        if m in ("COMPRINT", "COMSCAN", "COMRCVCLEAR", "COMXMITCLEAR", "COMRCVSTS"):
+            found += check_port_use(instr, 1 if m in ("COMPRINT", "COMSCAN") else 0, self.config)
+        if m == "STRPRINT":
+            found += check_format_use(instr, self.config.strings, 1, scan=False)
+        elif m == "STRSCAN":
+            found += check_format_use(instr, self.config.strings, 2, scan=True)
+        elif m in ("COMPRINT", "COMSCAN"):
+            found += check_format_use(instr, self.config.strings, 2, scan=m == "COMSCAN")
+        return found
+
+    # -- the driver ------------------------------------------------------------------------
+    def attach(self, engine, options: Mapping[str, object]) -> list[str]:
+        """Open the ports (manual: at start). ``options``: "ports" {logical:
+        device or URL} replaces physical fields, "record" a trace file to
+        write, "replay" a trace file to play every port from."""
+        self.engine = engine
+        clock = engine.clock
+        if getattr(clock, "realtime", False):
+            now_ns = time.monotonic_ns
+        else:
+            def now_ns(clock=clock) -> int:
+                return clock.now_ms * 1_000_000
+        self.now_ns = now_ns
+        overrides = dict(options.get("ports") or {})
+        replay = options.get("replay")
+        if replay:
+            for number in self.config.ports:
+                overrides.setdefault(number, f"replay://{replay}?port={number}")
+        unknown = sorted(set(overrides) - set(self.config.ports))
+        if unknown:
+            raise ModuleError(f"--port {unknown[0]}=...: logical port {unknown[0]} has no line in [PORTS] "
+                              f"(ports: {', '.join(map(str, self.config.ports)) or 'none'})", self.config.path)
+        self.ports = PortSet(self.config, self.debug, now_ns, overrides)
+        warnings = self.ports.open_all()
+        if options.get("record"):
+            self._start_recording(str(options["record"]))
+        return warnings
+
+    def _start_recording(self, path: str) -> None:
+        from .trace import TraceWriter
+
+        comments = [f"port {p.number}: {p.config.physical} -> {p.url} {p.config.baud} "
+                    f"{p.config.data_bits}{p.config.parity}{p.config.stop_bits} {p.config.encoding}"
+                    for p in self.ports.ports.values()]
+        try:
+            self.recorder = TraceWriter(path, comments)
+        except OSError as e:
+            self.ports.close()
+            raise ModuleError(f"--record: cannot write {path}: {e.strerror}") from None
+        start = self.now_ns()
+
+        def record(port: int, direction: str, data: bytes) -> None:
+            self.recorder.event((self.now_ns() - start) / 1e6, port, direction, data)
+
+        for p in self.ports.ports.values():
+            p.record = record
+
+    def on_input(self, engine) -> None:
+        if self.ports is not None:
+            self.ports.poll_input()
+
+    def on_output(self, engine, outputs_enabled: bool) -> None:
+        # Ports are communication, not outputs: TEST mode still talks (as a
+        # SoftPLC does in its test mode, where only the I/O image is held).
+        if self.ports is not None:
+            self.ports.flush_output()
+
+    def close(self) -> None:
+        if self.ports is not None:
+            for p in self.ports.ports.values():
+                serial = p.serial
+                if serial is not None and hasattr(serial, "report") and hasattr(serial, "mismatches"):
+                    self.log(serial.report())  # a replay port says whether the output matched
+            self.ports.close()
+        if self.recorder is not None:
+            self.recorder.close()
+            self.recorder = None
 
     def create(self, instr: Instruction, ctx: InstructionContext) -> Instance:
-        if instr.mnemonic == "STRPRINT":
+        m = instr.mnemonic
+        if m == "STRPRINT":
             return StrPrint(ctx, self.config.strings, self.debug)
-        if instr.mnemonic == "STRSCAN":
+        if m == "STRSCAN":
             return StrScan(ctx, self.config.strings, self.debug)
+        if self.ports is None:  # created outside an engine that attached us
+            self.ports = PortSet(self.config, self.debug, lambda: ctx.now_ms * 1_000_000)
+        if m == "COMPRINT":
+            return ComPrint(ctx, self.ports, self.config.strings, self.debug)
+        if m == "COMSCAN":
+            return ComScan(ctx, self.ports, self.config.strings, self.debug)
+        if m == "COMRCVCLEAR":
+            return ComRcvClear(ctx, self.ports, self.debug)
+        if m == "COMXMITCLEAR":
+            return ComXmitClear(ctx, self.ports, self.debug)
+        if m == "COMRCVSTS":
+            return ComRcvSts(ctx, self.ports, self.debug)
         return super().create(instr, ctx)
 
     def debug(self, level: int, message: str) -> None:
-        """DEBUG=1 logs errors, DEBUG=2 also each result (manual 5.1)."""
+        """DEBUG=1 logs port events and errors, DEBUG=2 also every frame in
+        hex and each result (manual 5.1); DEBUG=0 is silent."""
         if self.config.debug >= level:
-            self.log(f"{time.strftime('%H:%M:%S')} {message}")
+            t = time.time()
+            stamp = time.strftime("%H:%M:%S", time.localtime(t)) + f".{int(t * 1000) % 1000:03d}"
+            engine_ms = self.engine.clock.now_ms if self.engine is not None else 0
+            self.log(f"{stamp} t={engine_ms}ms {message}")
+
+
+def check_port_use(instr: Instruction, port_at: int, config: ComGeniusConfig) -> list[LadderError]:
+    """A constant port with no [PORTS] line: ER (or a minor fault) at run time."""
+    op = instr.operands[port_at]
+    if isinstance(op, Const) and op.value not in config.ports:
+        have = ", ".join(str(n) for n in config.ports) or "none"
+        return [LadderError(op.pos, f"{instr.mnemonic}: port {op.value} is not configured in [PORTS] of "
+                            f"{config.path} (configured: {have}); it will set "
+                            f"{'ER' if port_at else 'a minor fault'}")]
+    return []

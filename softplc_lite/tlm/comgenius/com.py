@@ -1,0 +1,224 @@
+"""The port instructions: COMPRINT, COMSCAN, COMRCVCLEAR, COMXMITCLEAR, COMRCVSTS
+(manual 4.3.1-4.3.5).
+
+``COMPRINT Control Port Format Param...`` starts on a false-to-true rung
+transition: it formats its output once, then puts all of it into the
+port's transmit buffer, or none of it while the buffer lacks room (no DN
+while it waits, no timeout). Queued: DN, LEN = bytes. A bad format index,
+bad or unconfigured port, a port that is down, an illegal format or a bad
+Param: DN ER. A false rung clears EN DN ER; an output still waiting for
+room is dropped.
+
+``COMSCAN Control Port Format Param...`` starts on the transition and each
+true scan matches the port's receive buffer against the format:
+
+============================================  ===========================================================
+matched                                       DN; LEN characters taken from the buffer; POS specs matched
+cannot match                                  DN ER; LEN the offset of the mismatch; POS; nothing taken
+more input needed, timeout expired            DN ER EM; LEN characters read; POS; nothing taken
+more input needed, within the timeout         no DN; LEN, POS as far as it got; it tries again next scan
+rung false before completion                  EN DN ER EM off; no completion
+============================================  ===========================================================
+
+The timeout is the port's ``[PORTS]`` timeout, measured on the engine's
+clock from the transition. Params are written while matching, whether or
+not the match completes (the manual's "staging areas").
+
+``COMRCVCLEAR Port``, ``COMXMITCLEAR Port`` and ``COMRCVSTS Port Counter``
+have no CONTROL: like STRPRINT they act on every scan their rung is true.
+COMRCVSTS sets the counter's PRE to the receive buffer size, ACC to the
+characters waiting, and OV while the buffer has overflowed. A bad port
+makes them raise minor fault S:17/3 with code 7 and do nothing else.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from ...ladder import status as S
+from ...ladder.instructions import K
+from ...ladder.semantics import OV
+from ..api import BoundOperand, ControlElement, ControlledInstruction, InstructionContext
+from .formats import FormatError, parse_scan
+from .instructions import _PARAMS, _PARAMS_OUT, FormatSource, param_problem, param_sources, spec
+from .params import ParamError
+from .ports import Port, PortSet
+from .printf import MAX_PARAMS, compile_print
+from .scanf import MATCHED, MISMATCH, compile_scan
+from .strings import StringTable
+
+COMPRINT = spec("COMPRINT", "format and send to a port", ("control", K.CONTROL), ("port", K.PORT),
+                ("format", K.FORMAT), *_PARAMS, optional=MAX_PARAMS)
+COMSCAN = spec("COMSCAN", "receive and match from a port", ("control", K.CONTROL), ("port", K.PORT),
+               ("format", K.FORMAT), *_PARAMS_OUT, optional=MAX_PARAMS)
+COMRCVCLEAR = spec("COMRCVCLEAR", "clear a port's receive buffer", ("port", K.PORT))
+COMXMITCLEAR = spec("COMXMITCLEAR", "clear a port's transmit buffer", ("port", K.PORT))
+COMRCVSTS = spec("COMRCVSTS", "receive buffer status into a counter", ("port", K.PORT), ("counter", K.COUNTER))
+
+Log = Callable[[int, str], None]
+
+
+class _PortOperand:
+    def __init__(self, operand: BoundOperand, ports: PortSet) -> None:
+        self.operand = operand
+        self.ports = ports
+
+    def get(self) -> tuple[Port | None, str | None]:
+        return self.ports.lookup(int(self.operand.value()))
+
+
+class _Controlled(ControlledInstruction):
+    """COMPRINT and COMSCAN: CONTROL, Port, Format, Params."""
+
+    def __init__(self, ctx: InstructionContext, ports: PortSet, strings: StringTable, log: Log) -> None:
+        super().__init__(ctx.operands[0])
+        ops = ctx.operands
+        self.port = _PortOperand(ops[1], ports)
+        self.format = FormatSource(ops[2], strings)
+        self.params = param_sources(ops[3:])
+        self.where = ctx.where()
+        self.log = log
+        self.ctx = ctx
+
+    def _error(self, ctl: ControlElement, message: str, empty: bool = False) -> bool:
+        ctl.finish(error=True, empty=empty)
+        self.log(1, f"{self.where}: {message} ({'ER EM' if empty else 'ER'})")
+        return True
+
+
+class ComPrint(_Controlled):
+    pending: tuple[Port, bytes] | None = None
+
+    def start(self, ctl: ControlElement) -> bool:
+        ctl.len = 0
+        port, problem = self.port.get()
+        if port is None:
+            return self._error(ctl, problem)
+        index, fmt = self.format.text()
+        if fmt is None:
+            return self._error(ctl, self.format.problem(index))
+        try:
+            out = compile_print(fmt).render(self.params())
+        except FormatError as e:
+            return self._error(ctl, f"format {index}: {e}")
+        except ParamError as e:
+            return self._error(ctl, f"format {index}: {e.reason}")
+        data = port.encoding.encode(out)
+        if len(data) > port.tx_size:
+            return self._error(ctl, f"format {index}: {len(data)} bytes never fit the {port.tx_size}-byte "
+                                    f"transmit buffer of port {port.number}")
+        self.pending = (port, data)
+        return self.step(ctl)
+
+    def step(self, ctl: ControlElement) -> bool:
+        port, data = self.pending
+        if not port.up:
+            self.pending = None
+            return self._error(ctl, f"port {port.number} is down: {port.error}")
+        if not port.queue(data):
+            return False  # waits for room: no DN, no timeout
+        self.pending = None
+        ctl.len = len(data)
+        ctl.finish()
+        return True
+
+    def cancel(self) -> None:
+        self.pending = None  # rung went false while waiting: no output
+
+
+class ComScan(_Controlled):
+    port_obj: Port | None = None
+
+    def start(self, ctl: ControlElement) -> bool:
+        ctl.len = 0
+        ctl.pos = 0
+        self.started_ms = self.ctx.now_ms
+        port, problem = self.port.get()
+        if port is None:
+            return self._error(ctl, problem)
+        index, fmt = self.format.text()
+        if fmt is None:
+            return self._error(ctl, self.format.problem(index))
+        try:
+            self.matcher = compile_scan(fmt)
+            problem = param_problem(parse_scan(fmt), self.params(), scan=True)
+        except FormatError as e:
+            return self._error(ctl, f"format {index}: {e}")
+        except ParamError as e:  # an indirect Param address that resolves nowhere
+            return self._error(ctl, f"format {index}: {e.reason}")
+        if problem:
+            return self._error(ctl, f"format {index}: {problem}")
+        self.index = index
+        self.port_obj = port
+        return self.step(ctl)
+
+    def step(self, ctl: ControlElement) -> bool:
+        port = self.port_obj
+        if not port.up:
+            return self._error(ctl, f"port {port.number} is down: {port.error}")
+        try:
+            result = self.matcher.match(port.rx, self.params(), final=False)
+        except ParamError as e:
+            return self._error(ctl, f"format {self.index}: {e.reason}")
+        ctl.len = result.used
+        ctl.pos = result.specs
+        if result.status == MATCHED:
+            port.take(result.used)
+            ctl.finish()
+            self.log(2, f"{self.where}: matched {result.used} characters, {result.specs} specs")
+            return True
+        if result.status == MISMATCH:
+            ctl.finish(error=True)
+            self.log(2, f"{self.where}: mismatch at offset {result.used} after {result.specs} specs (ER)")
+            return True
+        if self.ctx.now_ms - self.started_ms >= port.config.timeout_ms:
+            return self._error(ctl, f"timeout after {port.config.timeout_ms} ms with {len(port.rx)} "
+                                    f"characters waiting", empty=True)
+        return False
+
+
+class _PortAction:
+    """COMRCVCLEAR, COMXMITCLEAR, COMRCVSTS: every true scan."""
+
+    def __init__(self, ctx: InstructionContext, ports: PortSet, log: Log) -> None:
+        self.port = _PortOperand(ctx.operands[0], ports)
+        self.machine = ctx.machine
+        self.ctx = ctx
+        self.where = ctx.where()
+        self.log = log
+        self.last_problem: str | None = None
+
+    def __call__(self, c: bool) -> bool:
+        if not c:
+            return c
+        port, problem = self.port.get()
+        if port is None:
+            self.machine.minor(S.MINOR_MODULE_BIT, S.MINOR_CODE_PORT)
+            if problem != self.last_problem:  # logged once, not every scan
+                self.log(1, f"{self.where}: {problem} (minor fault S:17/3, code {S.MINOR_CODE_PORT})")
+            self.last_problem = problem
+            return c
+        self.last_problem = None
+        self.act(port)
+        return c
+
+    def act(self, port: Port) -> None:
+        raise NotImplementedError
+
+
+class ComRcvClear(_PortAction):
+    def act(self, port: Port) -> None:
+        port.clear_rx()
+
+
+class ComXmitClear(_PortAction):
+    def act(self, port: Port) -> None:
+        port.clear_tx()
+
+
+class ComRcvSts(_PortAction):
+    def act(self, port: Port) -> None:
+        d, i, _ = self.ctx.operands[1].location()
+        d[i + 1] = min(port.rx_size, 0x7FFF)  # PRE
+        d[i + 2] = len(port.rx)  # ACC
+        d[i] = (d[i] | OV) if port.overflow else (d[i] & ~OV)
