@@ -74,3 +74,20 @@ def test_subroutines(executor):
     t.write("B3/0", 1)  # the JMP now skips the counting rung
     r.run(10)
     assert t.read("N7:3") == 100 and t.read("N7:0") == 110
+
+
+@pytest.mark.parametrize("executor", ["compiled", "reference"])
+def test_loopback_prints_and_matches_its_echo_every_poll(executor):
+    r = runner("loopback", executor)
+    try:
+        sent = []
+        r.run(100, on_scan=lambda e: sent.append(e.table.read("R6:0/DN")))
+        t = r.table
+        good = t.read("C5:0.ACC")
+        polls = sum(1 for k in range(1, len(sent)) if sent[k] and not sent[k - 1])
+        assert good >= 10 and t.read("C5:1.ACC") == 0  # every echo matched
+        assert polls in (good, good + 1)  # the last poll may still be waiting for its echo
+        assert t.read("N7:0") == 5 + good and t.read("N7:10") == 5 + good - 1  # last rack matched back
+        assert t.read("N7:11") == 2 and t.read("R6:1.LEN") == 30
+    finally:
+        r.engine.close()

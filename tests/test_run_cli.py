@@ -145,3 +145,34 @@ def test_without_scans_it_runs_until_ctrl_c_then_saves(app):
     assert 20 < scans < 400  # about 5 ms per scan for about a second
     p = softplc("run", str(app), "--scans", "1", "--print", "N7:0")
     assert p.stdout == f"N7:0 = {scans + 1}\n"
+
+
+def test_record_then_replay_repeats_the_run_and_reports_differences(tmp_path):
+    trace = tmp_path / "loop.trace"
+    args = ("run", "programs/loopback", "--fresh", "--state", str(tmp_path / "state"), "--scans", "30",
+            "--print", "C5:0.ACC", "--print", "N7:10")
+    first = softplc(*args, "--record", str(trace))
+    assert first.returncode == 0, first.stderr
+    assert first.stdout == "C5:0.ACC = 4\nN7:10 = 8\n"
+    lines = trace.read_text().splitlines()
+    assert lines[0] == "# softplc_lite port trace 1" and sum(" TX " in ln for ln in lines) == 4
+    again = softplc(*args, "--replay", str(trace))
+    assert again.returncode == 0, again.stderr
+    assert again.stdout == first.stdout
+    assert "4 of 4 exchanges, output matched" in again.stderr
+    # change what the recording says the program sent first: the replay names the line and byte
+    trace.write_text(trace.read_text().replace(" TX 52", " TX 53", 1))
+    changed = softplc(*args, "--replay", str(trace))
+    assert "1 output difference(s)" in changed.stderr and "line 3: TX 0 byte 0: expected 53, got 52" in changed.stderr
+
+
+def test_port_override_and_a_missing_device(tmp_path):
+    args = ("run", "programs/loopback", "--fresh", "--state", str(tmp_path / "state"), "--scans", "30")
+    missing = softplc(*args, "--port", "0=/dev/softplc-no-such-tty")
+    assert missing.returncode == 1
+    assert missing.stderr.startswith("error: ") and "COMGENIUS.LST:10: [PORTS]: port 0: cannot open " \
+        "/dev/softplc-no-such-tty" in missing.stderr and "Traceback" not in missing.stderr
+    bad = softplc(*args, "--port", "zero=loop://")
+    assert bad.returncode == 1 and "expected N=DEVICE" in bad.stderr
+    unknown = softplc(*args, "--port", "3=loop://")
+    assert unknown.returncode == 1 and "logical port 3 has no line in [PORTS]" in unknown.stderr
