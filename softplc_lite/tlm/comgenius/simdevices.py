@@ -1,0 +1,148 @@
+"""Simulated devices: what sits at the far end of ``sim://NAME?device=KIND``.
+
+A device kind is registered with ``register_device(kind, factory)``; the
+factory gets the URL's remaining query options as ``dict[str, str]`` and
+returns a ``SimDevice``, or raises ``ValueError`` for an unknown or bad
+option (``check_options`` helps). The ``sim://`` handler turns that into a
+``SerialException``. Register a kind at import of the module that defines
+it, before a port opens a URL naming it.
+
+The device API (all times are int ns on the clock of the port the device
+is attached to):
+
+- ``attach(end)``: called once, before any other call. ``end.send(data,
+  at_ns)`` transmits toward the port, timed like a port write at ``at_ns``
+  (behind whatever the device sent before); ``end.char_ns`` is the character
+  time of the port's current settings (0 at ``rate=unlimited``).
+- ``receive(data, times_ns)``: bytes that have arrived from the port, with
+  each byte's arrival time (non-decreasing). One call may hold several
+  bursts: compare the times to find gaps.
+- ``poll(now_ns)``: called every time the port is used (read, in_waiting,
+  write, out_waiting), after ``receive`` has been given everything that
+  arrived by ``now_ns``. Decide time-based things here (a frame ends after
+  silence) and answer with ``end.send(reply, at_ns)``: an ``at_ns`` in the
+  past of ``now_ns`` is honoured, so the reply is timed from the moment the
+  device would really have answered, not from when the port looked.
+
+The ``echo`` device sends every received burst back. A burst is a run of
+bytes each arriving no later than 3.5 character times after the one before;
+it is complete once the port's clock reaches (last byte's arrival + 3.5
+character times), and the echo starts at (last byte's arrival +
+max(delay_ms, 3.5 character times)). Option: ``delay_ms`` (default 0).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Callable, Iterable
+
+if TYPE_CHECKING:
+    from .wire import DeviceEnd
+
+
+class SimDevice:
+    """Base class of simulated devices; the default methods do nothing."""
+
+    name = "device"
+
+    def attach(self, end: "DeviceEnd") -> None:
+        self.end = end
+
+    def receive(self, data: bytes, times_ns: list[int]) -> None:
+        pass
+
+    def poll(self, now_ns: int) -> None:
+        pass
+
+
+DeviceFactory = Callable[[dict[str, str]], SimDevice]
+DEVICES: dict[str, DeviceFactory] = {}
+
+
+def register_device(kind: str, factory: DeviceFactory) -> None:
+    """Make ``sim://NAME?device=kind`` create its device with ``factory(options)``.
+    Registering the same factory again is harmless; another one for a taken
+    kind is a ValueError."""
+    if not kind or not kind.replace("_", "").isalnum():
+        raise ValueError(f"device kind {kind!r} must be letters, digits and _")
+    known = DEVICES.get(kind)
+    if known is not None and known is not factory:
+        raise ValueError(f"device kind {kind!r} is already registered")
+    DEVICES[kind] = factory
+
+
+def create_device(kind: str, options: dict[str, str]) -> SimDevice:
+    """A new device of ``kind``; ValueError for an unknown kind or a bad option."""
+    factory = DEVICES.get(kind)
+    if factory is None:
+        raise ValueError(f"unknown device kind {kind!r} (known: {', '.join(sorted(DEVICES))})")
+    return factory(dict(options))
+
+
+def check_options(kind: str, options: dict[str, str], known: Iterable[str]) -> None:
+    """ValueError naming the first option not in ``known``."""
+    known = list(known)
+    for key in options:
+        if key not in known:
+            allowed = ", ".join(known) if known else "none"
+            raise ValueError(f"{kind} device: unknown option {key!r} (known: {allowed})")
+
+
+def float_option(kind: str, options: dict[str, str], key: str, default: float, minimum: float = 0.0) -> float:
+    """``options[key]`` as a finite float >= ``minimum`` (``default`` when absent)."""
+    if key not in options:
+        return default
+    try:
+        value = float(options[key])
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value < minimum:
+        raise ValueError(f"{kind} device: {key} must be a number >= {minimum:g}, not {options[key]!r}")
+    return value
+
+
+def silence_ns(char_ns: int) -> int:
+    """3.5 character times in ns, rounded half up (911460 at 38400 8N1)."""
+    return (7 * char_ns + 1) // 2
+
+
+class EchoDevice(SimDevice):
+    """Sends each received burst back (see the module docstring for the timing)."""
+
+    name = "echo"
+
+    def __init__(self, delay_ms: float = 0.0) -> None:
+        self.delay_ns = round(delay_ms * 1_000_000)
+        self._burst = bytearray()
+        self._last = 0
+
+    def receive(self, data: bytes, times_ns: list[int]) -> None:
+        gap = silence_ns(self.end.char_ns)
+        start = 0
+        previous = self._last if self._burst else None
+        for i, t in enumerate(times_ns):
+            if previous is not None and t - previous > gap:
+                self._burst += data[start:i]
+                self._last = previous
+                self._flush(gap)
+                start = i
+            previous = t
+        self._burst += data[start:]
+        self._last = times_ns[-1]
+
+    def poll(self, now_ns: int) -> None:
+        gap = silence_ns(self.end.char_ns)
+        if self._burst and now_ns >= self._last + gap:
+            self._flush(gap)
+
+    def _flush(self, gap: int) -> None:
+        self.end.send(bytes(self._burst), self._last + max(self.delay_ns, gap))
+        self._burst.clear()
+
+
+def _echo(options: dict[str, str]) -> EchoDevice:
+    check_options("echo", options, ["delay_ms"])
+    return EchoDevice(float_option("echo", options, "delay_ms", 0.0))
+
+
+register_device("echo", _echo)

@@ -1,0 +1,452 @@
+"""The simulated wire: character timing, links between two ends, the clock.
+
+Timing model (docs/simulated-wire.md explains it for users):
+
+- A character takes ``1 start bit + data bits + (1 if parity) + stop bits``
+  bit times: ``char_time_ns()`` gives it in whole nanoseconds, rounded to the
+  nearest (10 bits at 38400 baud: 260417 ns). The SENDER's settings decide
+  it; the receiver's settings do not matter (bytes arrive unchanged).
+- Each direction of a link is a ``Wire``: a queue of chunks, one per write
+  (``start_ns``, ``char_ns``, bytes, how many were taken). Bytes written at
+  ``t`` start at ``max(t, wire free)``; byte ``j`` (0-based) of the write
+  arrives at ``start + (j + 1) * char_ns``, and the wire is free again after
+  the last one. A receiver sees a byte once its clock reads at least the
+  byte's arrival time. Availability is computed from the chunk, never with
+  one Python object per byte.
+- ``char_ns == 0`` is the unlimited rate: a write arrives whole at once.
+
+Links: ``open_port_end(name)`` makes the calling port one end of the link
+``name`` (process-wide registry, thread-safe); the second call makes the
+other end, a third raises ``SerialException``. ``open_device_end(name,
+device)`` makes a link whose other end is a simulated device (simdevices.py).
+A link is forgotten when its ports are closed, so its name can be reused.
+
+The device side is "pumped" whenever its port end is used (``read``,
+``available``, ``write``, ``pending``): every byte that has arrived at the
+device by the port's clock is handed to ``device.receive(data, times_ns)``,
+then ``device.poll(now_ns)`` runs. A device answers with
+``DeviceEnd.send(data, at_ns)``, timed from ``at_ns`` even when that is
+already in the past of the port's clock (turnaround is exact, not rounded up
+to when the port next looks).
+
+``ClockedSerial`` is the pyserial base shared by the ``sim://`` and
+``replay://`` ports: ``set_clock()``, and reads that block only with the
+real-time default clock.
+"""
+
+from __future__ import annotations
+
+import numbers
+import threading
+import time
+from collections import deque
+from typing import TYPE_CHECKING, Callable
+
+from serial.serialutil import PortNotOpenError, SerialBase, SerialException, to_bytes
+
+if TYPE_CHECKING:
+    from .simdevices import SimDevice
+
+NS_PER_S = 1_000_000_000
+
+Clock = Callable[[], int]
+
+
+def char_time_ns(baudrate: int, bytesize: int = 8, parity: str = "N", stopbits: float = 1) -> int:
+    """Time of one character on the wire in whole ns (rounded half up).
+
+    >>> char_time_ns(38400), char_time_ns(38400, 7, "E", 1), char_time_ns(38400, 8, "N", 2)
+    (260417, 260417, 286458)
+    """
+    if not isinstance(baudrate, numbers.Integral) or baudrate <= 0:
+        raise ValueError(f"invalid baudrate: {baudrate!r}")
+    half_bits = 2 * (1 + bytesize + (parity != "N")) + round(2 * stopbits)
+    return (half_bits * NS_PER_S + baudrate) // (2 * baudrate)
+
+
+def mask_table(bytesize: int) -> bytes | None:
+    """A ``bytes.translate`` table keeping the low ``bytesize`` bits, or None for 8."""
+    if bytesize >= 8:
+        return None
+    keep = (1 << bytesize) - 1
+    return bytes(b & keep for b in range(256))
+
+
+class _Chunk:
+    """One write on a wire: ``data`` starts at ``start``, one byte every ``char_ns``."""
+
+    __slots__ = ("start", "char_ns", "data", "taken")
+
+    def __init__(self, start: int, char_ns: int, data: bytes) -> None:
+        self.start = start
+        self.char_ns = char_ns
+        self.data = data
+        self.taken = 0
+
+    def arrived(self, now: int) -> int:
+        """How many of the chunk's bytes have arrived by ``now`` (taken or not)."""
+        if self.char_ns == 0:
+            return len(self.data) if now >= self.start else 0
+        n = (now - self.start) // self.char_ns
+        if n <= 0:
+            return 0
+        return n if n < len(self.data) else len(self.data)
+
+    def end(self) -> int:
+        return self.start + len(self.data) * self.char_ns
+
+
+class Wire:
+    """One direction of a link: bytes in flight and arrived, not yet taken."""
+
+    def __init__(self) -> None:
+        self.chunks: deque[_Chunk] = deque()
+        self.free_at = 0  # when the last byte sent so far has arrived
+
+    def send(self, data: bytes, at_ns: int, char_ns: int) -> None:
+        if not data:
+            return
+        start = at_ns if at_ns > self.free_at else self.free_at
+        self.chunks.append(_Chunk(start, char_ns, data))
+        self.free_at = start + len(data) * char_ns
+
+    def available(self, now: int) -> int:
+        """Bytes arrived by ``now`` and not yet taken."""
+        total = 0
+        for chunk in self.chunks:
+            n = chunk.arrived(now)
+            total += n - chunk.taken
+            if n < len(chunk.data):
+                break
+        return total
+
+    def take(self, size: int, now: int) -> bytes:
+        """Up to ``size`` arrived bytes, removed from the wire."""
+        parts = []
+        chunks = self.chunks
+        while size > 0 and chunks:
+            chunk = chunks[0]
+            n = chunk.arrived(now)
+            k = min(n - chunk.taken, size)
+            if k <= 0:
+                break
+            parts.append(chunk.data[chunk.taken:chunk.taken + k])
+            chunk.taken += k
+            size -= k
+            if chunk.taken == len(chunk.data):
+                chunks.popleft()
+            else:
+                break
+        return parts[0] if len(parts) == 1 else b"".join(parts)
+
+    def take_timed(self, now: int) -> tuple[bytes, list[int]]:
+        """All arrived bytes, removed, with each byte's arrival time."""
+        parts, times = [], []
+        chunks = self.chunks
+        while chunks:
+            chunk = chunks[0]
+            n = chunk.arrived(now)
+            if n > chunk.taken:
+                parts.append(chunk.data[chunk.taken:n])
+                if chunk.char_ns:
+                    c = chunk.char_ns
+                    times.extend(range(chunk.start + (chunk.taken + 1) * c, chunk.start + (n + 1) * c, c))
+                else:
+                    times.extend([chunk.start] * (n - chunk.taken))
+                chunk.taken = n
+            if n < len(chunk.data):
+                break
+            chunks.popleft()
+        return b"".join(parts), times
+
+    def pending(self, now: int) -> int:
+        """Bytes sent but not yet arrived by ``now``."""
+        total = 0
+        for chunk in reversed(self.chunks):
+            n = chunk.arrived(now)
+            total += len(chunk.data) - n
+            if n:
+                break
+        return total
+
+    def discard_arrived(self, now: int) -> None:
+        while self.take(1 << 30, now):
+            pass
+
+    def abort(self, now: int) -> None:
+        """Drop every byte that has not arrived by ``now``; the wire is free at once."""
+        kept: deque[_Chunk] = deque()
+        for chunk in self.chunks:
+            n = chunk.arrived(now)
+            if n > chunk.taken:
+                chunk.data = chunk.data[:n]
+                kept.append(chunk)
+        self.chunks = kept
+        self.free_at = min(self.free_at, now)
+
+    def clear(self) -> None:
+        self.chunks.clear()
+
+
+class Link:
+    """Two wires between end 0 and end 1; ``wires[i]`` carries what end i sends."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.lock = threading.RLock()
+        self.wires = (Wire(), Wire())
+        self.ports: list[PortEnd | None] = [None, None]
+        self.device: SimDevice | None = None
+
+    def pump(self, now: int) -> None:
+        """Hand the device what has reached it by ``now``, then let it poll."""
+        device = self.device
+        if device is None:
+            return
+        data, times = self.wires[0].take_timed(now)
+        if data:
+            device.receive(data, times)
+        device.poll(now)
+
+    def __repr__(self) -> str:
+        other = f"device {self.device.name!r}" if self.device else f"{sum(p is not None for p in self.ports)} port end(s)"
+        return f"<Link {self.name!r}: {other}>"
+
+
+_links: dict[str, Link] = {}
+_registry_lock = threading.Lock()
+
+
+def open_port_end(name: str) -> "PortEnd":
+    """Become one end of the port-to-port link ``name`` (created on first use)."""
+    with _registry_lock:
+        link = _links.get(name)
+        if link is None:
+            link = _links[name] = Link(name)
+        if link.device is not None:
+            raise SerialException(f"link {name} already has two ends (a port and a {link.device.name} device)")
+        if None not in link.ports:
+            raise SerialException(f"link {name} already has two ends")
+        index = link.ports.index(None)
+        end = PortEnd(link, index)
+        with link.lock:
+            link.wires[1 - index].clear()  # what was sent while nobody listened is lost
+            link.ports[index] = end
+        return end
+
+
+def open_device_end(name: str, device: "SimDevice") -> "PortEnd":
+    """A new link ``name`` between the calling port (end 0) and ``device`` (end 1)."""
+    with _registry_lock:
+        if name in _links:
+            raise SerialException(f"link {name} is in use; a device link needs a name of its own")
+        link = _links[name] = Link(name)
+        end = PortEnd(link, 0)
+        link.ports[0] = end
+        link.device = device
+    try:
+        device.attach(DeviceEnd(link, end))
+    except BaseException:
+        end.close()
+        raise
+    return end
+
+
+def link_names() -> list[str]:
+    """Names of the links open now (for diagnostics and tests)."""
+    with _registry_lock:
+        return sorted(_links)
+
+
+class PortEnd:
+    """A port's end of a link; every method takes the port's clock reading."""
+
+    def __init__(self, link: Link, index: int) -> None:
+        self.link = link
+        self.index = index
+        self.char_ns = char_time_ns(9600)
+        self._table: bytes | None = None
+        self._out = link.wires[index]
+        self._in = link.wires[1 - index]
+
+    def configure(self, baudrate: int, bytesize: int, parity: str, stopbits: float, unlimited: bool) -> None:
+        char_ns = char_time_ns(baudrate, bytesize, parity, stopbits)
+        self.char_ns = 0 if unlimited else char_ns
+        self._table = mask_table(bytesize)
+
+    def mask(self, data: bytes) -> bytes:
+        return data if self._table is None else data.translate(self._table)
+
+    def write(self, data: bytes, now: int) -> None:
+        with self.link.lock:
+            self.link.pump(now)
+            self._out.send(self.mask(data), now, self.char_ns)
+            self.link.pump(now)
+
+    def read(self, size: int, now: int) -> bytes:
+        with self.link.lock:
+            self.link.pump(now)
+            return self._in.take(size, now)
+
+    def available(self, now: int) -> int:
+        with self.link.lock:
+            self.link.pump(now)
+            return self._in.available(now)
+
+    def pending(self, now: int) -> int:
+        with self.link.lock:
+            self.link.pump(now)
+            return self._out.pending(now)
+
+    def reset_input(self, now: int) -> None:
+        with self.link.lock:
+            self.link.pump(now)
+            self._in.discard_arrived(now)
+
+    def reset_output(self, now: int) -> None:
+        with self.link.lock:
+            self.link.pump(now)
+            self._out.abort(now)
+
+    def close(self) -> None:
+        link = self.link
+        with _registry_lock:
+            with link.lock:
+                if link.ports[self.index] is self:
+                    link.ports[self.index] = None
+            if link.ports == [None, None] and _links.get(link.name) is link:
+                del _links[link.name]
+
+
+class DeviceEnd:
+    """What a simulated device holds: its way to send toward the port."""
+
+    def __init__(self, link: Link, port: PortEnd) -> None:
+        self._link = link
+        self._port = port
+
+    @property
+    def char_ns(self) -> int:
+        """Character time in ns, from the settings of the port the device is attached to."""
+        return self._port.char_ns
+
+    def send(self, data: bytes, at_ns: int) -> None:
+        """Transmit ``data`` toward the port, timed like a port write at ``at_ns``
+        (queued behind what the device sent before)."""
+        with self._link.lock:
+            self._link.wires[1].send(self._port.mask(bytes(data)), at_ns, self._port.char_ns)
+
+
+class ClockedSerial(SerialBase):
+    """pyserial base of the simulated ports: a settable clock and polling reads.
+
+    Subclasses implement ``_open_port()``, ``_close_port()``,
+    ``_take(size, now)``, ``_available(now)``, ``_write(data, now)``,
+    ``_pending(now)``, ``_reset_input(now)``, ``_reset_output(now)`` and
+    ``_configure()``."""
+
+    POLL_S = 0.001
+
+    def __init__(self, *args, **kwargs) -> None:
+        self._clock: Clock = time.monotonic_ns
+        self._clock_set = False
+        super().__init__(*args, **kwargs)
+
+    def set_clock(self, fn: Clock) -> None:
+        """Use ``fn()`` (int ns) as this port's time; reads stop blocking."""
+        self._clock = fn
+        self._clock_set = True
+
+    # - - - open / close - - -
+
+    def open(self) -> None:
+        if self.is_open:
+            raise SerialException("Port is already open.")
+        if self._port is None:
+            raise SerialException("Port must be configured before it can be used.")
+        self._open_port()
+        try:
+            self.is_open = True
+            self._reconfigure_port()
+        except BaseException:
+            self.close()
+            raise
+
+    def close(self) -> None:
+        if getattr(self, "is_open", False):
+            self.is_open = False
+            self._close_port()
+
+    def _reconfigure_port(self) -> None:
+        if not isinstance(self._baudrate, numbers.Integral) or not 0 < self._baudrate < 2 ** 32:
+            raise ValueError(f"invalid baudrate: {self._baudrate!r}")
+        if self.is_open:
+            self._configure()
+
+    def _update_break_state(self) -> None:
+        pass
+
+    def _update_rts_state(self) -> None:
+        pass
+
+    def _update_dtr_state(self) -> None:
+        pass
+
+    def _check_open(self) -> None:
+        if not self.is_open:
+            raise PortNotOpenError()
+
+    # - - - data - - -
+
+    @property
+    def in_waiting(self) -> int:
+        self._check_open()
+        return self._available(self._clock())
+
+    @property
+    def out_waiting(self) -> int:
+        self._check_open()
+        return self._pending(self._clock())
+
+    def read(self, size: int = 1) -> bytes:
+        """Up to ``size`` bytes. Returns at once with what has arrived when a
+        clock was set or ``timeout == 0``; otherwise waits (polling) for
+        ``size`` bytes or the timeout, like a real port."""
+        self._check_open()
+        if size <= 0:
+            return b""
+        data = self._take(size, self._clock())
+        if len(data) >= size or self._clock_set or self._timeout == 0:
+            return data
+        parts = [data]
+        got = len(data)
+        deadline = None if self._timeout is None else time.monotonic() + self._timeout
+        while got < size and self.is_open:
+            if deadline is not None and time.monotonic() >= deadline:
+                break
+            time.sleep(self.POLL_S)
+            if not self.is_open:
+                break
+            more = self._take(size - got, self._clock())
+            parts.append(more)
+            got += len(more)
+        return b"".join(parts)
+
+    def write(self, data) -> int:
+        """Queue ``data`` on the wire; never blocks."""
+        self._check_open()
+        data = to_bytes(data)
+        self._write(data, self._clock())
+        return len(data)
+
+    def reset_input_buffer(self) -> None:
+        self._check_open()
+        self._reset_input(self._clock())
+
+    def reset_output_buffer(self) -> None:
+        self._check_open()
+        self._reset_output(self._clock())
+
+    def _settings(self) -> str:
+        stop = {1: "1", 1.5: "1.5", 2: "2"}.get(self._stopbits, str(self._stopbits))
+        return f"{self._baudrate} {self._bytesize}{self._parity}{stop}"
