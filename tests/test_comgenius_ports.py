@@ -543,3 +543,22 @@ def test_record_writes_every_frame_with_time_port_and_direction(plc, tmp_path):
     assert [(ev.t_ms, ev.port, ev.direction) for ev in events] == [(10.0, 0, "TX"), (20.0, 0, "RX")]
     assert events[0].data == b"Rack no:   5 has  2 modules.\r\n" == events[1].data
     assert "# port 0: loop:// -> loop:// 38400 8N1 ISO-8859-1" in trace.read_text()
+
+
+def test_check_warns_about_ports_and_formats_it_can_see():
+    from softplc_lite.ladder.ast import walk
+
+    module = ComGenius(parse_config(config_text()))
+    program = load_text("COMPRINT R6:0 4 1 N7:0 N7:1\nCOMSCAN R6:1 0 3 N7:0\nCOMRCVSTS 9 C5:0\n"
+                        "COMSCAN R6:2 N7:5 99\nCOMPRINT R6:3 0 1 N7:0 N7:1\n",
+                        instructions=instruction_set([module]))
+    found = [w.report() for rung in program.files[2].rungs for ins in walk(rung.elements)
+             for w in module.check(ins)]
+    assert found == [
+        "<program>:1:15: COMPRINT: port 4 is not configured in [PORTS] of COMGENIUS.LST (configured: 0); "
+        "it will set ER",
+        "<program>:2:18: COMSCAN: Param 1 is N7:0 (an integer); %s in format 3 needs a STRING",
+        "<program>:3:11: COMRCVSTS: port 9 is not configured in [PORTS] of COMGENIUS.LST (configured: 0); "
+        "it will set a minor fault",
+        "<program>:4:19: COMSCAN: format 99 is not in the string table (strings 1..10); it will set ER",
+    ]

@@ -215,4 +215,5 @@ def check_format_use(instr: Instruction, strings: StringTable, format_at: int, s
 def _describe(op) -> str:
     if isinstance(op, Const):
         return f"the constant {op.value}"
-    return f"{op.address} (a {_operand_kind(op)})"
+    kind = _operand_kind(op)
+    return f"{op.address} ({'an' if kind and kind[0] in 'aeiou' else 'a'} {kind})"
