@@ -10,6 +10,8 @@ import serial
 import softplc_lite.tlm.comgenius.urlhandler  # noqa: F401  (registers replay://)
 from softplc_lite.tlm.comgenius.urlhandler.protocol_replay import Mismatch
 
+from clocks import Clock
+
 QUERY = bytes.fromhex("02 03 00 00 00 7D 85 D8")
 
 TRACE = """\
@@ -25,12 +27,6 @@ TRACE = """\
 """
 
 
-class Clock:
-    def __init__(self, now: int = 0) -> None:
-        self.now = now
-
-    def __call__(self) -> int:
-        return self.now
 
 
 @pytest.fixture

@@ -14,6 +14,8 @@ import softplc_lite.tlm.comgenius.urlhandler as urlhandler
 from softplc_lite.tlm.comgenius import simdevices, wire
 from softplc_lite.tlm.comgenius.simdevices import EchoDevice
 
+from clocks import Clock
+
 CHAR_38400 = 260417  # 10 bits at 38400 baud, ns
 QUERY = bytes.fromhex("02 03 00 00 00 7D 85 D8")
 REPLY = bytes([0x02, 0x03, 0xFA]) + bytes(range(250)) + b"\x12\x34"  # 255 bytes
@@ -21,14 +23,6 @@ REPLY = bytes([0x02, 0x03, 0xFA]) + bytes(range(250)) + b"\x12\x34"  # 255 bytes
 _names = itertools.count()
 
 
-class Clock:
-    """A fake clock in int ns, advanced by the test."""
-
-    def __init__(self, now: int = 0) -> None:
-        self.now = now
-
-    def __call__(self) -> int:
-        return self.now
 
 
 @pytest.fixture

@@ -80,6 +80,19 @@ class _Controlled(ControlledInstruction):
         self.log = log
         self.ctx = ctx
 
+    def _port_and_format(self, ctl: ControlElement) -> tuple[Port, int, str] | None:
+        """The port and the format text at the start, or None after
+        finishing with ER (bad or down port, no such string)."""
+        port, problem = self.port.get()
+        if port is None:
+            self._error(ctl, problem)
+            return None
+        index, fmt = self.format.text()
+        if fmt is None:
+            self._error(ctl, self.format.problem(index))
+            return None
+        return port, index, fmt
+
     def _error(self, ctl: ControlElement, message: str, empty: bool = False) -> bool:
         ctl.finish(error=True, empty=empty)
         self.log(1, f"{self.where}: {message} ({'ER EM' if empty else 'ER'})")
@@ -91,12 +104,10 @@ class ComPrint(_Controlled):
 
     def start(self, ctl: ControlElement) -> bool:
         ctl.len = 0
-        port, problem = self.port.get()
-        if port is None:
-            return self._error(ctl, problem)
-        index, fmt = self.format.text()
-        if fmt is None:
-            return self._error(ctl, self.format.problem(index))
+        found = self._port_and_format(ctl)
+        if found is None:
+            return True
+        port, index, fmt = found
         try:
             out = compile_print(fmt).render(self.params())
         except FormatError as e:
@@ -133,12 +144,10 @@ class ComScan(_Controlled):
         ctl.len = 0
         ctl.pos = 0
         self.started_ms = self.ctx.now_ms
-        port, problem = self.port.get()
-        if port is None:
-            return self._error(ctl, problem)
-        index, fmt = self.format.text()
-        if fmt is None:
-            return self._error(ctl, self.format.problem(index))
+        found = self._port_and_format(ctl)
+        if found is None:
+            return True
+        port, index, fmt = found
         try:
             self.matcher = compile_scan(fmt)
             problem = param_problem(parse_scan(fmt), self.params(), scan=True)
