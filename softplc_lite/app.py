@@ -16,6 +16,8 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
+from .datatable import DataTableError
+from .display import Display, parse_display
 from .ladder.ast import Pos, Program, walk
 from .ladder.errors import LadderError
 from .ladder.instructions import BUILTIN, InstructionSet
@@ -55,6 +57,7 @@ class App:
     modules: list[TLM] = field(default_factory=list)  # enabled and configured
     instructions: InstructionSet = BUILTIN
     warnings: list[str] = field(default_factory=list)  # from module configs and checks
+    display: Display = field(default_factory=Display)  # softplc.toml [display]: run's status line and summary
 
     @property
     def name(self) -> str:
@@ -110,8 +113,11 @@ def load_settings(path: Path) -> Settings:
     }
     known = {f.name for f in fields(Settings)}
     for section, values in doc.items():
+        if section == "display":  # read by load_display, once the program's symbols are known
+            continue
         if section not in allowed or not isinstance(values, dict):
-            raise AppError(f"{path}: unknown section [{section}] (expected {', '.join(f'[{s}]' for s in allowed)})")
+            raise AppError(f"{path}: unknown section [{section}] (expected "
+                           f"{', '.join(f'[{s}]' for s in [*allowed, 'display'])})")
         for key, value in values.items():
             rule = allowed[section].get(key)
             if rule is None or key not in known:
@@ -125,6 +131,19 @@ def load_settings(path: Path) -> Settings:
                 raise AppError(f"{path}: [{section}] {key} = {value!r}; expected a positive integer")
             setattr(settings, key, value)
     return settings
+
+
+def load_display(path: Path, symbols=None) -> Display:
+    """The ``[display]`` section of softplc.toml (see display.py)."""
+    if not path.exists():
+        return Display()
+    doc = tomllib.loads(path.read_text(encoding="utf-8"))  # load_settings has reported syntax errors
+    if "display" not in doc:
+        return Display()
+    try:
+        return parse_display(doc["display"], str(path), symbols)
+    except DataTableError as e:
+        raise AppError(str(e)) from None
 
 
 def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
@@ -152,13 +171,14 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
         raise AppError(sorted(errors, key=lambda e: (e.pos.source, e.pos.line, e.pos.column)))
     warnings += [w.report() for w in _module_checks(resolved, modules)]
     settings = load_settings(path / SETTINGS_FILE) if is_dir else Settings()
+    display = load_display(path / SETTINGS_FILE, resolved.symbols) if is_dir else Display()
     table_json = path / DATATABLE_FILE if is_dir and (path / DATATABLE_FILE).exists() else None
     if state_dir is not None:
         state = Path(state_dir)
     else:
         state = path / STATE_DIR if is_dir else None
     return App(path, is_dir, files, resolved, settings, parsed, table_json, state,
-               modules=modules, instructions=instructions, warnings=warnings)
+               modules=modules, instructions=instructions, warnings=warnings, display=display)
 
 
 def app_instructions(path: Path) -> InstructionSet:

@@ -8,14 +8,19 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 from typing import Sequence
+
+from rich.console import Console
+from rich.live import Live
 
 from . import __version__
 from .app import AppError, app_instructions, lad_files, load_app, parse_files
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
 from .datatable.display import format_value
+from .display import StatusLine
 from .ladder.engine import Mode
 from .ladder.errors import LadderError
 from .ladder.fmt import STYLES, format_program
@@ -80,18 +85,49 @@ def _cmd_run(args: argparse.Namespace) -> int:
     )
     runner = Runner(app, options)
     try:
-        runner.run(args.scans)
+        _run_with_status(runner, app, args.scans)
     finally:
         runner.engine.close()
     engine = runner.engine
     runner.save()
     if args.dump:
         Path(args.dump).write_text(jsonio.dumps(runner.table), encoding="utf-8")
+    if app.display:
+        clock = "real" if engine.clock.realtime else "simulated"
+        print(f"{app.name}: {engine.scans} scans, {engine.clock.now_ms / 1000:.2f} s {clock} time")
+        for line in app.display.summary_lines(runner.table):
+            print(line)
     _print_values(runner.table, args.print, app.program.symbols)
     if engine.mode is Mode.FAULTED:
         print(f"softplc: {app.name}: {engine.fault}", file=sys.stderr)
         return EXIT_FAULT
     return EXIT_OK
+
+
+def _run_with_status(runner: Runner, app, scans: int | None) -> None:
+    """Run, with the app's [display] status line redrawn on standard error
+    while it is a terminal. rich's Live redraws from its own thread a few
+    times a second; the scan loop only refreshes the values, at most ten
+    times a second, so drawing never slows scanning."""
+    items = app.display.status
+    console = Console(stderr=True)
+    if not items or not console.is_terminal:
+        runner.run(scans)
+        return
+    line = StatusLine(app.name, items)
+    last = 0.0
+
+    def refresh(engine) -> None:
+        nonlocal last
+        now = time.monotonic()
+        if now - last >= 0.1:
+            last = now
+            line.update(engine.table, engine.scans, engine.clock.now_ms, engine.clock.realtime)
+
+    with Live(line, console=console, refresh_per_second=5, transient=False):
+        runner.run(scans, on_scan=refresh)
+        engine = runner.engine
+        line.update(engine.table, engine.scans, engine.clock.now_ms, engine.clock.realtime)
 
 
 def _cmd_check(args: argparse.Namespace) -> int:

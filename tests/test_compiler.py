@@ -56,8 +56,11 @@ def test_every_example_program_compiles_to_allowed_names():
             continue
         app = load_app(app_dir)
         engine = Engine(app.program, modules=app.modules)
-        for compiled, _ in engine.files.values():
-            assert all(ALLOWED.match(n) for n in _names(compiled.source)), app_dir
+        try:
+            for compiled, _ in engine.files.values():
+                assert all(ALLOWED.match(n) for n in _names(compiled.source)), app_dir
+        finally:
+            engine.close()  # the modules' ports
 
 
 def test_line_table_names_the_failing_instruction():

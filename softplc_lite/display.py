@@ -1,0 +1,135 @@
+"""What ``softplc run`` shows of an app while it runs and when it ends.
+
+An app names the values that tell its story in the ``[display]`` section
+of its ``softplc.toml``::
+
+    [display]
+    status = { polls = "C5:0.ACC", good = "C5:1.ACC" }   # a live status line
+    summary = { "first registers" = "#N11:0 10" }          # printed at the end
+
+A value is a data table address (or a program symbol), or ``#ADDR LEN``:
+LEN consecutive elements from ADDR, the file-address form COP and FLL
+take. ``status`` items are also printed in the summary, first.
+
+The status line is a rich renderable (:class:`StatusLine`); ``softplc run``
+redraws it a few times a second on standard error while standard error is
+a terminal, independently of the scan rate.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from typing import Iterable
+
+from rich.console import Console, ConsoleOptions, RenderResult
+from rich.text import Text
+
+from .datatable import DataTable, DataTableError, parse_address
+from .datatable.address import Address
+from .datatable.display import format_value
+
+_BLOCK = re.compile(r"#\s*(\S+)\s+([0-9]+)$")
+
+
+@dataclass(frozen=True)
+class Item:
+    """One named value: an address, or ``count`` elements from it."""
+
+    label: str
+    address: Address
+    count: int | None = None
+
+    @property
+    def text(self) -> str:
+        return f"#{self.address} {self.count}" if self.count is not None else str(self.address)
+
+    def read(self, table: DataTable) -> str:
+        if self.count is None:
+            return format_value(table.read(self.address))
+        return " ".join(format_value(v) for v in _block(table, self.address, self.count))
+
+
+def _block(table: DataTable, start: Address, count: int) -> Iterable[object]:
+    head, _, index = str(start).rpartition(":")  # parse_item made sure the element is a number
+    for k in range(count):
+        yield table.read(f"{head}:{int(index) + k}")
+
+
+def parse_item(label: str, value: object, where: str, symbols=None) -> Item:
+    if not isinstance(value, str):
+        raise DataTableError(f"{where}: [display] {label} = {value!r}; expected an address such as \"N7:0\" "
+                             "or a block such as \"#N11:0 10\"")
+    text = value.strip()
+    m = _BLOCK.match(text)
+    name = m.group(1) if m else text
+    if symbols and name in symbols:
+        address = symbols[name].address
+    else:
+        try:
+            address = parse_address(name)
+        except DataTableError as e:
+            raise DataTableError(f"{where}: [display] {label} = {value!r}: {e}") from None
+    if m:
+        count = int(m.group(2))
+        if not 1 <= count <= 1000 or not str(address).rpartition(":")[2].isdigit():
+            raise DataTableError(f"{where}: [display] {label} = {value!r}: a block is #FILE:ELEMENT LEN "
+                                 "with LEN 1..1000, e.g. \"#N11:0 10\"")
+        return Item(label, address, count)
+    return Item(label, address)
+
+
+@dataclass
+class Display:
+    status: list[Item] = field(default_factory=list)
+    summary: list[Item] = field(default_factory=list)
+
+    def __bool__(self) -> bool:
+        return bool(self.status or self.summary)
+
+    def summary_lines(self, table: DataTable) -> list[str]:
+        return [f"{item.label} ({item.text}) = {item.read(table)}" for item in self.status + self.summary]
+
+
+def parse_display(section: object, where: str, symbols=None) -> Display:
+    """The ``[display]`` table of softplc.toml."""
+    if not isinstance(section, dict):
+        raise DataTableError(f"{where}: [display] must be a table")
+    display = Display()
+    for key, value in section.items():
+        if key not in ("status", "summary") or not isinstance(value, dict):
+            raise DataTableError(f"{where}: [display] has {key} = {value!r}; expected status = {{...}} and/or "
+                                 "summary = {...}, each name = \"ADDRESS\"")
+        items = [parse_item(label, v, where, symbols) for label, v in value.items()]
+        getattr(display, key).extend(items)
+    return display
+
+
+class StatusLine:
+    """One line: the app, the scan count and time, then each status value."""
+
+    def __init__(self, name: str, items: list[Item]) -> None:
+        self.name = name
+        self.items = items
+        self.scans = 0
+        self.now_ms = 0
+        self.realtime = False
+        self.values: list[str] = ["-"] * len(items)
+
+    def update(self, table: DataTable, scans: int, now_ms: int, realtime: bool) -> None:
+        self.scans, self.now_ms, self.realtime = scans, now_ms, realtime
+        self.values = [item.read(table) for item in self.items]
+
+    def text(self) -> Text:
+        t = Text()
+        t.append(self.name, style="bold")
+        clock = "real" if self.realtime else "simulated"
+        t.append(f"  scan {self.scans}  {self.now_ms / 1000:.2f} s {clock}", style="dim")
+        for item, value in zip(self.items, self.values):
+            t.append("  ")
+            t.append(f"{item.label} ", style="cyan")
+            t.append(value, style="bold")
+        return t
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        yield self.text()
