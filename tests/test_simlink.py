@@ -269,15 +269,23 @@ def test_bad_urls(url, message):
     assert "x" not in wire.link_names()
 
 
-def test_device_link_name_is_exclusive(opened, clock):
+def test_device_links_are_per_port_and_apart_from_port_links(opened, clock):
     name = fresh()
-    opened(f"sim://{name}?device=echo", clock)
+    first = opened(f"sim://{name}?device=echo", clock, baudrate=38400)
+    second = opened(f"sim://{name}?device=echo", clock, baudrate=38400)  # its own link and echo device
+    first.write(b"one")
+    clock.now += 5_000_000
+    assert second.read(10) == b"" and first.read(10) == b"one"
+    assert len(wire.device_links(name)) == 2
     with pytest.raises(serial.SerialException, match="already has two ends"):
         serial.serial_for_url(f"sim://{name}")
     other = fresh()
     opened(f"sim://{other}", clock)
-    with pytest.raises(serial.SerialException, match="is in use"):
+    with pytest.raises(serial.SerialException, match="is in use between two ports"):
         serial.serial_for_url(f"sim://{other}?device=echo")
+    first.close()
+    second.close()
+    assert name not in wire.link_names()
 
 
 def test_echo_timing(opened, clock):

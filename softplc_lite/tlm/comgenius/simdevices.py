@@ -5,7 +5,9 @@ factory gets the URL's remaining query options as ``dict[str, str]`` and
 returns a ``SimDevice``, or raises ``ValueError`` for an unknown or bad
 option (``check_options`` helps). The ``sim://`` handler turns that into a
 ``SerialException``. Register a kind at import of the module that defines
-it, before a port opens a URL naming it.
+it, before a port opens a URL naming it. The built-in kinds that live in
+other modules (``BUILTIN_DEVICES``: kind -> "module:factory", e.g. ``modbus``
+in modbus_slave.py) are imported and registered on first use.
 
 The device API (all times are int ns on the clock of the port the device
 is attached to):
@@ -33,6 +35,7 @@ max(delay_ms, 3.5 character times)). Option: ``delay_ms`` (default 0).
 
 from __future__ import annotations
 
+import importlib
 import math
 from typing import TYPE_CHECKING, Callable, Iterable
 
@@ -57,6 +60,8 @@ class SimDevice:
 
 DeviceFactory = Callable[[dict[str, str]], SimDevice]
 DEVICES: dict[str, DeviceFactory] = {}
+# Built-in kinds defined in other modules: imported when first created.
+BUILTIN_DEVICES: dict[str, str] = {"modbus": "softplc_lite.tlm.comgenius.modbus_slave:create"}
 
 
 def register_device(kind: str, factory: DeviceFactory) -> None:
@@ -74,8 +79,13 @@ def register_device(kind: str, factory: DeviceFactory) -> None:
 def create_device(kind: str, options: dict[str, str]) -> SimDevice:
     """A new device of ``kind``; ValueError for an unknown kind or a bad option."""
     factory = DEVICES.get(kind)
+    if factory is None and kind in BUILTIN_DEVICES:
+        module, _, name = BUILTIN_DEVICES[kind].partition(":")
+        factory = getattr(importlib.import_module(module), name)
+        register_device(kind, factory)
     if factory is None:
-        raise ValueError(f"unknown device kind {kind!r} (known: {', '.join(sorted(DEVICES))})")
+        known = ", ".join(sorted({*DEVICES, *BUILTIN_DEVICES}))
+        raise ValueError(f"unknown device kind {kind!r} (known: {known})")
     return factory(dict(options))
 
 

@@ -213,18 +213,23 @@ class Link:
         return f"<Link {self.name!r}: {other}>"
 
 
-_links: dict[str, Link] = {}
+_links: dict[str, Link] = {}  # port-to-port links, by name
+# Device links, by name: each port that opens sim://NAME?device=... gets a
+# link and a device of its own, so two runtimes (or a test's two executors)
+# may run the same app side by side; the newest is last.
+_device_links: dict[str, list[Link]] = {}
 _registry_lock = threading.Lock()
 
 
 def open_port_end(name: str) -> "PortEnd":
     """Become one end of the port-to-port link ``name`` (created on first use)."""
     with _registry_lock:
+        if _device_links.get(name):
+            device = _device_links[name][-1].device
+            raise SerialException(f"link {name} already has two ends (a port and a {device.name} device)")
         link = _links.get(name)
         if link is None:
             link = _links[name] = Link(name)
-        if link.device is not None:
-            raise SerialException(f"link {name} already has two ends (a port and a {link.device.name} device)")
         if None not in link.ports:
             raise SerialException(f"link {name} already has two ends")
         index = link.ports.index(None)
@@ -239,8 +244,9 @@ def open_device_end(name: str, device: "SimDevice") -> "PortEnd":
     """A new link ``name`` between the calling port (end 0) and ``device`` (end 1)."""
     with _registry_lock:
         if name in _links:
-            raise SerialException(f"link {name} is in use; a device link needs a name of its own")
-        link = _links[name] = Link(name)
+            raise SerialException(f"link {name} is in use between two ports; a device link needs another name")
+        link = Link(name)
+        _device_links.setdefault(name, []).append(link)
         end = PortEnd(link, 0)
         link.ports[0] = end
         link.device = device
@@ -255,7 +261,13 @@ def open_device_end(name: str, device: "SimDevice") -> "PortEnd":
 def link_names() -> list[str]:
     """Names of the links open now (for diagnostics and tests)."""
     with _registry_lock:
-        return sorted(_links)
+        return sorted(set(_links) | set(_device_links))
+
+
+def device_links(name: str) -> list[Link]:
+    """The open device links named ``name``, oldest first."""
+    with _registry_lock:
+        return list(_device_links.get(name, ()))
 
 
 class PortEnd:
@@ -314,8 +326,14 @@ class PortEnd:
             with link.lock:
                 if link.ports[self.index] is self:
                     link.ports[self.index] = None
-            if link.ports == [None, None] and _links.get(link.name) is link:
-                del _links[link.name]
+            if link.ports == [None, None]:
+                if _links.get(link.name) is link:
+                    del _links[link.name]
+                same = _device_links.get(link.name, [])
+                if link in same:
+                    same.remove(link)
+                    if not same:
+                        del _device_links[link.name]
 
 
 class DeviceEnd:
