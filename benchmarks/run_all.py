@@ -1,4 +1,5 @@
-"""Run every benchmark (data table, ladder engine, COMGENIUS format engine), each in its own process, and summarize.
+"""Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports), each in its own process, and
+summarize.
 
     python benchmarks/run_all.py
 
@@ -19,6 +20,7 @@ import _common as C
 
 BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_comgenius_format",
+    "bench_comgenius_ports",
 )
 
 
@@ -100,6 +102,21 @@ def main() -> int:
             f"          decode ex. 4 {d['fast_us']:.1f} us [{d['verdict']} <= {d['target_us']:.0f}], "
             f"{d['ratio_naive_over_fast']:.1f}x naive; CRC-16 {crc['bytes_per_s']['crc16'] / 1e6:.1f} MB/s, "
             f"{crc['ratio_naive_over_table']:.1f}x bitwise"
+        )
+
+    ports = load("bench_comgenius_ports")
+    if ports:
+        for kind, r in ports["round_trips"].items():
+            rt, lr = r["round_trips_per_s"], r["ratio_ladder_over_raw"]
+            lines.append(
+                f"{'ports' if kind == 'text' else '':9} {kind} {r['frame_bytes']} B round trips/s: ladder loop:// "
+                f"{rt['ladder loop://']:,} ({lr['loop://']:.1f}x raw), pty {rt['ladder pty']:,} "
+                f"({lr['pty']:.1f}x raw), sim:// {rt['ladder sim://']:,} ({lr['sim://']:.0f}x raw)"
+            )
+        b = ports["throughput"]
+        lines.append(
+            f"          sim:// unlimited {b['bytes_per_s']['sim:// unlimited'] / 1e6:.0f} MB/s, loop:// "
+            f"{b['bytes_per_s']['loop://'] / 1e6:.2f} MB/s (4 KiB writes)"
         )
 
     print("=== summary " + "=" * 53)

@@ -39,7 +39,7 @@ from ...ladder import status as S
 from ...ladder.instructions import K
 from ...ladder.semantics import OV
 from ..api import BoundOperand, ControlElement, ControlledInstruction, InstructionContext
-from .formats import FormatError, parse_scan
+from .formats import FormatError
 from .instructions import _PARAMS, _PARAMS_OUT, FormatSource, param_problem, param_sources, spec
 from .params import ParamError
 from .ports import Port, PortSet
@@ -150,7 +150,7 @@ class ComScan(_Controlled):
         port, index, fmt = found
         try:
             self.matcher = compile_scan(fmt)
-            problem = param_problem(parse_scan(fmt), self.params(), scan=True)
+            problem = param_problem(self.matcher.items, self.params(), scan=True)  # parsed once, cached
         except FormatError as e:
             return self._error(ctl, f"format {index}: {e}")
         except ParamError as e:  # an indirect Param address that resolves nowhere

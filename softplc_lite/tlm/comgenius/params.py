@@ -65,6 +65,10 @@ class Param:
     def set_word(self, value: int, k: int = 0) -> None:
         raise ParamError(f"{self.name} is a {self.kind.value} param, not an integer")
 
+    def words(self, count: int) -> array:
+        """Words 0..count-1 as unsigned 16-bit values (``%.250C`` reads 125)."""
+        return array("H", [self.word(k) & 0xFFFF for k in range(count)])
+
     def set_words(self, words: array, k: int = 0) -> None:
         """Store a run of words from word ``k`` on (``%.250C`` fills 125)."""
         raise ParamError(f"{self.name} is a {self.kind.value} param, not an integer")
@@ -176,6 +180,13 @@ class TableParam(Param):
         if self.kind is not ParamKind.INTEGER:
             return super().set_word(value, k)
         self.data[self._at(k)] = to_signed(value & 0xFFFF)
+
+    def words(self, count: int) -> array:
+        if self.kind is not ParamKind.INTEGER or count == 0:
+            return super().words(count)
+        self._at(count - 1)  # past the end of the file: ParamError
+        i = self.index
+        return array("H", self.data[i:i + count].tobytes())  # one slice, reinterpreted unsigned
 
     def set_words(self, words: array, k: int = 0) -> None:
         if self.kind is not ParamKind.INTEGER:
