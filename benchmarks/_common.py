@@ -154,3 +154,42 @@ def vm_rss_bytes() -> int:
                 parts = line.split()
                 return int(parts[1]) * 1024  # kB
     raise RuntimeError("no VmRSS in /proc/self/status")
+
+
+def sample_rounds(bodies: dict, numbers: dict[str, int], rounds: int) -> dict[str, list[float]]:
+    """ns per call of each body (``body(number)`` runs ``number`` calls), one
+    sample per round, the bodies interleaved and their order rotating every
+    round so a slow spell of this shared machine lands on all of them; the
+    garbage collector paused while sampling. Each body runs once first (warm-up)."""
+    import gc
+    import time
+
+    for name, body in bodies.items():
+        body(numbers[name])
+    names = list(bodies)
+    samples: dict[str, list[float]] = {name: [] for name in names}
+    gc.collect()
+    gc.disable()
+    try:
+        for r in range(rounds):
+            for name in names[r % len(names):] + names[:r % len(names)]:
+                number = numbers[name]
+                t0 = time.perf_counter_ns()
+                bodies[name](number)
+                samples[name].append((time.perf_counter_ns() - t0) / number)
+    finally:
+        gc.enable()
+    return samples
+
+
+def median(samples: list[float]) -> float:
+    import statistics
+
+    return statistics.median(samples)
+
+
+def ratio(samples: dict[str, list[float]], slow: str, fast: str) -> float:
+    """Median of the per-round ratios slow / fast."""
+    import statistics
+
+    return statistics.median(s / f for s, f in zip(samples[slow], samples[fast]))

@@ -39,9 +39,7 @@ prints MISS; the script always exits 0.
 
 from __future__ import annotations
 
-import gc
 import re
-import statistics
 import time
 from array import array
 
@@ -82,33 +80,10 @@ def calibrate(body) -> int:
 
 def interleaved(cases: dict[str, object], rounds: int = ROUNDS) -> dict[str, list[float]]:
     """Per-call ns of each case, one sample per round, cases interleaved."""
-    numbers = {name: calibrate(body) for name, body in cases.items()}
-    for name, body in cases.items():  # warm-up, one sample each
-        body(numbers[name])
-    names = list(cases)
-    samples: dict[str, list[float]] = {name: [] for name in names}
-    gc.collect()
-    gc.disable()
-    try:
-        for r in range(rounds):
-            order = names[r % len(names):] + names[:r % len(names)]
-            for name in order:
-                number = numbers[name]
-                t0 = time.perf_counter_ns()
-                cases[name](number)
-                samples[name].append((time.perf_counter_ns() - t0) / number)
-    finally:
-        gc.enable()
-    return samples
+    return C.sample_rounds(cases, {name: calibrate(body) for name, body in cases.items()}, rounds)
 
 
-def median(samples: list[float]) -> float:
-    return statistics.median(samples)
-
-
-def ratio(samples: dict[str, list[float]], slow: str, fast: str) -> float:
-    """Median of the per-round ratios slow / fast."""
-    return statistics.median(s / f for s, f in zip(samples[slow], samples[fast]))
+median, ratio = C.median, C.ratio
 
 
 def stats(samples: list[float]) -> dict:

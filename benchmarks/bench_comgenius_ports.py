@@ -62,8 +62,6 @@ reply frame alone takes 66.4 ms on a real 38400 8N1 line).
 
 from __future__ import annotations
 
-import gc
-import statistics
 import sys
 import time
 
@@ -243,30 +241,10 @@ def calibrate(body, cap: int) -> int:
 def interleaved(cases: dict[str, tuple[object, int]], rounds: int = ROUNDS) -> dict[str, list[float]]:
     """ns per unit of each case, one sample per round, cases interleaved."""
     numbers = {name: calibrate(body, cap) for name, (body, cap) in cases.items()}
-    for name, (body, _) in cases.items():
-        body(numbers[name])
-    names = list(cases)
-    samples: dict[str, list[float]] = {name: [] for name in names}
-    gc.collect()
-    gc.disable()
-    try:
-        for r in range(rounds):
-            for name in names[r % len(names):] + names[:r % len(names)]:
-                number = numbers[name]
-                t0 = time.perf_counter_ns()
-                cases[name][0](number)
-                samples[name].append((time.perf_counter_ns() - t0) / number)
-    finally:
-        gc.enable()
-    return samples
+    return C.sample_rounds({name: body for name, (body, _) in cases.items()}, numbers, rounds)
 
 
-def median(xs: list[float]) -> float:
-    return statistics.median(xs)
-
-
-def ratio(samples: dict[str, list[float]], slow: str, fast: str) -> float:
-    return statistics.median(s / f for s, f in zip(samples[slow], samples[fast]))
+median, ratio = C.median, C.ratio
 
 
 def per_s(ns: float) -> float:

@@ -75,6 +75,7 @@ from __future__ import annotations
 
 import struct
 
+from .checksum import crc16_bytes
 from . import simdevices, wire
 from .simdevices import SimDevice, check_options, float_option, silence_ns
 
@@ -92,30 +93,13 @@ ILLEGAL_DATA_VALUE = 3
 _READS = {1: ("coils", 2000), 2: ("discrete_inputs", 2000), 3: ("holding_registers", 125), 4: ("input_registers", 125)}
 
 
-def _crc_table() -> list[int]:
-    table = []
-    for byte in range(256):
-        crc = byte
-        for _ in range(8):
-            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
-        table.append(crc)
-    return table
-
-
-_CRC_TABLE = _crc_table()
-
-
 def crc16(data: bytes) -> int:
     """The Modbus CRC (init 0xFFFF, polynomial 0xA001); sent low byte first.
 
     >>> hex(crc16(bytes.fromhex("02 03 00 00 00 7D")))
     '0xd885'
     """
-    crc = 0xFFFF
-    table = _CRC_TABLE
-    for byte in data:
-        crc = (crc >> 8) ^ table[(crc ^ byte) & 0xFF]
-    return crc
+    return crc16_bytes(data, 0xFFFF)  # the table-driven CRC the formats' %#R uses
 
 
 def with_crc(frame: bytes) -> bytes:

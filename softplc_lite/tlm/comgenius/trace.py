@@ -31,7 +31,6 @@ softplc_lite.tlm.comgenius.trace.TraceError: a.trace:1:12: expected a two-digit 
 
 from __future__ import annotations
 
-import io
 import math
 import os
 import re
