@@ -130,6 +130,12 @@ def _run_with_status(runner: Runner, app, scans: int | None) -> None:
         line.update(engine.table, engine.scans, engine.clock.now_ms, engine.clock.realtime)
 
 
+def _cmd_watch(args: argparse.Namespace) -> int:
+    from .watch.cli import watch_command
+
+    return watch_command(args)
+
+
 def _cmd_check(args: argparse.Namespace) -> int:
     try:
         app = load_app(args.app)
@@ -196,6 +202,27 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--record", metavar="TRACE", help="record every port's traffic to the TRACE file")
     r.add_argument("--replay", metavar="TRACE", help="play every port back from a recorded TRACE file")
     r.set_defaults(func=_cmd_run)
+
+    w = sub.add_parser("watch", help="step scans in a terminal view: rungs, power flow, values, ports")
+    w.add_argument("app", metavar="APP", help="app directory or .lad file")
+    w.add_argument("--watch", action="append", default=[], metavar="ADDR", help="add ADDR to the watch list")
+    w.add_argument("--watch-file", metavar="FILE", help="a watch file: one address or symbol a line")
+    w.add_argument("--force", action="append", default=[], metavar="ADDR=0|1", help="force a bit on or off")
+    w.add_argument("--break-when", action="append", default=[], metavar="EXPR",
+                   help='stop running when EXPR becomes true, e.g. "N7:0 > 100" or R6:0/ER')
+    w.add_argument("--realtime", action="store_true", help="use the wall clock instead of simulated time")
+    w.add_argument("--scan-ms", type=int, metavar="MS", help="simulated ms per scan (default from the app)")
+    w.add_argument("--state", metavar="DIR", help="keep the retentive snapshot in DIR (default APP/.softplc)")
+    w.add_argument("--fresh", action="store_true", help="ignore the retentive snapshot")
+    w.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE", help="set a value at start")
+    w.add_argument("--port", action="append", default=[], metavar="N=DEVICE", help="as for run")
+    w.add_argument("--replay", metavar="TRACE", help="play every port back from a recorded TRACE file")
+    w.add_argument("--scans", type=int, default=0, metavar="N", help="with --snapshot: scans to run first")
+    w.add_argument("--snapshot", metavar="FILE", help="render the view after --scans N scans to FILE "
+                   "(.svg: an SVG picture; otherwise text) and exit; needs no terminal")
+    w.add_argument("--width", type=int, default=100, metavar="COLS", help="--snapshot width (default 100)")
+    w.add_argument("--height", type=int, default=40, metavar="ROWS", help="--snapshot height (default 40)")
+    w.set_defaults(func=_cmd_watch)
 
     c = sub.add_parser("check", help="parse and validate an app; list every problem")
     c.add_argument("app", metavar="APP")

@@ -1,0 +1,149 @@
+"""Breakpoints: stop running at a rung, or when a condition becomes true.
+
+- **Rung breakpoint** (``b`` on the selected rung): running stops after a
+  scan in which that rung was scanned with its rung condition true (it
+  was executed, not skipped by a JMP or an uncalled subroutine, and power
+  reached its end). The check is made right after the rung runs, by
+  wrapping that one rung's callable, so rungs without a breakpoint cost
+  nothing.
+- **Condition breakpoint** (``--break-when "N7:0 > 100"``, ``--break-when
+  R6:0/ER``): a CMP-style expression, or a bit address, checked after each
+  scan; running stops when it goes from false to true.
+
+A stop is reported as a :class:`Hit`: which scan, and which rung or
+condition.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from ..datatable import DataTable, DataTableError
+from ..ladder.ast import AddressRef, Pos, SymbolRef
+from ..ladder.errors import LadderError
+from ..ladder.expr import evaluate
+from ..ladder.parser import parse_expression
+
+
+@dataclass(frozen=True)
+class Hit:
+    scan: int
+    file: int | None = None
+    rung: int | None = None
+    condition: str | None = None
+
+    def __str__(self) -> str:
+        if self.condition is not None:
+            return f"break: {self.condition} became true at scan {self.scan}"
+        return f"break: file {self.file} rung {self.rung} energized at scan {self.scan}"
+
+
+class _PureMath:
+    """Expression arithmetic without the status-file side effects the
+    engine's Machine has (a breakpoint must not set minor faults)."""
+
+    @staticmethod
+    def divide(a, b):
+        return a / b if b else 0
+
+    @staticmethod
+    def modulo(a, b):
+        return a % b if b else 0
+
+    @staticmethod
+    def power(a, b):
+        try:
+            return a ** b
+        except (OverflowError, ZeroDivisionError, ValueError):
+            return 0
+
+
+class Condition:
+    """A --break-when expression."""
+
+    def __init__(self, text: str, symbols=None) -> None:
+        self.text = text
+        try:
+            self.node = _resolve(parse_expression(text, Pos("--break-when", 1, 1)), symbols or {})
+        except LadderError as e:
+            raise DataTableError(f"--break-when {text!r}: {e.message if hasattr(e, 'message') else e}") from None
+        self.was = False
+
+    def value(self, table: DataTable) -> bool:
+        try:
+            return bool(evaluate(self.node, lambda ref: table.read(ref.address), _PureMath))
+        except DataTableError:
+            return False  # an address past its file is "not true", not a crash
+
+    def became_true(self, table: DataTable) -> bool:
+        now = self.value(table)
+        edge = now and not self.was
+        self.was = now
+        return edge
+
+
+def _resolve(node, symbols):
+    """Symbols in a --break-when expression become their addresses."""
+    if isinstance(node, SymbolRef):
+        if node.name not in symbols:
+            raise DataTableError(f"--break-when: {node.name!r} is neither an address nor a program symbol")
+        return AddressRef(symbols[node.name].address, node.pos)
+    for name in ("left", "right", "operand", "arg"):
+        child = getattr(node, name, None)
+        if child is not None:
+            object.__setattr__(node, name, _resolve(child, symbols))
+    return node
+
+
+class Breakpoints:
+    """Rung and condition breakpoints of one engine."""
+
+    def __init__(self, engine, rung_power: Callable | None = None) -> None:
+        self.engine = engine
+        self.rung_power = rung_power  # (rung, table) -> power with .out; None: any execution counts
+        self.rungs: set[tuple[int, int]] = set()
+        self.conditions: list[Condition] = []
+        self.hits: list[Hit] = []
+        self._original: dict[tuple[int, int], Callable] = {}
+
+    # -- rungs ----------------------------------------------------------------------------
+    def toggle(self, file: int, rung: int) -> bool:
+        """Set or clear a rung breakpoint; True when it is now set."""
+        key = (file, rung)
+        if key in self.rungs:
+            self.rungs.discard(key)
+            self.engine.files[file][0].rungs[rung] = self._original.pop(key)
+            return False
+        self.rungs.add(key)
+        compiled = self.engine.files[file][0]
+        original = compiled.rungs[rung]
+        self._original[key] = original
+        source = self.engine.program.files[file].rungs[rung]
+        table = self.engine.table
+
+        def watched(c, original=original, source=source, key=key):
+            result = original(c)
+            energized = True if self.rung_power is None else bool(self.rung_power(source, table).out)
+            if energized and c:
+                self.hits.append(Hit(self.engine.scans + 1, key[0], key[1]))
+            return result
+
+        compiled.rungs[rung] = watched
+        return True
+
+    # -- conditions -------------------------------------------------------------------------
+    def add_condition(self, text: str, symbols=None) -> Condition:
+        cond = Condition(text, symbols)
+        cond.was = cond.value(self.engine.table)  # only a change from now on breaks
+        self.conditions.append(cond)
+        return cond
+
+    def after_scan(self) -> Hit | None:
+        """Call after each scan: the first hit of this scan, if any."""
+        for cond in self.conditions:
+            if cond.became_true(self.engine.table):
+                self.hits.append(Hit(self.engine.scans, condition=cond.text))
+        hit = self.hits[0] if self.hits else None
+        self.hits.clear()
+        return hit

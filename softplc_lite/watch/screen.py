@@ -1,0 +1,131 @@
+"""The watch view's screen: the status bar over the rungs, the watch list,
+ports and forces beside them (or below, on a narrow terminal), and the
+keys at the bottom. Each part is a renderable of its own; this module only
+composes them for the space there is (80x24 and up)."""
+
+from __future__ import annotations
+
+from rich.console import Console, ConsoleOptions, Group, RenderResult
+from rich.layout import Layout
+from rich.text import Text
+
+from ..ladder import status as S
+from ..ladder.engine import Mode
+from .portsview import PortsView
+from .session import WatchSession
+
+WIDE = 120  # from this width the side panels go beside the rungs
+SIDE_WIDTH = 46
+KEYS = ("space/n step  r run  p pause  +/- speed  ↑↓/jk rung  f file  g go to rung  b breakpoint  "
+        "⌫ back  F force  U unforce  q quit")
+
+
+class StatusBar:
+    """Mode, scan, time, scan times, faults, and what the session is doing."""
+
+    def __init__(self, session: WatchSession) -> None:
+        self.session = session
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        s = self.session
+        e = s.engine
+        line = Text(no_wrap=True, overflow="ellipsis")
+        line.append(f" {s.app.name} ", style="bold reverse")
+        mode_style = {"RUN": "green", "FAULTED": "bold red"}.get(e.mode.name, "yellow")
+        line.append(f" {e.mode.name} ", style=mode_style)
+        if s.history.live:
+            line.append(f" scan {e.scans}")
+        else:
+            line.append(f" scan {s.shown_scan} of {e.scans} (history)", style="bold magenta")
+        frame = s.history.shown
+        now_ms = frame.now_ms if frame is not None and not s.history.live else e.clock.now_ms
+        line.append(f"  {now_ms / 1000:.3f} s {'real' if e.clock.realtime else 'sim'}")
+        line.append("  RUNNING " if s.running else "  PAUSED ", style="bold green" if s.running else "bold")
+        line.append(s.speed_text, style="dim")
+        line.append(f"  scan time {e.last_scan_ms:.2f} ms, max {e.max_scan_ms:.2f}", style="dim")
+        second = Text(no_wrap=True, overflow="ellipsis")
+        if e.mode is Mode.FAULTED and e.fault is not None:
+            second.append(f" {e.fault}", style="bold red")
+        else:
+            minor = e.s[S.MINOR_FAULT_BITS]
+            if minor:
+                second.append(f" minor faults S:17={minor & 0xFFFF:#06x} code {e.s[S.MINOR_FAULT_CODE]}",
+                              style="yellow")
+        if s.message:
+            second.append(f" {s.message}", style="cyan")
+        yield line
+        yield second
+
+
+class ForcesView:
+    def __init__(self, session: WatchSession) -> None:
+        self.session = session
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        forced = self.session.forces.listed()
+        text = Text("forces: ", style="bold")
+        if not forced:
+            text.append("none", style="dim")
+        for k, f in enumerate(forced):
+            text.append(("  " if k else "") + f"{f.address}={'ON' if f.on else 'OFF'}", style="bold red")
+        yield text
+
+
+class RungsPanel:
+    """The shown program file's rungs from the session's first rung, as many
+    as fit; scrolls the session so the selected rung stays in view."""
+
+    def __init__(self, session: WatchSession, view_factory) -> None:
+        self.session = session
+        self.view_factory = view_factory
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        s = self.session
+        height = options.height or console.height
+        yield Text(f" program file {s.file}  rung {s.selected} of {len(s.rungs)}", style="bold underline")
+        view = self.view_factory(s, height - 1)
+        yield view
+        last = getattr(view, "last_drawn", None)
+        if last is not None and s.selected > last and s.top < s.selected:
+            s.top += max(1, s.selected - last)  # keep the selection in view next time
+
+
+class WatchScreen:
+    def __init__(self, session: WatchSession, view_factory, prompt: str | None = None) -> None:
+        self.session = session
+        self.status = StatusBar(session)
+        self.rungs = RungsPanel(session, view_factory)
+        self.ports = PortsView(session.engine)
+        self.forces = ForcesView(session)
+        self.prompt = prompt
+
+    def side(self) -> Group:
+        parts = [self.session.watch, self.forces]
+        if self.ports:
+            parts.append(self.ports)
+        return Group(*parts)
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        width = options.max_width
+        height = options.height or console.height
+        root = Layout()
+        bottom = Text(f" {self.prompt}", style="bold reverse") if self.prompt else Text(f" {KEYS}", style="dim")
+        root.split_column(Layout(self.status, size=2), Layout(name="body"), Layout(bottom, size=1))
+        body = root["body"]
+        if width >= WIDE:
+            body.split_row(Layout(self.rungs), Layout(self.side(), size=SIDE_WIDTH))
+        else:
+            side_lines = 4 + len(self.session.watch.items) + (6 if self.ports else 0)
+            rung_lines = max(8, height - 3 - side_lines)
+            body.split_column(Layout(self.rungs, size=rung_lines), Layout(self.side()))
+        yield from root.__rich_console__(console, options.update(height=height))
+
+
+def rung_view(session: WatchSession, height: int):
+    """The rungs of the session's shown file that fit ``height`` lines."""
+    from .rungs import ProgramFileView
+
+    s = session
+    return ProgramFileView(s.app.program.files[s.file], s.engine.table, symbols=s.app.program.symbols,
+                           first=s.top, selected=s.selected, breakpoints=frozenset(s.breaks.rungs),
+                           forced=frozenset(s.forces.forces), height=height, instructions=s.app.instructions)

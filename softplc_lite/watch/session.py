@@ -1,0 +1,192 @@
+"""A watch session: one app's engine with history, forces, breakpoints and
+a watch list, driven by commands (keys, or calls from tests); no terminal
+here (terminal.py reads keys, screen.py draws).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from ..app import App
+from ..ladder.engine import Mode
+from ..runner import RunOptions, Runner
+from .breakpoints import Breakpoints, Hit
+from .forces import Forces, parse_force
+from .history import History
+from .watchlist import WatchList
+
+# Run speeds ("+" and "-"): scans per second of wall time; 0 = as fast as it goes.
+SPEEDS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 0)
+
+
+@dataclass
+class WatchOptions:
+    run: RunOptions = field(default_factory=RunOptions)
+    watch: tuple[str, ...] = ()
+    forces: tuple[str, ...] = ()
+    break_when: tuple[str, ...] = ()
+    speed: int = 6  # index into SPEEDS: 100 scans/s
+
+
+class WatchSession:
+    def __init__(self, app: App, options: WatchOptions | None = None, rung_power=None) -> None:
+        self.app = app
+        self.options = options = options or WatchOptions()
+        self.runner = Runner(app, options.run)
+        self.engine = engine = self.runner.engine
+        symbols = app.program.symbols
+        self.history = History(engine.table)
+        self.forces = Forces(engine)
+        for text in options.forces:
+            self.forces.set(parse_force(text, symbols))
+        if rung_power is None:
+            from .power import rung_power
+        self.breaks = Breakpoints(engine, rung_power)
+        for text in options.break_when:
+            self.breaks.add_condition(text, symbols)
+        self.watch = WatchList(list(options.watch), symbols)
+        if engine.mode is not Mode.RUN:
+            engine.set_mode(Mode.RUN)
+        self.running = False
+        self.speed = min(max(options.speed, 0), len(SPEEDS) - 1)
+        self.files = sorted(app.program.files)
+        self.file = self.files[0] if 2 not in self.files else 2
+        self.selected = 0  # selected rung of the shown file
+        self.top = 0  # first rung shown
+        self.message = ""
+        self.last_hit: Hit | None = None
+        self.watch.sample(engine.table)
+
+    # -- scanning ---------------------------------------------------------------------------
+    def scan(self) -> Hit | None:
+        """One scan forward: from history when stepping back, else a new one."""
+        if not self.history.live:
+            frame = self.history.forward()
+            self.message = f"history: scan {frame.scan}" if not self.history.live else "live"
+            self.watch.sample(self.engine.table)
+            return None
+        engine = self.engine
+        engine.scan()
+        self.history.record(engine.scans, engine.clock.now_ms)
+        self.watch.sample(engine.table)
+        hit = self.breaks.after_scan()
+        if engine.mode is Mode.FAULTED:
+            self.running = False
+            self.message = str(engine.fault)
+        if hit is not None:
+            self.running = False
+            self.last_hit = hit
+            self.message = str(hit)
+            if hit.file is not None:
+                self.file, self.selected = hit.file, hit.rung
+                self.top = min(self.top, hit.rung)
+        return hit
+
+    def run_for(self, seconds: float) -> int:
+        """Scan for up to ``seconds`` of wall time at the run speed (or until
+        a breakpoint or fault stops the run); returns the scans done."""
+        if self.engine.mode is Mode.FAULTED:
+            self.running = False
+            return 0
+        if not self.history.live:
+            self.history.latest()
+        rate = SPEEDS[self.speed]
+        start = time.monotonic()
+        done = 0
+        while self.running and time.monotonic() - start < seconds:
+            if rate:
+                due = int((time.monotonic() - self._run_started) * rate) - self._run_scans
+                if due <= 0:
+                    time.sleep(min(0.005, seconds))
+                    continue
+            self.scan()
+            done += 1
+            self._run_scans += 1
+        return done
+
+    def start(self) -> None:
+        if not self.history.live:
+            self.history.latest()
+        self.running = True
+        self.message = "running"
+        self._run_started = time.monotonic()
+        self._run_scans = 0
+
+    def pause(self) -> None:
+        self.running = False
+        self.message = f"paused at scan {self.engine.scans}"
+
+    def faster(self) -> None:
+        self.speed = min(self.speed + 1, len(SPEEDS) - 1)
+        self._reset_rate()
+
+    def slower(self) -> None:
+        self.speed = max(self.speed - 1, 0)
+        self._reset_rate()
+
+    def _reset_rate(self) -> None:
+        self._run_started = time.monotonic()
+        self._run_scans = 0
+
+    @property
+    def speed_text(self) -> str:
+        rate = SPEEDS[self.speed]
+        return f"{rate} scans/s" if rate else "full speed"
+
+    def back(self) -> None:
+        frame = self.history.back()
+        self.running = False
+        if frame is None:
+            self.message = "history: no earlier scan kept"
+        else:
+            self.message = f"history: scan {frame.scan} (n forward, r runs live)"
+        self.watch.sample(self.engine.table)
+
+    @property
+    def shown_scan(self) -> int:
+        frame = self.history.shown
+        return frame.scan if frame is not None else self.engine.scans
+
+    # -- navigation ---------------------------------------------------------------------------
+    @property
+    def rungs(self):
+        return self.app.program.files[self.file].rungs
+
+    def move(self, delta: int) -> None:
+        self.selected = max(0, min(len(self.rungs) - 1, self.selected + delta))
+        if self.selected < self.top:
+            self.top = self.selected
+
+    def goto(self, rung: int) -> None:
+        self.selected = max(0, min(len(self.rungs) - 1, rung))
+        self.top = self.selected
+
+    def next_file(self) -> None:
+        k = self.files.index(self.file)
+        self.file = self.files[(k + 1) % len(self.files)]
+        self.selected = self.top = 0
+
+    def toggle_breakpoint(self) -> None:
+        on = self.breaks.toggle(self.file, self.selected)
+        self.message = f"breakpoint {'set' if on else 'cleared'}: file {self.file} rung {self.selected}"
+
+    def force(self, text: str) -> None:
+        self.forces.set(parse_force(text, self.app.program.symbols))
+        self.message = f"forced {text}"
+
+    def unforce(self, text: str) -> None:
+        symbols = self.app.program.symbols
+        found = self.forces.remove(symbols[text].address if text in symbols else text)
+        self.message = f"force removed: {text}" if found else f"{text} is not forced"
+
+    # -- the end ---------------------------------------------------------------------------------
+    def quit(self) -> None:
+        """Save the retentive data table (the newest scan) and close the ports."""
+        self.running = False
+        if not self.history.live:
+            self.history.latest()
+        try:
+            self.runner.save()
+        finally:
+            self.engine.close()

@@ -1,0 +1,163 @@
+"""The interactive watch view: keys in, screen out.
+
+Keys are read unbuffered from the terminal (cbreak mode, restored on
+exit). While running, scanning happens in short slices between key checks,
+and the screen is redrawn at most REDRAW_HZ times a second whatever the
+scan rate, so a fast run never waits on drawing.
+"""
+
+from __future__ import annotations
+
+import os
+import select
+import sys
+import termios
+import time
+import tty
+
+from rich.console import Console
+from rich.live import Live
+
+from ..datatable import DataTableError
+from .screen import WatchScreen
+from .session import WatchSession
+
+REDRAW_HZ = 10
+SLICE_S = 0.02  # scanning time between two looks at the keyboard
+
+_ESCAPES = {"\x1b[A": "up", "\x1b[B": "down", "\x1bOA": "up", "\x1bOB": "down",
+            "\x1b[5~": "pgup", "\x1b[6~": "pgdown"}
+
+
+class RawKeys:
+    """Single key presses from a terminal's standard input."""
+
+    def __init__(self, fd: int | None = None) -> None:
+        self.fd = sys.stdin.fileno() if fd is None else fd
+        self.saved = None
+
+    def __enter__(self) -> "RawKeys":
+        self.saved = termios.tcgetattr(self.fd)
+        tty.setcbreak(self.fd)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        termios.tcsetattr(self.fd, termios.TCSADRAIN, self.saved)
+
+    def read(self, timeout: float) -> str | None:
+        ready, _, _ = select.select([self.fd], [], [], timeout)
+        if not ready:
+            return None
+        data = os.read(self.fd, 32).decode("utf-8", "replace")
+        if data.startswith("\x1b") and len(data) > 1:
+            return _ESCAPES.get(data, "esc")
+        return data[:1] if data else None
+
+
+class Controller:
+    """What each key does to the session (and the one-line prompts)."""
+
+    def __init__(self, session: WatchSession) -> None:
+        self.session = session
+        self.prompt: str | None = None  # "go to rung: 12", "force ADDR=1|0: ..."
+        self.prompt_kind = ""
+        self.buffer = ""
+        self.done = False
+
+    def key(self, k: str) -> None:
+        s = self.session
+        if self.prompt_kind:
+            self._prompt_key(k)
+            return
+        if k in (" ", "n"):
+            s.scan()
+        elif k == "r":
+            s.start()
+        elif k == "p":
+            s.pause()
+        elif k == "+":
+            s.faster()
+        elif k == "-":
+            s.slower()
+        elif k in ("down", "j"):
+            s.move(1)
+        elif k in ("up", "k"):
+            s.move(-1)
+        elif k == "pgdown":
+            s.move(10)
+        elif k == "pgup":
+            s.move(-10)
+        elif k == "f":
+            s.next_file()
+        elif k == "b":
+            s.toggle_breakpoint()
+        elif k in ("\x7f", "\x08"):
+            s.back()
+        elif k == "g":
+            self._ask("g", "go to rung: ")
+        elif k == "F":
+            self._ask("F", "force ADDR=1 or ADDR=0: ")
+        elif k == "U":
+            self._ask("U", "remove the force on ADDR: ")
+        elif k == "q":
+            self.done = True
+
+    def _ask(self, kind: str, text: str) -> None:
+        self.prompt_kind, self.buffer = kind, ""
+        self.prompt = text
+
+    def _prompt_key(self, k: str) -> None:
+        label = {"g": "go to rung: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: "}
+        if k == "esc":
+            self.prompt_kind, self.prompt = "", None
+            return
+        if k in ("\r", "\n"):
+            kind, text = self.prompt_kind, self.buffer.strip()
+            self.prompt_kind, self.prompt = "", None
+            if text:
+                self._submit(kind, text)
+            return
+        if k in ("\x7f", "\x08"):
+            self.buffer = self.buffer[:-1]
+        elif len(k) == 1 and k.isprintable():
+            self.buffer += k
+        self.prompt = label[self.prompt_kind] + self.buffer
+
+    def _submit(self, kind: str, text: str) -> None:
+        s = self.session
+        try:
+            if kind == "g":
+                s.goto(int(text))
+            elif kind == "F":
+                s.force(text)
+            elif kind == "U":
+                s.unforce(text)
+        except (ValueError, DataTableError) as e:
+            s.message = f"{text}: {e}"
+
+
+def run_terminal(session: WatchSession, view_factory, console: Console | None = None) -> int:
+    console = console or Console()
+    control = Controller(session)
+    screen = WatchScreen(session, view_factory)
+    redraws = 0
+    with RawKeys() as keys, Live(screen, console=console, auto_refresh=False, screen=True,
+                                 redirect_stdout=False, redirect_stderr=False) as live:
+        last_draw = 0.0
+        dirty = True
+        while not control.done:
+            k = keys.read(0 if session.running else 1 / REDRAW_HZ)
+            if k is not None:
+                control.key(k)
+                dirty = True
+            if session.running:
+                session.run_for(SLICE_S)
+                dirty = True
+            now = time.monotonic()
+            if dirty and now - last_draw >= 1 / REDRAW_HZ or (k is not None):
+                screen.prompt = control.prompt
+                live.update(screen, refresh=True)
+                last_draw, dirty = now, False
+                redraws += 1
+    session.redraws = redraws
+    return 0

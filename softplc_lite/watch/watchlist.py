@@ -1,0 +1,81 @@
+"""The watch list: chosen addresses, their values, what changed, and a
+small trend (sparkline) of each numeric value over the last scans."""
+
+from __future__ import annotations
+
+from collections import deque
+
+from rich.console import Console, ConsoleOptions, RenderResult
+from rich.table import Table
+from rich.text import Text
+
+from ..datatable import DataTable, parse_address
+from ..datatable.display import format_value
+
+BARS = "▁▂▃▄▅▆▇█"
+TREND = 24  # samples kept per address
+
+
+def sparkline(values: list[float]) -> str:
+    if not values:
+        return ""
+    lo, hi = min(values), max(values)
+    if hi == lo:
+        return BARS[0] * len(values)
+    scale = (len(BARS) - 1) / (hi - lo)
+    return "".join(BARS[int((v - lo) * scale + 0.5)] for v in values)
+
+
+class WatchItem:
+    def __init__(self, text: str, symbols=None) -> None:
+        self.text = text
+        self.address = symbols[text].address if symbols and text in symbols else parse_address(text)
+        self.trend: deque[float] = deque(maxlen=TREND)
+        self.value: object = None
+        self.changed = False
+
+    def sample(self, table: DataTable) -> None:
+        try:
+            value = table.read(self.address)
+        except Exception as e:  # an address past its file shows why, it does not stop the view
+            value = f"? {e}"
+        self.changed = self.value is not None and value != self.value
+        self.value = value
+        if isinstance(value, (int, float)) and not isinstance(value, bool):
+            self.trend.append(float(value))
+
+
+class WatchList:
+    """Addresses given with --watch (or a watch file), sampled every scan."""
+
+    def __init__(self, addresses: list[str], symbols=None) -> None:
+        self.items = [WatchItem(a, symbols) for a in addresses]
+
+    def sample(self, table: DataTable) -> None:
+        for item in self.items:
+            item.sample(table)
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        table = Table(title="watch", title_justify="left", expand=True, show_edge=False, pad_edge=False)
+        table.add_column("address", no_wrap=True)
+        table.add_column("value", no_wrap=True)
+        table.add_column("trend", no_wrap=True)
+        if not self.items:
+            table.add_row(Text("(none: --watch ADDR)", style="dim"), "", "")
+        for item in self.items:
+            shown = format_value(item.value) if not isinstance(item.value, str) or not item.value.startswith("?") \
+                else item.value
+            table.add_row(item.text, Text(shown, style="bold yellow" if item.changed else ""),
+                          Text(sparkline(list(item.trend)), style="cyan"))
+        yield table
+
+
+def read_watch_file(path: str) -> list[str]:
+    """A watch file: one address (or symbol) a line; ``#`` starts a comment."""
+    out = []
+    with open(path, encoding="utf-8") as f:
+        for line in f:
+            text = line.split("#", 1)[0].strip()
+            if text:
+                out.append(text)
+    return out

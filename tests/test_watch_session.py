@@ -1,0 +1,199 @@
+"""The watch view's engine parts, without a terminal: forces, breakpoints,
+stepping back through history, the watch list."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from softplc_lite.app import load_app
+from softplc_lite.datatable import DataTableError
+from softplc_lite.runner import RunOptions
+from softplc_lite.watch.breakpoints import Condition
+from softplc_lite.watch.forces import ForceError, parse_force
+from softplc_lite.watch.history import DEPTH
+from softplc_lite.watch.session import WatchOptions, WatchSession
+
+PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
+
+MOTOR = """
+SYMBOL Start I:0/0
+SYMBOL Motor O:0/0
+// count scans
+ADD N7:0 1 N7:0
+// the motor follows the start input
+XIC Start OTE Motor
+// a subroutine-free rung that is energized only when N7:0 is a multiple of 5
+CMP "N7:0 MOD 5 = 0" OTE B3/0
+// the program tries to switch O:0/1 on every scan
+OTE O:0/1
+"""
+
+
+@pytest.fixture
+def session(tmp_path):
+    made = []
+
+    def make(text: str = MOTOR, **kw) -> WatchSession:
+        d = tmp_path / f"app{len(made)}"
+        d.mkdir()
+        (d / "main.lad").write_text(text)
+        app = load_app(d, state_dir=tmp_path / f"state{len(made)}")
+        s = WatchSession(app, WatchOptions(run=RunOptions(fresh=True), **kw))
+        made.append(s)
+        return s
+    yield make
+    for s in made:
+        s.quit()
+
+
+def read(s: WatchSession, addr: str):
+    return s.engine.table.read(addr)
+
+
+# -- forces ---------------------------------------------------------------------------------
+
+def test_a_forced_input_wins_over_the_input_scan_and_the_program_sees_it(session):
+    s = session(forces=("Start=1",))
+    s.scan()
+    assert read(s, "O:0/0") == 1  # the ladder read the forced input
+    s.engine.table.write("I:0/0", 0)  # what an input scan would write
+    s.scan()
+    assert read(s, "I:0/0") == 1 and read(s, "O:0/0") == 1
+    s.unforce("Start")
+    s.engine.table.write("I:0/0", 0)
+    s.scan()
+    assert read(s, "O:0/0") == 0
+
+
+def test_a_forced_output_wins_over_the_program(session):
+    s = session()
+    s.force("O:0/1=0")
+    for _ in range(3):
+        s.scan()
+        assert read(s, "O:0/1") == 0  # OTE O:0/1 writes 1 every scan; the force holds 0
+    assert [str(f) for f in s.forces.listed()] == ["O:0/1=0"]
+    s.forces.clear()
+    s.scan()
+    assert read(s, "O:0/1") == 1
+
+
+def test_any_bit_can_be_forced_but_only_bits(session):
+    s = session()
+    s.force("N7:3/15=1")
+    s.scan()
+    assert read(s, "N7:3") == -32768
+    with pytest.raises(ForceError, match="only a direct bit address"):
+        parse_force("N7:0=1")
+    with pytest.raises(ForceError, match="expected ADDR=1 or ADDR=0"):
+        parse_force("O:0/0=2")
+
+
+# -- breakpoints --------------------------------------------------------------------------------
+
+def test_break_when_a_condition_becomes_true(session):
+    s = session(break_when=("N7:0 > 7",))
+    s.start()
+    s.run_for(5.0)
+    assert not s.running and read(s, "N7:0") == 8
+    assert s.message == "break: N7:0 > 7 became true at scan 8"
+    s.start()
+    s.run_for(0.05)  # stays true: no new break until it goes false and true again
+    assert read(s, "N7:0") > 8
+
+
+def test_break_when_a_bit_address_goes_on(session):
+    s = session(break_when=("B3/0",))
+    s.start()
+    s.run_for(5.0)
+    assert read(s, "N7:0") == 5 and s.last_hit.condition == "B3/0"
+
+
+def test_rung_breakpoint_stops_when_the_rung_is_energized(session):
+    s = session()
+    s.goto(2)  # the CMP rung
+    s.toggle_breakpoint()
+    s.start()
+    s.run_for(5.0)
+    assert not s.running and read(s, "N7:0") == 5
+    assert (s.last_hit.file, s.last_hit.rung, s.last_hit.scan) == (2, 2, 5)
+    assert s.message == "break: file 2 rung 2 energized at scan 5"
+    s.start()
+    s.run_for(5.0)
+    assert read(s, "N7:0") == 10  # the next time
+    s.toggle_breakpoint()  # cleared: runs on
+    s.start()
+    s.run_for(0.05)
+    assert s.running and read(s, "N7:0") > 10
+
+
+def test_bad_break_condition_is_a_clear_error(session):
+    with pytest.raises(DataTableError, match="--break-when"):
+        Condition("N7:0 >")
+    with pytest.raises(DataTableError, match="neither an address nor a program symbol"):
+        session(break_when=("Nothing > 1",))
+
+
+# -- history --------------------------------------------------------------------------------------
+
+def test_step_back_and_forward_through_history_without_rerunning(session):
+    s = session()
+    for _ in range(10):
+        s.scan()
+    assert read(s, "N7:0") == 10
+    s.back()
+    s.back()
+    assert read(s, "N7:0") == 8 and s.shown_scan == 8 and s.engine.scans == 10
+    s.scan()  # forward in history, not a new scan
+    assert read(s, "N7:0") == 9 and s.engine.scans == 10
+    s.scan()
+    s.scan()  # live again: now a new scan
+    assert read(s, "N7:0") == 11 and s.engine.scans == 11 and s.history.live
+
+
+def test_history_keeps_at_least_a_thousand_scans(session):
+    s = session()
+    for _ in range(DEPTH + 50):
+        s.scan()
+    for _ in range(DEPTH - 1):
+        s.back()
+    assert s.shown_scan == 51 and read(s, "N7:0") == 51
+    s.back()
+    assert "no earlier scan" in s.message and s.shown_scan == 51
+    s.start()  # running goes back to the newest scan first
+    s.run_for(0.02)
+    assert read(s, "N7:0") > DEPTH + 50
+
+
+def test_watch_list_samples_values_and_trends(session):
+    s = session(watch=("N7:0", "O:0/0"))
+    for _ in range(5):
+        s.scan()
+    n7 = s.watch.items[0]
+    assert n7.value == 5 and n7.changed and list(n7.trend) == [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]
+
+
+def test_quit_saves_the_retentive_table(session, tmp_path):
+    s = session()
+    for _ in range(3):
+        s.scan()
+    s.quit()
+    from softplc_lite.datatable import snapshot
+
+    assert snapshot.load(tmp_path / "state0" / "datatable.snap").read("N7:0") == 3
+
+
+def test_modbus_master_session_shows_ports(session):
+    app = load_app(PROGRAMS / "modbus_master", state_dir=None)
+    app.state_dir = None
+    s = WatchSession(app, WatchOptions(run=RunOptions(fresh=True)))
+    try:
+        for _ in range(200):
+            s.scan()
+        from softplc_lite.watch.portsview import ports_of
+
+        (port,) = ports_of(s.engine)
+        assert port.tx_bytes >= 8 and port.rx_bytes >= 255
+    finally:
+        s.quit()

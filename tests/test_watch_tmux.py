@@ -1,0 +1,100 @@
+"""The real ``softplc watch`` in a terminal: tmux runs it, ``send-keys``
+steps and quits, ``capture-pane`` reads the screen."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+class Tmux:
+    """One tmux server of our own (-L socket), killed at the end."""
+
+    def __init__(self, name: str) -> None:
+        self.socket = f"softplc-test-{os.getpid()}-{name}"
+        self.session = name
+
+    def run(self, *args: str) -> str:
+        out = subprocess.run(["tmux", "-L", self.socket, *args], capture_output=True, text=True, timeout=10)
+        return out.stdout
+
+    def start(self, command: str, width: int = 100, height: int = 30) -> None:
+        env = f"cd {ROOT} && PYTHONPATH={ROOT} TERM=xterm-256color {command}"
+        subprocess.run(["tmux", "-L", self.socket, "new-session", "-d", "-s", self.session, "-x", str(width),
+                        "-y", str(height), env], check=True, timeout=10)
+
+    def screen(self) -> str:
+        return self.run("capture-pane", "-p", "-t", self.session)
+
+    def keys(self, *keys: str) -> None:
+        for k in keys:
+            self.run("send-keys", "-t", self.session, k)
+
+    def wait_for(self, text: str, seconds: float = 15.0) -> str:
+        deadline = time.monotonic() + seconds
+        screen = ""
+        while time.monotonic() < deadline:
+            screen = self.screen()
+            if text in screen:
+                return screen
+            time.sleep(0.1)
+        raise AssertionError(f"{text!r} not on screen after {seconds} s:\n{screen}")
+
+    def alive(self) -> bool:
+        return subprocess.run(["tmux", "-L", self.socket, "has-session", "-t", self.session],
+                              capture_output=True, timeout=10).returncode == 0
+
+    def kill(self) -> None:
+        subprocess.run(["tmux", "-L", self.socket, "kill-server"], capture_output=True, timeout=10)
+
+
+@pytest.fixture
+def tmux(request):
+    if shutil.which("tmux") is None:
+        pytest.skip("tmux is not installed (apt-get install -y tmux)")
+    t = Tmux(request.node.name[:20].replace("[", "_").replace("]", "_"))
+    yield t
+    t.kill()
+
+
+def test_step_run_and_quit_in_a_real_terminal(tmux, tmp_path):
+    state = tmp_path / "state"
+    tmux.start(f"{sys.executable} -m softplc_lite watch programs/blinker --fresh --state {state} "
+               f"--watch C5:0.ACC --watch T4:0.ACC")
+    tmux.wait_for("PAUSED")
+    assert "scan 0" in tmux.screen()
+    tmux.keys("n", "n", "n")
+    screen = tmux.wait_for("scan 3")
+    assert "T4:0.ACC" in screen and "XIO" in screen or "]/[" in screen  # rungs and the watch list are drawn
+    tmux.keys("Space")
+    screen = tmux.wait_for("scan 4")
+    tmux.keys("BSpace")  # step back through history
+    screen = tmux.wait_for("scan 3 of 4 (history)")
+    tmux.keys("n")
+    tmux.wait_for("scan 4 ")
+    tmux.keys("q")
+    deadline = time.monotonic() + 10
+    while tmux.alive() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not tmux.alive(), "q did not end softplc watch"
+    from softplc_lite.datatable import snapshot
+
+    assert snapshot.load(state / "datatable.snap").read("S:100") == 4  # saved at quit, after 4 scans
+
+
+def test_run_until_a_breakpoint_condition(tmux, tmp_path):
+    tmux.start(f"{sys.executable} -m softplc_lite watch programs/blinker --fresh --state {tmp_path} "
+               f'--break-when "C5:0.ACC >= 2" --watch C5:0.ACC')
+    tmux.wait_for("PAUSED")
+    tmux.keys("+", "+", "+", "+", "+", "r")  # faster, run
+    screen = tmux.wait_for("became true at scan", seconds=30)
+    assert "break: C5:0.ACC >= 2 became true at scan 153" in screen and "scan 153 " in screen
+    tmux.keys("q")
