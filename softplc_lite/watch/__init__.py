@@ -1,0 +1,1 @@
+"""``softplc watch``: a running PLC's online view in the terminal."""
