@@ -136,28 +136,47 @@ class Controller:
             s.message = f"{text}: {e}"
 
 
+class ViewLoop:
+    """The interactive loop without the terminal: a key (or None) in, then
+    scan a slice if running, then redraw if due. ``draw`` puts the screen on
+    the terminal (rich Live here; a benchmark passes its own)."""
+
+    def __init__(self, session: WatchSession, screen: WatchScreen, draw) -> None:
+        self.session = session
+        self.screen = screen
+        self.draw = draw
+        self.control = Controller(session)
+        self.redraws = 0
+        self.last_draw = 0.0
+        self.dirty = True
+
+    def tick(self, k: str | None) -> None:
+        session = self.session
+        if k is not None:
+            self.control.key(k)
+            self.dirty = True
+        if session.running:
+            session.run_for(SLICE_S)
+            self.dirty = True
+        now = time.monotonic()
+        if k is not None or (self.dirty and now - self.last_draw >= 1 / REDRAW_HZ):
+            self.screen.prompt = self.control.prompt
+            self.draw(self.screen)
+            self.last_draw, self.dirty = now, False
+            self.redraws += 1
+
+    @property
+    def done(self) -> bool:
+        return self.control.done
+
+
 def run_terminal(session: WatchSession, view_factory, console: Console | None = None) -> int:
     console = console or Console()
-    control = Controller(session)
     screen = WatchScreen(session, view_factory)
-    redraws = 0
     with RawKeys() as keys, Live(screen, console=console, auto_refresh=False, screen=True,
                                  redirect_stdout=False, redirect_stderr=False) as live:
-        last_draw = 0.0
-        dirty = True
-        while not control.done:
-            k = keys.read(0 if session.running else 1 / REDRAW_HZ)
-            if k is not None:
-                control.key(k)
-                dirty = True
-            if session.running:
-                session.run_for(SLICE_S)
-                dirty = True
-            now = time.monotonic()
-            if dirty and now - last_draw >= 1 / REDRAW_HZ or (k is not None):
-                screen.prompt = control.prompt
-                live.update(screen, refresh=True)
-                last_draw, dirty = now, False
-                redraws += 1
-    session.redraws = redraws
+        loop = ViewLoop(session, screen, lambda renderable: live.update(renderable, refresh=True))
+        while not loop.done:
+            loop.tick(keys.read(0 if session.running else 1 / REDRAW_HZ))
+    session.redraws = loop.redraws
     return 0
