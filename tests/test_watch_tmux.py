@@ -80,6 +80,12 @@ def test_step_run_and_quit_in_a_real_terminal(tmux, tmp_path):
     screen = tmux.wait_for("scan 3 of 4 (history)")
     tmux.keys("n")
     tmux.wait_for("scan 4 ")
+    tmux.keys("F", "O:0/0=1", "Enter")  # force the lamp on from the view
+    tmux.wait_for("forces: O:0/0=ON")
+    tmux.keys("n")
+    tmux.wait_for("scan 5 ")
+    tmux.keys("U", "O:0/0", "Enter")  # and remove the force
+    tmux.wait_for("forces: none")
     tmux.keys("q")
     deadline = time.monotonic() + 10
     while tmux.alive() and time.monotonic() < deadline:
@@ -87,7 +93,8 @@ def test_step_run_and_quit_in_a_real_terminal(tmux, tmp_path):
     assert not tmux.alive(), "q did not end softplc watch"
     from softplc_lite.datatable import snapshot
 
-    assert snapshot.load(state / "datatable.snap").read("S:100") == 4  # saved at quit, after 4 scans
+    saved = snapshot.load(state / "datatable.snap")
+    assert saved.read("S:100") == 5 and saved.read("O:0/0") == 1  # saved at quit: 5 scans, the forced lamp
 
 
 def test_run_until_a_breakpoint_condition(tmux, tmp_path):

@@ -35,6 +35,7 @@ class RawKeys:
     def __init__(self, fd: int | None = None) -> None:
         self.fd = sys.stdin.fileno() if fd is None else fd
         self.saved = None
+        self.pending = ""  # typed ahead (a paste, tmux send-keys): one key at a time
 
     def __enter__(self) -> "RawKeys":
         self.saved = termios.tcgetattr(self.fd)
@@ -45,13 +46,26 @@ class RawKeys:
         termios.tcsetattr(self.fd, termios.TCSADRAIN, self.saved)
 
     def read(self, timeout: float) -> str | None:
-        ready, _, _ = select.select([self.fd], [], [], timeout)
-        if not ready:
-            return None
-        data = os.read(self.fd, 32).decode("utf-8", "replace")
-        if data.startswith("\x1b") and len(data) > 1:
-            return _ESCAPES.get(data, "esc")
-        return data[:1] if data else None
+        if not self.pending:
+            ready, _, _ = select.select([self.fd], [], [], timeout)
+            if not ready:
+                return None
+            self.pending = os.read(self.fd, 256).decode("utf-8", "replace")
+            if not self.pending:
+                return None
+        return self._next_key()
+
+    def _next_key(self) -> str:
+        data = self.pending
+        if data.startswith("\x1b"):
+            for seq, name in _ESCAPES.items():
+                if data.startswith(seq):
+                    self.pending = data[len(seq):]
+                    return name
+            self.pending = data[1:]
+            return "esc"
+        self.pending = data[1:]
+        return data[0]
 
 
 class Controller:
