@@ -1,5 +1,5 @@
-"""Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports), each in its own process, and
-summarize.
+"""Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports, the Modbus RTU master), each in
+its own process, and summarize.
 
     python benchmarks/run_all.py
 
@@ -20,7 +20,7 @@ import _common as C
 
 BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_comgenius_format",
-    "bench_comgenius_ports",
+    "bench_comgenius_ports", "bench_modbus_master",
 )
 
 
@@ -117,6 +117,21 @@ def main() -> int:
         lines.append(
             f"          sim:// unlimited {b['bytes_per_s']['sim:// unlimited'] / 1e6:.0f} MB/s, loop:// "
             f"{b['bytes_per_s']['loop://'] / 1e6:.2f} MB/s (4 KiB writes)"
+        )
+
+    modbus = load("bench_modbus_master")
+    if modbus:
+        pty, sim = modbus["pty"], modbus["sim"]
+        tps = pty["transactions_per_s"]
+        lines.append(
+            f"modbus    pty transactions/s: ladder {tps['ladder']:,}, pymodbus sync {tps['sync']:,}, async "
+            f"{tps['async']:,}; ladder/sync {pty['ratios']['ladder/sync']:.2f}x [{pty['verdict_ladder_over_sync']} "
+            f">= {pty['target_ladder_over_sync']:.1f}], ladder/async {pty['ratios']['ladder/async']:.2f}x"
+        )
+        lines.append(
+            f"          sim:// {sim['ms_per_transaction']:.2f} ms per transaction = {sim['ratio_over_wire_min']:.3f}x "
+            f"the wire minimum {sim['wire_min_ms']:.2f} ms [{sim['verdict']} <= {sim['target_ratio']:.2f}]; "
+            f"{sim['scans_per_wall_s']:,} scans/s, {sim['transactions_per_wall_s']:,} transactions per wall second"
         )
 
     print("=== summary " + "=" * 53)

@@ -562,3 +562,14 @@ def test_check_warns_about_ports_and_formats_it_can_see():
         "it will set a minor fault",
         "<program>:4:19: COMSCAN: format 99 is not in the string table (strings 1..10); it will set ER",
     ]
+
+
+def test_an_operation_lost_to_a_restore_starts_again(plc):
+    # A snapshot taken while COMSCAN waited holds EN without DN; the new run's
+    # instruction has nothing in progress: it starts again instead of hanging.
+    e = plc(SCAN, values={"N7:9": 7, "B3/0": 1, "R6:0/EN": 1})
+    e.scan()
+    assert bits(e) == "EN"  # matching again, timeout counted from now
+    for _ in range(5):
+        e.scan()
+    assert bits(e) == "EN DN ER EM"

@@ -236,6 +236,9 @@ class ControlledInstruction:
       until the rung goes false ("allow the rung to go false").
     - Rung false: EN, DN, ER and EM off; an unfinished operation is dropped
       (``cancel()``): no completion.
+    - Rung true, EN on but neither DN nor ER and nothing in progress (a
+      data table restored from a snapshot taken mid-operation): started
+      again, as if on a new transition.
 
     The EN bit is the memory of the previous rung state, as in PLC-5 file
     and message instructions, so the data table alone says what happens on
@@ -264,6 +267,13 @@ class ControlledInstruction:
         elif self.busy:
             ctl = ControlElement(d, i)
             self.busy = not self.step(ctl)
+        elif not w & (R_DN | R_ER):
+            # EN on, nothing in progress, no completion: the operation was
+            # lost, e.g. the data table was restored from a retentive
+            # snapshot taken mid-operation. Start it again, or the rung would
+            # wait for a completion that can never come.
+            d[i] = w & ~R_EM
+            self.busy = not self.start(ControlElement(d, i))
         return c
 
     def start(self, ctl: ControlElement) -> bool:

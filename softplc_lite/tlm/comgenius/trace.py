@@ -146,6 +146,7 @@ class TraceWriter:
     ``close()``) or an open text file (left open: ``close()`` only flushes
     it). Also a context manager.
 
+    >>> import io
     >>> out = io.StringIO()
     >>> with TraceWriter(out, ["port 0: loop://"]) as w:
     ...     w.event(0, 0, "TX", b"\\x02\\x03")
