@@ -1,5 +1,5 @@
-"""Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports, the Modbus RTU master), each in
-its own process, and summarize.
+"""Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports, the Modbus RTU master, the watch
+view), each in its own process, and summarize.
 
     python benchmarks/run_all.py
 
@@ -20,7 +20,7 @@ import _common as C
 
 BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_comgenius_format",
-    "bench_comgenius_ports", "bench_modbus_master",
+    "bench_comgenius_ports", "bench_modbus_master", "bench_watch",
 )
 
 
@@ -132,6 +132,16 @@ def main() -> int:
             f"          sim:// {sim['ms_per_transaction']:.2f} ms per transaction = {sim['ratio_over_wire_min']:.3f}x "
             f"the wire minimum {sim['wire_min_ms']:.2f} ms [{sim['verdict']} <= {sim['target_ratio']:.2f}]; "
             f"{sim['scans_per_wall_s']:,} scans/s, {sim['transactions_per_wall_s']:,} transactions per wall second"
+        )
+
+    watch = load("bench_watch")
+    if watch:
+        sps = watch["scans_per_s"]
+        lines.append(
+            f"watch     scans/s: run {sps['run']:,}, view at full speed {sps['view']:,} = "
+            f"{watch['ratio_view_over_run']:.2f}x [{watch['verdict']} >= {watch['target_ratio_view_over_run']:.2f}], "
+            f"per-scan work alone {watch['ratio_session_over_run']:.2f}x; {watch['redraws_per_s']:.1f} redraws/s "
+            f"of {watch['ms_per_redraw']:.1f} ms ({100 * watch['drawing_share_of_wall']:.0f}% of the time)"
         )
 
     print("=== summary " + "=" * 53)

@@ -128,6 +128,14 @@ def test_rung_breakpoint_stops_when_the_rung_is_energized(session):
     assert s.running and read(s, "N7:0") > 10
 
 
+def test_rung_breakpoint_judges_the_rung_on_the_values_it_reads(session):
+    # a self-resetting timer writes what it reads: true in the scan DN goes on, false in the next
+    s = session("XIO T4:0/DN TON T4:0 0.01 3 0\n")
+    s.toggle_breakpoint()
+    hits = [s.scan() is not None for _ in range(6)]
+    assert hits == [True, True, True, True, False, True]
+
+
 def test_bad_break_condition_is_a_clear_error(session):
     with pytest.raises(DataTableError, match="--break-when"):
         Condition("N7:0 >")

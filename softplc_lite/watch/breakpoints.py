@@ -3,9 +3,11 @@
 - **Rung breakpoint** (``b`` on the selected rung): running stops after a
   scan in which that rung was scanned with its rung condition true (it
   was executed, not skipped by a JMP or an uncalled subroutine, and power
-  reached its end). The check is made right after the rung runs, by
-  wrapping that one rung's callable, so rungs without a breakpoint cost
-  nothing.
+  reached its end). The check is made as the rung runs, by wrapping that
+  one rung's callable, so rungs without a breakpoint cost nothing; the
+  rung condition is evaluated on the values the rung reads, just before
+  it runs (a self-resetting timer, ``XIO T4:0/DN TON T4:0``, is true in
+  the scan its DN goes on and false in the next).
 - **Condition breakpoint** (``--break-when "N7:0 > 100"``, ``--break-when
   R6:0/ER``): a CMP-style expression, or a bit address, checked after each
   scan; running stops when it goes from false to true.
@@ -123,9 +125,11 @@ class Breakpoints:
         table = self.engine.table
 
         def watched(c, original=original, source=source, key=key):
+            # the rung condition on the values the rung reads: before it runs, so a
+            # rung that writes what it reads (XIO T4:0/DN TON T4:0) is judged as scanned
+            energized = c and (self.rung_power is None or bool(self.rung_power(source, table).out))
             result = original(c)
-            energized = True if self.rung_power is None else bool(self.rung_power(source, table).out)
-            if energized and c:
+            if energized:
                 self.hits.append(Hit(self.engine.scans + 1, key[0], key[1]))
             return result
 
@@ -141,6 +145,8 @@ class Breakpoints:
 
     def after_scan(self) -> Hit | None:
         """Call after each scan: the first hit of this scan, if any."""
+        if not self.hits and not self.conditions:
+            return None
         for cond in self.conditions:
             if cond.became_true(self.engine.table):
                 self.hits.append(Hit(self.engine.scans, condition=cond.text))

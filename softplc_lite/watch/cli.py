@@ -47,10 +47,14 @@ def watch_command(args) -> int:
         session.quit()
 
 
-def render(session: WatchSession, width: int, height: int) -> Console:
+def render(session: WatchSession, width: int, height: int, measured: bool = False) -> Console:
+    """The view of ``session`` at ``width`` x ``height``, recorded (export it
+    with ``export_text()`` or ``save_svg()``). The status bar shows the
+    status file's scan times (S:8, S:9) unless ``measured``: on simulated
+    time a snapshot is then the same on every machine."""
     console = Console(width=width, height=height, record=True, color_system="truecolor", force_terminal=True,
                       file=io.StringIO(), legacy_windows=False)
-    console.print(WatchScreen(session, rung_view))
+    console.print(WatchScreen(session, rung_view, measured=measured))
     return console
 
 

@@ -54,8 +54,7 @@ class Forces:
         self.table: DataTable = engine.table
         self.forces: dict[str, Force] = {}
         self._resolved: list[tuple[object, int, int, bool]] = []
-        engine.input_hooks.append(self._apply_in)  # after the modules' input hooks
-        engine.output_hooks.insert(0, self._apply_out)  # before any module sends
+        self._hooked = False
 
     def set(self, force: Force) -> None:
         self.forces[str(force.address)] = force
@@ -85,6 +84,19 @@ class Forces:
             f, index, bit = self.table.resolve(force.address)
             out.append((f.data, index, bit_mask(bit), force.on))
         self._resolved = out
+        self._hook(bool(out))
+
+    def _hook(self, on: bool) -> None:
+        """The engine calls the forces only while there are some (a scan
+        without forces pays nothing for them)."""
+        engine = self.engine
+        if on and not self._hooked:
+            engine.input_hooks.append(self._apply_in)  # after the modules' input hooks
+            engine.output_hooks.insert(0, self._apply_out)  # before any module sends
+        elif not on and self._hooked:
+            engine.input_hooks.remove(self._apply_in)
+            engine.output_hooks.remove(self._apply_out)
+        self._hooked = on
 
     def apply(self) -> None:
         for data, index, mask, on in self._resolved:

@@ -5,8 +5,10 @@ composes them for the space there is (80x24 and up)."""
 
 from __future__ import annotations
 
+from rich.cells import cell_len
 from rich.console import Console, ConsoleOptions, Group, RenderResult
 from rich.layout import Layout
+from rich.padding import Padding
 from rich.text import Text
 
 from ..ladder import status as S
@@ -18,13 +20,23 @@ WIDE = 120  # from this width the side panels go beside the rungs
 SIDE_WIDTH = 46
 KEYS = ("space/n step  r run  p pause  +/- speed  ↑↓/jk rung  f file  g go to rung  b breakpoint  "
         "⌫ back  F force  U unforce  q quit")
+# The keys line at narrower widths: the longest that fits (q quit always shown from 80 columns).
+KEY_LINES = (KEYS, "n step  r run  p pause  +/- speed  ↑↓ rung  f file  g go to  b break  ⌫ back  F/U force  q quit",
+             "n step  r run  p pause  +/- speed  ↑↓ rung  b break  ⌫ back  F/U force  q quit",
+             "n step  r run  p pause  ⌫ back  q quit")
 
 
 class StatusBar:
-    """Mode, scan, time, scan times, faults, and what the session is doing."""
+    """Mode, scan, time, scan times, faults, and what the session is doing.
 
-    def __init__(self, session: WatchSession) -> None:
+    ``measured``: the scan times measured on the wall clock (the live
+    view); otherwise the status file's S:8 and S:9 (whole ms: the simulated
+    ``scan_ms`` on simulated time), so a snapshot of a simulated run is the
+    same every time."""
+
+    def __init__(self, session: WatchSession, measured: bool = True) -> None:
         self.session = session
+        self.measured = measured
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         s = self.session
@@ -42,7 +54,10 @@ class StatusBar:
         line.append(f"  {now_ms / 1000:.3f} s {'real' if e.clock.realtime else 'sim'}")
         line.append("  RUNNING " if s.running else "  PAUSED ", style="bold green" if s.running else "bold")
         line.append(s.speed_text, style="dim")
-        line.append(f"  scan time {e.last_scan_ms:.2f} ms, max {e.max_scan_ms:.2f}", style="dim")
+        if self.measured:
+            line.append(f"  scan time {e.last_scan_ms:.2f} ms, max {e.max_scan_ms:.2f}", style="dim")
+        else:
+            line.append(f"  scan time {e.s[S.LAST_SCAN_MS]} ms, max {e.s[S.MAX_SCAN_MS]}", style="dim")
         second = Text(no_wrap=True, overflow="ellipsis")
         if e.mode is Mode.FAULTED and e.fault is not None:
             second.append(f" {e.fault}", style="bold red")
@@ -91,9 +106,10 @@ class RungsPanel:
 
 
 class WatchScreen:
-    def __init__(self, session: WatchSession, view_factory, prompt: str | None = None) -> None:
+    def __init__(self, session: WatchSession, view_factory, prompt: str | None = None,
+                 measured: bool = True) -> None:
         self.session = session
-        self.status = StatusBar(session)
+        self.status = StatusBar(session, measured)
         self.rungs = RungsPanel(session, view_factory)
         self.ports = PortsView(session.engine)
         self.forces = ForcesView(session)
@@ -109,15 +125,20 @@ class WatchScreen:
         width = options.max_width
         height = options.height or console.height
         root = Layout()
-        bottom = Text(f" {self.prompt}", style="bold reverse") if self.prompt else Text(f" {KEYS}", style="dim")
+        if self.prompt:
+            bottom = Text(f" {self.prompt}", style="bold reverse")
+        else:
+            keys = next((k for k in KEY_LINES if cell_len(k) < width), KEY_LINES[-1])
+            bottom = Text(f" {keys}", style="dim", no_wrap=True, overflow="ellipsis")
         root.split_column(Layout(self.status, size=2), Layout(name="body"), Layout(bottom, size=1))
         body = root["body"]
+        side = self.side()
         if width >= WIDE:
-            body.split_row(Layout(self.rungs), Layout(self.side(), size=SIDE_WIDTH))
-        else:
-            side_lines = 4 + len(self.session.watch.items) + (6 if self.ports else 0)
+            body.split_row(Layout(self.rungs), Layout(Padding(side, (0, 0, 0, 1)), size=SIDE_WIDTH))
+        else:  # the side panels below the rungs, all of their lines if the rungs keep 8
+            side_lines = len(console.render_lines(side, options.update(width=width, height=None), pad=False))
             rung_lines = max(8, height - 3 - side_lines)
-            body.split_column(Layout(self.rungs, size=rung_lines), Layout(self.side()))
+            body.split_column(Layout(self.rungs, size=rung_lines), Layout(side))
         yield from root.__rich_console__(console, options.update(height=height))
 
 

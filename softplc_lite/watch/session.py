@@ -61,7 +61,7 @@ class WatchSession:
     # -- scanning ---------------------------------------------------------------------------
     def scan(self) -> Hit | None:
         """One scan forward: from history when stepping back, else a new one."""
-        if not self.history.live:
+        if self.history.position is not None:  # not live
             frame = self.history.forward()
             self.message = f"history: scan {frame.scan}" if not self.history.live else "live"
             self.watch.sample(self.engine.table)
@@ -69,7 +69,8 @@ class WatchSession:
         engine = self.engine
         engine.scan()
         self.history.record(engine.scans, engine.clock.now_ms)
-        self.watch.sample(engine.table)
+        if self.watch.items:
+            self.watch.sample(engine.table)
         hit = self.breaks.after_scan()
         if engine.mode is Mode.FAULTED:
             self.running = False
@@ -92,14 +93,23 @@ class WatchSession:
         if not self.history.live:
             self.history.latest()
         rate = SPEEDS[self.speed]
-        start = time.monotonic()
+        clock = time.monotonic
+        end = clock() + seconds
         done = 0
-        while self.running and time.monotonic() - start < seconds:
-            if rate:
-                due = int((time.monotonic() - self._run_started) * rate) - self._run_scans
-                if due <= 0:
-                    time.sleep(min(0.005, seconds))
-                    continue
+        if not rate:  # full speed: look at the clock every 8 scans, not every scan
+            scan = self.scan
+            while self.running and clock() < end:
+                for _ in range(8):
+                    if scan() is not None or not self.running:
+                        break
+                    done += 1
+            self._run_scans += done
+            return done
+        while self.running and clock() < end:
+            due = int((clock() - self._run_started) * rate) - self._run_scans
+            if due <= 0:
+                time.sleep(min(0.005, seconds))
+                continue
             self.scan()
             done += 1
             self._run_scans += 1

@@ -22,7 +22,8 @@ from ..datatable import DataTableError
 from .screen import WatchScreen
 from .session import WatchSession
 
-REDRAW_HZ = 10
+REDRAW_HZ = 10  # at most
+DRAW_SHARE = 0.04  # of the wall time spent drawing while running, at most
 SLICE_S = 0.02  # scanning time between two looks at the keyboard
 
 _ESCAPES = {"\x1b[A": "up", "\x1b[B": "down", "\x1bOA": "up", "\x1bOB": "down",
@@ -162,6 +163,7 @@ class ViewLoop:
         self.control = Controller(session)
         self.redraws = 0
         self.last_draw = 0.0
+        self.interval = 1 / REDRAW_HZ
         self.dirty = True
 
     def tick(self, k: str | None) -> None:
@@ -173,10 +175,14 @@ class ViewLoop:
             session.run_for(SLICE_S)
             self.dirty = True
         now = time.monotonic()
-        if k is not None or (self.dirty and now - self.last_draw >= 1 / REDRAW_HZ):
+        if k is not None or (self.dirty and now - self.last_draw >= self.interval):
             self.screen.prompt = self.control.prompt
             self.draw(self.screen)
-            self.last_draw, self.dirty = now, False
+            drawn = time.monotonic()
+            # Drawing takes at most DRAW_SHARE of the time while running: a
+            # big screen redraws less often rather than slowing the scans.
+            self.interval = max(1 / REDRAW_HZ, (drawn - now) / DRAW_SHARE)
+            self.last_draw, self.dirty = drawn, False
             self.redraws += 1
 
     @property

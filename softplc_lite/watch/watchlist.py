@@ -9,7 +9,7 @@ from rich.console import Console, ConsoleOptions, RenderResult
 from rich.table import Table
 from rich.text import Text
 
-from ..datatable import DataTable, parse_address
+from ..datatable import DataTable, DataTableError, ValueKind, parse_address
 from ..datatable.display import format_value
 
 BARS = "▁▂▃▄▅▆▇█"
@@ -33,12 +33,35 @@ class WatchItem:
         self.trend: deque[float] = deque(maxlen=TREND)
         self.value: object = None
         self.changed = False
+        self._table: DataTable | None = None
+        self._ref: tuple | None = None  # (array, index, mask or None) of a direct bit, word or float
+
+    def _bind(self, table: DataTable) -> None:
+        """A direct bit, word or float address is read straight from its file's
+        array, as compiled rungs read it (the arrays stay in place for the
+        table's life); anything else through ``table.read`` every sample."""
+        self._table, self._ref = table, None
+        a = self.address
+        try:
+            if a.is_direct and a.kind is ValueKind.BIT:
+                self._ref = table.bit_ref(a)
+            elif a.is_direct and a.kind in (ValueKind.WORD, ValueKind.FLOAT):
+                self._ref = (*table.word_ref(a), None)
+        except DataTableError:
+            pass  # past the end of its file (for now): read() says why
 
     def sample(self, table: DataTable) -> None:
-        try:
-            value = table.read(self.address)
-        except Exception as e:  # an address past its file shows why, it does not stop the view
-            value = f"? {e}"
+        if table is not self._table:
+            self._bind(table)
+        ref = self._ref
+        if ref is not None:
+            data, index, mask = ref
+            value = data[index] if mask is None else (1 if data[index] & mask else 0)
+        else:
+            try:
+                value = table.read(self.address)
+            except Exception as e:  # an address past its file shows why, it does not stop the view
+                value = f"? {e}"
         self.changed = self.value is not None and value != self.value
         self.value = value
         if isinstance(value, (int, float)) and not isinstance(value, bool):
