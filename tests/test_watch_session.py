@@ -205,3 +205,14 @@ def test_modbus_master_session_shows_ports(session):
         assert port.tx_bytes >= 8 and port.rx_bytes >= 255
     finally:
         s.quit()
+
+
+def test_history_steps_do_not_add_to_the_trend(session):
+    s = session(watch=("N7:0",))
+    for _ in range(4):
+        s.scan()
+    s.back()
+    s.back()
+    s.scan()
+    item = s.watch.items[0]
+    assert item.value == 3 and list(item.trend) == [0.0, 1.0, 2.0, 3.0, 4.0]

@@ -37,15 +37,19 @@ class WatchSession:
         self.engine = engine = self.runner.engine
         symbols = app.program.symbols
         self.history = History(engine.table)
-        self.forces = Forces(engine)
-        for text in options.forces:
-            self.forces.set(parse_force(text, symbols))
-        if rung_power is None:
-            from .power import rung_power
-        self.breaks = Breakpoints(engine, rung_power)
-        for text in options.break_when:
-            self.breaks.add_condition(text, symbols)
-        self.watch = WatchList(list(options.watch), symbols)
+        try:
+            self.forces = Forces(engine)
+            for text in options.forces:
+                self.forces.set(parse_force(text, symbols))
+            if rung_power is None:
+                from .power import rung_power
+            self.breaks = Breakpoints(engine, rung_power)
+            for text in options.break_when:
+                self.breaks.add_condition(text, symbols)
+            self.watch = WatchList(list(options.watch), symbols)
+        except BaseException:
+            engine.close()  # a bad --force/--break-when/--watch: release the ports opened
+            raise
         if engine.mode is not Mode.RUN:
             engine.set_mode(Mode.RUN)
         self.running = False
@@ -64,7 +68,7 @@ class WatchSession:
         if self.history.position is not None:  # not live
             frame = self.history.forward()
             self.message = f"history: scan {frame.scan}" if not self.history.live else "live"
-            self.watch.sample(self.engine.table)
+            self.watch.sample(self.engine.table, trend=False)
             return None
         engine = self.engine
         engine.scan()
@@ -151,7 +155,7 @@ class WatchSession:
             self.message = "history: no earlier scan kept"
         else:
             self.message = f"history: scan {frame.scan} (n forward, r runs live)"
-        self.watch.sample(self.engine.table)
+        self.watch.sample(self.engine.table, trend=False)
 
     @property
     def shown_scan(self) -> int:

@@ -50,7 +50,9 @@ class WatchItem:
         except DataTableError:
             pass  # past the end of its file (for now): read() says why
 
-    def sample(self, table: DataTable) -> None:
+    def sample(self, table: DataTable, trend: bool = True) -> None:
+        """Read the value; ``trend``: also add it to the trend (a scan ran;
+        not when a scan from history is shown)."""
         if table is not self._table:
             self._bind(table)
         ref = self._ref
@@ -64,7 +66,7 @@ class WatchItem:
                 value = f"? {e}"
         self.changed = self.value is not None and value != self.value
         self.value = value
-        if isinstance(value, (int, float)) and not isinstance(value, bool):
+        if trend and isinstance(value, (int, float)) and not isinstance(value, bool):
             self.trend.append(float(value))
 
 
@@ -74,9 +76,9 @@ class WatchList:
     def __init__(self, addresses: list[str], symbols=None) -> None:
         self.items = [WatchItem(a, symbols) for a in addresses]
 
-    def sample(self, table: DataTable) -> None:
+    def sample(self, table: DataTable, trend: bool = True) -> None:
         for item in self.items:
-            item.sample(table)
+            item.sample(table, trend)
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         table = Table(title="watch", title_justify="left", expand=True, show_edge=False, pad_edge=False)
