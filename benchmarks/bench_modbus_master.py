@@ -54,10 +54,8 @@ socat is missing or a check fails.
 from __future__ import annotations
 
 import asyncio
-import json
 import logging
 import statistics
-import subprocess
 import sys
 import time
 
@@ -69,6 +67,7 @@ if str(C.REPO / "tests") not in sys.path:
 from pymodbus import FramerType  # noqa: E402
 from pymodbus.client import AsyncModbusSerialClient, ModbusSerialClient  # noqa: E402
 
+from modbus_peer import PeerProcess  # noqa: E402
 from ptypair import PtyPair, SocatMissing  # noqa: E402
 from softplc_lite.app import load_app  # noqa: E402
 from softplc_lite.runner import RunOptions, Runner  # noqa: E402
@@ -89,40 +88,6 @@ WIRE_MIN_MS = (8 * CHAR_NS + GAP_NS + 255 * CHAR_NS + GAP_NS) / 1e6
 TARGET_LADDER_OVER_SYNC = 1.0
 TARGET_SIM_RATIO = 1.10
 NOTES_PER_S = {"sync": 400, "async": 1500}  # /work/shared/testing-notes.md
-
-
-PEER_PROCESS = """
-import json, sys
-sys.path.insert(0, sys.argv[1])
-from modbus_peer import ModbusPeer
-peer = ModbusPeer(sys.argv[2], json.loads(sys.argv[3])).start()
-print("ready", flush=True)
-sys.stdin.read()  # serve until the benchmark closes stdin (or dies)
-peer.stop()
-"""
-
-
-class PeerProcess:
-    """tests/modbus_peer.py's ModbusPeer in a process of its own: an
-    in-process server thread starves while the ladder scans free-running
-    (the GIL), see the module docstring."""
-
-    def __init__(self, port: str, registers: list[int]) -> None:
-        self.proc = subprocess.Popen([sys.executable, "-c", PEER_PROCESS, str(C.REPO / "tests"), port,
-                                      json.dumps(registers)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-        if self.proc.stdout.readline().strip() != "ready":
-            self.stop()
-            raise CheckFailed(f"the pymodbus process did not start on {port}")
-
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.stdin.close()
-            try:
-                self.proc.wait(10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(10)
-        self.proc.stdout.close()
 
 
 def master(**options) -> Runner:

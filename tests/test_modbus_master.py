@@ -25,7 +25,6 @@ stops its pymodbus servers and relays, and ends its socat.
 from __future__ import annotations
 
 import importlib.util
-import json
 import re
 import selectors
 import socket
@@ -47,7 +46,7 @@ from softplc_lite.tlm.comgenius.trace import read_trace
 from ptypair import PtyPair, require_socat, socat_processes
 
 pytest.importorskip("pymodbus", minversion="3.16.1")
-from modbus_peer import ModbusPeer, free_tcp_port  # noqa: E402
+from modbus_peer import ModbusPeer, PeerProcess, free_tcp_port  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 TESTS = Path(__file__).resolve().parent
@@ -151,43 +150,6 @@ def peers():
     yield start
     for peer in started:
         peer.stop()
-
-
-PEER_PROCESS = """
-import json, sys
-sys.path.insert(0, sys.argv[1])
-from modbus_peer import ModbusPeer
-peer = ModbusPeer(sys.argv[2], json.loads(sys.argv[3])).start()
-print("ready", flush=True)
-sys.stdin.read()  # serve until the test closes stdin (or dies)
-peer.stop()
-"""
-
-
-class PeerProcess:
-    """ModbusPeer in a process of its own, as a slave is on a real line. A
-    master scanning free-running (scan_ms=0) in this process holds the GIL
-    so much that an in-process pymodbus thread answers late, or after the
-    250 ms timeout (measured: about 60 transactions/s and a few timeouts per
-    thousand, against about 1,900/s and none with the server in another
-    process)."""
-
-    def __init__(self, port: str, registers=REGISTERS) -> None:
-        self.proc = subprocess.Popen([sys.executable, "-c", PEER_PROCESS, str(TESTS), port, json.dumps(registers)],
-                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
-        if self.proc.stdout.readline().strip() != "ready":
-            self.stop()
-            raise RuntimeError(f"the pymodbus process did not start on {port} (status {self.proc.returncode})")
-
-    def stop(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.stdin.close()
-            try:
-                self.proc.wait(10)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait(10)
-        self.proc.stdout.close()
 
 
 @pytest.fixture
@@ -333,7 +295,7 @@ def test_pymodbus_over_a_pty_pair(executor, masters, peers, pair):
 
 def test_pymodbus_in_another_process_free_running(masters, pair):
     """Free-running scans (scan_ms=0), pymodbus in a process of its own (see PeerProcess)."""
-    peer = PeerProcess(pair.b)
+    peer = PeerProcess(pair.b, REGISTERS)
     try:
         r = masters(realtime=True, scan_ms=0, ports=(f"0={pair.a}",))
         assert run_until(r, lambda: r.table.read("C5:1.ACC") >= 100, seconds=DEADLINE_S), counts(r)
