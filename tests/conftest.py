@@ -1,14 +1,19 @@
-"""Shared test helpers: random data tables built from raw contents."""
+"""Shared test helpers: random data tables built from raw contents, and
+sim:// ports on a hand-moved clock."""
 
 from __future__ import annotations
 
 import math
 from array import array
 
+import pytest
+import serial
 from hypothesis import strategies as st
 
 from softplc_lite.datatable import DataTable
 from softplc_lite.datatable.filetypes import FILE_TYPES
+
+from clocks import Clock
 
 
 @st.composite
@@ -34,3 +39,28 @@ def random_tables(draw, max_elements: int = 12) -> DataTable:
 
 
 FILE_LETTERS = list(FILE_TYPES)
+
+
+@pytest.fixture
+def clock() -> Clock:
+    return Clock()
+
+
+@pytest.fixture
+def opened():
+    """Opens sim:// (and replay://) ports, on ``clock`` when one is given,
+    and closes them after the test."""
+    import softplc_lite.tlm.comgenius.urlhandler  # noqa: F401  (registers the schemes)
+
+    ports = []
+
+    def open_(url: str, clock: Clock | None = None, **settings) -> serial.SerialBase:
+        port = serial.serial_for_url(url, **settings)
+        ports.append(port)
+        if clock is not None:
+            port.set_clock(clock)
+        return port
+
+    yield open_
+    for port in ports:
+        port.close()

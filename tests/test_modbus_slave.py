@@ -42,7 +42,6 @@ from softplc_lite.tlm.comgenius.modbus_slave import (
     with_crc,
 )
 
-from clocks import Clock
 
 CHAR = 260_417  # one character at 38400 8N1, ns
 GAP = 911_460  # 3.5 characters
@@ -398,25 +397,10 @@ def test_bit_packing():
 # - - - over the wire - - -
 
 
-@pytest.fixture
-def clock() -> Clock:
-    return Clock()
-
-
-@pytest.fixture
-def opened():
-    """Opens sim:// ports and closes them after the test."""
-    ports = []
-
-    def open_(url: str, clock: Clock, **settings) -> serial.SerialBase:
-        port = serial.serial_for_url(url, **settings)
-        ports.append(port)
-        port.set_clock(clock)
-        return port
-
-    yield open_
-    for port in ports:
-        port.close()
+@pytest.fixture(autouse=True)
+def no_links_left():
+    """Every link a test opened is gone once its ports are closed."""
+    yield
     assert not any(name.startswith("mb_") for name in wire.link_names())
 
 

@@ -16,6 +16,7 @@ from softplc_lite.tlm.comgenius.simdevices import EchoDevice
 
 from clocks import Clock
 
+
 CHAR_38400 = 260417  # 10 bits at 38400 baud, ns
 QUERY = bytes.fromhex("02 03 00 00 00 7D 85 D8")
 REPLY = bytes([0x02, 0x03, 0xFA]) + bytes(range(250)) + b"\x12\x34"  # 255 bytes
@@ -25,26 +26,10 @@ _names = itertools.count()
 
 
 
-@pytest.fixture
-def clock() -> Clock:
-    return Clock()
-
-
-@pytest.fixture
-def opened():
-    """Opens sim:// ports and closes them after the test."""
-    ports = []
-
-    def open_(url: str, clock: Clock | None = None, **settings) -> serial.SerialBase:
-        port = serial.serial_for_url(url, **settings)
-        ports.append(port)
-        if clock is not None:
-            port.set_clock(clock)
-        return port
-
-    yield open_
-    for port in ports:
-        port.close()
+@pytest.fixture(autouse=True)
+def no_links_left():
+    """Every link a test opened is gone once its ports are closed."""
+    yield
     assert not any(name.startswith("t_") for name in wire.link_names())
 
 
