@@ -123,7 +123,7 @@ def _string_line(raw: str, line: int, path: str, table: StringTable) -> None:
     table.add(value, line)
 
 
-_COM = re.compile(r"COM([1-9][0-9]?)", re.IGNORECASE)
+COM_NAME = re.compile(r"COM([1-9][0-9]?)", re.IGNORECASE)  # COM1..COM99: in [DRIVER] keys and [PORTS]
 
 
 def _driver_line(content: str, line: int, path: str, config: "ComGeniusConfig") -> None:
@@ -145,10 +145,10 @@ def _driver_line(content: str, line: int, path: str, config: "ComGeniusConfig") 
     elif name == "RETRY_MS":
         config.retry_ms = _int_field(value, "RETRY_MS", 10, None,
                                      lambda m: ModuleError(f"[DRIVER]: {m}", path, line))
-    elif _COM.fullmatch(name):
+    elif COM_NAME.fullmatch(name):
         if not value:
             raise ModuleError(f"[DRIVER]: {key}= needs a device (e.g. {key}=/dev/ttyUSB0) or a URL", path, line)
-        config.com_devices[int(_COM.fullmatch(name).group(1))] = value
+        config.com_devices[int(COM_NAME.fullmatch(name).group(1))] = value
     else:
         raise ModuleError(f"[DRIVER]: unknown setting {key!r} (settings: DEBUG, PORT_ERRORS, RETRY_MS, "
                           f"COM1..COM99)", path, line)

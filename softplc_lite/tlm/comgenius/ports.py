@@ -25,7 +25,6 @@ logical port N.
 
 from __future__ import annotations
 
-import re
 import sys
 import time
 from collections import deque
@@ -34,7 +33,7 @@ from typing import Callable
 import serial
 
 from ..errors import ModuleError
-from .config import ComGeniusConfig, PortConfig
+from .config import COM_NAME, ComGeniusConfig, PortConfig
 from .encodings import encoding
 from .transports import Transport, transport_for
 
@@ -43,7 +42,6 @@ TX_BUFFER_BYTES = 4096  # bytes; a COMPRINT waits until its whole output fits
 HISTORY = 16  # recent frames kept per port (for the watch view and debugging)
 
 _PARITY = {"N": serial.PARITY_NONE, "E": serial.PARITY_EVEN, "O": serial.PARITY_ODD}
-_COM = re.compile(r"COM([1-9][0-9]?)", re.IGNORECASE)
 
 # Errors that mean "this port does not work (any more)". termios.error is
 # not a SerialException (testing notes: a pty refusing 7E1), so list it.
@@ -66,7 +64,7 @@ def physical_url(physical: str, com_devices: dict[int, str] | None = None, platf
     text = physical.strip()
     if text.isdigit():  # the manual's sample: physical port 0 is COM1
         text = f"COM{int(text) + 1}"
-    m = _COM.fullmatch(text)
+    m = COM_NAME.fullmatch(text)
     if m:
         n = int(m.group(1))
         return (com_devices or {}).get(n) or default_com_device(n, platform)
@@ -82,13 +80,14 @@ class Port:
     """One logical port: its pyserial port, receive and transmit buffers."""
 
     def __init__(self, config: PortConfig, url: str, log: Callable[[int, str], None],
-                 now_ns: Callable[[], int], retry_ms: int = 1000) -> None:
+                 now_ns: Callable[[], int], retry_ms: int = 1000, log_frames: bool = False) -> None:
         self.config = config
         self.number = config.logical
         self.url = url
         self.encoding = encoding(config.encoding)
         self.decoder = self.encoding.decoder()
         self.log = log
+        self.log_frames = log_frames  # DEBUG=2: every frame in hex (formatted only then)
         self.now_ns = now_ns
         self.retry_s = retry_ms / 1000
         self.rx = ""  # received characters COMSCAN has not taken
@@ -218,7 +217,8 @@ class Port:
         self.history.append((t_ms, direction, data))
         if self.record is not None:
             self.record(self.number, direction, data)
-        self.log(2, f"port {self.number} {direction} {len(data):4d} bytes: {hexdump(data)}")
+        if self.log_frames:
+            self.log(2, f"port {self.number} {direction} {len(data):4d} bytes: {hexdump(data)}")
 
     # -- what the instructions do ----------------------------------------------------------
     def queue(self, data: bytes) -> bool:
@@ -282,7 +282,7 @@ class PortSet:
         for number, pc in sorted(config.ports.items()):
             physical = (overrides or {}).get(number, pc.physical)
             url = physical_url(physical, config.com_devices)
-            self.ports[number] = Port(pc, url, log, now_ns, config.retry_ms)
+            self.ports[number] = Port(pc, url, log, now_ns, config.retry_ms, log_frames=config.debug >= 2)
 
     def open_all(self, keep_going: bool | None = None) -> list[str]:
         """Open every port. A port that cannot be opened raises ModuleError

@@ -7,16 +7,14 @@ from __future__ import annotations
 
 from typing import Callable
 
-from . import Transport
+from .loop import LoopTransport
 
 
-class SimulatedTransport(Transport):
+class SimulatedTransport(LoopTransport):
+    """Read and written as loop:// is (exact ``in_waiting``, no write
+    timeout), and on the engine's clock."""
+
     kind = "sim"
-    write_timeout = None
-
-    def read(self) -> bytes:
-        n = self.serial.in_waiting
-        return self.serial.read(n) if n else b""
 
     def set_clock(self, now_ns: Callable[[], int]) -> None:
         self.serial.set_clock(now_ns)
