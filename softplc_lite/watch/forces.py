@@ -74,9 +74,6 @@ class Forces:
     def listed(self) -> list[Force]:
         return [self.forces[k] for k in sorted(self.forces)]
 
-    def is_forced(self, address: str) -> bool:
-        return address in self.forces
-
     def _resolve(self) -> None:
         out = []
         for force in self.forces.values():

@@ -51,10 +51,6 @@ class PortConfig:
     timeout_ms: int
     line: int = 0
 
-    def describe(self) -> str:
-        return (f"{self.logical}, {self.physical}, {self.encoding}, {self.baud}, {self.data_bits}, "
-                f"{self.parity}, {self.stop_bits}, {self.timeout_ms}")
-
 
 @dataclass
 class ComGeniusConfig:

@@ -112,11 +112,6 @@ class Port:
     def up(self) -> bool:
         return self.error is None
 
-    def describe(self) -> str:
-        c = self.config
-        return (f"port {c.logical} ({self.url}, {c.baud} {c.data_bits}{c.parity}{c.stop_bits}, {c.encoding}), "
-                f"[PORTS] line {c.line}")
-
     # -- open and close ------------------------------------------------------------------
     def open(self) -> None:
         """Open the device; on failure the port is down and the reason
