@@ -99,14 +99,22 @@ def _display(f: Path, base: Path) -> str:
         return str(f)
 
 
-def load_settings(path: Path) -> Settings:
-    settings = Settings()
+def read_settings_file(path: Path) -> dict:
+    """softplc.toml as a dict ({} when the app has none); a syntax error
+    names the file, line and column."""
     if not path.exists():
-        return settings
+        return {}
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as e:
         raise AppError(f"{path}: {e}") from None
+
+
+def load_settings(path: Path, doc: dict | None = None) -> Settings:
+    """The engine settings of softplc.toml (``doc``: the file already read)."""
+    settings = Settings()
+    if doc is None:
+        doc = read_settings_file(path)
     allowed = {
         "math": {"overflow": ("clamp", "wrap"), "divide_by_zero": ("overflow", "fault")},
         "scan": {"scan_ms": int, "watchdog_ms": int, "jsr_depth": int},
@@ -133,11 +141,10 @@ def load_settings(path: Path) -> Settings:
     return settings
 
 
-def load_display(path: Path, symbols=None) -> Display:
+def load_display(path: Path, symbols=None, doc: dict | None = None) -> Display:
     """The ``[display]`` section of softplc.toml (see display.py)."""
-    if not path.exists():
-        return Display()
-    doc = tomllib.loads(path.read_text(encoding="utf-8"))  # load_settings has reported syntax errors
+    if doc is None:
+        doc = read_settings_file(path)
     if "display" not in doc:
         return Display()
     try:
@@ -170,8 +177,9 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
     if errors:
         raise AppError(sorted(errors, key=lambda e: (e.pos.source, e.pos.line, e.pos.column)))
     warnings += [w.report() for w in _module_checks(resolved, modules)]
-    settings = load_settings(path / SETTINGS_FILE) if is_dir else Settings()
-    display = load_display(path / SETTINGS_FILE, resolved.symbols) if is_dir else Display()
+    settings_doc = read_settings_file(path / SETTINGS_FILE) if is_dir else {}
+    settings = load_settings(path / SETTINGS_FILE, settings_doc)
+    display = load_display(path / SETTINGS_FILE, resolved.symbols, settings_doc)
     table_json = path / DATATABLE_FILE if is_dir and (path / DATATABLE_FILE).exists() else None
     if state_dir is not None:
         state = Path(state_dir)
