@@ -24,6 +24,7 @@ from .ladder.instructions import BUILTIN, InstructionSet
 from .ladder.parser import parse_program, syntax_problems
 from .ladder.semantics import Settings
 from .ladder.validate import check
+from .ports import claim_conflicts
 from .tlm.api import TLM, find_file
 from .tlm.errors import ModuleError
 from .tlm.registry import installed, instruction_set, load_module, load_modules
@@ -170,6 +171,9 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
         instructions = instruction_set(modules, hints=True)
     except ModuleError as e:
         raise AppError(e.report()) from None
+    conflicts = claim_conflicts([c for m in modules for c in m.port_claims()])
+    if conflicts:
+        raise AppError("\n".join(conflicts))
     warnings += _unused_configs(module_dir, modules)
     parsed, errors = parse_files(files, path, instructions)
     resolved, problems = check(parsed, instructions)

@@ -25,7 +25,7 @@ from .ladder.engine import Mode
 from .ladder.errors import LadderError
 from .ladder.fmt import STYLES, format_program
 from .runner import RunOptions, Runner
-from .tlm.errors import ModuleError
+from .errors import LocatedError
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT = 0, 1, 2, 3
 
@@ -254,8 +254,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_OK
     try:
         return args.func(args)
-    except (DataTableError, AppError, LadderError, ModuleError) as e:
-        text = e.report() if isinstance(e, (LadderError, ModuleError)) else str(e)
+    except (DataTableError, AppError, LadderError, LocatedError) as e:
+        text = e.report() if isinstance(e, (LadderError, LocatedError)) else str(e)
         print(f"error: {text}" if not isinstance(e, AppError) else text, file=sys.stderr)
         return EXIT_ERROR
     except OSError as e:

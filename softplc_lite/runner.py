@@ -19,6 +19,7 @@ from .app import App
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
 from .ladder.engine import Engine, Mode, RealClock, SimulatedClock
+from .ports import parse_port_overrides
 
 SAVE_EVERY_S = 5.0
 
@@ -46,25 +47,13 @@ class RunOptions:
     load: tuple[str, ...] = ()
     sets: tuple[str, ...] = ()
     executor: str = "compiled"
-    ports: tuple[str, ...] = ()  # --port N=DEVICE (logical port N on DEVICE or a URL)
+    ports: tuple[str, ...] = ()  # --port [MODULE:]N=DEVICE (port N on DEVICE or a URL)
     record: str | None = None  # --record TRACE: write every port's traffic
     replay: str | None = None  # --replay TRACE: play every port back from a recording
 
     def module_options(self) -> dict[str, object]:
         """What modules get at attach (see tlm.api.TLM.attach)."""
         return {"ports": parse_port_overrides(self.ports), "record": self.record, "replay": self.replay}
-
-
-def parse_port_overrides(items: tuple[str, ...]) -> dict[int, str]:
-    """``--port 0=/dev/ttyUSB0`` items: logical port number to device or URL."""
-    out: dict[int, str] = {}
-    for text in items:
-        number, eq, device = text.partition("=")
-        if not eq or not number.strip().isdigit() or not device.strip():
-            raise DataTableError(f"--port {text!r}: expected N=DEVICE, e.g. --port 0=/dev/ttyUSB0 "
-                                 "or --port 1=socket://127.0.0.1:5020")
-        out[int(number)] = device.strip()
-    return out
 
 
 class Runner:

@@ -50,7 +50,7 @@ def clock() -> Clock:
 def opened():
     """Opens sim:// (and replay://) ports, on ``clock`` when one is given,
     and closes them after the test."""
-    import softplc_lite.tlm.comgenius.urlhandler  # noqa: F401  (registers the schemes)
+    import softplc_lite.ports.urlhandler  # noqa: F401  (registers the schemes)
 
     ports = []
 

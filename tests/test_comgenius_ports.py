@@ -18,7 +18,8 @@ from softplc_lite.ladder import status as S
 from softplc_lite.ladder.engine import SimulatedClock
 from softplc_lite.tlm.comgenius import ComGenius
 from softplc_lite.tlm.comgenius.config import parse_config
-from softplc_lite.tlm.comgenius.ports import RX_BUFFER_CHARS, TX_BUFFER_BYTES, physical_url
+from softplc_lite.ports import OverrideError
+from softplc_lite.tlm.comgenius.ports import RX_BUFFER_CHARS, TX_BUFFER_BYTES, port_url
 from softplc_lite.tlm.errors import ModuleError
 from softplc_lite.tlm.registry import instruction_set
 
@@ -378,12 +379,12 @@ def test_utf8_sequence_split_across_reads_waits_for_the_rest(plc):
 # -- ports: names, overrides, faults -----------------------------------------------------
 
 def test_physical_port_names():
-    assert physical_url("COM1", {}, "linux") == "/dev/ttyS0"
-    assert physical_url("com2", {}, "win32") == "COM2"
-    assert physical_url("0", {}, "linux") == "/dev/ttyS0"  # the manual's sample: port 0 is COM1
-    assert physical_url("COM3", {3: "/dev/ttyUSB0"}, "linux") == "/dev/ttyUSB0"
-    assert physical_url("socket://h:1", {}, "linux") == "socket://h:1"
-    assert physical_url("/dev/ttyACM0", {}, "linux") == "/dev/ttyACM0"
+    assert port_url("COM1", {}, "linux") == "/dev/ttyS0"
+    assert port_url("com2", {}, "win32") == "COM2"
+    assert port_url("0", {}, "linux") == "/dev/ttyS0"  # the manual's sample: port 0 is COM1
+    assert port_url("COM3", {3: "/dev/ttyUSB0"}, "linux") == "/dev/ttyUSB0"
+    assert port_url("socket://h:1", {}, "linux") == "socket://h:1"
+    assert port_url("/dev/ttyACM0", {}, "linux") == "/dev/ttyACM0"
 
 
 def test_a_port_that_cannot_be_opened_stops_the_start_naming_its_line(plc):
@@ -402,7 +403,7 @@ def test_port_override_replaces_the_physical_field(plc):
 
 
 def test_override_of_an_unconfigured_port_is_an_error(plc):
-    with pytest.raises(ModuleError, match="logical port 4 has no line in"):
+    with pytest.raises(OverrideError, match=r"--port 4=loop://: no module has a port 4 \(ports: COMGENIUS: 0\)"):
         plc("DATA N7 1", options={"ports": {4: "loop://"}})
 
 
@@ -537,7 +538,7 @@ def test_record_writes_every_frame_with_time_port_and_direction(plc, tmp_path):
     e.scan()
     e.scan()
     e.close()
-    from softplc_lite.tlm.comgenius.trace import read_trace
+    from softplc_lite.ports.trace import read_trace
 
     events = read_trace(trace)
     assert [(ev.t_ms, ev.port, ev.direction) for ev in events] == [(10.0, 0, "TX"), (20.0, 0, "RX")]

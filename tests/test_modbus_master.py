@@ -39,9 +39,9 @@ import pytest
 
 from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions, Runner
-from softplc_lite.tlm.comgenius import modbus_slave
-from softplc_lite.tlm.comgenius.modbus_slave import initial_value, with_crc
-from softplc_lite.tlm.comgenius.trace import read_trace
+from softplc_lite.ports import modbus_slave
+from softplc_lite.ports.modbus_slave import initial_value, with_crc
+from softplc_lite.ports.trace import read_trace
 
 from ptypair import PtyPair, require_socat, socat_processes
 

@@ -30,9 +30,9 @@ import time
 import pytest
 import serial
 
-import softplc_lite.tlm.comgenius.urlhandler  # noqa: F401  (registers sim://)
-from softplc_lite.tlm.comgenius import modbus_slave, simdevices, wire
-from softplc_lite.tlm.comgenius.modbus_slave import (
+import softplc_lite.ports.urlhandler  # noqa: F401  (registers sim://)
+from softplc_lite.ports import modbus_slave, simdevices, wire
+from softplc_lite.ports.modbus_slave import (
     ModbusSlave,
     find_slave,
     initial_value,
@@ -568,8 +568,8 @@ def test_unknown_kind_lists_modbus():
 def test_create_device_imports_the_modbus_module_itself():
     code = (
         "import sys\n"
-        "from softplc_lite.tlm.comgenius import simdevices\n"
-        "assert 'softplc_lite.tlm.comgenius.modbus_slave' not in sys.modules\n"
+        "from softplc_lite.ports import simdevices\n"
+        "assert 'softplc_lite.ports.modbus_slave' not in sys.modules\n"
         "device = simdevices.create_device('modbus', {'id': '5'})\n"
         "print(type(device).__name__, device.slave_id, sorted(simdevices.DEVICES))\n"
     )
@@ -580,7 +580,7 @@ def test_create_device_imports_the_modbus_module_itself():
 
 def test_registration_is_the_same_factory_either_way():
     assert simdevices.DEVICES["modbus"] is modbus_slave.create
-    assert simdevices.BUILTIN_DEVICES["modbus"] == "softplc_lite.tlm.comgenius.modbus_slave:create"
+    assert simdevices.BUILTIN_DEVICES["modbus"] == "softplc_lite.ports.modbus_slave:create"
     simdevices.register_device("modbus", modbus_slave.create)  # harmless
 
 

@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 import serial
 
-import softplc_lite.tlm.comgenius.urlhandler  # noqa: F401  (registers replay://)
-from softplc_lite.tlm.comgenius.urlhandler.protocol_replay import Mismatch
+import softplc_lite.ports.urlhandler  # noqa: F401  (registers replay://)
+from softplc_lite.ports.urlhandler.protocol_replay import Mismatch
 
 from clocks import Clock
 
@@ -229,13 +229,14 @@ def test_bad_trace_file_names_line_and_column(tmp_path, text, where):
 
 @pytest.mark.parametrize("url,message", [
     ("replay://", "no trace file path"),
-    ("replay://x.trace?port=36", "port must be 0-35"),
+    ("replay://x.trace?port=36", "port must be 0-35 or MODULE:N"),
+    ("replay://x.trace?port=MODBMAST:99", "port must be 0-35 or MODULE:N"),
     ("replay://x.trace?speed=2", "unknown option 'speed=2'"),
 ])
 def test_bad_urls(url, message):
     with pytest.raises(serial.SerialException) as info:
         serial.serial_for_url(url)
-    assert 'expected a string in the form "replay://PATH[?port=N]"' in str(info.value)
+    assert 'expected a string in the form "replay://PATH[?port=N|MODULE:N]"' in str(info.value)
     assert message in str(info.value)
 
 

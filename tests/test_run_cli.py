@@ -175,4 +175,5 @@ def test_port_override_and_a_missing_device(tmp_path):
     bad = softplc(*args, "--port", "zero=loop://")
     assert bad.returncode == 1 and "expected N=DEVICE" in bad.stderr
     unknown = softplc(*args, "--port", "3=loop://")
-    assert unknown.returncode == 1 and "logical port 3 has no line in [PORTS]" in unknown.stderr
+    assert unknown.returncode == 1 and "--port 3=loop://: no module has a port 3 (ports: COMGENIUS: 0)" \
+        in unknown.stderr and "Traceback" not in unknown.stderr

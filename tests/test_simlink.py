@@ -10,9 +10,9 @@ import time
 import pytest
 import serial
 
-import softplc_lite.tlm.comgenius.urlhandler as urlhandler
-from softplc_lite.tlm.comgenius import simdevices, wire
-from softplc_lite.tlm.comgenius.simdevices import EchoDevice
+import softplc_lite.ports.urlhandler as urlhandler
+from softplc_lite.ports import simdevices, wire
+from softplc_lite.ports.simdevices import EchoDevice
 
 from clocks import Clock
 

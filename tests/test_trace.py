@@ -10,8 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from softplc_lite.tlm.comgenius import trace
-from softplc_lite.tlm.comgenius.trace import TraceError, TraceEvent, TraceWriter, parse_trace, read_trace
+from softplc_lite.ports import trace
+from softplc_lite.ports.trace import TraceError, TraceEvent, TraceWriter, parse_trace, read_trace
 
 EXAMPLE = """\
 # softplc_lite port trace 1
@@ -44,14 +44,16 @@ def test_equal_times_are_allowed():
     ("x 0 TX 01\n", 1, 1, "expected a time in ms such as 12.345, found 'x'"),
     ("-1.0 0 TX 01\n", 1, 1, "expected a time in ms"),
     ("1. 0 TX 01\n", 1, 1, "expected a time in ms"),
-    ("0 36 TX 01\n", 1, 3, "expected a port number 0-35, found '36'"),
-    ("0 p1 TX 01\n", 1, 3, "expected a port number 0-35, found 'p1'"),
+    ("0 36 TX 01\n", 1, 3, "expected a port number 0-35 or MODULE:N, found '36'"),
+    ("0 p1 TX 01\n", 1, 3, "expected a port number 0-35 or MODULE:N, found 'p1'"),
+    ("0 MODBMAST:36 TX 01\n", 1, 3, "expected a port number 0-35 or MODULE:N, found 'MODBMAST:36'"),
+    ("0 :1 TX 01\n", 1, 3, "expected a port number 0-35 or MODULE:N, found ':1'"),
     ("0 0 tx 01\n", 1, 5, "expected TX or RX, found 'tx'"),
     ("0 0 TX 01\n  0 0 TX 0G\n", 2, 10, "expected a two-digit hex byte, found '0G'"),
     ("0 0 TX 0102\n", 1, 8, "expected a two-digit hex byte, found '0102'"),
     ("0 0 TX\n", 1, 8, "expected one or more hex bytes after 'TX'"),
     ("0 0 TX # 01\n", 1, 8, "expected one or more hex bytes after 'TX'"),
-    ("0\n", 1, 3, "expected a port number (0-35) after '0'"),
+    ("0\n", 1, 3, "expected a port (0-35, or MODULE:N) after '0'"),
     ("0 0\n", 1, 5, "expected TX or RX after '0'"),
     ("1.5 0 TX 01\n\n1.25 0 RX 02\n", 3, 1, "time 1.25 is before the previous event's 1.500 (line 1)"),
     ("# softplc_lite port trace 2\n0 0 TX 01\n", 1, 27, "trace format version 2 is not supported"),
@@ -110,7 +112,8 @@ def test_writer_to_a_path(tmp_path: Path):
 
 
 @pytest.mark.parametrize("args,message", [
-    ((1.0, 36, "TX", b"\x01"), "port 36 is outside 0-35"),
+    ((1.0, 36, "TX", b"\x01"), "port 36 is not 0-35 or MODULE:N"),
+    ((1.0, "MODBMAST", "TX", b"\x01"), "port 'MODBMAST' is not 0-35 or MODULE:N"),
     ((1.0, 0, "tx", b"\x01"), "direction must be TX or RX"),
     ((-0.5, 0, "TX", b"\x01"), "is not a time"),
     ((float("nan"), 0, "TX", b"\x01"), "is not a time"),
@@ -157,3 +160,17 @@ def test_round_trip(steps, comments):
 def test_module_doctests():
     result = doctest.testmod(trace, optionflags=doctest.ELLIPSIS)
     assert result.attempted > 0 and result.failed == 0
+
+
+def test_module_ports_are_labelled_module_colon_number():
+    """A port of a module other than COMGENIUS is written MODULE:N (upper
+    case) and read back as that label; plain numbers stay numbers."""
+    out = io.StringIO()
+    with TraceWriter(out) as w:
+        w.event(0.0, 0, "TX", b"\x01")
+        w.event(1.5, "modbmast:3", "RX", b"\x02\x03")
+    text = out.getvalue()
+    assert "1.500 MODBMAST:3 RX 02 03" in text
+    events = parse_trace(text)
+    assert [e.port for e in events] == [0, "MODBMAST:3"]
+    assert events[1] == TraceEvent(1.5, "MODBMAST:3", "RX", b"\x02\x03")

@@ -182,6 +182,7 @@ class Engine:
         self._deadline = 0.0
         self._owner = {spec.mnemonic: m for m in self.modules for spec in m.instructions()}
         self.module_warnings: list[str] = []
+        self.recorder = None  # the --record trace, shared by the modules' ports
         self._attach_modules(module_options or {})
         self._attach_hooks()
         self.files = {}
@@ -193,10 +194,13 @@ class Engine:
 
     # -- plug-in modules (TLMs) --------------------------------------------------------
     def _attach_modules(self, options) -> None:
+        from ..tlm.api import attach_options
+
+        per_module, self.recorder = attach_options(self.modules, options)
         attached = []
         try:
             for m in self.modules:
-                self.module_warnings += m.attach(self, options)
+                self.module_warnings += m.attach(self, per_module[m.name])
                 attached.append(m)
         except BaseException:
             for m in attached:  # a module refused to start: release what the others opened
@@ -228,6 +232,9 @@ class Engine:
         """End of the run: modules release what they hold (ports, files)."""
         for m in self.modules:
             m.close()
+        if self.recorder is not None:
+            self.recorder.close()
+            self.recorder = None
 
     # -- modes --------------------------------------------------------------------------
     def set_mode(self, mode: Mode) -> None:

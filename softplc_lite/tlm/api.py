@@ -13,9 +13,14 @@ for that app:
    before running (``softplc check`` prints them with their location);
 4. ``attach(engine, options)`` is called once when an engine takes the
    module, before the first scan: open what it drives (ports). ``options``
-   holds the run's module options (``softplc run --port/--record/--replay``:
-   keys "ports", "record", "replay"); a module ignores keys it does not use.
-   Raise ModuleError to refuse to start;
+   holds the run's module options, already split between modules by
+   ``attach_options``: "ports" ({N: device} from ``softplc run --port``, only
+   this module's ports), "recorder" (a ports.Recorder for ``--record``, or
+   None) and "replay" (a trace path for ``--replay``, or None); a module
+   ignores keys it does not use. Raise ModuleError to refuse to start. A
+   module that drives serial ports lists them in ``port_claims()`` (after
+   ``configure``), so that ``--port N=...`` finds its owner and no two ports
+   open one device;
 5. ``create(instr, ctx)`` makes one instance per instruction in the
    program. Each scan the engine calls the instance with the rung-in
    condition and takes its return value as the rung-out condition;
@@ -39,6 +44,8 @@ from ..ladder.compiler import address_fault
 from ..ladder.errors import LadderError
 from ..ladder.instructions import InstructionSpec
 from ..ladder.semantics import R_DN, R_EM, R_EN, R_ER, Machine
+from ..ports import PortClaim, Recorder, assign_port_overrides, claim_conflicts, physical_url
+from .errors import ModuleError
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..datatable import DataTable
@@ -74,6 +81,14 @@ class TLM:
         """An engine takes the module (before its first scan); return warnings."""
         return []
 
+    def port_claims(self) -> list[PortClaim]:
+        """The serial ports the module will open, from its config."""
+        return []
+
+    def serial_ports(self) -> list:
+        """The module's open ports (ports.SerialPort), for the watch view."""
+        return []
+
     # driver hooks: no-ops unless overridden
     def on_input(self, engine: "Engine") -> None:
         pass
@@ -90,6 +105,34 @@ class TLM:
     def log(self, message: str) -> None:
         """Diagnostics (a module's DEBUG output): standard error by default."""
         print(f"{self.name}: {message}", file=sys.stderr)
+
+
+def attach_options(modules: list[TLM], options: Mapping[str, object]) -> tuple[dict[str, dict], Recorder | None]:
+    """Each module's attach options, and the run's trace recorder.
+
+    ``options``: "ports" ({N or (MODULE or None, N): device}, the run's
+    ``--port`` items), "record" (a trace path) and "replay" (a trace path).
+    Overrides go to the module that has the port (ModuleError when none or
+    two do); ports that would share one device are refused."""
+    raw = options.get("ports") or {}
+    overrides = {(key if isinstance(key, tuple) else (None, key)): device for key, device in raw.items()}
+    claims = {m.name: m.port_claims() for m in modules}
+    split = assign_port_overrides(overrides, {name: [c.number for c in cs] for name, cs in claims.items() if cs})
+    final = []
+    for name, cs in claims.items():
+        mine = split.get(name, {})
+        for c in cs:
+            device = mine.get(c.number)
+            final.append(c if device is None else PortClaim(name, c.number, physical_url(device),
+                                                            f"--port {name}:{c.number}={device}"))
+    conflicts = claim_conflicts(final)
+    if conflicts:
+        raise ModuleError(conflicts[0])
+    record = options.get("record")
+    recorder = Recorder(str(record)) if record else None
+    per_module = {m.name: {"ports": split.get(m.name, {}), "recorder": recorder, "replay": options.get("replay")}
+                  for m in modules}
+    return per_module, recorder
 
 
 def find_file(directory: Path, name: str) -> Path | None:

@@ -1,5 +1,6 @@
-"""COMGENIUS ports in the watch view: per port, its state, receive and
-transmit counts, characters waiting, and the last frames in hex and ASCII."""
+"""Serial ports in the watch view (every module's: COMGENIUS, MODBMAST): per
+port, its state, receive and transmit counts, what is waiting (COMGENIUS's
+receive buffer), and the last frames in hex and ASCII."""
 
 from __future__ import annotations
 
@@ -12,11 +13,10 @@ HEX_BYTES = 12  # bytes of a frame shown
 
 
 def ports_of(engine) -> list:
-    """The Port objects of every module that has a PortSet (COMGENIUS)."""
+    """The open ports (ports.SerialPort) of every module."""
     found = []
     for module in engine.modules:
-        port_set = getattr(module, "ports", None)
-        found += list(getattr(port_set, "ports", {}).values())
+        found += module.serial_ports()
     return found
 
 
@@ -37,9 +37,10 @@ class PortsView:
         table.add_column("rx/tx bytes, waiting", no_wrap=True)
         table.add_column("last frames")
         for port in ports_of(self.engine):
-            state = Text(f"{port.number} ", style="bold")
+            state = Text(f"{port.label} ", style="bold")
             state.append("up" if port.up else "down", style="green" if port.up else "red")
-            counts = f"{port.rx_bytes}/{port.tx_bytes}, {len(port.rx)}" + (" OV" if port.overflow else "")
+            counts = f"{port.rx_bytes}/{port.tx_bytes}, {getattr(port, 'waiting', 0)}"
+            counts += " OV" if getattr(port, "overflow", False) else ""
             frames = Text()
             for t_ms, direction, data in list(port.history)[-FRAMES:]:
                 if frames:

@@ -42,7 +42,7 @@ from ..api import BoundOperand, ControlElement, ControlledInstruction, Instructi
 from .formats import FormatError
 from .instructions import _PARAMS, _PARAMS_OUT, FormatSource, param_problem, param_sources, spec
 from .params import ParamError
-from .ports import Port, PortSet
+from .ports import ComPort, PortSet
 from .printf import MAX_PARAMS, compile_print
 from .scanf import MATCHED, MISMATCH, compile_scan
 from .strings import StringTable
@@ -63,7 +63,7 @@ class _PortOperand:
         self.operand = operand
         self.ports = ports
 
-    def get(self) -> tuple[Port | None, str | None]:
+    def get(self) -> tuple[ComPort | None, str | None]:
         return self.ports.lookup(int(self.operand.value()))
 
 
@@ -80,7 +80,7 @@ class _Controlled(ControlledInstruction):
         self.log = log
         self.ctx = ctx
 
-    def _port_and_format(self, ctl: ControlElement) -> tuple[Port, int, str] | None:
+    def _port_and_format(self, ctl: ControlElement) -> tuple[ComPort, int, str] | None:
         """The port and the format text at the start, or None after
         finishing with ER (bad or down port, no such string)."""
         port, problem = self.port.get()
@@ -100,7 +100,7 @@ class _Controlled(ControlledInstruction):
 
 
 class ComPrint(_Controlled):
-    pending: tuple[Port, bytes] | None = None
+    pending: tuple[ComPort, bytes] | None = None
 
     def start(self, ctl: ControlElement) -> bool:
         ctl.len = 0
@@ -138,7 +138,7 @@ class ComPrint(_Controlled):
 
 
 class ComScan(_Controlled):
-    port_obj: Port | None = None
+    port_obj: ComPort | None = None
 
     def start(self, ctl: ControlElement) -> bool:
         ctl.len = 0
@@ -211,22 +211,22 @@ class _PortAction:
         self.act(port)
         return c
 
-    def act(self, port: Port) -> None:
+    def act(self, port: ComPort) -> None:
         raise NotImplementedError
 
 
 class ComRcvClear(_PortAction):
-    def act(self, port: Port) -> None:
+    def act(self, port: ComPort) -> None:
         port.clear_rx()
 
 
 class ComXmitClear(_PortAction):
-    def act(self, port: Port) -> None:
+    def act(self, port: ComPort) -> None:
         port.clear_tx()
 
 
 class ComRcvSts(_PortAction):
-    def act(self, port: Port) -> None:
+    def act(self, port: ComPort) -> None:
         d, i, _ = self.ctx.operands[1].location()
         d[i + 1] = min(port.rx_size, 0x7FFF)  # PRE
         d[i + 2] = len(port.rx)  # ACC

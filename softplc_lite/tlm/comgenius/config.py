@@ -26,6 +26,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ...ports import COM_NAME  # COM1..COM99: in [DRIVER] keys and [PORTS]
 from ..api import find_file
 from ..errors import ModuleError
 from .strings import MAX_LENGTH, MAX_STRINGS, EscapeError, StringTable, decode_escapes
@@ -119,7 +120,6 @@ def _string_line(raw: str, line: int, path: str, table: StringTable) -> None:
     table.add(value, line)
 
 
-COM_NAME = re.compile(r"COM([1-9][0-9]?)", re.IGNORECASE)  # COM1..COM99: in [DRIVER] keys and [PORTS]
 
 
 def _driver_line(content: str, line: int, path: str, config: "ComGeniusConfig") -> None:

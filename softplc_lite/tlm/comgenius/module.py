@@ -15,8 +15,8 @@ from typing import Mapping
 from ...ladder.ast import Const, Instruction
 from ...ladder.errors import LadderError
 from ...ladder.instructions import InstructionSpec
+from ...ports import PortClaim
 from ..api import TLM, InstructionContext, Instance
-from ..errors import ModuleError
 from .config import CONFIG_FILE, ComGeniusConfig, load_config
 from .com import (COMPRINT, COMRCVCLEAR, COMRCVSTS, COMSCAN, COMXMITCLEAR, ComPrint, ComRcvClear, ComRcvSts,
                   ComScan, ComXmitClear)
@@ -34,7 +34,6 @@ class ComGenius(TLM):
         self.ports: PortSet | None = None
         self.engine = None
         self.recorder = None
-        self.replays: list = []
 
     def configure(self, app_dir: Path | None) -> list[str]:
         if app_dir is not None:
@@ -58,10 +57,16 @@ class ComGenius(TLM):
         return found
 
     # -- the driver ------------------------------------------------------------------------
+    def port_claims(self) -> list[PortClaim]:
+        return PortSet(self.config, self.debug, lambda: 0).claims(self.name)
+
+    def serial_ports(self) -> list:
+        return list(self.ports.ports.values()) if self.ports is not None else []
+
     def attach(self, engine, options: Mapping[str, object]) -> list[str]:
         """Open the ports (manual: at start). ``options``: "ports" {logical:
-        device or URL} replaces physical fields, "record" a trace file to
-        write, "replay" a trace file to play every port from."""
+        device or URL} replaces physical fields, "recorder" records every
+        port's traffic, "replay" a trace file to play every port from."""
         self.engine = engine
         clock = engine.clock
         if getattr(clock, "realtime", False):
@@ -75,34 +80,14 @@ class ComGenius(TLM):
         if replay:
             for number in self.config.ports:
                 overrides.setdefault(number, f"replay://{replay}?port={number}")
-        unknown = sorted(set(overrides) - set(self.config.ports))
-        if unknown:
-            raise ModuleError(f"--port {unknown[0]}=...: logical port {unknown[0]} has no line in [PORTS] "
-                              f"(ports: {', '.join(map(str, self.config.ports)) or 'none'})", self.config.path)
         self.ports = PortSet(self.config, self.debug, now_ns, overrides)
         warnings = self.ports.open_all()
-        if options.get("record"):
-            self._start_recording(str(options["record"]))
+        self.recorder = options.get("recorder")
+        if self.recorder is not None:
+            for p in self.ports.ports.values():
+                c = p.config
+                self.recorder.add_port(p, f"{c.physical} -> {p.url} {p.settings} {c.encoding}", now_ns)
         return warnings
-
-    def _start_recording(self, path: str) -> None:
-        from .trace import TraceWriter
-
-        comments = [f"port {p.number}: {p.config.physical} -> {p.url} {p.config.baud} "
-                    f"{p.config.data_bits}{p.config.parity}{p.config.stop_bits} {p.config.encoding}"
-                    for p in self.ports.ports.values()]
-        try:
-            self.recorder = TraceWriter(path, comments)
-        except OSError as e:
-            self.ports.close()
-            raise ModuleError(f"--record: cannot write {path}: {e.strerror}") from None
-        start = self.now_ns()
-
-        def record(port: int, direction: str, data: bytes) -> None:
-            self.recorder.event((self.now_ns() - start) / 1e6, port, direction, data)
-
-        for p in self.ports.ports.values():
-            p.record = record
 
     def on_input(self, engine) -> None:
         if self.ports is not None:
@@ -113,6 +98,8 @@ class ComGenius(TLM):
         # SoftPLC does in its test mode, where only the I/O image is held).
         if self.ports is not None:
             self.ports.flush_output()
+        if self.recorder is not None:
+            self.recorder.flush()
 
     def close(self) -> None:
         if self.ports is not None:
@@ -121,9 +108,7 @@ class ComGenius(TLM):
                 if serial is not None and hasattr(serial, "report") and hasattr(serial, "mismatches"):
                     self.log(serial.report())  # a replay port says whether the output matched
             self.ports.close()
-        if self.recorder is not None:
-            self.recorder.close()
-            self.recorder = None
+        self.recorder = None  # the engine closes the run's recorder
 
     def create(self, instr: Instruction, ctx: InstructionContext) -> Instance:
         m = instr.mnemonic

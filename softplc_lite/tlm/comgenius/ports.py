@@ -1,23 +1,22 @@
 """COMGENIUS ports: one per ``[PORTS]`` line, each with its buffers.
 
-A Port owns the pyserial port of its line (opened with
-``serial.serial_for_url``), a receive buffer of 16-bit characters (what
-COMSCAN matches; its size is COMRCVSTS's PRE) and a transmit buffer of
-bytes (what COMPRINT fills). The driver moves bytes at the engine's input
-and output points, never blocking the scan:
+A ComPort is a ``SerialPort`` (softplc_lite.ports: opening through
+``serial_for_url``, non-blocking reads and writes, down and retried when its
+device fails) with what COMGENIUS adds: a receive buffer of 16-bit
+characters (what COMSCAN matches; its size is COMRCVSTS's PRE) and a
+transmit buffer of bytes (what COMPRINT fills). The driver moves bytes at
+the engine's input and output points, never blocking the scan:
 
 - input: read what has arrived, decode it with the port's encoding and
   append it to the receive buffer; characters that do not fit are dropped
   and the overflow flag (COMRCVSTS OV) is set;
 - output: hand as much of the transmit buffer to the port as it takes now.
 
-A port that cannot be opened, or whose device goes away while running (a
-USB adapter pulled, a pty whose other side closed), is *down*: the
-instructions on it set ER, the engine keeps scanning, and the port is
-tried again every ``RETRY_MS`` of wall-clock time until it comes back.
+A port that is down makes the instructions on it set ER; the engine keeps
+scanning, and the port is tried again every ``RETRY_MS`` until it comes back.
 
-The physical field of a ``[PORTS]`` line (see :func:`physical_url`):
-``COMn`` (a bare number ``n`` is ``COM(n+1)``) maps to a device through
+The physical field of a ``[PORTS]`` line (see :func:`port_url`): ``COMn``
+(a bare number ``n`` is ``COM(n+1)``) maps to a device through
 ``[DRIVER] COMn=...`` or the platform default; anything else is a device
 path or a pyserial URL. ``softplc run --port N=DEVICE`` replaces it for
 logical port N.
@@ -26,159 +25,58 @@ logical port N.
 from __future__ import annotations
 
 import sys
-import time
-from collections import deque
 from typing import Callable
 
 import serial
 
+from ...ports import LineSettings, PortClaim, SerialPort, physical_url
 from ..errors import ModuleError
-from .config import COM_NAME, ComGeniusConfig, PortConfig
+from .config import MAX_PORT, ComGeniusConfig, PortConfig
 from .encodings import encoding
-from .transports import Transport, transport_for
 
 RX_BUFFER_CHARS = 4096  # characters; COMRCVSTS sets PRE to this
 TX_BUFFER_BYTES = 4096  # bytes; a COMPRINT waits until its whole output fits
-HISTORY = 16  # recent frames kept per port (for the watch view and debugging)
-
-_PARITY = {"N": serial.PARITY_NONE, "E": serial.PARITY_EVEN, "O": serial.PARITY_ODD}
-
-# Errors that mean "this port does not work (any more)". termios.error is
-# not a SerialException (testing notes: a pty refusing 7E1), so list it.
-try:
-    import termios
-
-    PORT_ERRORS: tuple[type[BaseException], ...] = (serial.SerialException, OSError, ValueError, termios.error)
-except ImportError:  # pragma: no cover - Windows
-    PORT_ERRORS = (serial.SerialException, OSError, ValueError)
 
 
-def default_com_device(n: int, platform: str = sys.platform) -> str:
-    """The device of COMn when COMGENIUS.LST does not say: ``COMn`` on
-    Windows, the n-th on-board UART ``/dev/ttyS{n-1}`` elsewhere."""
-    return f"COM{n}" if platform.startswith("win") else f"/dev/ttyS{n - 1}"
-
-
-def physical_url(physical: str, com_devices: dict[int, str] | None = None, platform: str = sys.platform) -> str:
+def port_url(physical: str, com_devices: dict[int, str] | None = None, platform: str = sys.platform) -> str:
     """What to give ``serial_for_url`` for a ``[PORTS]`` physical field."""
     text = physical.strip()
     if text.isdigit():  # the manual's sample: physical port 0 is COM1
         text = f"COM{int(text) + 1}"
-    m = COM_NAME.fullmatch(text)
-    if m:
-        n = int(m.group(1))
-        return (com_devices or {}).get(n) or default_com_device(n, platform)
-    return text
+    return physical_url(text, com_devices, platform)
 
 
-def hexdump(data: bytes, limit: int = 64) -> str:
-    text = data[:limit].hex(" ").upper()
-    return text + (f" ... ({len(data)} bytes)" if len(data) > limit else "")
-
-
-class Port:
-    """One logical port: its pyserial port, receive and transmit buffers."""
+class ComPort(SerialPort):
+    """One logical port: a SerialPort with receive and transmit buffers."""
 
     def __init__(self, config: PortConfig, url: str, log: Callable[[int, str], None],
                  now_ns: Callable[[], int], retry_ms: int = 1000, log_frames: bool = False) -> None:
+        settings = LineSettings(config.baud, config.data_bits, config.parity, config.stop_bits)
+        super().__init__(str(config.logical), url, settings, log, now_ns, retry_ms, log_frames)
         self.config = config
         self.number = config.logical
-        self.url = url
         self.encoding = encoding(config.encoding)
         self.decoder = self.encoding.decoder()
-        self.log = log
-        self.log_frames = log_frames  # DEBUG=2: every frame in hex (formatted only then)
-        self.now_ns = now_ns
-        self.retry_s = retry_ms / 1000
         self.rx = ""  # received characters COMSCAN has not taken
         self.rx_size = RX_BUFFER_CHARS
         self.overflow = False
         self.tx = bytearray()
         self.tx_size = TX_BUFFER_BYTES
-        self.serial = None
-        self.transport: Transport | None = None
-        self.error: str | None = "not opened"  # why the port is down; None when up
-        self.next_try = 0.0
-        self.rx_bytes = self.tx_bytes = 0  # totals since start
         self.dropped = 0  # characters lost to overflows
-        self.history: deque[tuple[float, str, bytes]] = deque(maxlen=HISTORY)
-        self.record: Callable[[int, str, bytes], None] | None = None
-
-    def __repr__(self) -> str:
-        state = "up" if self.up else f"down ({self.error})"
-        return f"<Port {self.number} {self.url} {state}>"
 
     @property
-    def up(self) -> bool:
-        return self.error is None
+    def waiting(self) -> int:
+        """Characters received and not yet taken (the watch view shows it)."""
+        return len(self.rx)
 
-    # -- open and close ------------------------------------------------------------------
-    def open(self) -> None:
-        """Open the device; on failure the port is down and the reason
-        raised as a SerialException."""
-        c = self.config
-        s = None
-        try:
-            s = serial.serial_for_url(self.url, do_not_open=True)
-            s.baudrate = c.baud
-            s.bytesize = c.data_bits
-            s.parity = _PARITY[c.parity]
-            s.stopbits = c.stop_bits
-            s.timeout = 0
-            transport = transport_for(self.url, s)
-            s.write_timeout = transport.write_timeout
-            s.open()
-            transport.set_clock(self.now_ns)
-        except PORT_ERRORS as e:
-            if s is not None:
-                _quiet_close(s)
-            self._down(_reason(e))
-            raise serial.SerialException(self.error) from None
-        self.serial, self.transport = s, transport
+    def opened(self) -> None:
         self.decoder.reset()
-        self.error = None
-        self.log(1, f"port {self.number}: opened {self.url} ({c.baud} {c.data_bits}{c.parity}{c.stop_bits})")
-
-    def _down(self, reason: str) -> None:
-        if self.serial is not None:
-            _quiet_close(self.serial)
-        self.serial = self.transport = None
-        was_up = self.error is None
-        self.error = reason
-        self.next_try = time.monotonic() + self.retry_s
-        if was_up:
-            self.log(1, f"port {self.number}: down: {reason}; retrying every {self.retry_s * 1000:g} ms")
-
-    def retry(self) -> None:
-        """Try a down port again once its retry time has come."""
-        if self.up or time.monotonic() < self.next_try:
-            return
-        try:
-            self.open()
-        except serial.SerialException:
-            self.next_try = time.monotonic() + self.retry_s
-            return
-        self.log(1, f"port {self.number}: back up")
-
-    def close(self) -> None:
-        if self.serial is not None:
-            _quiet_close(self.serial)
-        self.serial = self.transport = None
-        self.error = "closed"
 
     # -- the driver's two points ---------------------------------------------------------
     def poll_input(self) -> None:
-        if self.transport is None:
-            return
-        try:
-            data = self.transport.read()
-        except PORT_ERRORS as e:
-            self._down(_reason(e))
-            return
+        data = self.read()
         if not data:
             return
-        self.rx_bytes += len(data)
-        self._traffic("RX", data)
         text = self.decoder.decode(data)
         room = self.rx_size - len(self.rx)
         if len(text) > room:
@@ -192,28 +90,10 @@ class Port:
             self.rx += text
 
     def flush_output(self) -> None:
-        if self.transport is None or not self.tx:
-            return
-        try:
-            n = self.transport.write(bytes(self.tx))
-        except serial.SerialTimeoutException:
-            n = 0
-        except PORT_ERRORS as e:
-            self._down(_reason(e))
-            return
-        if n:
-            sent = bytes(self.tx[:n])
-            del self.tx[:n]
-            self.tx_bytes += n
-            self._traffic("TX", sent)
-
-    def _traffic(self, direction: str, data: bytes) -> None:
-        t_ms = self.now_ns() / 1e6
-        self.history.append((t_ms, direction, data))
-        if self.record is not None:
-            self.record(self.number, direction, data)
-        if self.log_frames:
-            self.log(2, f"port {self.number} {direction} {len(data):4d} bytes: {hexdump(data)}")
+        if self.tx:
+            n = self.write(bytes(self.tx))
+            if n:
+                del self.tx[:n]
 
     # -- what the instructions do ----------------------------------------------------------
     def queue(self, data: bytes) -> bool:
@@ -234,33 +114,11 @@ class Port:
     def clear_rx(self) -> None:
         self.rx = ""
         self.decoder.reset()
-        if self.serial is not None:
-            try:
-                self.serial.reset_input_buffer()
-            except PORT_ERRORS:
-                pass
+        self.reset_input()
 
     def clear_tx(self) -> None:
         self.tx.clear()
-        if self.serial is not None:
-            try:
-                self.serial.reset_output_buffer()
-            except PORT_ERRORS:
-                pass
-
-
-def _quiet_close(s) -> None:
-    try:
-        s.close()
-    except Exception:  # closing a port that is already gone must not fail the run
-        pass
-
-
-def _reason(e: BaseException) -> str:
-    text = str(e) or type(e).__name__
-    if isinstance(e, OSError) and e.strerror:
-        text = f"{e.strerror}" + (f": {e.filename}" if e.filename else "")
-    return text
+        self.reset_output()
 
 
 class PortSet:
@@ -268,16 +126,16 @@ class PortSet:
 
     def __init__(self, config: ComGeniusConfig, log: Callable[[int, str], None], now_ns: Callable[[], int],
                  overrides: dict[int, str] | None = None) -> None:
-        from .urlhandler import register  # sim:// and replay:// join pyserial's URL schemes
+        from ...ports.urlhandler import register  # sim:// and replay:// join pyserial's URL schemes
 
         register()
         self.config = config
         self.log = log
-        self.ports: dict[int, Port] = {}
+        self.ports: dict[int, ComPort] = {}
         for number, pc in sorted(config.ports.items()):
             physical = (overrides or {}).get(number, pc.physical)
-            url = physical_url(physical, config.com_devices)
-            self.ports[number] = Port(pc, url, log, now_ns, config.retry_ms, log_frames=config.debug >= 2)
+            url = port_url(physical, config.com_devices)
+            self.ports[number] = ComPort(pc, url, log, now_ns, config.retry_ms, log_frames=config.debug >= 2)
 
     def open_all(self, keep_going: bool | None = None) -> list[str]:
         """Open every port. A port that cannot be opened raises ModuleError
@@ -315,12 +173,16 @@ class PortSet:
         for port in self.ports.values():
             port.close()
 
-    def lookup(self, number: int) -> tuple[Port | None, str | None]:
+    def claims(self, module: str) -> list[PortClaim]:
+        """The devices these ports open (for the one-owner check)."""
+        return [PortClaim(module, n, p.url, f"{self.config.path}:{p.config.line}") for n, p in self.ports.items()]
+
+    def lookup(self, number: int) -> tuple[ComPort | None, str | None]:
         """The port for an instruction, or why there is none."""
         port = self.ports.get(number)
         if port is None:
-            if not 0 <= number <= 35:
-                return None, f"port {number} is out of range (0..35)"
+            if not 0 <= number <= MAX_PORT:
+                return None, f"port {number} is out of range (0..{MAX_PORT})"
             have = ", ".join(str(n) for n in self.ports) or "none"
             return None, f"port {number} is not configured in [PORTS] (configured: {have})"
         if port.error is not None:

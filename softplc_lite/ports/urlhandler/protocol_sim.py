@@ -77,11 +77,22 @@ class Serial(wire.ClockedSerial):
             self._end = None
 
     def _configure(self) -> None:
+        self._end.set_rts(bool(self._rts_state), self._clock())  # pyserial raises RTS on open
         self._end.configure(self._baudrate, self._bytesize, self._parity, self._stopbits, self._unlimited)
 
     def _take(self, size: int, now: int) -> bytes:
         end = self._end
         return end.read(size, now) if end is not None else b""
+
+    def _take_timed(self, now: int) -> tuple[bytes, list[int]]:
+        end = self._end
+        return end.read_timed(now) if end is not None else (b"", [])
+
+    def _set_rts(self, on: bool, now: int) -> None:
+        self._end.set_rts(on, now)
+
+    def _cts(self, now: int) -> tuple[bool, int]:
+        return self._end.cts(now)
 
     def _available(self, now: int) -> int:
         return self._end.available(now)

@@ -5,7 +5,7 @@ each package named in ``serial.protocol_handler_packages``. ``register()``
 appends this package there (once: calling it again changes nothing), and
 importing this package calls it, so after
 
-    import softplc_lite.tlm.comgenius.urlhandler
+    import softplc_lite.ports.urlhandler
 
 ``serial.serial_for_url("sim://bus")`` and ``serial.serial_for_url(
 "replay://session.trace?port=0")`` open like ``loop://`` or ``socket://``.

@@ -10,14 +10,16 @@ A trace is a UTF-8 text file (docs/simulated-wire.md has the full page)::
 
 - ``#`` starts a comment (to the end of the line); blank lines are ignored.
 - An event line has the time in ms (a decimal number, never smaller than the
-  time of the line before it), the logical port (0-35), the direction (``TX``:
-  written by the program, ``RX``: received by the program) and one or more
-  two-digit hex bytes (any case). One event is one line however long it is.
+  time of the line before it), the port, the direction (``TX``: written by
+  the program, ``RX``: received by the program) and one or more two-digit hex
+  bytes (any case). One event is one line however long it is.
+- The port is a COMGENIUS logical port number (0-35), or a port of another
+  module written ``MODULE:N`` (``MODBMAST:1``, N 0-35): ``port_label()``.
 - The first line is the header ``# softplc_lite port trace 1``. A reader
   tolerates a file without it, but refuses another version number.
 
 Errors name the file, line and column: ``parse_trace`` raises a
-``TraceError`` (a ``ModuleError``), whose ``report()`` reads
+``TraceError`` (a ``PortError``), whose ``report()`` reads
 ``path:line:column: reason``.
 
 >>> events = parse_trace("0.000 0 TX 02 03\\n1.5 0 RX 02 83 # exception\\n")
@@ -26,7 +28,7 @@ TraceEvent(t_ms=1.5, port=0, direction='RX', data=b'\\x02\\x83')
 >>> parse_trace("0.000 0 TX 2\\n", "a.trace")
 Traceback (most recent call last):
 ...
-softplc_lite.tlm.comgenius.trace.TraceError: a.trace:1:12: expected a two-digit hex byte, found '2'
+softplc_lite.ports.trace.TraceError: a.trace:1:12: expected a two-digit hex byte, found '2'
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ import re
 from dataclasses import dataclass, field
 from typing import IO, Sequence
 
-from ..errors import ModuleError
+from .errors import PortError
 
 HEADER = "# softplc_lite port trace 1"
 VERSION = 1
@@ -46,12 +48,12 @@ DIRECTIONS = ("TX", "RX")
 
 _HEADER = re.compile(r"^\s*#\s*softplc_lite port trace\s+(\S+)\s*$")
 _TIME = re.compile(r"^\d+(\.\d+)?$")
-_PORT = re.compile(r"^\d+$")
+_PORT = re.compile(r"^(?:([A-Za-z][A-Za-z0-9_]*):)?(\d+)$")
 _HEX = re.compile(r"^[0-9A-Fa-f]{2}$")
 _FIELD = re.compile(r"\S+")
 
 
-class TraceError(ModuleError):
+class TraceError(PortError):
     """A trace file that cannot be read, with its path, line and column."""
 
 
@@ -63,7 +65,7 @@ class TraceEvent:
     read from a file); equality ignores it."""
 
     t_ms: float
-    port: int
+    port: int | str  # a COMGENIUS logical port number, or "MODULE:N"
     direction: str
     data: bytes
     line: int = field(default=0, compare=False, repr=False)
@@ -106,9 +108,10 @@ def _parse_event(fields: list[re.Match], end_column: int, number: int, path: str
     time = fields[0]
     if not _TIME.match(time.group()):
         raise fail(f"expected a time in ms such as 12.345, found '{time.group()}'", time.start() + 1)
-    port = need(1, "a port number (0-35)")
-    if not _PORT.match(port.group()) or int(port.group()) > MAX_PORT:
-        raise fail(f"expected a port number 0-{MAX_PORT}, found '{port.group()}'", port.start() + 1)
+    port = need(1, "a port (0-35, or MODULE:N)")
+    label = port_label(port.group())
+    if label is None:
+        raise fail(f"expected a port number 0-{MAX_PORT} or MODULE:N, found '{port.group()}'", port.start() + 1)
     direction = need(2, "TX or RX")
     if direction.group() not in DIRECTIONS:
         raise fail(f"expected TX or RX, found '{direction.group()}'", direction.start() + 1)
@@ -117,7 +120,20 @@ def _parse_event(fields: list[re.Match], end_column: int, number: int, path: str
         if not _HEX.match(byte.group()):
             raise fail(f"expected a two-digit hex byte, found '{byte.group()}'", byte.start() + 1)
     data = bytes.fromhex("".join(m.group() for m in fields[3:]))
-    return TraceEvent(float(time.group()), int(port.group()), direction.group(), data, number)
+    return TraceEvent(float(time.group()), label, direction.group(), data, number)
+
+
+def port_label(text: str | int) -> int | str | None:
+    """A trace's port field: the number for "0".."35", "MODULE:N" (module
+    name upper-cased) for a module's port, None when it is neither.
+
+    >>> port_label("3"), port_label("modbmast:1"), port_label("36"), port_label("x")
+    (3, 'MODBMAST:1', None, None)
+    """
+    m = _PORT.match(str(text).strip())
+    if m is None or int(m.group(2)) > MAX_PORT:
+        return None
+    return f"{m.group(1).upper()}:{int(m.group(2))}" if m.group(1) else int(m.group(2))
 
 
 def read_trace(path: str | os.PathLike) -> list[TraceEvent]:
@@ -133,7 +149,7 @@ def read_trace(path: str | os.PathLike) -> list[TraceEvent]:
     return parse_trace(text, name)
 
 
-def format_event(t_ms: float, port: int, direction: str, data: bytes) -> str:
+def format_event(t_ms: float, port: int | str, direction: str, data: bytes) -> str:
     """One event line (no newline): time with 3 decimals, hex in upper case."""
     return f"{t_ms:.3f} {port} {direction} {data.hex(' ').upper()}"
 
@@ -173,12 +189,13 @@ class TraceWriter:
             for line in str(comment).splitlines() or [""]:
                 self._file.write(f"# {line}".rstrip() + "\n")
 
-    def event(self, t_ms: float, port: int, direction: str, data: bytes) -> None:
+    def event(self, t_ms: float, port: int | str, direction: str, data: bytes) -> None:
         """Write one event. Nothing is written for empty ``data``. Raises
         ValueError for a bad port or direction, or a time that is negative,
         not finite, or before the previous event's."""
-        if not 0 <= port <= MAX_PORT:
-            raise ValueError(f"port {port} is outside 0-{MAX_PORT}")
+        label = port_label(port)
+        if label is None:
+            raise ValueError(f"port {port!r} is not 0-{MAX_PORT} or MODULE:N")
         if direction not in DIRECTIONS:
             raise ValueError(f"direction must be TX or RX, not {direction!r}")
         if not math.isfinite(t_ms) or t_ms < 0:
@@ -188,7 +205,7 @@ class TraceWriter:
         if not data:
             return
         self._last_t = t_ms
-        self._file.write(format_event(t_ms, port, direction, bytes(data)) + "\n")
+        self._file.write(format_event(t_ms, label, direction, bytes(data)) + "\n")
 
     def flush(self) -> None:
         self._file.flush()

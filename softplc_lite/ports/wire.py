@@ -29,9 +29,15 @@ then ``device.poll(now_ns)`` runs. A device answers with
 already in the past of the port's clock (turnaround is exact, not rounded up
 to when the port next looks).
 
+Modem lines: each port end drives RTS (``set_rts(on, now)``, remembered with
+the time it changed). Between two ports the link is a null-modem cable: one
+end's CTS is the other end's RTS. A device decides the port's CTS
+(``SimDevice.cts(now)``; by default it follows the port's RTS at once).
+
 ``ClockedSerial`` is the pyserial base shared by the ``sim://`` and
-``replay://`` ports: ``set_clock()``, and reads that block only with the
-real-time default clock.
+``replay://`` ports: ``set_clock()``, reads that block only with the
+real-time default clock, ``read_timed()`` (what has arrived with each byte's
+arrival time) and ``cts_state()`` (CTS and when it last changed).
 """
 
 from __future__ import annotations
@@ -197,6 +203,7 @@ class Link:
         self.wires = (Wire(), Wire())
         self.ports: list[PortEnd | None] = [None, None]
         self.device: SimDevice | None = None
+        self.rts: list[tuple[bool, int]] = [(False, 0), (False, 0)]  # per end: (on, when it changed)
 
     def pump(self, now: int) -> None:
         """Hand the device what has reached it by ``now``, then let it poll."""
@@ -300,6 +307,28 @@ class PortEnd:
             self.link.pump(now)
             return self._in.take(size, now)
 
+    def read_timed(self, now: int) -> tuple[bytes, list[int]]:
+        """Everything arrived by ``now``, with each byte's arrival time."""
+        with self.link.lock:
+            self.link.pump(now)
+            return self._in.take_timed(now)
+
+    def set_rts(self, on: bool, now: int) -> None:
+        with self.link.lock:
+            self.link.pump(now)
+            if self.link.rts[self.index][0] != on:
+                self.link.rts[self.index] = (on, now)
+
+    def cts(self, now: int) -> tuple[bool, int]:
+        """CTS at ``now`` and when it last changed: the other end's RTS
+        (a null-modem cable), or what the device says."""
+        with self.link.lock:
+            self.link.pump(now)
+            device = self.link.device
+            if device is not None:
+                return device.cts(now)
+            return self.link.rts[1 - self.index]
+
     def available(self, now: int) -> int:
         with self.link.lock:
             self.link.pump(now)
@@ -347,6 +376,10 @@ class DeviceEnd:
     def char_ns(self) -> int:
         """Character time in ns, from the settings of the port the device is attached to."""
         return self._port.char_ns
+
+    def rts(self) -> tuple[bool, int]:
+        """The port's RTS and when it last changed."""
+        return self._link.rts[self._port.index]
 
     def send(self, data: bytes, at_ns: int) -> None:
         """Transmit ``data`` toward the port, timed like a port write at ``at_ns``
@@ -405,7 +438,38 @@ class ClockedSerial(SerialBase):
         pass
 
     def _update_rts_state(self) -> None:
+        if self.is_open:
+            self._set_rts(bool(self._rts_state), self._clock())
+
+    def _set_rts(self, on: bool, now: int) -> None:
         pass
+
+    def cts_state(self) -> tuple[bool, int]:
+        """CTS now and the time (ns) it last changed."""
+        self._check_open()
+        return self._cts(self._clock())
+
+    def _cts(self, now: int) -> tuple[bool, int]:
+        return True, 0
+
+    @property
+    def cts(self) -> bool:
+        return self.cts_state()[0]
+
+    @property
+    def dsr(self) -> bool:
+        self._check_open()
+        return True
+
+    @property
+    def ri(self) -> bool:
+        self._check_open()
+        return False
+
+    @property
+    def cd(self) -> bool:
+        self._check_open()
+        return True
 
     def _update_dtr_state(self) -> None:
         pass
@@ -449,6 +513,16 @@ class ClockedSerial(SerialBase):
             parts.append(more)
             got += len(more)
         return b"".join(parts)
+
+    def read_timed(self) -> tuple[bytes, list[int]]:
+        """Everything that has arrived by the clock's time, with each byte's
+        arrival time in ns; never blocks."""
+        self._check_open()
+        return self._take_timed(self._clock())
+
+    def _take_timed(self, now: int) -> tuple[bytes, list[int]]:
+        data = self._take(1 << 30, now)
+        return data, [now] * len(data)
 
     def write(self, data) -> int:
         """Queue ``data`` on the wire; never blocks."""

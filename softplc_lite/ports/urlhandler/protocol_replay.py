@@ -1,8 +1,9 @@
-# URL format:    replay://PATH[?port=N]
+# URL format:    replay://PATH[?port=N|MODULE:N]
 # PATH: a trace file (trace.py), absolute or relative to the current
 #   directory, taken literally up to the first "?"
 # options:
-# - "port=N" the logical port of the trace to play (0-35, default 0)
+# - "port=N" the port of the trace to play: a COMGENIUS logical port 0-35
+#   (default 0), or MODULE:N for another module's port (MODBMAST:1)
 """``replay://``: play back the received side of a port trace.
 
 The port delivers the recorded RX events of one port of a trace file,
@@ -28,15 +29,14 @@ mismatch (bytes are counted by position, so later events stay in step).
 from __future__ import annotations
 
 import bisect
-import re
 from dataclasses import dataclass
 
 from serial.serialutil import SerialException
 
 from .. import wire
-from ..trace import MAX_PORT, TraceError, TraceEvent, read_trace
+from ..trace import MAX_PORT, TraceError, TraceEvent, port_label, read_trace
 
-FORM = "replay://PATH[?port=N]"
+FORM = "replay://PATH[?port=N|MODULE:N]"
 MAX_SHOWN = 5
 
 
@@ -58,7 +58,7 @@ class Mismatch:
     line: int
 
 
-def parse_url(url: str) -> tuple[str, int]:
+def parse_url(url: str) -> tuple[str, int | str]:
     """``(path, port)``; ValueError when bad."""
     scheme, sep, rest = url.partition("://")
     if not sep or scheme.lower() != "replay":
@@ -72,9 +72,10 @@ def parse_url(url: str) -> tuple[str, int]:
             key, eq, value = option.partition("=")
             if key != "port" or not eq:
                 raise ValueError(f"unknown option {option!r}")
-            if not re.fullmatch(r"\d+", value) or int(value) > MAX_PORT:
-                raise ValueError(f"port must be 0-{MAX_PORT}, not {value!r}")
-            port = int(value)
+            label = port_label(value)
+            if label is None:
+                raise ValueError(f"port must be 0-{MAX_PORT} or MODULE:N, not {value!r}")
+            port = label
     return path, port
 
 
@@ -133,6 +134,7 @@ class Serial(wire.ClockedSerial):
         self._next_rx = 0
         self._last_rx_ns: int | None = None
         self._buffer = bytearray()
+        self._times: list[int] = []  # arrival (due) time of each byte in the buffer
         self.mismatches = []
         self._open_ns = self._clock()
         self._rebased = self._clock_set
@@ -168,7 +170,9 @@ class Serial(wire.ClockedSerial):
             due = self._due(self._next_rx)
             if due is None or due > now:
                 return
-            self._buffer += self._rx[self._next_rx][0].data
+            data = self._rx[self._next_rx][0].data
+            self._buffer += data
+            self._times += [due] * len(data)
             self._last_rx_ns = due
             self._next_rx += 1
 
@@ -178,7 +182,18 @@ class Serial(wire.ClockedSerial):
         self._pump(now)
         data = bytes(self._buffer[:size])
         del self._buffer[:size]
+        del self._times[:size]
         return data
+
+    def _take_timed(self, now: int) -> tuple[bytes, list[int]]:
+        """Each recorded RX event's bytes arrive together, at its due time."""
+        if not self.is_open:
+            return b"", []
+        self._pump(now)
+        data, times = bytes(self._buffer), self._times
+        self._buffer.clear()
+        self._times = []
+        return data, times
 
     def _available(self, now: int) -> int:
         self._pump(now)
@@ -190,6 +205,7 @@ class Serial(wire.ClockedSerial):
     def _reset_input(self, now: int) -> None:
         self._pump(now)
         self._buffer.clear()
+        self._times.clear()
 
     def _reset_output(self, now: int) -> None:
         pass

@@ -19,6 +19,8 @@ is attached to):
 - ``receive(data, times_ns)``: bytes that have arrived from the port, with
   each byte's arrival time (non-decreasing). One call may hold several
   bursts: compare the times to find gaps.
+- ``cts(now_ns)``: the port's CTS line and the time it last changed (by
+  default the port's RTS, as ``end.rts()`` gives it: always ready).
 - ``poll(now_ns)``: called every time the port is used (read, in_waiting,
   write, out_waiting), after ``receive`` has been given everything that
   arrived by ``now_ns``. Decide time-based things here (a frame ends after
@@ -57,11 +59,16 @@ class SimDevice:
     def poll(self, now_ns: int) -> None:
         pass
 
+    def cts(self, now_ns: int) -> tuple[bool, int]:
+        """The port's CTS and when it last changed: by default it follows
+        the port's RTS at once (a device that is always ready)."""
+        return self.end.rts()
+
 
 DeviceFactory = Callable[[dict[str, str]], SimDevice]
 DEVICES: dict[str, DeviceFactory] = {}
 # Built-in kinds defined in other modules: imported when first created.
-BUILTIN_DEVICES: dict[str, str] = {"modbus": "softplc_lite.tlm.comgenius.modbus_slave:create"}
+BUILTIN_DEVICES: dict[str, str] = {"modbus": "softplc_lite.ports.modbus_slave:create"}
 
 
 def register_device(kind: str, factory: DeviceFactory) -> None:
