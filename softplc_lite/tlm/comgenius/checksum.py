@@ -20,18 +20,7 @@ from __future__ import annotations
 
 from typing import Iterable
 
-
-def _table() -> list[int]:
-    table = []
-    for byte in range(256):
-        crc = byte
-        for _ in range(8):
-            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
-        table.append(crc)
-    return table
-
-
-_CRC_TABLE = _table()
+from ...modbus.crc import crc16 as modbus_crc16  # one CRC-16 table for the formats and every Modbus part
 
 
 def low_bytes(chars: str) -> bytes:
@@ -48,12 +37,9 @@ def crc16(chars: str, preload: int = 0) -> int:
 
 
 def crc16_bytes(data: bytes | Iterable[int], preload: int = 0) -> int:
-    """The same over bytes (for tests and the Modbus peers)."""
-    crc = preload
-    table = _CRC_TABLE
-    for b in data:
-        crc = (crc >> 8) ^ table[(crc ^ b) & 0xFF]
-    return crc
+    """The same over bytes: the Modbus codec's table-driven CRC, with this
+    module's default preload of 0."""
+    return modbus_crc16(data, preload)
 
 
 def sum16(chars: str, negate: bool = False, one_byte: bool = False) -> int:
