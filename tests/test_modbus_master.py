@@ -245,12 +245,12 @@ def test_sim_silent_slave_times_out_then_replies_resume(executor, masters):
     r = masters(executor)
     assert run_until(r, lambda: r.table.read("C5:1.ACC") >= 2, scans=1000)  # ends a transaction: Busy off
     slave = modbus_slave.find_slave("modbus")
-    slave.slave_id = 3  # the queries are for slave 2 now: silence
+    slave.unit(2).online = False  # slave 2 switched off: silence
     start_ms = r.engine.clock.now_ms
     assert run_until(r, lambda: r.table.read("C5:3.ACC") >= 2, scans=1000)
     assert r.engine.clock.now_ms - start_ms >= 2 * 250  # the port's timeout, on simulated time
     assert slave.ignored == 2
-    slave.slave_id = 2
+    slave.unit(2).online = True
     assert run_until(r, lambda: r.table.read("C5:1.ACC") >= 5, scans=1000)
     c = counts(r)
     assert c["timeouts"] == 2 and c["exceptions"] == c["garbage"] == 0, c

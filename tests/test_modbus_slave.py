@@ -548,7 +548,11 @@ def test_rate_unlimited_answers_at_once(opened, clock):
     ("registers=65537", "registers must be an integer 1..65536"),
     ("values=random", "values must be one of pattern, index, zero"),
     ("turnaround_ms=-1", "turnaround_ms must be a number >= 0"),
-    ("delay_ms=5", r"unknown option 'delay_ms' \(known: id, registers, values, turnaround_ms\)"),
+    ("delay_ms=5", r"unknown option 'delay_ms' \(known: id, registers, values, framing, turnaround_ms, "
+                   r"cts_delay_ms, cts, cut, pause_after, pause_ms, garbage, bad_crc, silent\)"),
+    ("framing=binary", "framing must be rtu or ascii, not 'binary'"),
+    ("garbage=zz", "garbage must be hex bytes"),
+    ("id=2,300", r"id must be an integer 1..247, not '300' \(several: id=1,2,5\)"),
 ])
 def test_bad_options(options, message):
     name = fresh()

@@ -1,105 +1,95 @@
-"""A simulated Modbus RTU slave: the device behind ``sim://NAME?device=modbus``.
+"""Simulated Modbus slaves: the device behind ``sim://NAME?device=modbus``.
 
-It answers Modbus RTU requests like a real RS-485 slave, with wire timing, so
-that a PLC program's Modbus master can be tested without hardware. Its
-behaviour follows the Modbus specification (Application Protocol V1.1b3 and
-the Serial Line guide V1.02); a Siemens S7-200 Freeport Modbus slave (an STL
-program answering functions 1-6, 15, 16 after a quiet-line timeout) served as
-the example of a real device.
+They answer Modbus RTU (or ASCII) requests like real RS-485 slaves, with wire
+timing, so that a Modbus master (a ladder program's, MODBMAST) can be tested
+without hardware. The protocol is the one Modbus codec (softplc_lite.modbus:
+PDUs and framers); behaviour follows the Modbus specification (Application
+Protocol V1.1b3 and the Serial Line guide V1.02).
 
 Options (``sim://NAME?device=modbus&id=2&registers=200``; any other option is
 a ValueError):
 
-- ``id``: the slave address, 1..247 (default 1).
-- ``registers``: the size of each of the four tables, 1..65536 (default
-  200): holding registers, input registers, coils and discrete inputs,
-  addressed 0..registers-1 (the protocol address, as sent in the request).
+- ``id``: the slave address, 1..247 (default 1), or several on one line
+  (``id=1,2,5``): one slave each, each with its own tables; the line is
+  silent for any other id.
+- ``registers``: the size of each of the four tables of each slave,
+  1..65536 (default 200): holding registers, input registers, coils and
+  discrete inputs, addressed 0..registers-1 (the protocol address).
 - ``values``: how the tables start (default ``pattern``), see
-  ``initial_value()``:
+  ``initial_value()``; the k-th id of a list (k from 0) has the pattern
+  XOR k * 0x1111 in its registers and its bit patterns shifted by k, so two
+  slaves never look alike.
+- ``framing``: ``rtu`` (default) or ``ascii``.
+- ``turnaround_ms``: extra time before replying (default 0; a number >= 0).
+- ``cts_delay_ms``: CTS follows the port's RTS after this delay (default 0,
+  at once); ``cts=off``: CTS never rises (a modem that does not answer).
 
-    table               pattern (the default)                        index   zero
-    holding register k  (k * 257 + 1) & 0xFFFF: 0x0001, 0x0102,      k       0
-                        0x0203, ... (0x0000 at k=255, 0x0101 at 256)
-    input register k    holding register k ^ 0xFFFF: 0xFFFE, 0xFEFD  k       0
-    coil k              on when k % 3 == 0                           k odd   off
-    discrete input k    on when k % 4 == 1                           k odd   off
+Framing and timing: an RTU frame is a run of bytes each arriving no later
+than 3.5 character times (``simdevices.silence_ns``) after the one before;
+it ends once the port's clock reaches its last byte's arrival + 3.5
+character times, and the reply starts then + ``turnaround_ms``. An ASCII
+frame runs from ':' to CR LF; the reply starts when the LF has arrived +
+``turnaround_ms``. Frames are answered in order, each reply queued behind
+the one before.
 
-  ``pattern`` makes mistakes visible: a register never holds its own
-  address, neighbouring registers differ in both bytes (an off-by-one
-  shows), below k = 255 the two bytes of a register differ (byte order
-  shows), the 65536 holding values are all different, an input register
-  never equals the holding register at the same address (function 3 vs 4),
-  and the bit patterns repeat every 3 and 4 bits, never every 8 (bit order
-  shows).
-- ``turnaround_ms``: extra time the slave takes before replying, after the
-  3.5-character silence that ends the request (default 0; a number >= 0).
+A frame is ignored, without reply (counted in ``ignored``), when it is too
+short or too long, has a bad CRC or LRC, or is for an id the line does not
+have. Address 0 is a broadcast: every slave executes it, none answers.
+Every other frame is a request (counted in ``requests``) and gets a reply:
+the normal one, or an exception with the code checked in the
+specification's order: 01 illegal function (other than 1-6, 15, 16, 22,
+23), 03 illegal data value (a quantity out of range, a byte count that does
+not match, a coil value other than 0xFF00/0x0000, a wrong length), 02
+illegal data address (past the end of the table).
 
-Framing: a frame is a run of bytes each arriving no later than 3.5 character
-times (``simdevices.silence_ns``) after the one before; it ends once the
-port's clock reaches its last byte's arrival + 3.5 character times, and the
-reply starts then + ``turnaround_ms`` (the first reply byte arrives one
-character time later). Frames are answered in order; a reply is queued
-behind the one before it.
-
-A frame is ignored, without reply (counted in ``ignored``), when it is
-shorter than 4 bytes, longer than 256, has a bad CRC, or is for another
-slave. Address 0 is a broadcast: it is executed (writes take effect) but
-never answered. Every other frame is a request (counted in ``requests``) and
-gets a reply: the normal one, or an exception ``id, function | 0x80, code,
-CRC`` with the code checked in this order (as the specification's flow
-charts):
-
-- 01 illegal function: a function other than 1, 2, 3, 4, 5, 6, 15, 16;
-- 03 illegal data value: a quantity out of range (1..2000 for functions 1
-  and 2, 1..125 for 3 and 4, 1..1968 for 15, 1..123 for 16), a byte count
-  that does not match the quantity or the bytes sent, a value other than
-  0xFF00 / 0x0000 for function 5, or a request of the wrong length;
-- 02 illegal data address: start + quantity past the end of the table.
+Faults, for testing a master (``device.fault``, a ``ReplyFault``; URL
+options of the same names set it at start): ``cut=N`` sends only the first N
+bytes of each reply; ``pause_after=N&pause_ms=X`` pauses X ms after the
+first N bytes; ``garbage=HEX`` sends those bytes just before each reply;
+``bad_crc=1`` corrupts the check; ``silent=1`` answers nothing (a slave that
+is present again once it is cleared). A unit's ``online`` flag does the
+same for one id.
 
 Simplifications: the gap is measured between byte arrivals (the ends of the
-characters), so a pause of more than 2.5 character times between two
-characters splits a frame (the specification's 3.5 counts from the end of
-one character to the start of the next; a master keeping the 1.5-character
-limit within a frame is never split); there is no 1.5-character rule; and the
-slave does not model half duplex (a request arriving while it is still
-replying is answered in its turn).
+characters); there is no 1.5-character rule on the slave side; and no
+half-duplex model (a request arriving while the slave is still replying is
+answered in its turn).
 
-The tables are lists a test may read and change: ``holding_registers`` and
-``input_registers`` (ints 0..0xFFFF), ``coils`` and ``discrete_inputs``
-(bools). ``respond(request, slave)`` is the whole protocol without a wire:
-request ADU in, reply ADU (or None for silence) out. ``find_slave(name)``
-gives the device of the open link ``name``.
+The tables are lists a test may read and change, per id: ``unit(id)``'s
+``holding_registers``, ``input_registers`` (ints 0..0xFFFF), ``coils`` and
+``discrete_inputs`` (bools); the device's own attributes of those names are
+its first id's. ``respond(request, slave)`` is the whole protocol without a
+wire: request frame in, reply frame (or None for silence) out.
+``find_slave(name)`` gives the device of the open link ``name``.
 """
 
 from __future__ import annotations
 
-import struct
+from dataclasses import dataclass
 
-from ..tlm.comgenius.checksum import crc16_bytes  # TEMP: moves to the Modbus codec
+from ..modbus.crc import crc16
+from ..modbus.framing import AsciiFramer, FrameError, RtuFramer
+from ..modbus.packing import pack_bits, unpack_bits
+from ..modbus.pdu import (ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ExceptionResponse, MaskWriteRegisterRequest,
+                          MaskWriteRegisterResponse, ModbusDecodeError, ReadCoilsRequest, ReadCoilsResponse,
+                          ReadDiscreteInputsRequest, ReadDiscreteInputsResponse, ReadHoldingRegistersRequest,
+                          ReadHoldingRegistersResponse, ReadInputRegistersRequest, ReadInputRegistersResponse,
+                          ReadWriteMultipleRegistersRequest, ReadWriteMultipleRegistersResponse,
+                          WriteMultipleCoilsRequest, WriteMultipleCoilsResponse, WriteMultipleRegistersRequest,
+                          WriteMultipleRegistersResponse, WriteSingleCoilRequest, WriteSingleCoilResponse,
+                          WriteSingleRegisterRequest, WriteSingleRegisterResponse, decode_request)
 from . import simdevices, wire
 from .simdevices import SimDevice, check_options, float_option, silence_ns
 
 KIND = "modbus"
-OPTIONS = ("id", "registers", "values", "turnaround_ms")
+OPTIONS = ("id", "registers", "values", "framing", "turnaround_ms", "cts_delay_ms", "cts", "cut", "pause_after",
+           "pause_ms", "garbage", "bad_crc", "silent")
 VALUES = ("pattern", "index", "zero")
 TABLES = ("holding", "input", "coil", "discrete")
 MAX_ADU = 256
 
-ILLEGAL_FUNCTION = 1
-ILLEGAL_DATA_ADDRESS = 2
-ILLEGAL_DATA_VALUE = 3
-
-# function: (table attribute, largest quantity)
-_READS = {1: ("coils", 2000), 2: ("discrete_inputs", 2000), 3: ("holding_registers", 125), 4: ("input_registers", 125)}
-
-
-def crc16(data: bytes) -> int:
-    """The Modbus CRC (init 0xFFFF, polynomial 0xA001); sent low byte first.
-
-    >>> hex(crc16(bytes.fromhex("02 03 00 00 00 7D")))
-    '0xd885'
-    """
-    return crc16_bytes(data, 0xFFFF)  # the table-driven CRC the formats' %#R uses
+__all__ = ["ModbusSlave", "ModbusUnit", "ReplyFault", "crc16", "find_slave", "initial_value", "pack_bits", "respond",
+           "unpack_bits", "with_crc"]
 
 
 def with_crc(frame: bytes) -> bytes:
@@ -111,23 +101,26 @@ def with_crc(frame: bytes) -> bytes:
     return bytes(frame) + crc16(frame).to_bytes(2, "little")
 
 
-def initial_value(k: int, table: str = "holding", values: str = "pattern") -> int | bool:
+def initial_value(k: int, table: str = "holding", values: str = "pattern", unit: int = 0) -> int | bool:
     """What entry ``k`` of ``table`` ("holding", "input", "coil" or "discrete")
-    holds when a slave starts with option ``values`` (see the module docstring).
+    holds when a slave starts with option ``values``; ``unit`` is the
+    slave's place in the ``id`` list (0 for the first).
 
     >>> [hex(initial_value(k)) for k in range(3)], hex(initial_value(1, "input"))
     (['0x1', '0x102', '0x203'], '0xfefd')
     >>> [initial_value(k, "coil") for k in range(4)], [initial_value(k, "discrete") for k in range(4)]
     ([True, False, False, True], [False, True, False, False])
+    >>> hex(initial_value(0, unit=1)), [initial_value(k, "coil", unit=1) for k in range(4)]
+    ('0x1110', [False, False, True, False])
     """
     if table not in TABLES:
         raise ValueError(f"table must be one of {', '.join(TABLES)}, not {table!r}")
     if values == "pattern":
         if table == "holding":
-            return (k * 257 + 1) & 0xFFFF
+            return ((k * 257 + 1) & 0xFFFF) ^ (unit * 0x1111)
         if table == "input":
-            return ((k * 257 + 1) & 0xFFFF) ^ 0xFFFF
-        return k % 3 == 0 if table == "coil" else k % 4 == 1
+            return ((k * 257 + 1) & 0xFFFF) ^ 0xFFFF ^ (unit * 0x1111)
+        return (k + unit) % 3 == 0 if table == "coil" else (k + unit) % 4 == 1
     if values == "index":
         return k & 0xFFFF if table in ("holding", "input") else k % 2 == 1
     if values == "zero":
@@ -135,63 +128,152 @@ def initial_value(k: int, table: str = "holding", values: str = "pattern") -> in
     raise ValueError(f"values must be one of {', '.join(VALUES)}, not {values!r}")
 
 
+@dataclass
+class ReplyFault:
+    """What goes wrong with every reply (for testing masters)."""
+
+    cut: int | None = None  # send only the first N bytes
+    pause_after: int | None = None  # pause after the first N bytes ...
+    pause_ms: float = 0.0  # ... for this long
+    garbage: bytes = b""  # sent just before the reply
+    bad_crc: bool = False  # the CRC (or LRC) of the reply is wrong
+    silent: bool = False  # no reply at all
+
+
+class ModbusUnit:
+    """One slave id's four tables."""
+
+    def __init__(self, slave_id: int, size: int, values: str, position: int = 0) -> None:
+        self.slave_id = slave_id
+        self.online = True  # False: this id answers nothing (a slave switched off)
+        self.holding_registers: list[int] = [initial_value(k, "holding", values, position) for k in range(size)]
+        self.input_registers: list[int] = [initial_value(k, "input", values, position) for k in range(size)]
+        self.coils: list[bool] = [initial_value(k, "coil", values, position) for k in range(size)]
+        self.discrete_inputs: list[bool] = [initial_value(k, "discrete", values, position) for k in range(size)]
+
+    def __repr__(self) -> str:
+        return f"<ModbusUnit id={self.slave_id}{'' if self.online else ' offline'}>"
+
+
 class ModbusSlave(SimDevice):
-    """A Modbus RTU slave on a simulated wire (see the module docstring)."""
+    """Modbus slaves on a simulated wire (see the module docstring)."""
 
     name = KIND
 
-    def __init__(self, slave_id: int = 1, registers: int = 200, values: str = "pattern",
-                 turnaround_ms: float = 0.0) -> None:
-        if not 1 <= slave_id <= 247:
-            raise ValueError(f"{KIND} device: id must be 1..247, not {slave_id}")
+    def __init__(self, slave_id: int | list[int] = 1, registers: int = 200, values: str = "pattern",
+                 turnaround_ms: float = 0.0, framing: str = "rtu", cts_delay_ms: float = 0.0, cts: bool = True,
+                 fault: ReplyFault | None = None) -> None:
+        ids = [slave_id] if isinstance(slave_id, int) else list(slave_id)
+        for i in ids:
+            if not 1 <= i <= 247:
+                raise ValueError(f"{KIND} device: id must be 1..247, not {i}")
+        if len(set(ids)) != len(ids) or not ids:
+            raise ValueError(f"{KIND} device: ids must be different, not {ids}")
         if not 1 <= registers <= 65536:
             raise ValueError(f"{KIND} device: registers must be 1..65536, not {registers}")
         if values not in VALUES:
             raise ValueError(f"{KIND} device: values must be one of {', '.join(VALUES)}, not {values!r}")
-        self.slave_id = slave_id
+        if framing not in ("rtu", "ascii"):
+            raise ValueError(f"{KIND} device: framing must be rtu or ascii, not {framing!r}")
+        self.units = {i: ModbusUnit(i, registers, values, k) for k, i in enumerate(ids)}
+        self.slave_id = ids[0]
         self.size = registers
         self.values = values
+        self.framing = framing
+        self.framer = RtuFramer if framing == "rtu" else AsciiFramer
         self.turnaround_ns = round(turnaround_ms * 1_000_000)
-        self.holding_registers: list[int] = [initial_value(k, "holding", values) for k in range(registers)]
-        self.input_registers: list[int] = [initial_value(k, "input", values) for k in range(registers)]
-        self.coils: list[bool] = [initial_value(k, "coil", values) for k in range(registers)]
-        self.discrete_inputs: list[bool] = [initial_value(k, "discrete", values) for k in range(registers)]
+        self.cts_delay_ns = round(cts_delay_ms * 1_000_000)
+        self.cts_enabled = cts
+        self.fault = fault or ReplyFault()
         self.requests = 0  # frames executed (answered, or broadcast)
         self.ignored = 0  # frames dropped: too short or long, bad CRC, another slave's
         self._frame = bytearray()
         self._last = 0  # arrival time of the frame's last byte
 
+    # the first id's tables, as the device's own
+    holding_registers = property(lambda self: self.units[self.slave_id].holding_registers)
+    input_registers = property(lambda self: self.units[self.slave_id].input_registers)
+    coils = property(lambda self: self.units[self.slave_id].coils)
+    discrete_inputs = property(lambda self: self.units[self.slave_id].discrete_inputs)
+
+    def unit(self, slave_id: int) -> ModbusUnit:
+        return self.units[slave_id]
+
+    # -- the wire --------------------------------------------------------------------------------
     def receive(self, data: bytes, times_ns: list[int]) -> None:
+        if self.framing == "ascii":
+            self._receive_ascii(data, times_ns)
+            return
         gap = silence_ns(self.end.char_ns)
         frame = self._frame
         for byte, t in zip(data, times_ns):
             if frame and t - self._last > gap:
-                self._finish(gap)
+                self._finish(self._last + gap)
             if len(frame) <= MAX_ADU:  # one byte over marks the frame as too long
                 frame.append(byte)
             self._last = t
 
-    def poll(self, now_ns: int) -> None:
-        gap = silence_ns(self.end.char_ns)
-        if self._frame and now_ns >= self._last + gap:
-            self._finish(gap)
+    def _receive_ascii(self, data: bytes, times_ns: list[int]) -> None:
+        frame = self._frame
+        for byte, t in zip(data, times_ns):
+            if byte == 0x3A:  # ':' starts a frame, whatever came before
+                frame.clear()
+            if frame or byte == 0x3A:
+                if len(frame) <= AsciiFramer.MAX_FRAME_LENGTH:
+                    frame.append(byte)
+                if byte == 0x0A and frame[-2:] == b"\r\n":
+                    self._last = t
+                    self._finish(t)
 
-    def _finish(self, gap: int) -> None:
+    def poll(self, now_ns: int) -> None:
+        if self.framing == "rtu":
+            gap = silence_ns(self.end.char_ns)
+            if self._frame and now_ns >= self._last + gap:
+                self._finish(self._last + gap)
+
+    def cts(self, now_ns: int) -> tuple[bool, int]:
+        on, since = self.end.rts()
+        if not self.cts_enabled:
+            return False, 0
+        if not on:
+            return False, since
+        rises = since + self.cts_delay_ns
+        return (True, rises) if now_ns >= rises else (False, since)
+
+    def _finish(self, ended_at: int) -> None:
         request = bytes(self._frame)
         self._frame.clear()
         reply = respond(request, self)
-        if reply is not None:
-            self.end.send(reply, self._last + gap + self.turnaround_ns)
+        fault = self.fault
+        if reply is None or fault.silent:
+            return
+        if fault.bad_crc:
+            reply = reply[:-3] + bytes([reply[-3] ^ 0x01]) + reply[-2:] if self.framing == "ascii" else \
+                reply[:-1] + bytes([reply[-1] ^ 0xFF])
+        if fault.cut is not None:
+            reply = reply[:fault.cut]
+        at = ended_at + self.turnaround_ns
+        if fault.garbage:
+            self.end.send(fault.garbage, at)
+            at += len(fault.garbage) * self.end.char_ns
+        if fault.pause_after is not None and fault.pause_after < len(reply):
+            first, rest = reply[:fault.pause_after], reply[fault.pause_after:]
+            self.end.send(first, at)
+            at += len(first) * self.end.char_ns + round(fault.pause_ms * 1_000_000)
+            reply = rest
+        self.end.send(reply, at)
 
     def __repr__(self) -> str:
-        return (f"<ModbusSlave id={self.slave_id} registers={self.size} values={self.values}: "
+        ids = ",".join(map(str, self.units))
+        return (f"<ModbusSlave id={ids} registers={self.size} values={self.values} {self.framing}: "
                 f"{self.requests} request(s), {self.ignored} ignored>")
 
 
 def respond(request: bytes, slave: ModbusSlave) -> bytes | None:
-    """Execute one request ADU (address, PDU, CRC) on ``slave``; the reply
-    ADU, or None when the slave stays silent (ignored frame or broadcast).
-    Counts the frame in ``slave.requests`` or ``slave.ignored``.
+    """Execute one request frame (RTU, or ASCII on an ASCII slave) on
+    ``slave``; the reply frame, or None when the line stays silent (ignored
+    frame, an id it does not have, or a broadcast). Counts the frame in
+    ``slave.requests`` or ``slave.ignored``.
 
     >>> slave = ModbusSlave(slave_id=2)
     >>> respond(with_crc(bytes.fromhex("02 03 00 00 00 02")), slave).hex(" ")
@@ -201,111 +283,142 @@ def respond(request: bytes, slave: ModbusSlave) -> bytes | None:
     >>> respond(with_crc(bytes.fromhex("03 03 00 00 00 02")), slave) is None
     True
     """
-    if not 4 <= len(request) <= MAX_ADU or crc16(request[:-2]) != int.from_bytes(request[-2:], "little"):
+    framer = slave.framer
+    if len(request) > (MAX_ADU if framer is RtuFramer else AsciiFramer.MAX_FRAME_LENGTH):
         slave.ignored += 1
         return None
-    address = request[0]
-    if address != 0 and address != slave.slave_id:
+    try:
+        address, pdu = framer.decode(request)
+    except FrameError:
+        slave.ignored += 1
+        return None
+    units = [u for u in slave.units.values() if u.online]
+    if address != 0:
+        units = [u for u in units if u.slave_id == address]
+    if not units or not pdu:
         slave.ignored += 1
         return None
     slave.requests += 1
-    pdu = _execute(slave, request[1:-2])
-    return None if address == 0 else with_crc(bytes([address]) + pdu)
+    replies = [_execute(unit, pdu, slave.size) for unit in units]
+    return None if address == 0 else framer.encode(address, replies[0])
 
 
-def _exception(function: int, code: int) -> bytes:
-    return bytes([function | 0x80, code])
-
-
-def _execute(slave: ModbusSlave, pdu: bytes) -> bytes:
+def _execute(unit: ModbusUnit, pdu: bytes, size: int) -> bytes:
     """The reply PDU to ``pdu`` (function code + data), after executing it."""
-    function, data = pdu[0], pdu[1:]
-    if function in _READS:
-        attribute, most = _READS[function]
-        if len(data) != 4:
-            return _exception(function, ILLEGAL_DATA_VALUE)
-        start, count = struct.unpack(">HH", data)
-        if not 1 <= count <= most:
-            return _exception(function, ILLEGAL_DATA_VALUE)
-        table = getattr(slave, attribute)
-        if start + count > len(table):
-            return _exception(function, ILLEGAL_DATA_ADDRESS)
-        if function <= 2:
-            packed = pack_bits(table[start:start + count])
-        else:
-            packed = struct.pack(f">{count}H", *table[start:start + count])
-        return bytes([function, len(packed)]) + packed
-    if function in (5, 6):
-        if len(data) != 4:
-            return _exception(function, ILLEGAL_DATA_VALUE)
-        address, value = struct.unpack(">HH", data)
-        if function == 5 and value not in (0x0000, 0xFF00):
-            return _exception(function, ILLEGAL_DATA_VALUE)
-        if address >= slave.size:
-            return _exception(function, ILLEGAL_DATA_ADDRESS)
-        if function == 5:
-            slave.coils[address] = value == 0xFF00
-        else:
-            slave.holding_registers[address] = value
-        return pdu
-    if function in (15, 16):
-        if len(data) < 5:
-            return _exception(function, ILLEGAL_DATA_VALUE)
-        start, count, byte_count = struct.unpack(">HHB", data[:5])
-        most, needed = (1968, (count + 7) // 8) if function == 15 else (123, 2 * count)
-        if not 1 <= count <= most or byte_count != needed or len(data) != 5 + byte_count:
-            return _exception(function, ILLEGAL_DATA_VALUE)
-        if start + count > slave.size:
-            return _exception(function, ILLEGAL_DATA_ADDRESS)
-        if function == 15:
-            slave.coils[start:start + count] = unpack_bits(data[5:], count)
-        else:
-            slave.holding_registers[start:start + count] = struct.unpack(f">{count}H", data[5:])
-        return pdu[:5]
-    return _exception(function, ILLEGAL_FUNCTION)
+    try:
+        request = decode_request(pdu)
+    except ModbusDecodeError as e:
+        if not 1 <= pdu[0] <= 0x7F:  # no function has that code: the exception says so as sent
+            return bytes([pdu[0] | 0x80, e.exception_code])
+        return ExceptionResponse(pdu[0], e.exception_code).encode()
+    f = pdu[0]
 
+    def fits(address: int, count: int) -> bool:
+        return address + count <= size
 
-def pack_bits(bits) -> bytes:
-    """Bits 8 a byte, the first in the lowest bit of the first byte; unused high bits 0.
-
-    >>> pack_bits([True, False, False, True, False, False, True, False, False, True]).hex(" ")
-    '49 02'
-    """
-    out = bytearray((len(bits) + 7) // 8)
-    for i, bit in enumerate(bits):
-        if bit:
-            out[i >> 3] |= 1 << (i & 7)
-    return bytes(out)
-
-
-def unpack_bits(data: bytes, count: int) -> list[bool]:
-    """The first ``count`` bits of ``data`` (lowest bit of the first byte first)."""
-    return [bool(data[i >> 3] >> (i & 7) & 1) for i in range(count)]
+    if isinstance(request, (ReadCoilsRequest, ReadDiscreteInputsRequest)):
+        if not fits(request.address, request.count):
+            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
+        table = unit.coils if f == 1 else unit.discrete_inputs
+        bits = tuple(table[request.address:request.address + request.count])
+        return (ReadCoilsResponse if f == 1 else ReadDiscreteInputsResponse)(bits).encode()
+    if isinstance(request, (ReadHoldingRegistersRequest, ReadInputRegistersRequest)):
+        if not fits(request.address, request.count):
+            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
+        table = unit.holding_registers if f == 3 else unit.input_registers
+        values = tuple(table[request.address:request.address + request.count])
+        return (ReadHoldingRegistersResponse if f == 3 else ReadInputRegistersResponse)(values).encode()
+    if isinstance(request, WriteSingleCoilRequest):
+        if not fits(request.address, 1):
+            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
+        unit.coils[request.address] = request.value
+        return WriteSingleCoilResponse(request.address, request.value).encode()
+    if isinstance(request, WriteSingleRegisterRequest):
+        if not fits(request.address, 1):
+            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
+        unit.holding_registers[request.address] = request.value
+        return WriteSingleRegisterResponse(request.address, request.value).encode()
+    if isinstance(request, WriteMultipleCoilsRequest):
+        if not fits(request.address, request.count):
+            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
+        unit.coils[request.address:request.address + request.count] = list(request.values)
+        return WriteMultipleCoilsResponse(request.address, request.count).encode()
+    if isinstance(request, WriteMultipleRegistersRequest):
+        if not fits(request.address, request.count):
+            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
+        unit.holding_registers[request.address:request.address + request.count] = list(request.values)
+        return WriteMultipleRegistersResponse(request.address, request.count).encode()
+    if isinstance(request, MaskWriteRegisterRequest):  # 6.16: (current AND and) OR (or AND NOT and)
+        if not fits(request.address, 1):
+            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
+        current = unit.holding_registers[request.address]
+        unit.holding_registers[request.address] = (current & request.and_mask) | (request.or_mask & ~request.and_mask
+                                                                                 & 0xFFFF)
+        return MaskWriteRegisterResponse(request.address, request.and_mask, request.or_mask).encode()
+    # 23 (6.17): the write goes first, then the read
+    if not fits(request.read_address, request.read_count) or not fits(request.write_address, request.write_count):
+        return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
+    unit.holding_registers[request.write_address:request.write_address + request.write_count] = list(request.values)
+    values = tuple(unit.holding_registers[request.read_address:request.read_address + request.read_count])
+    return ReadWriteMultipleRegistersResponse(values).encode()
 
 
 def _int_option(options: dict[str, str], key: str, default: int, low: int, high: int) -> int:
     if key not in options:
         return default
     text = options[key]
-    value = int(text) if text.isascii() and text.isdigit() else None
+    value = int(text) if text.isascii() and text.isdigit() and len(text) < 8 else None
     if value is None or not low <= value <= high:
         raise ValueError(f"{KIND} device: {key} must be an integer {low}..{high}, not {text!r}")
+    return value
+
+
+def _ids(options: dict[str, str]) -> list[int]:
+    text = options.get("id", "1")
+    out = []
+    for item in text.split(","):
+        value = int(item) if item.isascii() and item.isdigit() and len(item) < 4 else None
+        if value is None or not 1 <= value <= 247:
+            raise ValueError(f"{KIND} device: id must be an integer 1..247, not {item!r} (several: id=1,2,5)")
+        out.append(value)
+    return out
+
+
+def _choice(options: dict[str, str], key: str, choices: tuple[str, ...]) -> str:
+    value = options.get(key, choices[0])
+    if value not in choices:
+        raise ValueError(f"{KIND} device: {key} must be {' or '.join(choices)}, not {value!r}")
     return value
 
 
 def create(options: dict[str, str]) -> ModbusSlave:
     """The ``modbus`` device factory: ``options`` as given in the URL."""
     check_options(KIND, options, OPTIONS)
+    garbage = options.get("garbage", "")
+    try:
+        garbage_bytes = bytes.fromhex(garbage)
+    except ValueError:
+        raise ValueError(f"{KIND} device: garbage must be hex bytes such as 00FF, not {garbage!r}") from None
+    cut = _int_option(options, "cut", -1, 0, MAX_ADU * 3)
+    pause_after = _int_option(options, "pause_after", -1, 0, MAX_ADU * 3)
+    fault = ReplyFault(cut=None if cut < 0 else cut, pause_after=None if pause_after < 0 else pause_after,
+                       pause_ms=float_option(KIND, options, "pause_ms", 0.0), garbage=garbage_bytes,
+                       bad_crc=_choice(options, "bad_crc", ("0", "1")) == "1",
+                       silent=_choice(options, "silent", ("0", "1")) == "1")
     return ModbusSlave(
-        slave_id=_int_option(options, "id", 1, 1, 247),
+        slave_id=_ids(options),
         registers=_int_option(options, "registers", 200, 1, 65536),
         values=options.get("values", "pattern"),
         turnaround_ms=float_option(KIND, options, "turnaround_ms", 0.0),
+        framing=_choice(options, "framing", ("rtu", "ascii")),
+        cts_delay_ms=float_option(KIND, options, "cts_delay_ms", 0.0),
+        cts=_choice(options, "cts", ("on", "off")) == "on",
+        fault=fault,
     )
 
 
 def find_slave(name: str) -> ModbusSlave:
-    """The Modbus slave at the far end of the open ``sim://`` link ``name``
+    """The Modbus slaves at the far end of the open ``sim://`` link ``name``
     (the newest, when several ports have opened one of that name);
     LookupError when there is none."""
     links = wire.device_links(name)
