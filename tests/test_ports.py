@@ -89,7 +89,7 @@ def test_two_ports_on_one_device_are_reported_with_both_places(tmp_path):
 class _Port:
     def __init__(self, label: str) -> None:
         self.label = label
-        self.record = None
+        self.record = None  # set by Recorder.add_port: record(label, direction, data, at_ns=None)
 
 
 def test_the_recorder_writes_every_port_in_time_order(tmp_path):
@@ -108,11 +108,12 @@ def test_the_recorder_writes_every_port_in_time_order(tmp_path):
     rec.flush()
     clock.now = 8_000_000
     b.record("MODBMAST:1", "TX", b"\x03")
+    b.record("MODBMAST:1", "RX", b"\x04", 7_500_000)  # a timed read: recorded at the bytes' arrival
     rec.close()
     text = path.read_text()
     assert "# port 0: COM1 -> loop://" in text and "# port MODBMAST:1: COM2 -> sim://bus" in text
     assert [(e.t_ms, e.port, e.data) for e in parse_trace(text)] == [
-        (1.0, "MODBMAST:1", b"\x02"), (2.0, 0, b"\x01"), (3.0, "MODBMAST:1", b"\x03")]
+        (1.0, "MODBMAST:1", b"\x02"), (2.0, 0, b"\x01"), (2.5, "MODBMAST:1", b"\x04"), (3.0, "MODBMAST:1", b"\x03")]
 
 
 def test_the_recorder_never_writes_a_time_before_one_already_written(tmp_path):

@@ -183,6 +183,7 @@ class Engine:
         self._owner = {spec.mnemonic: m for m in self.modules for spec in m.instructions()}
         self.module_warnings: list[str] = []
         self.recorder = None  # the --record trace, shared by the modules' ports
+        self._reference_module_blocks()
         self._attach_modules(module_options or {})
         self._attach_hooks()
         self.files = {}
@@ -206,6 +207,17 @@ class Engine:
             for m in attached:  # a module refused to start: release what the others opened
                 m.close()
             raise
+
+    def _reference_module_blocks(self) -> None:
+        if not self._owner:
+            return
+        for pfile in self.program.files.values():
+            for rung in pfile.rungs:
+                for ins in walk(rung.elements):
+                    module = self._owner.get(ins.mnemonic)
+                    if module is not None:
+                        for address in module.references(ins):
+                            self.table.reference(address)
 
     def _attach_hooks(self) -> None:
         from ..tlm.api import overrides
@@ -239,6 +251,11 @@ class Engine:
     # -- modes --------------------------------------------------------------------------
     def set_mode(self, mode: Mode) -> None:
         if mode is self.mode:
+            if mode is Mode.PROGRAM:
+                # SoftPLC: asking for PROGRAM while in PROGRAM tells the
+                # modules to reload their configuration (MODBMAST manual 5.2).
+                for hook in self.mode_hooks:
+                    hook(self, mode, mode)
             return
         if mode not in TRANSITIONS[self.mode]:
             raise ModeError(f"cannot go from {self.mode.name} to {mode.name}"
@@ -379,6 +396,11 @@ class Engine:
         s[S.MODE_WORD] = Mode.FAULTED.value
         for hook in self.mode_hooks:
             hook(self, old, Mode.FAULTED)
+
+    def module_fault(self, code: int, message: str) -> None:
+        """A module's major fault outside the ladder (a driver whose
+        configuration failed to reload): FAULTED, with S:11/S:12 set."""
+        self._major(MajorFault(code, message))
 
     def run(self, scans: int) -> None:
         for _ in range(scans):

@@ -31,6 +31,7 @@ class K(Enum):
     PROGRAM_FILE = "program file number 3..999"
     EXPRESSION = "expression"
     FILE = "file address (#N7:0)"
+    WORD_FILE = "word file address (#B3:0)"  # a block of 16-bit words (module instructions)
     FILE_SOURCE = "number, or file address (#N7:0)"
     LENGTH = "length 1..1000"
     STRING = "string element (ST)"

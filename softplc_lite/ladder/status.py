@@ -43,7 +43,8 @@ FAULT_JSR_NESTING = 30  # subroutines nested too deep
 FAULT_NEGATIVE_TIMER = 34  # negative timer preset or accumulator
 FAULT_WATCHDOG = 200  # softplc: scan longer than S:28
 FAULT_DIV_ZERO = 201  # softplc: division by zero with divide_by_zero = "fault"
-FAULT_BLOCK_RANGE = 202  # softplc: COP/FLL block past the end of its file
+FAULT_BLOCK_RANGE = 202  # softplc: COP/FLL (or a module's) block past the end of its file
+FAULT_MODULE_CONFIG = 203  # softplc: a module's configuration file failed to (re)load
 FAULT_INTERNAL = 255  # softplc: an internal error (a bug), contained as a fault
 
 # Minor fault codes (S:102)
@@ -54,3 +55,4 @@ MINOR_CODE_FORMAT_INDEX = 4  # a format index with no string in the table
 MINOR_CODE_FORMAT = 5  # an illegal format string (e.g. %k)
 MINOR_CODE_PARAM = 6  # a Param missing, of the wrong kind, or past the end of its file
 MINOR_CODE_PORT = 7  # a module instruction names a port that is not configured or is down
+MINOR_CODE_OPERAND = 8  # a module instruction operand out of its range (e.g. a slave id past 247)

@@ -49,7 +49,7 @@ _WANT = {
     K.TIMER: (ValueKind.TIMER,), K.COUNTER: (ValueKind.COUNTER,), K.CONTROL: (ValueKind.CONTROL,),
     K.RESETTABLE: (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL),
     K.STRING: (ValueKind.STRING,),
-    K.PORT: (ValueKind.WORD,), K.FORMAT: (ValueKind.WORD,),
+    K.PORT: (ValueKind.WORD,), K.FORMAT: (ValueKind.WORD,), K.WORD_FILE: (ValueKind.WORD,),
     K.PARAM: (ValueKind.WORD, ValueKind.FLOAT, ValueKind.STRING),
     K.PARAM_OUT: (ValueKind.WORD, ValueKind.FLOAT, ValueKind.STRING),
 }
@@ -170,7 +170,7 @@ class _Checker:
         if a.kind not in want:
             bad(kind.value)
             return None
-        if kind in (K.FILE, K.FILE_SOURCE) and a.indexed:
+        if kind in (K.FILE, K.FILE_SOURCE, K.WORD_FILE) and a.indexed:
             # '#' marks a file operand here (PLC-5 file instructions), not indexing.
             return AddressRef(Address(a.type_letter, a.file, a.element, a.member, a.bit, False), resolved.pos)
         return resolved

@@ -190,7 +190,7 @@ class SerialPort:
             return b"", None
         if data:
             self.rx_bytes += len(data)
-            self._traffic("RX", data)
+            self._traffic("RX", data, times[-1])  # when it arrived, not when the driver looked
         return data, times
 
     def write(self, data: bytes) -> int:
@@ -256,11 +256,11 @@ class SerialPort:
         except PORT_ERRORS:
             return False, None
 
-    def _traffic(self, direction: str, data: bytes) -> None:
-        t_ms = self.now_ns() / 1e6
+    def _traffic(self, direction: str, data: bytes, at_ns: int | None = None) -> None:
+        t_ms = (self.now_ns() if at_ns is None else at_ns) / 1e6
         self.history.append((t_ms, direction, data))
         if self.record is not None:
-            self.record(self.label, direction, data)
+            self.record(self.label, direction, data, at_ns)
         if self.log_frames:
             self.log(2, f"port {self.label} {direction} {len(data):4d} bytes: {hexdump(data)}")
 

@@ -37,9 +37,9 @@ class Recorder:
         if self._start_ns is None:
             self._start_ns = now_ns()
 
-        def record(label: str, direction: str, data: bytes) -> None:
+        def record(label: str, direction: str, data: bytes, at_ns: int | None = None) -> None:
             self._seq += 1
-            self._events.append((now_ns(), self._seq, label, direction, bytes(data)))
+            self._events.append((now_ns() if at_ns is None else at_ns, self._seq, label, direction, bytes(data)))
 
         port.record = record
 

@@ -34,6 +34,7 @@ The engine has no special case for any module; COMGENIUS uses exactly this.
 from __future__ import annotations
 
 import sys
+import time
 from array import array
 from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Mapping
@@ -74,6 +75,12 @@ class TLM:
         """Warnings about one (validated) instruction of this module."""
         return []
 
+    def references(self, instr: Instruction) -> list:
+        """Data table addresses one of the module's instructions reaches
+        beyond its operands (the last word of a block operand), so that the
+        engine grows those files as it does for COP."""
+        return []
+
     def create(self, instr: Instruction, ctx: "InstructionContext") -> Instance:
         raise NotImplementedError(f"module {self.name} cannot run {instr.mnemonic}")
 
@@ -105,6 +112,14 @@ class TLM:
     def log(self, message: str) -> None:
         """Diagnostics (a module's DEBUG output): standard error by default."""
         print(f"{self.name}: {message}", file=sys.stderr)
+
+    def log_stamped(self, message: str, engine: "Engine | None" = None) -> None:
+        """A diagnostic line stamped with the wall-clock time and the
+        engine's time (the DEBUG output of the serial modules)."""
+        t = time.time()
+        stamp = time.strftime("%H:%M:%S", time.localtime(t)) + f".{int(t * 1000) % 1000:03d}"
+        engine_ms = engine.clock.now_ms if engine is not None else 0
+        self.log(f"{stamp} t={engine_ms}ms {message}")
 
 
 def attach_options(modules: list[TLM], options: Mapping[str, object]) -> tuple[dict[str, dict], Recorder | None]:

@@ -134,10 +134,7 @@ class ComGenius(TLM):
         """DEBUG=1 logs port events and errors, DEBUG=2 also every frame in
         hex and each result (manual 5.1); DEBUG=0 is silent."""
         if self.config.debug >= level:
-            t = time.time()
-            stamp = time.strftime("%H:%M:%S", time.localtime(t)) + f".{int(t * 1000) % 1000:03d}"
-            engine_ms = self.engine.clock.now_ms if self.engine is not None else 0
-            self.log(f"{stamp} t={engine_ms}ms {message}")
+            self.log_stamped(message, self.engine)
 
 
 def check_port_use(instr: Instruction, port_at: int, config: ComGeniusConfig) -> list[LadderError]:
