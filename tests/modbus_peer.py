@@ -1,10 +1,17 @@
-"""A third-party Modbus RTU slave for tests and benchmarks: pymodbus's
+"""A third-party Modbus slave line for tests and benchmarks: pymodbus's
 serial server, run in a background thread with its own asyncio loop.
 
 ``port`` is a serial device (one end of a socat pty pair) or
-``socket://127.0.0.1:PORT``, where pymodbus listens on TCP with RTU
-framing (testing notes). Like a real RS-485 slave it stays silent for
-other unit ids (pymodbus would answer those with exception 04).
+``socket://127.0.0.1:PORT``, where pymodbus listens on TCP with serial
+framing (testing notes). Like real RS-485 slaves the line stays silent for
+unit ids it does not have (pymodbus would answer those with exception 04).
+
+Two kinds of line: ``ModbusPeer(port, registers)`` is one slave (id 2 by
+default) whose holding registers are ``registers``; ``ModbusPeer(port,
+ids=[1, 2], size=200)`` has one slave per id, each with four tables of
+``size`` entries holding what our simulated slave holds
+(``modbus_slave.initial_value(k, table, unit=position)``), so a test
+expects the same values from either. ``framer`` is "rtu" or "ascii".
 """
 
 from __future__ import annotations
@@ -43,28 +50,50 @@ def wait_for_tcp(port: int, seconds: float = 5.0) -> None:
 
 
 class ModbusPeer:
-    """pymodbus's RTU server for unit ``device_id`` with ``registers``
-    holding registers (addresses 0..len-1)."""
+    """pymodbus's serial server: unit ``device_id`` with ``registers`` as its
+    holding registers (addresses 0..len-1), or the units ``ids`` with four
+    tables each (see the module docstring)."""
 
-    def __init__(self, port: str, registers: list[int], device_id: int = 2, baudrate: int = 38400) -> None:
+    def __init__(self, port: str, registers: list[int] | None = None, device_id: int = 2, baudrate: int = 38400,
+                 ids: list[int] | None = None, size: int = 200, framer: str = "rtu") -> None:
         self.port = port
-        self.registers = list(registers)
-        self.device_id = device_id
+        self.registers = list(registers or [])
+        self.ids = list(ids) if ids is not None else [device_id]
+        self.device_id = self.ids[0]
+        self.size = size
+        self.four_tables = ids is not None
+        self.framer = framer
         self.baudrate = baudrate
         self._loop: asyncio.AbstractEventLoop | None = None
         self._thread: threading.Thread | None = None
         self._server: ModbusSerialServer | None = None
 
     def _drop_other_ids(self, sending: bool, pdu):
-        if not sending and pdu.dev_id != self.device_id:
+        if not sending and pdu.dev_id not in self.ids:
             return None  # silence, as on a real multi-drop line
         return pdu
 
+    def _devices(self) -> list[SimDevice]:
+        if not self.four_tables:
+            return [SimDevice(self.device_id, simdata=[SimData(0, values=self.registers, datatype=DataType.REGISTERS)])]
+        from softplc_lite.ports.modbus_slave import initial_value
+
+        def table(name: str, position: int, datatype: DataType) -> list[SimData]:
+            return [SimData(0, values=[initial_value(k, name, unit=position) for k in range(self.size)],
+                            datatype=datatype)]
+
+        return [SimDevice(unit, simdata=(table("coil", k, DataType.BITS), table("discrete", k, DataType.BITS),
+                                         table("holding", k, DataType.REGISTERS),
+                                         table("input", k, DataType.REGISTERS)))
+                for k, unit in enumerate(self.ids)]
+
     async def _start(self) -> None:
-        device = SimDevice(self.device_id, simdata=[
-            SimData(0, values=self.registers, datatype=DataType.REGISTERS)])
-        self._server = ModbusSerialServer(device, port=self.port, baudrate=self.baudrate,
-                                          trace_pdu=self._drop_other_ids)
+        from pymodbus.framer import FramerType
+
+        devices = self._devices()
+        framer = FramerType.ASCII if self.framer == "ascii" else FramerType.RTU
+        self._server = ModbusSerialServer(devices if len(devices) > 1 else devices[0], framer=framer,
+                                          port=self.port, baudrate=self.baudrate, trace_pdu=self._drop_other_ids)
         await self._server.serve_forever(background=True)
 
     def start(self) -> "ModbusPeer":
@@ -116,7 +145,7 @@ _PEER_PROCESS = """
 import json, sys
 sys.path.insert(0, sys.argv[1])
 from modbus_peer import ModbusPeer
-peer = ModbusPeer(sys.argv[2], json.loads(sys.argv[3])).start()
+peer = ModbusPeer(sys.argv[2], **json.loads(sys.argv[3])).start()
 print("ready", flush=True)
 sys.stdin.read()  # serve until the parent closes stdin (or dies)
 peer.stop()
@@ -131,9 +160,11 @@ class PeerProcess:
     thousand, against about 1,900/s and none with the server in another
     process)."""
 
-    def __init__(self, port: str, registers: list[int]) -> None:
+    def __init__(self, port: str, registers: list[int] | None = None, **options) -> None:
         here = str(Path(__file__).resolve().parent)
-        self.proc = subprocess.Popen([sys.executable, "-c", _PEER_PROCESS, here, port, json.dumps(registers)],
+        if registers is not None:
+            options["registers"] = registers
+        self.proc = subprocess.Popen([sys.executable, "-c", _PEER_PROCESS, here, port, json.dumps(options)],
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
         if self.proc.stdout.readline().strip() != "ready":
             self.stop()

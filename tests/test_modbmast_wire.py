@@ -342,3 +342,20 @@ def test_demoting_a_dead_slave_stops_it_costing_a_timeout_on_every_pass(apps):
     assert dead[1] == 4 + 2  # two passes, then one probe a second
     assert alive[1] > 5 * alive[0]
     assert status(demoting, 1, 5).demoted and not status(demoting, 1, 5).present
+
+
+def test_a_request_still_in_the_ports_queue_at_the_timeout_is_wait_xmitted(apps):
+    """Table 14's -6: the port's transmit queue does not empty (here 1000
+    bytes already queued on the port ahead of the request: 260 ms of wire
+    at 38400 baud), so when requestTimeout expires the request has not even
+    left the port."""
+    from softplc_lite.tlm.modbmast.status import WAIT_XMITTED
+
+    r = apps(port_xml(link(), f'<Slave id="2">{read4()}</Slave>'), run=False)
+    driver(r).port.serial.write(b"\x00" * 1000)  # the backlog, through the same pyserial port
+    r.engine.set_mode(Mode.RUN)
+    scans(r, 4)  # the request went at 0 ms; 2 ms of it, then 30 ms of requestTimeout
+    s = status(r, 1, 2)
+    assert s.last_code == WAIT_XMITTED and not s.present and s.words()[1] == 0
+    scans(r, 40)  # the backlog drains; the slave answers again
+    assert s.present and s.last_code == 0 and r.table.read("N7:1") == initial_value(1)

@@ -91,3 +91,39 @@ def test_loopback_prints_and_matches_its_echo_every_poll(executor):
         assert t.read("N7:11") == 2 and t.read("R6:1.LEN") == 30
     finally:
         r.engine.close()
+
+
+@pytest.mark.parametrize("executor", ["compiled", "reference"])
+def test_modbus_scada_polls_two_slaves_and_reports_the_missing_one(executor):
+    """programs/modbus_scada: MODBMAST on a simulated line with slaves 1 and
+    2 (values=index), slave 3 missing; the rungs as its comments say."""
+    from softplc_lite.ports.modbus_slave import find_slave
+
+    r = runner("modbus_scada", executor)
+    t = r.table
+    failed = []
+    r.run(100, on_scan=lambda e: failed.append(e.table.read("B13/3")))  # 1 s
+    slave = find_slave("scada")
+    assert slave.unit(1).holding_registers[:2] == [100, 300]  # the start-up write
+    assert [t.read(f"N10:{k}") for k in (0, 1, 10, 11)] == [0, 1, 2, 3]  # one read, scattered
+    assert t.read_word("I:0") == 0b1010101010101010 - 0x10000  # discretes 1, 3, 5 ... on
+    assert [t.read(f"N11:{k}") for k in range(6)] == [0, 1, 2, 3, 4, 5]
+    assert slave.unit(2).holding_registers[100:102] == [1500, 1]  # gathered: SpeedSet, then the constant
+    assert slave.unit(1).coils[:4] == [True, False, False, False] and t.read("B3/16") == 1  # PumpRunning
+    assert t.read_word("B13:0") == 8  # only slave 3 Not Present
+    first = failed.index(1)  # slave 3's first timeout: it is Not Present from then on
+    assert failed[first:] == [1] * (100 - first) and 0 < first < 20
+    assert t.read("C5:1.ACC") == 1 and t.read("C5:0.ACC") == 100 - first  # rung 0 counts every failed scan
+    blocks = [[t.read(f"N20:{5 * k + w}") for w in range(5)] for k in range(3)]
+    assert blocks[0][1:] == [0, 0, 0, 0] and blocks[1][1:] == [0, 0, 0, 0]
+    assert blocks[2][3:] == [4, -3] and blocks[2][1] >= 5  # a timeout on each pass (~8 a second)
+    t.write("B3/0", 1)  # ClearStats
+    r.run(1)
+    assert t.read("N20:11") >= 5  # rung 2 copied the block before rung 3 cleared it ...
+    r.run(1)
+    assert t.read("N20:11") <= 1  # ... so the next scan shows it cleared (a new timeout may have come since)
+    r.engine.set_mode(Mode.PROGRAM)  # leaving RUN: the stop request turns the pumps off
+    for _ in range(10):
+        r.engine.scan()
+    assert slave.unit(1).coils[:4] == [False] * 4
+    r.engine.close()

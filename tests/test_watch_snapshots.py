@@ -66,6 +66,7 @@ CASES = [
     Case("loopback", "loopback", 100, watch=("C5:0.ACC", "GotRack")),
     Case("modbus_master", "modbus_master", 400, watch=("N11:0", "C5:1.ACC"),
          cli=("--watch", "N11:0", "--watch", "C5:1.ACC")),
+    Case("modbus_scada", "modbus_scada", 100, watch=("FaultMap", "N20:11", "N20:14", "N11:1")),
     # the lamp forced off while its rung is true (rung 2 selected), two scans back in history
     Case("blinker-forced-history", "blinker", 80, watch=("Lamp", "T4:1.ACC"), forces=("Lamp=0",), back=2,
          goto=2, sizes=((80, 24),)),

@@ -319,15 +319,17 @@ class PortDriver:
             status.present, status.silent_requests, status.demoted = True, 0, False
             self._fail(BAD_REPLY, at, frame)
             return
-        status.replied((at - tx.tx_end) / MS)
+        # A pty ignores the baud rate: a reply can come before the request's
+        # computed end of transmission. A response time is never negative.
+        response_ms = max(at - tx.tx_end, 0) / MS
+        status.replied(response_ms)
         if code:
             self._fail(code, at, frame)
             return
         p.store(data)
         status.succeeded()
         self.good += 1
-        self._say(2, f"slave {p.slave}: {p.request.name} ok in "
-                    f"{(at - tx.tx_end) / MS:.2f} ms: {hexdump(frame, 24)}")
+        self._say(2, f"slave {p.slave}: {p.request.name} ok in {response_ms:.2f} ms: {hexdump(frame, 24)}")
         self.tx = None
         self._next(at + self.gap_ns)
 
