@@ -27,7 +27,7 @@ from .ladder.validate import check
 from .ports import claim_conflicts
 from .tlm.api import TLM, find_file
 from .tlm.errors import ModuleError
-from .tlm.registry import installed, instruction_set, load_module, load_modules
+from .tlm.registry import configure_modules, installed, instruction_set, load_module, load_modules
 
 SETTINGS_FILE = "softplc.toml"
 DATATABLE_FILE = "datatable.json"
@@ -38,7 +38,7 @@ SNAPSHOT_NAME = "datatable.snap"
 class AppError(Exception):
     """A problem loading an app: missing path, bad config, program errors."""
 
-    def __init__(self, errors: list[LadderError] | str) -> None:
+    def __init__(self, errors: list[LadderError | ModuleError] | str) -> None:
         self.errors = errors if isinstance(errors, list) else []
         text = errors if isinstance(errors, str) else "\n".join(e.report() for e in errors)
         super().__init__(text)
@@ -167,19 +167,21 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
         raise AppError(f"{path}: expected an app directory or a .lad file")
     module_dir = path if is_dir else path.parent
     try:
-        modules, warnings = load_modules(module_dir)
+        modules, _ = load_modules(module_dir, configure=False)
         instructions = instruction_set(modules, hints=True)
     except ModuleError as e:
         raise AppError(e.report()) from None
-    conflicts = claim_conflicts([c for m in modules for c in m.port_claims()])
-    if conflicts:
-        raise AppError("\n".join(conflicts))
+    # Every problem at once: the modules' config files, then the program's.
+    warnings, config_problems = configure_modules(modules, module_dir)
+    if not config_problems:
+        conflicts = claim_conflicts([c for m in modules for c in m.port_claims()])
+        config_problems = [ModuleError(c) for c in conflicts]
     warnings += _unused_configs(module_dir, modules)
     parsed, errors = parse_files(files, path, instructions)
     resolved, problems = check(parsed, instructions)
     errors += problems
-    if errors:
-        raise AppError(sorted(errors, key=lambda e: (e.pos.source, e.pos.line, e.pos.column)))
+    if errors or config_problems:
+        raise AppError(config_problems + sorted(errors, key=lambda e: (e.pos.source, e.pos.line, e.pos.column)))
     warnings += [w.report() for w in _module_checks(resolved, modules)]
     settings_doc = read_settings_file(path / SETTINGS_FILE) if is_dir else {}
     settings = load_settings(path / SETTINGS_FILE, settings_doc)

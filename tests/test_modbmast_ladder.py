@@ -204,3 +204,17 @@ def test_record_then_replay_gives_the_same_data_table(tmp_path):
     again = softplc(*args, "--replay", str(trace))
     assert again.returncode == 0, again.stderr
     assert again.stdout == first.stdout and "output matched" in again.stderr
+
+
+def test_check_lists_the_config_files_problems_and_the_programs_together(tmp_path):
+    xml = serial_xml('<Port num="40" baudrate="9600"><Slave id="0"/></Port>', 'debug="7"')
+    d = write_app(tmp_path / "app", xml, "XIC B3/0 OTE B3/1\nMOV 1 N7:0 N7:1\n",
+                  modules="COMGENIUS\nMODBMAST\n", extra={"COMGENIUS.LST": "[DRIVER]\nDEBUG=5\n"})
+    result = softplc("check", str(d))
+    lines = result.stderr.splitlines()
+    assert result.returncode == 1 and lines[-1] == "5 problems found"
+    assert lines[0].endswith("COMGENIUS.LST:2: [DRIVER]: DEBUG must be 0, 1 or 2, not '5'")
+    assert lines[1].endswith("MODBMAST.XML:1:15: debug='7': expected an integer 0..2")
+    assert lines[2].endswith("MODBMAST.XML:2:7: num='40': expected an integer 0..31")
+    assert lines[3].endswith("MODBMAST.XML:2:39: id='0': expected an integer 1..247")
+    assert "main.lad:2:1: MOV takes 2 operands" in lines[4]

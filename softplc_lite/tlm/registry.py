@@ -24,7 +24,7 @@ from pathlib import Path
 
 from ..ladder.instructions import InstructionSet
 from .api import TLM, find_file
-from .errors import ModuleError
+from .errors import ModuleError, ModuleErrors
 
 GROUP = "softplc_lite.tlms"
 MODULES_FILE = "MODULES.LST"
@@ -112,9 +112,25 @@ def load_modules(app_dir: Path | None, configure: bool = True) -> tuple[list[TLM
         modules.append(load_module(entry.name, available))
     instruction_set(modules)  # two modules claiming one mnemonic: an error now, not at run time
     if configure:
-        for module in modules:
-            warnings += module.configure(app_dir)
+        warnings, problems = configure_modules(modules, app_dir)
+        if problems:
+            raise ModuleErrors(problems)
     return modules, warnings
+
+
+def configure_modules(modules: list[TLM], app_dir: Path) -> tuple[list[str], list[ModuleError]]:
+    """Let each module read its config: the warnings, and every problem of
+    every module's file (one module's bad file does not hide another's)."""
+    warnings: list[str] = []
+    problems: list[ModuleError] = []
+    for module in modules:
+        try:
+            warnings += module.configure(app_dir)
+        except ModuleErrors as e:
+            problems += e.problems
+        except ModuleError as e:
+            problems.append(e)
+    return warnings, problems
 
 
 def instruction_set(modules: list[TLM], hints: bool = False) -> InstructionSet:
