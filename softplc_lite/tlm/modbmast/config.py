@@ -447,7 +447,7 @@ def _check_address(c: _Checker, node: XmlNode, attr: str, text: str, kind: Reque
         c.error(node, f"{attr}={text!r}: a block address must be direct (no [..] or #)", attr)
         return None
     if address.type_letter not in files or address.member is not None:
-        c.error(node, f"{attr}={text!r}: {'reply data goes' if to else 'request data comes from'} a word of an "
+        c.error(node, f"{attr}={text!r}: {'reply data goes into' if to else 'request data comes from'} a word of an "
                       f"{', '.join(files[:-1])} or {files[-1]} file", attr)
         return None
     if address.bit is not None:
