@@ -216,3 +216,46 @@ def test_history_steps_do_not_add_to_the_trend(session):
     s.scan()
     item = s.watch.items[0]
     assert item.value == 3 and list(item.trend) == [0.0, 1.0, 2.0, 3.0, 4.0]
+
+
+def test_the_mode_prompt_changes_modes_and_program_again_reloads_the_drivers(tmp_path):
+    """M, then program / run / test, through the real key handling; PROGRAM
+    while in PROGRAM makes MODBMAST read its file again (manual 5.2)."""
+    import shutil
+
+    from softplc_lite.ladder.engine import Mode
+    from softplc_lite.watch.terminal import Controller
+
+    app_dir = tmp_path / "scada"
+    shutil.copytree(Path(__file__).resolve().parent.parent / "programs" / "modbus_scada", app_dir,
+                    ignore=shutil.ignore_patterns(".softplc"))
+    s = WatchSession(load_app(app_dir, tmp_path / "state"), WatchOptions(run=RunOptions(fresh=True)))
+    keys = Controller(s)
+
+    def type_(text: str) -> None:
+        for k in ["M", *text, "\r"]:
+            keys.key(k)
+
+    try:
+        assert s.engine.mode is Mode.RUN
+        type_("p")
+        assert s.engine.mode is Mode.PROGRAM and s.message == "mode PROGRAM"
+        xml = (app_dir / "MODBMAST.XML").read_text().replace('dest="N11:0" count="6"', 'dest="N14:0" count="6"')
+        (app_dir / "MODBMAST.XML").write_text(xml)
+        type_("program")
+        assert s.message == "PROGRAM again: the modules reloaded their configuration"
+        for _ in range(20):
+            s.scan()
+        assert s.engine.table.read("N14:5") == 5  # the drive's registers land where the new file says
+        type_("sideways")
+        assert s.message == "mode 'sideways': expected program, run or test" and s.engine.mode is Mode.PROGRAM
+        (app_dir / "MODBMAST.XML").write_text("<ModbusSerial><Port/></ModbusSerial>")
+        type_("PROGRAM")
+        assert s.engine.mode is Mode.FAULTED and "major fault 203" in s.message
+        type_("run")
+        assert "clear the fault first" in s.message and s.engine.mode is Mode.FAULTED
+        type_("p")
+        type_("test")
+        assert s.engine.mode is Mode.TEST and s.message == "mode TEST"
+    finally:
+        s.quit()

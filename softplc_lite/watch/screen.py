@@ -19,9 +19,10 @@ from .session import WatchSession
 WIDE = 120  # from this width the side panels go beside the rungs
 SIDE_WIDTH = 46
 KEYS = ("space/n step  r run  p pause  +/- speed  ↑↓/jk rung  f file  g go to rung  b breakpoint  "
-        "⌫ back  F force  U unforce  q quit")
+        "⌫ back  F force  U unforce  M mode  q quit")
 # The keys line at narrower widths: the longest that fits (q quit always shown from 80 columns).
-KEY_LINES = (KEYS, "n step  r run  p pause  +/- speed  ↑↓ rung  f file  g go to  b break  ⌫ back  F/U force  q quit",
+KEY_LINES = (KEYS, "n step  r run  p pause  +/- speed  ↑↓ rung  f file  g go to  b break  ⌫ back  F/U force  M mode  "
+                   "q quit",
              "n step  r run  p pause  +/- speed  ↑↓ rung  b break  ⌫ back  F/U force  q quit",
              "n step  r run  p pause  ⌫ back  q quit")
 

@@ -9,7 +9,7 @@ import time
 from dataclasses import dataclass, field
 
 from ..app import App
-from ..ladder.engine import Mode
+from ..ladder.engine import Mode, ModeError
 from ..runner import RunOptions, Runner
 from .breakpoints import Breakpoints, Hit
 from .forces import Forces, parse_force
@@ -188,6 +188,31 @@ class WatchSession:
     def force(self, text: str) -> None:
         self.forces.set(parse_force(text, self.app.program.symbols))
         self.message = f"forced {text}"
+
+    def set_mode(self, text: str) -> None:
+        """PROGRAM, RUN or TEST (any case, or P/R/T). PROGRAM while in
+        PROGRAM asks the modules to reload their configuration (SoftPLC's
+        PROGRAM -> PROGRAM, MODBMAST manual 5.2)."""
+        modes = {"P": Mode.PROGRAM, "PROGRAM": Mode.PROGRAM, "R": Mode.RUN, "RUN": Mode.RUN, "T": Mode.TEST,
+                 "TEST": Mode.TEST}
+        mode = modes.get(text.strip().upper())
+        if mode is None:
+            self.message = f"mode {text!r}: expected program, run or test"
+            return
+        engine = self.engine
+        again = engine.mode is mode
+        try:
+            engine.set_mode(mode)
+        except ModeError as e:
+            self.message = str(e)
+            return
+        if engine.mode is Mode.FAULTED:
+            self.running = False
+            self.message = str(engine.fault)
+        elif again and mode is Mode.PROGRAM:
+            self.message = "PROGRAM again: the modules reloaded their configuration"
+        else:
+            self.message = f"mode {mode.name}"
 
     def unforce(self, text: str) -> None:
         symbols = self.app.program.symbols

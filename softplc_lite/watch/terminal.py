@@ -114,6 +114,8 @@ class Controller:
             self._ask("F", "force ADDR=1 or ADDR=0: ")
         elif k == "U":
             self._ask("U", "remove the force on ADDR: ")
+        elif k == "M":
+            self._ask("M", "mode (program, run, test): ")
         elif k == "q":
             self.done = True
 
@@ -122,7 +124,8 @@ class Controller:
         self.prompt = text
 
     def _prompt_key(self, k: str) -> None:
-        label = {"g": "go to rung: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: "}
+        label = {"g": "go to rung: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: ",
+                 "M": "mode (program, run, test): "}
         if k == "esc":
             self.prompt_kind, self.prompt = "", None
             return
@@ -147,6 +150,8 @@ class Controller:
                 s.force(text)
             elif kind == "U":
                 s.unforce(text)
+            elif kind == "M":
+                s.set_mode(text)
         except (ValueError, DataTableError) as e:
             s.message = f"{text}: {e}"
 
