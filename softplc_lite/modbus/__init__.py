@@ -25,51 +25,8 @@ b':F7031389000A60\\r\\n'
 """
 
 from .crc import crc16, lrc
-from .errors import (
-    ACKNOWLEDGE, EXCEPTION_NAMES, GATEWAY_PATH_UNAVAILABLE, GATEWAY_TARGET_FAILED_TO_RESPOND,
-    ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ILLEGAL_FUNCTION, MEMORY_PARITY_ERROR,
-    NEGATIVE_ACKNOWLEDGE, SLAVE_DEVICE_BUSY, SLAVE_DEVICE_FAILURE, ModbusDecodeError,
-)
 from .framing import FRAMERS, AsciiFramer, FrameError, RtuFramer, rtu_intervals_ns
-from .packing import bytes_to_registers, pack_bits, registers_to_bytes, unpack_bits
-from .pdu import (
-    MAX_PDU_LENGTH, REQUESTS, RESPONSES, ModbusRequest, ModbusResponse, decode_request,
-    decode_response,
-)
-from .request_pdus import (
-    MaskWriteRegisterRequest, ReadCoilsRequest, ReadDiscreteInputsRequest,
-    ReadHoldingRegistersRequest, ReadInputRegistersRequest, ReadWriteMultipleRegistersRequest,
-    WriteMultipleCoilsRequest, WriteMultipleRegistersRequest, WriteSingleCoilRequest,
-    WriteSingleRegisterRequest,
-)
-from .response_pdus import (
-    ExceptionResponse, MaskWriteRegisterResponse, ReadCoilsResponse, ReadDiscreteInputsResponse,
-    ReadHoldingRegistersResponse, ReadInputRegistersResponse, ReadWriteMultipleRegistersResponse,
-    WriteMultipleCoilsResponse, WriteMultipleRegistersResponse, WriteSingleCoilResponse,
-    WriteSingleRegisterResponse,
-)
+from .pdu import *  # noqa: F403  (PDUs, exception codes, decoder tables, packing helpers)
+from .pdu import __all__ as _PDU_NAMES
 
-__all__ = [
-    # check sums
-    "crc16", "lrc",
-    # exception codes and decode errors
-    "ILLEGAL_FUNCTION", "ILLEGAL_DATA_ADDRESS", "ILLEGAL_DATA_VALUE", "SLAVE_DEVICE_FAILURE",
-    "ACKNOWLEDGE", "SLAVE_DEVICE_BUSY", "NEGATIVE_ACKNOWLEDGE", "MEMORY_PARITY_ERROR",
-    "GATEWAY_PATH_UNAVAILABLE", "GATEWAY_TARGET_FAILED_TO_RESPOND", "EXCEPTION_NAMES",
-    "ModbusDecodeError",
-    # PDUs
-    "MAX_PDU_LENGTH", "REQUESTS", "RESPONSES", "ModbusRequest", "ModbusResponse",
-    "decode_request", "decode_response",
-    "ReadCoilsRequest", "ReadDiscreteInputsRequest", "ReadHoldingRegistersRequest",
-    "ReadInputRegistersRequest", "WriteSingleCoilRequest", "WriteSingleRegisterRequest",
-    "WriteMultipleCoilsRequest", "WriteMultipleRegistersRequest", "MaskWriteRegisterRequest",
-    "ReadWriteMultipleRegistersRequest",
-    "ReadCoilsResponse", "ReadDiscreteInputsResponse", "ReadHoldingRegistersResponse",
-    "ReadInputRegistersResponse", "WriteSingleCoilResponse", "WriteSingleRegisterResponse",
-    "WriteMultipleCoilsResponse", "WriteMultipleRegistersResponse", "MaskWriteRegisterResponse",
-    "ReadWriteMultipleRegistersResponse", "ExceptionResponse",
-    # data-moving helpers
-    "pack_bits", "unpack_bits", "registers_to_bytes", "bytes_to_registers",
-    # framers
-    "FrameError", "RtuFramer", "AsciiFramer", "FRAMERS", "rtu_intervals_ns",
-]
+__all__ = ["crc16", "lrc", "FRAMERS", "AsciiFramer", "FrameError", "RtuFramer", "rtu_intervals_ns", *_PDU_NAMES]

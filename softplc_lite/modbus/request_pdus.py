@@ -44,8 +44,10 @@ __all__ = [
 
 
 @dataclass(frozen=True)
-class _ReadRequest:
-    """Functions 1-4: read ``count`` items from ``address`` (sections 6.1-6.4)."""
+class _AddressQuantity:
+    """A PDU that is a start address and a quantity: the requests of
+    functions 1-4 (sections 6.1-6.4) and the responses of 15 and 16 (6.11,
+    6.12)."""
 
     function_code: ClassVar[int]
     MAX_COUNT: ClassVar[int]
@@ -65,6 +67,10 @@ class _ReadRequest:
         check_quantity(cls, "quantity", count, cls.MAX_COUNT)
         check_address_block(cls, address, count)
         return cls(address, count)
+
+
+class _ReadRequest(_AddressQuantity):
+    """Functions 1-4: read ``count`` items from ``address`` (sections 6.1-6.4)."""
 
 
 class _ReadBitsRequest(_ReadRequest):

@@ -25,13 +25,13 @@ from dataclasses import dataclass
 from typing import ClassVar, Self
 
 from ._fields import (
-    FC_B, FC_HH, check_address_block, check_pdu_length, check_pdu_start, check_quantity,
-    refuse, require_bits, require_block, require_range, require_registers, unpack_fixed,
+    FC_B, check_pdu_length, check_pdu_start, check_quantity,
+    refuse, require_bits, require_range, require_registers,
 )
 from .errors import EXCEPTION_NAMES, ILLEGAL_FUNCTION
 from .packing import bytes_to_registers, pack_bits, registers_to_bytes, unpack_bits
 from .request_pdus import (  # the echoes share their request's layout
-    WriteMultipleCoilsRequest, WriteMultipleRegistersRequest, _MaskWrite, _SingleCoil,
+    WriteMultipleCoilsRequest, WriteMultipleRegistersRequest, _AddressQuantity, _MaskWrite, _SingleCoil,
     _SingleRegister,
 )
 
@@ -140,28 +140,8 @@ class MaskWriteRegisterResponse(_MaskWrite):
     """22 Mask Write Register response: the request echoed."""
 
 
-@dataclass(frozen=True)
-class _WriteMultipleResponse:
+class _WriteMultipleResponse(_AddressQuantity):
     """Functions 15 and 16 (sections 6.11, 6.12): start address and quantity written."""
-
-    function_code: ClassVar[int]
-    MAX_COUNT: ClassVar[int]
-
-    address: int
-    count: int
-
-    def __post_init__(self) -> None:
-        require_block(type(self).__name__, self.address, self.count, self.MAX_COUNT)
-
-    def encode(self) -> bytes:
-        return FC_HH.pack(self.function_code, self.address, self.count)
-
-    @classmethod
-    def decode(cls, pdu: bytes) -> Self:
-        address, count = unpack_fixed(cls, pdu, FC_HH)
-        check_quantity(cls, "quantity", count, cls.MAX_COUNT)
-        check_address_block(cls, address, count)
-        return cls(address, count)
 
 
 class WriteMultipleCoilsResponse(_WriteMultipleResponse):

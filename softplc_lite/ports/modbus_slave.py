@@ -70,7 +70,7 @@ from dataclasses import dataclass
 from ..modbus.crc import crc16
 from ..modbus.framing import AsciiFramer, FrameError, RtuFramer
 from ..modbus.packing import pack_bits, unpack_bits
-from ..modbus.pdu import (ILLEGAL_DATA_ADDRESS, ILLEGAL_DATA_VALUE, ExceptionResponse, MaskWriteRegisterRequest,
+from ..modbus.pdu import (ILLEGAL_DATA_ADDRESS, ExceptionResponse, MaskWriteRegisterRequest,
                           MaskWriteRegisterResponse, ModbusDecodeError, ReadCoilsRequest, ReadCoilsResponse,
                           ReadDiscreteInputsRequest, ReadDiscreteInputsResponse, ReadHoldingRegistersRequest,
                           ReadHoldingRegistersResponse, ReadInputRegistersRequest, ReadInputRegistersResponse,
@@ -312,55 +312,44 @@ def _execute(unit: ModbusUnit, pdu: bytes, size: int) -> bytes:
             return bytes([pdu[0] | 0x80, e.exception_code])
         return ExceptionResponse(pdu[0], e.exception_code).encode()
     f = pdu[0]
-
-    def fits(address: int, count: int) -> bool:
-        return address + count <= size
-
+    if any(address + count > size for address, count in _spans(request)):
+        return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
     if isinstance(request, (ReadCoilsRequest, ReadDiscreteInputsRequest)):
-        if not fits(request.address, request.count):
-            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
         table = unit.coils if f == 1 else unit.discrete_inputs
         bits = tuple(table[request.address:request.address + request.count])
         return (ReadCoilsResponse if f == 1 else ReadDiscreteInputsResponse)(bits).encode()
     if isinstance(request, (ReadHoldingRegistersRequest, ReadInputRegistersRequest)):
-        if not fits(request.address, request.count):
-            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
         table = unit.holding_registers if f == 3 else unit.input_registers
         values = tuple(table[request.address:request.address + request.count])
         return (ReadHoldingRegistersResponse if f == 3 else ReadInputRegistersResponse)(values).encode()
     if isinstance(request, WriteSingleCoilRequest):
-        if not fits(request.address, 1):
-            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
         unit.coils[request.address] = request.value
         return WriteSingleCoilResponse(request.address, request.value).encode()
     if isinstance(request, WriteSingleRegisterRequest):
-        if not fits(request.address, 1):
-            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
         unit.holding_registers[request.address] = request.value
         return WriteSingleRegisterResponse(request.address, request.value).encode()
     if isinstance(request, WriteMultipleCoilsRequest):
-        if not fits(request.address, request.count):
-            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
         unit.coils[request.address:request.address + request.count] = list(request.values)
         return WriteMultipleCoilsResponse(request.address, request.count).encode()
     if isinstance(request, WriteMultipleRegistersRequest):
-        if not fits(request.address, request.count):
-            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
         unit.holding_registers[request.address:request.address + request.count] = list(request.values)
         return WriteMultipleRegistersResponse(request.address, request.count).encode()
     if isinstance(request, MaskWriteRegisterRequest):  # 6.16: (current AND and) OR (or AND NOT and)
-        if not fits(request.address, 1):
-            return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
         current = unit.holding_registers[request.address]
         unit.holding_registers[request.address] = (current & request.and_mask) | (request.or_mask & ~request.and_mask
                                                                                  & 0xFFFF)
         return MaskWriteRegisterResponse(request.address, request.and_mask, request.or_mask).encode()
     # 23 (6.17): the write goes first, then the read
-    if not fits(request.read_address, request.read_count) or not fits(request.write_address, request.write_count):
-        return ExceptionResponse(f, ILLEGAL_DATA_ADDRESS).encode()
     unit.holding_registers[request.write_address:request.write_address + request.write_count] = list(request.values)
     values = tuple(unit.holding_registers[request.read_address:request.read_address + request.read_count])
     return ReadWriteMultipleRegistersResponse(values).encode()
+
+
+def _spans(request) -> list[tuple[int, int]]:
+    """(address, count) of each table range a request touches."""
+    if isinstance(request, ReadWriteMultipleRegistersRequest):
+        return [(request.read_address, request.read_count), (request.write_address, request.write_count)]
+    return [(request.address, getattr(request, "count", 1))]
 
 
 def _int_option(options: dict[str, str], key: str, default: int, low: int, high: int) -> int:

@@ -136,13 +136,18 @@ class _Mbr:
             self._minor(S.MINOR_CODE_PORT, f"port {number} is not configured in MODBMAST.XML (ports: {have})")
         return statuses
 
-    def _range(self, start_op, count_op) -> range | None:
+    def _slaves(self, start_op, count_op) -> tuple[dict, range] | None:
+        """The port's statuses and the slave ids SlaveStart..; None after
+        raising the minor fault a bad port or range gives."""
+        statuses = self._statuses()
+        if statuses is None:
+            return None
         start, count = int(start_op.value()), int(count_op.value())
         if count < 1 or start < 1 or start + count - 1 > MAX_SLAVE:
             self._minor(S.MINOR_CODE_OPERAND, f"slaves {start}..{start + count - 1} (SlaveStart {start}, "
                                               f"SlaveCount {count}) are outside 1..{MAX_SLAVE}")
             return None
-        return range(start, start + count)
+        return statuses, range(start, start + count)
 
     @staticmethod
     def _block(operand, words: int) -> tuple[array, int]:
@@ -181,12 +186,10 @@ class GetStatus(_Mbr):
         self.result, _, self.start, self.count = ctx.operands
 
     def __call__(self, c: bool) -> bool:
-        if not c:
+        found = self._slaves(self.start, self.count) if c else None
+        if found is None:
             return c
-        statuses = self._statuses()
-        slaves = self._range(self.start, self.count) if statuses is not None else None
-        if slaves is None:
-            return c
+        statuses, slaves = found
         d, i = self._block(self.result, STATUS_WORDS * len(slaves))
         out = []
         for slave in slaves:
@@ -203,12 +206,10 @@ class ClearStatus(_Mbr):
         _, self.start, self.count = ctx.operands
 
     def __call__(self, c: bool) -> bool:
-        if not c:
+        found = self._slaves(self.start, self.count) if c else None
+        if found is None:
             return c
-        statuses = self._statuses()
-        slaves = self._range(self.start, self.count) if statuses is not None else None
-        if slaves is None:
-            return c
+        statuses, slaves = found
         for slave in slaves:
             s = statuses.get(slave)
             if s is not None:
