@@ -177,16 +177,32 @@ def parse_integer(text: str) -> int | None:
     return -value if m.group(1) == "-" else value
 
 
+MAX_PROBLEMS = 200  # listed; a file with more gets a count of the rest
+
+
 class _Checker:
     """Walks the tree, collecting every problem."""
 
     def __init__(self, path: str) -> None:
         self.path = path
         self.problems: list[ModuleError] = []
+        self.more = 0  # problems past MAX_PROBLEMS, counted
 
     def error(self, node: XmlNode, message: str, attr: str | None = None) -> None:
+        if len(self.problems) >= MAX_PROBLEMS:
+            self.more += 1
+            return
         line, column = node.where(attr)
         self.problems.append(ModuleError(message, self.path, line, column))
+
+    def found(self) -> list[ModuleError]:
+        """The problems, with a last line counting those not listed."""
+        if not self.more:
+            return self.problems
+        last = self.problems[-1]
+        return self.problems + [ModuleError(f"... and {self.more} more problem{'s' if self.more != 1 else ''} "
+                                            f"(the first {MAX_PROBLEMS} are listed)", self.path, last.line,
+                                            last.column + 1)]
 
     # - - - attributes - - -
     def attributes(self, node: XmlNode) -> dict[str, object]:
@@ -235,25 +251,31 @@ class _Checker:
     def children(self, node: XmlNode, model: list[tuple[str, int, int]]) -> list[list[XmlNode]]:
         """Match the children against a sequence of (name, min, max): the
         children found for each item, and a problem for what does not fit."""
-        kids = node.children
-        groups: list[list[XmlNode]] = []
-        i = 0
-        for name, low, high in model:
-            group = []
-            while i < len(kids) and kids[i].name == name and len(group) < high:
-                group.append(kids[i])
-                i += 1
-            if len(group) < low:
-                where = kids[i] if i < len(kids) else node
-                self.error(where, f"<{node.name}> needs <{name}> here ({_content(model)})")
-            groups.append(group)
-        for extra in kids[i:]:
-            known = extra.name in ATTRIBUTES or extra.name == ROOT
-            close = difflib.get_close_matches(extra.name, [n for n, _, _ in model] + list(REQUEST_KINDS), n=1)
-            what = f"<{extra.name}> is not allowed here" if known else f"unknown element <{extra.name}>"
-            hint = f"; did you mean <{close[0]}>?" if close and not known else ""
-            self.error(extra, f"{what} (<{node.name}> contains {_content(model)}){hint}")
+        groups: list[list[XmlNode]] = [[] for _ in model]
+        i = 0  # the model item the last child fitted
+        for kid in node.children:
+            # The first item from here on this child fits (a later one when this one is full).
+            j = next((j for j in range(i, len(model)) if model[j][0] == kid.name
+                      and (j > i or len(groups[j]) < model[j][2])), None)
+            if j is None:  # fits nowhere from here: reported, and the next child matched on
+                self._extra(node, kid, model)
+                continue
+            for k in range(i, j):  # items skipped over
+                if len(groups[k]) < model[k][1]:
+                    self.error(kid, f"<{node.name}> needs <{model[k][0]}> here ({_content(model)})")
+            i = j
+            groups[j].append(kid)
+        for k in range(i, len(model)):
+            if len(groups[k]) < model[k][1]:
+                self.error(node, f"<{node.name}> needs <{model[k][0]}> here ({_content(model)})")
         return groups
+
+    def _extra(self, node: XmlNode, extra: XmlNode, model: list[tuple[str, int, int]]) -> None:
+        known = extra.name in ATTRIBUTES or extra.name == ROOT
+        close = difflib.get_close_matches(extra.name, [n for n, _, _ in model] + list(REQUEST_KINDS), n=1)
+        what = f"<{extra.name}> is not allowed here" if known else f"unknown element <{extra.name}>"
+        hint = f"; did you mean <{close[0]}>?" if close and not known else ""
+        self.error(extra, f"{what} (<{node.name}> contains {_content(model)}){hint}")
 
     def text_integer(self, node: XmlNode, low: int, high: int, what: str) -> int | None:
         self.attributes(node)
@@ -292,7 +314,7 @@ def _check_port(c: _Checker, node: XmlNode) -> PortConfig | None:
         c.children(modem, [])
         wait_cts = m.get("waitDelayCTS", 0)
     framing = a.get("framing", "RTU")
-    if framing == "RTU" and a.get("dataBits") == 7:
+    if a.get("framing") == "RTU" and a.get("dataBits") == 7:  # (not when framing itself is wrong)
         c.error(node, "dataBits=7 needs framing=\"ASCII\": RTU sends 8-bit bytes (manual 4.3: use 8 for RTU)",
                 "dataBits")
     slaves: dict[int, Slave] = {}
@@ -346,8 +368,8 @@ def _check_slave(c: _Checker, node: XmlNode, port: dict) -> Slave | None:
 def _check_request(c: _Checker, node: XmlNode, slave_id: int, slave: dict, port: dict) -> Request | None:
     kind = REQUEST_KINDS[node.name]
     a = c.attributes(node)
+    ok = len(c.problems)  # (a content problem, too, leaves the quantities unchecked)
     groups = c.children(node, kind.model)
-    ok = len(c.problems)
 
     def found(element: str) -> list[list[XmlNode]]:
         return [g for (name, _, _), g in zip(kind.model, groups) if name == element]
@@ -420,7 +442,7 @@ def _check_block(c: _Checker, node: XmlNode, kind: RequestKind, to: bool) -> Blo
         c.attributes(const_node)
         c.children(const_node, [])
         const = _check_const(c, const_node, a.get("fmt"), a.get("count"))
-    elif not to and "source" not in a:
+    elif not to and "source" not in node.attrs:  # (an empty or bad one is reported as such)
         c.error(node, "<fromBlock> needs the attribute source (a data table address), or a <const> list "
                       "to send instead")
     fmt = a.get("fmt")
@@ -495,7 +517,7 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ModbmastConfig:
         raise ModuleErrors([ModuleError(e.message, path, e.line, e.column)]) from None
     if root.name != ROOT:
         c.error(root, f"the top element is <{root.name}>; expected <{ROOT}> (manual Table 8)")
-        raise ModuleErrors(c.problems)
+        raise ModuleErrors(c.found())
     a = c.attributes(root)
     (port_nodes,) = c.children(root, [("Port", 0, MANY)])
     config = ModbmastConfig(path=path, debug=a.get("debug", 0), port_errors=a.get("portErrors", "stop"),
@@ -503,16 +525,17 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ModbmastConfig:
     lines: dict[int, int] = {}
     for node in port_nodes:
         port = _check_port(c, node)
-        if port is None:
+        num = parse_integer(node.attrs.get("num", ""))  # a repeated num counts even on a port with other problems
+        if num is not None and num in lines:
+            c.error(node, f"port num {num} is used twice (first on line {lines[num]}); num is unique among ports",
+                    "num")
             continue
-        if port.num in config.ports:
-            c.error(node, f"port num {port.num} is used twice (first on line {lines[port.num]}); num is unique "
-                          "among ports", "num")
-            continue
-        config.ports[port.num] = port
-        lines[port.num] = node.line
+        if num is not None:
+            lines[num] = node.line
+        if port is not None:
+            config.ports[port.num] = port
     if c.problems:
-        raise ModuleErrors(c.problems)
+        raise ModuleErrors(c.found())
     return config
 
 

@@ -44,17 +44,47 @@ class XmlSyntaxError(ValueError):
         self.column = column
 
 
-_ATTR = re.compile(rb"([A-Za-z_][\w.\-:]*)\s*=\s*")
+# An attribute with its quoted value (so that text inside a value is never
+# taken for an attribute), or the end of the start tag.
+_ATTR = re.compile(rb"""([^\s=<>/"']+)\s*=\s*(?:"[^"]*"|'[^']*')|>""")
+_UTF16 = ((b"\xff\xfe", "utf-16"), (b"\xfe\xff", "utf-16"), (b"<\x00", "utf-16-le"), (b"\x00<", "utf-16-be"))
+_DECLARED = re.compile(rb"(?:\xef\xbb\xbf)?<\?xml[^>]*\sencoding\s*=")
+
+
+def _where(text: str) -> tuple[int, int]:
+    """(line, column) just after ``text``."""
+    lines = re.split(r"\r\n?|\n", text)
+    return len(lines), len(lines[-1]) + 1
+
+
+def _as_utf8(data: bytes) -> tuple[bytes, str | None]:
+    """UTF-16 turned into UTF-8 (attribute positions are looked for in the
+    bytes), and the encoding to tell expat; a file without an encoding
+    declaration must be UTF-8 (XmlSyntaxError at the first byte that is not)."""
+    for bom, codec in _UTF16:
+        if data.startswith(bom):
+            try:
+                return data.decode(codec).encode("utf-8"), "utf-8"
+            except UnicodeDecodeError as e:
+                raise XmlSyntaxError(f"the file is UTF-16 but its bytes {e.start}..{e.end - 1} are not: {e.reason}",
+                                     *_where(data[:e.start].decode(codec, "replace"))) from None
+    if _DECLARED.match(data) is None:
+        try:
+            data.decode("utf-8")
+        except UnicodeDecodeError as e:
+            raise XmlSyntaxError(f"byte 0x{data[e.start]:02X} is not UTF-8, and a file without an encoding "
+                                 "declaration must be UTF-8: save it as UTF-8, or declare its encoding "
+                                 "(<?xml version=\"1.0\" encoding=\"ISO-8859-1\"?>)",
+                                 *_where(data[:e.start].decode("utf-8"))) from None
+    return data, None
+
+
+_BREAK = re.compile(rb"\r\n?|\n")
 
 
 def _line_starts(data: bytes) -> list[int]:
-    starts = [0]
-    find = data.find
-    i = find(b"\n")
-    while i >= 0:
-        starts.append(i + 1)
-        i = find(b"\n", i + 1)
-    return starts
+    """Where each line starts: after LF, CR LF or a lone CR, as expat counts lines."""
+    return [0, *(m.end() for m in _BREAK.finditer(data))]
 
 
 def read_xml(data: bytes) -> XmlNode:
@@ -63,11 +93,14 @@ def read_xml(data: bytes) -> XmlNode:
     if len(data) > MAX_BYTES:
         raise XmlSyntaxError(f"the file has {len(data):,} bytes; a configuration file may have at most "
                              f"{MAX_BYTES:,}", 1, 1)
-    parser = xml.parsers.expat.ParserCreate()
+    data, encoding = _as_utf8(data)
+    parser = xml.parsers.expat.ParserCreate(encoding)
     stack: list[XmlNode] = []
+    texts: list[list[str]] = []  # the text pieces of each open element (joined once: += would be quadratic)
     root: list[XmlNode] = []
     starts: list[int] | None = None
     refused: list[XmlSyntaxError] = []
+    last = [-1, 1]  # the last offset given a position, and its column
 
     def position(offset: int) -> tuple[int, int]:
         nonlocal starts
@@ -80,14 +113,19 @@ def read_xml(data: bytes) -> XmlNode:
                 lo = mid
             else:
                 hi = mid - 1
-        return lo + 1, offset - starts[lo] + 1
+        # The column in characters, as expat counts them; offsets come in
+        # increasing order, so count on from the last one on the same line.
+        base, column = (last[0], last[1]) if last[0] >= starts[lo] and last[0] <= offset else (starts[lo], 1)
+        column += len(data[base:offset].decode("utf-8", "replace"))
+        last[:] = [offset, column]
+        return lo + 1, column
 
     def start(name: str, attrs: dict[str, str]) -> None:
         node = XmlNode(name, dict(attrs), parser.CurrentLineNumber, parser.CurrentColumnNumber + 1)
         if attrs:
-            offset = parser.CurrentByteIndex
-            end = data.find(b">", offset)
-            for m in _ATTR.finditer(data, offset, end if end >= 0 else len(data)):
+            for m in _ATTR.finditer(data, parser.CurrentByteIndex):
+                if m.group(1) is None:  # the end of the start tag
+                    break
                 key = m.group(1).decode("utf-8", "replace")
                 if key in attrs and key not in node.attr_pos:
                     node.attr_pos[key] = position(m.start())
@@ -96,13 +134,14 @@ def read_xml(data: bytes) -> XmlNode:
         else:
             root.append(node)
         stack.append(node)
+        texts.append([])
 
     def end(name: str) -> None:
-        stack.pop()
+        stack.pop().text = "".join(texts.pop())
 
     def text(chars: str) -> None:
-        if stack:
-            stack[-1].text += chars
+        if texts:
+            texts[-1].append(chars)
 
     def refuse(what: str):
         def handler(*args) -> None:
