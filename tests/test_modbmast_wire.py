@@ -10,6 +10,8 @@ reply."""
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from softplc_lite.ladder.engine import Mode
@@ -359,3 +361,26 @@ def test_a_request_still_in_the_ports_queue_at_the_timeout_is_wait_xmitted(apps)
     assert s.last_code == WAIT_XMITTED and not s.present and s.words()[1] == 0
     scans(r, 40)  # the backlog drains; the slave answers again
     assert s.present and s.last_code == 0 and r.table.read("N7:1") == initial_value(1)
+
+
+@pytest.mark.parametrize("level", [0, 1, 2])
+def test_debug_levels(apps, capsys, level):
+    """Manual 6.2: 0 minimal (nothing), 1 more (port events, failures,
+    slaves going Not Present), 2 adds each transaction with its timing."""
+    body = f'<Slave id="2">{read4()}</Slave><Slave id="5" requestTimeout="5">{read4()}</Slave>'
+    xml = port_xml(link(), body).replace("<ModbusSerial>", f'<ModbusSerial debug="{level}">')
+    r = apps(xml)
+    scans(r, 3)
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if line.startswith("MODBMAST: ")]
+    failed = [line for line in lines if "slave 5: ReadMultipleRegisters failed: -3 NO REPLY" in line]
+    ok = [line for line in lines if "slave 2: ReadMultipleRegisters ok in" in line]
+    if level == 0:
+        assert lines == []
+    else:
+        assert failed and any("port MODBMAST:1: opened sim://" in line for line in lines)
+        assert any("slave 5: Not Present" in line for line in lines)
+        assert bool(ok) is (level == 2)
+        assert any(" TX    8 bytes: 02 03 00 00 00 04 44 3A" in line for line in lines) is (level == 2)
+        # stamped with the wall clock, the engine's time, and the event's own time on the port
+        assert re.match(r"MODBMAST: \d\d:\d\d:\d\d\.\d{3} t=\d+ms port 1 @\d+\.\d{3}ms slave 5", failed[0])
