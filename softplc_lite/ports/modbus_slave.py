@@ -17,8 +17,8 @@ a ValueError):
   discrete inputs, addressed 0..registers-1 (the protocol address).
 - ``values``: how the tables start (default ``pattern``), see
   ``initial_value()``; the k-th id of a list (k from 0) has the pattern
-  XOR k * 0x1111 in its registers and its bit patterns shifted by k, so two
-  slaves never look alike.
+  XOR (k * 0x1111 & 0xFFFF) in its registers and its bit patterns shifted by
+  k, so neighbouring slaves never look alike.
 - ``framing``: ``rtu`` (default) or ``ascii``.
 - ``turnaround_ms``: extra time before replying (default 0; a number >= 0).
 - ``cts_delay_ms``: CTS follows the port's RTS after this delay (default 0,
@@ -116,10 +116,11 @@ def initial_value(k: int, table: str = "holding", values: str = "pattern", unit:
     if table not in TABLES:
         raise ValueError(f"table must be one of {', '.join(TABLES)}, not {table!r}")
     if values == "pattern":
+        shift = (unit * 0x1111) & 0xFFFF  # registers stay 16-bit whatever the place in a long id list
         if table == "holding":
-            return ((k * 257 + 1) & 0xFFFF) ^ (unit * 0x1111)
+            return ((k * 257 + 1) & 0xFFFF) ^ shift
         if table == "input":
-            return ((k * 257 + 1) & 0xFFFF) ^ 0xFFFF ^ (unit * 0x1111)
+            return ((k * 257 + 1) & 0xFFFF) ^ 0xFFFF ^ shift
         return (k + unit) % 3 == 0 if table == "coil" else (k + unit) % 4 == 1
     if values == "index":
         return k & 0xFFFF if table in ("holding", "input") else k % 2 == 1
@@ -292,9 +293,11 @@ def respond(request: bytes, slave: ModbusSlave) -> bytes | None:
     except FrameError:
         slave.ignored += 1
         return None
-    units = [u for u in slave.units.values() if u.online]
-    if address != 0:
-        units = [u for u in units if u.slave_id == address]
+    if address == 0:
+        units = [u for u in slave.units.values() if u.online]
+    else:
+        unit = slave.units.get(address)
+        units = [unit] if unit is not None and unit.online else []
     if not units or not pdu:
         slave.ignored += 1
         return None
