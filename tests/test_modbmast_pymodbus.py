@@ -154,6 +154,7 @@ def test_every_function_against_pymodbus_and_a_slave_that_comes_back(tmp_path, l
         start(framer)
         assert run_until(runner, lambda: status(runner, 1, 1).present and status(runner, 1, 2).present and
                          t.read("N10:0") == signed(initial_value(0, unit=1)))
+        runner.engine.scan()  # a slave may have answered after this scan's ladder copied the map
         assert t.read("B13/1") == 0 and t.read("B13/2") == 0 and t.read("B13/3") == 1
     finally:
         runner.engine.close()
@@ -194,3 +195,27 @@ def test_a_port_that_takes_no_more_bytes_fails_requests_with_no_xmit_room(tmp_pa
         if conn is not None:
             conn.close()
         server.close()
+
+
+def test_a_reply_is_stored_at_the_input_point_only(tmp_path, line):
+    """On a real port a reply can complete at the output point (wall time
+    passed during the ladder); its data waits for the next input point, so
+    the table changes only there and an input force holds between scans."""
+    from softplc_lite.watch.forces import Forces, parse_force
+
+    device, start = line
+    start("rtu")
+    xml = serial_xml(f'<Port num="1" baudrate="38400" device="{device}"><Slave id="1"><ReadCoils><refNum>00001'
+                     f'</refNum><toBlock dest="I:0" count="16" fmt="bit"/></ReadCoils></Slave></Port>')
+    runner = Runner(load_app(write_app(tmp_path / "app", xml)), RunOptions(fresh=True, realtime=True, scan_ms=0))
+    Forces(runner.engine).set(parse_force("I:0/0=0"))  # coil 0 is on at the slave
+    driver = runner.engine.modules[0].drivers[0]
+    seen_at_output = []
+    runner.engine.output_hooks.append(lambda e, enabled: seen_at_output.append(
+        (len(driver.pending), e.table.read("I:0/0"), e.table.read("I:0/3"))))
+    try:
+        runner.engine.set_mode(Mode.RUN)
+        assert run_until(runner, lambda: runner.table.read("I:0/3") == 1 and any(p for p, _, _ in seen_at_output))
+        assert all(forced == 0 for _, forced, _ in seen_at_output)  # never the slave's 1, at any point
+    finally:
+        runner.engine.close()

@@ -147,8 +147,10 @@ class Wire:
 
     def take_timed(self, now: int) -> tuple[bytes, list[int]]:
         """All arrived bytes, removed, with each byte's arrival time."""
-        parts, times = [], []
         chunks = self.chunks
+        if not chunks or chunks[0].arrived(now) <= chunks[0].taken:
+            return b"", []  # the usual case while a driver waits: nothing new
+        parts, times = [], []
         while chunks:
             chunk = chunks[0]
             n = chunk.arrived(now)

@@ -46,7 +46,7 @@ MS = 1_000_000
 
 class Transaction:
     __slots__ = ("prepared", "index", "attempt", "frame", "sent_at", "tx_end", "deadline", "buffer", "first_at",
-                 "last_at", "written", "rts_at")
+                 "last_at", "written", "rts_at", "expected")
 
     def __init__(self, prepared: Prepared, index: int, attempt: int) -> None:
         self.prepared = prepared
@@ -56,6 +56,7 @@ class Transaction:
         self.sent_at = self.tx_end = self.deadline = self.first_at = self.last_at = self.rts_at = 0
         self.buffer = bytearray()
         self.written = 0
+        self.expected: int | None = None  # an RTU reply's length, once its first bytes tell
 
 
 class PortDriver:
@@ -83,9 +84,17 @@ class PortDriver:
         self.free_at = 0  # the line is free for the next request (after the gap)
         self.ready_at = 0  # when the next request may go: free_at, or later when none is due yet
         self.vt = 0  # the port's clock (ns): the time of the event being handled
+        # A simulated port has been read up to this time since the last
+        # write: reading it again up to then cannot find anything new.
+        self.read_to = 0
         self.tx: Transaction | None = None
         self.retry: Transaction | None = None
         self.transactions = self.good = 0  # counts, for diagnostics and benchmarks
+        # Replies completed at the output point wait for the next input point,
+        # so the data table changes only there (and input forces hold).
+        self.pending: list[tuple[Prepared, bytes]] = []
+        self.at_input = True
+        self.input_target = -1  # the time the last input point caught up to
         self.was_up = False
 
     def clock(self) -> int:
@@ -114,10 +123,19 @@ class PortDriver:
         At the input point a send due exactly at ``target`` waits for the
         output point, so it carries this scan's outputs."""
         port = self.port
+        self.at_input = input_point
+        if input_point and self.pending:
+            for prepared, data in self.pending:
+                prepared.store(data)
+            self.pending.clear()
         if not port.up:
             self._down(target)
             return
         clocked = port.clocked
+        if input_point:
+            self.input_target = target
+        elif clocked and target == self.input_target and self.state is not IDLE:
+            return  # the same instant as the input point, which handled all but a send due right now
         for _ in range(MAX_STEPS):
             state = self.state
             if state is IDLE:
@@ -128,15 +146,25 @@ class PortDriver:
                 self._begin()
             elif state is WAITING or state is RECEIVING:
                 due = self._due()
-                self.vt = min(due, target) if clocked else target
-                data, times = port.read_timed()
-                if data:
-                    self._received(data, times or [self.vt] * len(data))
-                elif not port.up:
-                    return
-                if self.state is state and self.tx is not None and self.vt >= self._due():
+                if not clocked:
+                    step = target
+                elif state is RECEIVING and self.tx.expected is not None and target < due:
+                    return  # an RTU reply of known length cannot be complete yet; its byte times tell the rest
+                else:
+                    step = min(due, target)
+                if not clocked or step > self.read_to:
+                    self.vt = step
+                    data, times = port.read_timed()
+                    self.read_to = step
+                    if data:
+                        self._received(data, times or [step] * len(data))
+                        continue  # the reply may be complete, or has moved on: look again
+                    if not port.up:
+                        return
+                if step >= due:
+                    self.vt = step
                     self._expired()
-                elif self.state is state and self.vt >= target:
+                elif step >= target:
                     return
             elif state is CTS_WAIT:
                 tx = self.tx
@@ -188,7 +216,7 @@ class PortDriver:
 
     def _send(self) -> None:
         tx = self.tx
-        tx.sent_at = self.vt
+        tx.sent_at = self.read_to = self.vt  # a reply to this can come before times read already
         tx.written = 0
         self.state = SENDING
         self._send_more()
@@ -223,10 +251,9 @@ class PortDriver:
         if self.state is WAITING:
             return tx.deadline
         limit = tx.last_at + self.char_ns + self.inter_ns
-        if not self.ascii:
-            expected = self.framer.response_length(bytes(tx.buffer[:3]))
-            if expected is not None and expected > len(tx.buffer):
-                return max(limit, tx.last_at + (expected - len(tx.buffer)) * self.char_ns)
+        expected = tx.expected
+        if expected is not None and expected > len(tx.buffer):
+            return max(limit, tx.last_at + (expected - len(tx.buffer)) * self.char_ns)
         return limit
 
     def _received(self, data: bytes, times: list[int]) -> None:
@@ -258,7 +285,9 @@ class PortDriver:
             end = self.framer.frame_end(bytes(buffer))
             complete = end is not None
         else:
-            end = self.framer.response_length(bytes(buffer[:3]))
+            if tx.expected is None:
+                tx.expected = self.framer.response_length(bytes(buffer[:3]))
+            end = tx.expected
             complete = end is not None and len(buffer) >= end
         if complete:
             self._ended(times[end - (len(buffer) - cut) - 1], complete=True, length=end)
@@ -274,8 +303,8 @@ class PortDriver:
                 self._fail(WAIT_XMITTED, tx.deadline if self.port.clocked else self.vt)
                 return
             self._timeout()
-        else:
-            self._ended(min(self.vt, self._due()) if self.port.clocked else self.vt, complete=False)
+        else:  # nothing came after the last byte for longer than the inter-character limit
+            self._ended(tx.last_at + self.char_ns + self.inter_ns if self.port.clocked else self.vt, complete=False)
 
     def _timeout(self) -> None:
         tx = self.tx
@@ -326,7 +355,10 @@ class PortDriver:
         if code:
             self._fail(code, at, frame)
             return
-        p.store(data)
+        if self.at_input:
+            p.store(data)
+        else:
+            self.pending.append((p, data))
         status.succeeded()
         self.good += 1
         self._say(2, f"slave {p.slave}: {p.request.name} ok in {response_ms:.2f} ms: {hexdump(frame, 24)}")
