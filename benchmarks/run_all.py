@@ -1,4 +1,4 @@
-"""Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports, the Modbus RTU master, the watch
+"""Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports, the Modbus RTU master, MODBMAST, the watch
 view), each in its own process, and summarize.
 
     python benchmarks/run_all.py
@@ -20,7 +20,7 @@ import _common as C
 
 BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_comgenius_format",
-    "bench_comgenius_ports", "bench_modbus_master", "bench_watch",
+    "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_watch",
 )
 
 
@@ -133,6 +133,17 @@ def main() -> int:
             f"the wire minimum {sim['wire_min_ms']:.2f} ms [{sim['verdict']} <= {sim['target_ratio']:.2f}]; "
             f"{sim['scans_per_wall_s']:,} scans/s, {sim['transactions_per_wall_s']:,} transactions per wall second"
         )
+
+    mbm = load("bench_modbmast")
+    if mbm:
+        p, w, s = mbm["pty"], mbm["wire"], mbm["scale"]
+        lines.append(f"modbmast  pty {p['transactions_per_s']['modbmast']:,}/s vs sync {p['transactions_per_s']['sync']:,}/s "
+                     f"= {p['ratios']['modbmast/sync']:.2f}x [{p['verdict']}]; sim wire worst {w['worst_ratio']:.4f}x "
+                     f"the limit [{w['verdict']}]")
+        lines.append(f"          32x32x4: waiting {s['idle']['hook_us_per_port_scan']:.2f} us/port/scan "
+                     f"[{s['idle']['verdict']}], {s['mixed']['scan_10ms']['us_per_transaction']:.1f} us/transaction "
+                     f"at 10 ms [{s['verdict_transaction']}] ({s['mixed']['scan_1ms']['us_per_transaction']:.1f} at "
+                     f"1 ms), {s['memory']['bytes_per_request']:,} B/request [{s['memory']['verdict']}]")
 
     watch = load("bench_watch")
     if watch:
