@@ -6,7 +6,7 @@ import time
 
 import pytest
 
-from softplc_lite.ladder import Engine, Mode, ModeError, RealClock, Settings, SimulatedClock, load_text
+from softplc_lite.ladder import Engine, Mode, ModeError, RealClock, Settings, SimulatedClock, load_text, run_text
 from softplc_lite.ladder import status as S
 
 
@@ -151,3 +151,24 @@ def test_simulated_clock_is_deterministic_and_real_clock_follows_the_wall():
     time.sleep(0.05)
     e.scan()
     assert 3 <= e.table.read("T4:0.ACC") <= 100
+
+
+def test_a_module_hook_that_raises_faults_the_plc_instead_of_ending_the_run():
+    """A bug in a plug-in's driver hook becomes major fault 255 naming the
+    module and the error; the engine keeps scanning (and keeps its data)."""
+    from softplc_lite.tlm import TLM
+
+    class Broken(TLM):
+        name = "BROKEN"
+        calls = 0
+
+        def on_input(self, engine):
+            Broken.calls += 1
+            raise KeyError("slave 9")
+
+    engine = run_text("XIC S:1/15 OTL B3/0", scans=0, modules=[Broken()])
+    engine.set_mode(Mode.RUN)
+    engine.run(3)
+    assert engine.mode is Mode.FAULTED and engine.fault.code == 255
+    assert engine.fault.message == "internal error in BROKEN's on_input: KeyError: 'slave 9'"
+    assert Broken.calls == 3 and engine.scans == 0 and engine.table.read("B3/0") == 0

@@ -280,12 +280,25 @@ class Engine:
         m = self.machine
         m.dt = self.clock.advance()
         for hook in self.input_hooks:
-            hook(self)
+            try:
+                hook(self)
+            except Exception as exc:  # a module's bug faults the PLC; it never ends the run with a traceback
+                self._hook_failed(hook, exc)
         if self.mode in (Mode.RUN, Mode.TEST):
             self._ladder()
         enabled = self.mode is Mode.RUN
         for hook in self.output_hooks:
-            hook(self, enabled)
+            try:
+                hook(self, enabled)
+            except Exception as exc:
+                self._hook_failed(hook, exc)
+
+    def _hook_failed(self, hook, exc: Exception) -> None:
+        owner = getattr(getattr(hook, "__self__", None), "name", None) or getattr(hook, "__qualname__", "a hook")
+        message = f"internal error in {owner}'s {getattr(hook, '__name__', 'hook')}: {type(exc).__name__}: {exc}"
+        if self.mode is Mode.FAULTED and self.fault is not None and self.fault.message == message:
+            return  # the same failure again, scan after scan: the fault already says it
+        self._major(MajorFault(S.FAULT_INTERNAL, message))
 
     def _ladder(self) -> None:
         s = self.s
