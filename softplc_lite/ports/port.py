@@ -157,6 +157,12 @@ class SerialPort:
         self.log(1, f"port {self.label}: back up")
         return True
 
+    def replay_report(self) -> str | None:
+        """What a ``replay://`` port says of the run (did the program's output
+        match the recording); None for any other port."""
+        s = self.serial
+        return s.report() if s is not None and hasattr(s, "mismatches") else None
+
     def close(self) -> None:
         if self.serial is not None:
             quiet_close(self.serial)

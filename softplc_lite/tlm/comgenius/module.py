@@ -104,9 +104,9 @@ class ComGenius(TLM):
     def close(self) -> None:
         if self.ports is not None:
             for p in self.ports.ports.values():
-                serial = p.serial
-                if serial is not None and hasattr(serial, "report") and hasattr(serial, "mismatches"):
-                    self.log(serial.report())  # a replay port says whether the output matched
+                report = p.replay_report()
+                if report is not None:
+                    self.log(report)
             self.ports.close()
         self.recorder = None  # the engine closes the run's recorder
 

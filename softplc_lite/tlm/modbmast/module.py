@@ -206,10 +206,9 @@ class Modbmast(TLM):
 
     def close(self) -> None:
         for driver in self.drivers:
-            port = driver.port
-            serial_ = port.serial
-            if serial_ is not None and hasattr(serial_, "report") and hasattr(serial_, "mismatches"):
-                self.log(serial_.report())  # a replay port says whether the output matched
+            report = driver.port.replay_report()
+            if report is not None:
+                self.log(report)
         self._close_ports()
         self.recorder = None  # the engine closes the run's recorder
 

@@ -45,15 +45,15 @@ MS = 1_000_000
 
 
 class Transaction:
-    __slots__ = ("prepared", "index", "attempt", "frame", "sent_at", "tx_end", "deadline", "buffer", "first_at",
-                 "last_at", "written", "rts_at", "expected")
+    __slots__ = ("prepared", "index", "attempt", "frame", "sent_at", "tx_end", "deadline", "buffer", "last_at",
+                 "written", "rts_at", "expected")
 
     def __init__(self, prepared: Prepared, index: int, attempt: int) -> None:
         self.prepared = prepared
         self.index = index
         self.attempt = attempt
         self.frame = b""
-        self.sent_at = self.tx_end = self.deadline = self.first_at = self.last_at = self.rts_at = 0
+        self.sent_at = self.tx_end = self.deadline = self.last_at = self.rts_at = 0
         self.buffer = bytearray()
         self.written = 0
         self.expected: int | None = None  # an RTU reply's length, once its first bytes tell
@@ -67,10 +67,8 @@ class PortDriver:
         self.mode = mode
         self.log = log
         self.status = status
-        requests = [r for s in config.slaves.values() for r in s.requests]
-        self.prepared = [prepared[id(r)] for r in requests]
-        self._by_request = {id(r): p for r, p in zip(requests, self.prepared)}
-        self.scan = ScanList(requests, config.slaves, status)
+        self.prepared = prepared  # by id() of each configured request
+        self.scan = ScanList([r for s in config.slaves.values() for r in s.requests], config.slaves, status)
         self.framer = FRAMERS[config.framing]
         self.ascii = config.framing == "ASCII"
         self.char_ns = port.settings.char_ns
@@ -198,7 +196,7 @@ class PortDriver:
             if request is None:
                 self.ready_at = index  # the earliest time one is due (NEVER: none in this mode)
                 return
-            tx = Transaction(self._by_request[id(request)], index, 1)
+            tx = Transaction(self.prepared[id(request)], index, 1)
         self.tx = tx
         idle = tx.prepared.request.when == "run" and self.mode() is not Mode.RUN
         tx.frame = tx.prepared.frame(idle)
@@ -262,7 +260,6 @@ class PortDriver:
         if self.state is WAITING:
             if self.port.clocked and times[0] > tx.deadline:
                 return  # too late: the timeout comes first
-            tx.first_at = times[0]
             self.state = RECEIVING
             previous = times[0] - char  # as if a character had just ended: no silence before the first
         else:
