@@ -99,7 +99,6 @@ fails.
 from __future__ import annotations
 
 import argparse
-import asyncio
 import cProfile
 import gc
 import io
@@ -122,8 +121,7 @@ if str(C.REPO / "tests") not in sys.path:
 from modbmast_apps import serial_xml, write_app
 from modbus_peer import PeerProcess
 from ptypair import PtyPair, SocatMissing
-from pymodbus import FramerType
-from pymodbus.client import AsyncModbusSerialClient, ModbusSerialClient
+from pymodbus_clients import async_reads, sync_reads
 
 from softplc_lite.app import load_app
 from softplc_lite.ladder.engine import Mode
@@ -259,52 +257,17 @@ def modbmast_case(app_dir: Path, window_s: float) -> tuple[int, float, dict]:
 
 
 def sync_case(port: str, window_s: float) -> tuple[int, float, dict]:
-    client = ModbusSerialClient(port, framer=FramerType.RTU, baudrate=38400, timeout=1, retries=0)
-    if not client.connect():
-        raise CheckFailed(f"sync: cannot open {port}")
-    try:
-        read = client.read_holding_registers
-        for _ in range(WARMUP):
-            read(0, count=125, device_id=2)
-        done = 0
-        now = time.perf_counter
-        t0 = now()
-        end = t0 + window_s
-        while now() < end:
-            reply = read(0, count=125, device_id=2)
-            done += 1
-        elapsed = now() - t0
-        if reply.isError() or reply.registers != REGISTERS[:125]:
-            raise CheckFailed(f"sync: {reply}")
-        return done, elapsed, {}
-    finally:
-        client.close()
+    return _checked("sync", sync_reads(port, WARMUP, window_s=window_s))
 
 
 def async_case(port: str, window_s: float) -> tuple[int, float, dict]:
-    async def run() -> tuple[int, float]:
-        client = AsyncModbusSerialClient(port, framer=FramerType.RTU, baudrate=38400, timeout=1, retries=0)
-        if not await client.connect():
-            raise CheckFailed(f"async: cannot open {port}")
-        try:
-            read = client.read_holding_registers
-            for _ in range(WARMUP):
-                await read(0, count=125, device_id=2)
-            done = 0
-            now = time.perf_counter
-            t0 = now()
-            end = t0 + window_s
-            while now() < end:
-                reply = await read(0, count=125, device_id=2)
-                done += 1
-            elapsed = now() - t0
-            if reply.isError() or reply.registers != REGISTERS[:125]:
-                raise CheckFailed(f"async: {reply}")
-            return done, elapsed
-        finally:
-            client.close()
+    return _checked("async", async_reads(port, WARMUP, window_s=window_s))
 
-    done, elapsed = asyncio.run(run())
+
+def _checked(name: str, result) -> tuple[int, float, dict]:
+    done, elapsed, reply = result
+    if reply.isError() or reply.registers != REGISTERS[:125]:
+        raise CheckFailed(f"{name}: {reply}")
     return done, elapsed, {}
 
 

@@ -53,7 +53,6 @@ socat is missing or a check fails.
 
 from __future__ import annotations
 
-import asyncio
 import logging
 import statistics
 import sys
@@ -64,8 +63,7 @@ import _common as C
 if str(C.REPO / "tests") not in sys.path:
     sys.path.insert(1, str(C.REPO / "tests"))  # ptypair, modbus_peer (the tests' helpers)
 
-from pymodbus import FramerType  # noqa: E402
-from pymodbus.client import AsyncModbusSerialClient, ModbusSerialClient  # noqa: E402
+from pymodbus_clients import async_reads, sync_reads  # noqa: E402
 
 from modbus_peer import PeerProcess  # noqa: E402
 from ptypair import PtyPair, SocatMissing  # noqa: E402
@@ -140,44 +138,18 @@ def ladder_case(port: str) -> tuple[float, dict]:
 
 
 def sync_case(port: str) -> tuple[float, dict]:
-    client = ModbusSerialClient(port, framer=FramerType.RTU, baudrate=38400, timeout=1, retries=0)
-    if not client.connect():
-        raise CheckFailed(f"sync: cannot open {port}")
-    try:
-        read = client.read_holding_registers
-        for _ in range(WARMUP):
-            read(0, count=125, device_id=2)
-        t0 = time.perf_counter()
-        for _ in range(TRANSACTIONS):
-            reply = read(0, count=125, device_id=2)
-        elapsed = time.perf_counter() - t0
-        if reply.isError() or reply.registers != REGISTERS[:125]:
-            raise CheckFailed(f"sync: {reply}")
-        return elapsed, {}
-    finally:
-        client.close()
+    return _checked("sync", sync_reads(port, WARMUP, transactions=TRANSACTIONS))
 
 
 def async_case(port: str) -> tuple[float, dict]:
-    async def run() -> float:
-        client = AsyncModbusSerialClient(port, framer=FramerType.RTU, baudrate=38400, timeout=1, retries=0)
-        if not await client.connect():
-            raise CheckFailed(f"async: cannot open {port}")
-        try:
-            read = client.read_holding_registers
-            for _ in range(WARMUP):
-                await read(0, count=125, device_id=2)
-            t0 = time.perf_counter()
-            for _ in range(TRANSACTIONS):
-                reply = await read(0, count=125, device_id=2)
-            elapsed = time.perf_counter() - t0
-            if reply.isError() or reply.registers != REGISTERS[:125]:
-                raise CheckFailed(f"async: {reply}")
-            return elapsed
-        finally:
-            client.close()
+    return _checked("async", async_reads(port, WARMUP, transactions=TRANSACTIONS))
 
-    return asyncio.run(run()), {}
+
+def _checked(name: str, result) -> tuple[float, dict]:
+    _, elapsed, reply = result
+    if reply.isError() or reply.registers != REGISTERS[:125]:
+        raise CheckFailed(f"{name}: {reply}")
+    return elapsed, {}
 
 
 CASES = {"ladder": ladder_case, "sync": sync_case, "async": async_case}
