@@ -101,6 +101,7 @@ def test_the_recorder_writes_every_port_in_time_order(tmp_path):
     a, b = _Port("0"), _Port("MODBMAST:1")
     rec.add_port(a, "COM1 -> loop://", clock)
     rec.add_port(b, "COM2 -> sim://bus", clock)
+    rec.open()  # the engine opens it once every module has attached
     clock.now = 7_000_000
     a.record("0", "TX", b"\x01")
     clock.now = 6_000_000  # recorded later, happened earlier
@@ -121,6 +122,7 @@ def test_the_recorder_never_writes_a_time_before_one_already_written(tmp_path):
     rec = Recorder(str(tmp_path / "t.trace"))
     port = _Port("0")
     rec.add_port(port, "x", clock)
+    rec.open()
     clock.now = 2_000_000
     port.record("0", "TX", b"\x01")
     rec.flush()
@@ -198,3 +200,25 @@ def test_a_port_that_cannot_be_opened_is_down_with_the_reason(clock):
     assert port.retry() and port.up and "back up" in log.getvalue()
     port.close()
     assert not port.retry()  # a closed port stays closed
+
+
+def test_an_unwritable_trace_stops_the_start_and_nothing_is_written(tmp_path):
+    """--record to a place that cannot be written: refused before the first
+    scan (exit 1, the path named), not a fault in the middle of the run."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    run = subprocess.run([sys.executable, "-m", "softplc_lite", "run", "programs/loopback", "--fresh", "--state",
+                          str(tmp_path / "s"), "--scans", "20", "--record", str(tmp_path / "no-dir" / "x.trace")],
+                         cwd=root, capture_output=True, text=True, timeout=60)
+    assert run.returncode == 1 and "Traceback" not in run.stderr
+    assert run.stderr.strip() == f"error: --record: cannot write {tmp_path / 'no-dir' / 'x.trace'}: No such file or directory"
+
+
+def test_a_recorder_that_never_opened_closes_quietly(tmp_path):
+    rec = Recorder(str(tmp_path / "never.trace"))
+    rec.add_port(_Port("0"), "x", Clock(0))
+    rec.close()
+    assert not (tmp_path / "never.trace").exists()

@@ -203,6 +203,8 @@ class Engine:
             for m in self.modules:
                 self.module_warnings += m.attach(self, per_module[m.name])
                 attached.append(m)
+            if self.recorder is not None:
+                self.recorder.open()  # every port is described now; an unwritable TRACE stops the start
         except BaseException:
             for m in attached:  # a module refused to start: release what the others opened
                 m.close()

@@ -1,7 +1,8 @@
 """``softplc run --record TRACE``: one trace file for the ports of every module.
 
 Each module hands its ports to the run's ``Recorder`` (``add_port``): their
-traffic is buffered and written to the trace (trace.py) in time order when a
+traffic is buffered and written to the trace (trace.py), which the engine
+opens once every module has attached (``open()``), in time order when a
 module calls ``flush()`` at its output point, so that a driver which catches
 up on simulated time within a scan (MODBMAST), and modules whose hooks run in
 either order, still give a file whose times never go back. Every port's
@@ -54,10 +55,8 @@ class Recorder:
     def flush(self) -> None:
         """Write what was recorded, in time order (a frame never goes before
         one already written: their times are equal then)."""
-        if not self._events:
+        if not self._events or self._writer is None:
             return
-        if self._writer is None:
-            self.open()
         events = sorted(self._events)
         self._events.clear()
         start = self._start_ns or 0
@@ -67,7 +66,7 @@ class Recorder:
             self._writer.event((t_ns - start) / 1e6, label, direction, data)
 
     def close(self) -> None:
+        if self._writer is None:  # never opened: the run did not start
+            return
         self.flush()
-        if self._writer is None:
-            self.open()
         self._writer.close()
