@@ -218,3 +218,42 @@ def test_check_lists_the_config_files_problems_and_the_programs_together(tmp_pat
     assert lines[2].endswith("MODBMAST.XML:2:7: num='40': expected an integer 0..31")
     assert lines[3].endswith("MODBMAST.XML:2:39: id='0': expected an integer 1..247")
     assert "main.lad:2:1: MOV takes 2 operands" in lines[4]
+
+
+def test_a_port_that_opens_late_is_retried_and_recorded(tmp_path):
+    """portErrors="retry": a port whose device is missing at start leaves its
+    slaves Not Present (-5); once the device exists it opens, its slaves
+    answer, and --record has its traffic."""
+    import os
+    import time
+
+    from softplc_lite.runner import RunOptions, Runner
+    from softplc_lite.tlm.modbmast.status import NO_XMIT_ROOM
+    from ptypair import PtyPair, require_socat
+
+    require_socat()
+    late = tmp_path / "late-tty"
+    body = ('<Slave id="2" requestTimeout="50"><ReadMultipleRegisters><refNum>40001</refNum>'
+            '<toBlock dest="N7:0" count="1" fmt="i2"/></ReadMultipleRegisters></Slave>')
+    xml = serial_xml(f'<Port num="1" baudrate="38400" device="{late}">{body}</Port>', 'portErrors="retry" retryMs="10"')
+    d = write_app(tmp_path / "app", xml)
+    trace = tmp_path / "run.trace"
+    runner = Runner(load_app(d), RunOptions(fresh=True, realtime=True, scan_ms=0, record=str(trace)))
+    pair = None
+    try:
+        assert any("cannot open" in w for w in runner.engine.module_warnings)
+        runner.engine.set_mode(Mode.RUN)
+        runner.engine.scan()
+        s = status(runner, 1, 2)
+        assert not s.present and s.last_code == NO_XMIT_ROOM
+        pair = PtyPair(tmp_path)
+        os.symlink(pair.a, late)  # the device appears; nothing answers on it: NO REPLY now, not NO XMIT ROOM
+        end = time.monotonic() + 10
+        while s.last_code != -3 and time.monotonic() < end:
+            runner.engine.scan()
+        assert s.last_code == -3 and modbmast(runner).drivers[0].port.up
+    finally:
+        runner.engine.close()
+        if pair is not None:
+            pair.close()
+    assert "MODBMAST:1 TX 02 03 00 00 00 01" in trace.read_text()

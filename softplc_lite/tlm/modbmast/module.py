@@ -140,9 +140,10 @@ class Modbmast(TLM):
                                 f"Present and it is retried every {config.retry_ms} ms")
                 for s in self.status[number].values():
                     s.present, s.last_code = False, NO_XMIT_ROOM
-                continue
-            driver.started(self._now(driver))
-            if self.recorder is not None:
+                driver.vt = self._now(driver)  # its clock until it comes back (then started() sets it)
+            else:
+                driver.started(self._now(driver))
+            if self.recorder is not None:  # a port that comes back later is recorded too
                 self.recorder.add_port(port, f"{self.port_url(pc)} -> {url} {settings} {pc.framing}", driver.clock)
         return warnings
 
