@@ -91,7 +91,7 @@ class SerialPort:
         self.next_try = 0.0
         self.rx_bytes = self.tx_bytes = 0  # totals since start
         self.history: deque[tuple[float, str, bytes]] = deque(maxlen=HISTORY)
-        self.record: Callable[[str, str, bytes], None] | None = None
+        self.record: Callable[..., None] | None = None  # record(label, direction, data, at_ns=None)
         self.clocked = False  # a simulated port on the clock it was given (exact arrival times)
 
     def __repr__(self) -> str:
