@@ -174,6 +174,17 @@ def test_ton_several_ticks_per_scan_stop_at_the_preset(run):
     assert timer(e) == (1, 0, 1, 10)
 
 
+def test_ton_millisecond_base_counts_each_ms(run):
+    # MicroLogix 1100's 0.001 base: one tick a millisecond, no fraction to keep.
+    e = run("TON T4:0 0.001 7 0", scans=0, settings=Settings(scan_ms=3))
+    assert [t[3] for t in scans(e, 4, timer)] == [0, 3, 6, 7]
+    assert timer(e) == (1, 0, 1, 7)
+    e = run("RTO T4:0 0.001 50 0", scans=4, settings=Settings(scan_ms=2))
+    assert e.table.read("T4:0.ACC") == 6
+    e = run("XIC B3/0 TOF T4:0 0.001 4 0", scans=0, settings=Settings(scan_ms=1))
+    assert [t[2] for t in steps(e, [1, 0, 0, 0, 0, 0], timer)] == [1, 1, 1, 1, 1, 0]
+
+
 def test_ton_preset_and_accumulator_operands_initialise_the_element(run):
     e = run("XIC B3/0 TON T4:0 0.01 250 7")
     assert e.table.read("T4:0") == {"EN": 0, "TT": 0, "DN": 0, "PRE": 250, "ACC": 0}  # false rung resets ACC

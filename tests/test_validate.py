@@ -16,7 +16,7 @@ def problems(text: str) -> list[str]:
 CASES = [
     ("XIC B3/0 XIX B3/1 OTE O:0/0\n", "v.lad:1:10: unknown instruction 'XIX' (did you mean XIO?)"),
     ("XIX(B3/0)OTE(O:0/0);\n", "v.lad:1:1: unknown instruction 'XIX'"),
-    ("TON T4:0 0.5 100 0\n", "v.lad:1:10: TON operand 2 (base) must be the time base 1.0 or 0.01"),
+    ("TON T4:0 0.5 100 0\n", "v.lad:1:10: TON operand 2 (base) must be the time base 1.0, 0.01 or 0.001"),
     ("TON(T4:0,1.0,100);\n", "v.lad:1:1: TON takes 4 operands (TON timer base preset accum), got 3"),
     ("XIC N7:0\n", "v.lad:1:5: XIC operand 1 (bit) must be bit address, not N7:0 (a word)"),
     ("ADD N7:0 B3/1 N7:2\n", "v.lad:1:10: ADD operand 2 (b) must be number or word/float address, not B3/1 (a bit)"),

@@ -25,7 +25,7 @@ class K(Enum):
     COUNTER = "counter element (C)"
     CONTROL = "control element (R)"
     RESETTABLE = "timer, counter or control element"
-    TIMEBASE = "time base 1.0 or 0.01"
+    TIMEBASE = "time base 1.0, 0.01 or 0.001"
     PRESET = "integer constant"
     LABEL = "label number 0..999"
     PROGRAM_FILE = "program file number 3..999"

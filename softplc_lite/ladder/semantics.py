@@ -440,4 +440,4 @@ def lim(low, test, high) -> bool:
     return test >= low or test <= high
 
 
-BASE_MS = {1.0: 1000, 0.01: 10}
+BASE_MS = {1.0: 1000, 0.01: 10, 0.001: 1}  # 0.001: MicroLogix 1100's 1 ms time base

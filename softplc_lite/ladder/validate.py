@@ -132,8 +132,8 @@ class _Checker:
                 return None
             v = resolved.value
             if kind is K.TIMEBASE:
-                if v not in (1.0, 0.01):
-                    bad("the time base 1.0 or 0.01")
+                if v not in (1.0, 0.01, 0.001):
+                    bad("the time base 1.0, 0.01 or 0.001")
                     return None
                 return resolved
             if isinstance(v, float):
