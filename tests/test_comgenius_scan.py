@@ -49,8 +49,8 @@ def le2(value: int) -> str:
     return chr(value & 0xFF) + chr(value >> 8 & 0xFF)
 
 
-def word() -> ValueParam:
-    return ValueParam(0)
+def word(value: int = 0) -> ValueParam:
+    return ValueParam(value)
 
 
 def words(n: int) -> ValueParam:
@@ -750,8 +750,43 @@ def test_illegal_scan_format_is_format_error(fmt, offset):
 
 @pytest.mark.parametrize("fmt", ["%5*d", "%.*d", "%3.*s", "%#.*R"], ids=["width-star", "prec-star", "s", "R"])
 def test_star_width_or_precision_is_not_allowed_in_scan(fmt):
-    with pytest.raises(FormatError, match="may not be"):
+    # The manual forbids '*' in a scan width or precision; softplc's one
+    # exception is the precision of c and C (below).
+    with pytest.raises(FormatError, match="may not be|may be '\\*' only"):
         compile_scan(fmt)
+
+
+def test_star_precision_of_c_takes_the_count_from_a_param():
+    buf = ValueParam([0] * 4)
+    assert scan_text("%.*c", "ABCDE", [word(3), buf]) == ScanResult(MATCHED, 3, 1)
+    assert buf.value[:2] == [0x4241, 0x43]
+    assert scan_text("%.*C%c", "ABCDE", [word(4), buf, word()]) == ScanResult(MATCHED, 5, 2)
+    assert buf.value[:2] == [0x4142, 0x4344]
+    # the count Param is consumed even when the field is suppressed
+    n = word()
+    assert scan_text("%*.*c%c", "ABCDE", [word(4), n]) == ScanResult(MATCHED, 5, 2) and n.value == [ord("E")]
+    assert [k for _, k in params_needed(parse_scan("%*.*c%.*hc"), scan=True)] == ["integer", "integer", "integer"]
+    # short input waits for more (or fails at the end); a count of 0 reads nothing
+    assert scan_text("%.*c", "AB", [word(3), buf], final=False) == ScanResult(NEED_MORE, 2, 0)
+    assert scan_text("%.*cZ", "Z", [word(0), buf]) == ScanResult(MATCHED, 1, 1)
+    with pytest.raises(ParamError, match="below 0"):
+        scan_text("%.*c", "AB", [word(-1), buf])
+
+
+def test_h_on_c_stores_one_character_a_word():
+    buf = ValueParam([7] * 6)
+    assert scan_text("%.4hc", "\x01\x03\xff\x00", [buf]) == ScanResult(MATCHED, 4, 1)
+    assert buf.value == [1, 3, 255, 0, 7, 7]
+    assert scan_text("%.*HC", "\u0141\x80", [word(2), buf]).status == MATCHED
+    assert buf.value[:2] == [0x41, 0x80]  # low 8 bits of each character, high byte 0
+    table = array("h", [0] * 3)
+    with pytest.raises(ParamError, match="past the end"):
+        scan_text("%.*hc", "ABCD", [word(4), TableParam(ParamKind.INTEGER, table, 0, "N7:0")])
+
+
+def test_h_on_c_prints_the_low_byte_of_each_word():
+    assert format_text("%.*hc", [word(3), ValueParam([0x141, 0x42, -189])]) == "ABC"
+    assert format_text("%.2hC|%.0hc", [ValueParam([0x7F01, 2]), ValueParam([1])]) == "\x01\x02|"
 
 
 def test_too_few_params():

@@ -5,9 +5,12 @@ format strings with slightly different grammars (manual 4.3.4 and 4.3.5):
 
     print:  %[flags][width][.precision][l|L|h]conv
             flags - + space 0 #; width and precision digits or *
+            (h with c or C: one byte a word, softplc's addition)
             conv  b d i o u x X s c C f e E g G % S R
     scan:   %[*|#][width][.precision][l|L|h|H]conv
-            width and precision digits only
+            width digits; precision digits, or * for c and C (softplc's
+            addition: the count from the next integer Param); h or H with
+            c or C: one character a word (softplc's addition)
             conv  b d i o u x X c C e E f g G s S R n, %%, and % followed
             by a whitespace character (matches that one character)
 
@@ -46,13 +49,18 @@ class Spec:
     flags: str = ""  # print: any of "-+ 0#"; scan: "*" and/or "#"
     width: int | None = None  # None: not given; STAR: from a Param
     precision: int | None = None  # None: no '.'; '.' alone is 0
-    length: str = ""  # "l"/"L" (32-bit), "h"/"H" (one-byte sum)
+    length: str = ""  # "l"/"L" (32-bit), "h"/"H" (one-byte sum; c/C: one byte a word)
     offset: int = 0  # of the '%' in the format string
     text: str = ""  # the spec as written, for messages
 
     @property
     def long(self) -> bool:
         return self.length in ("l", "L")
+
+    @property
+    def byte_per_word(self) -> bool:
+        """%hc / %hC: one byte in the low half of each word (softplc's addition)."""
+        return self.length in ("h", "H") and self.conv in "cC"
 
     @property
     def suppressed(self) -> bool:  # scan only
@@ -177,17 +185,25 @@ def parse_scan(fmt: str) -> list[str | Spec]:
             i += 1
         width, i = _digits(fmt, i)
         if i < n and fmt[i] == "*":
-            raise FormatError(i, "a scan width or precision may not be '*'")
+            raise FormatError(i, "a scan width may not be '*'")
         precision: int | None = None
+        star_at = None
         if i < n and fmt[i] == ".":
             i += 1
             if i < n and fmt[i] == "*":
-                raise FormatError(i, "a scan width or precision may not be '*'")
-            precision, i = _digits(fmt, i)
-            precision = precision or 0
+                precision, star_at = STAR, i
+                i += 1
+            else:
+                precision, i = _digits(fmt, i)
+                precision = precision or 0
         length, conv, i = _length_and_conversion(
             fmt, start, i, "lLhH", SCAN_CONVERSIONS,
             f"scan conversions: {' '.join(SCAN_CONVERSIONS)}, %%, % and a space")
+        if star_at is not None and conv not in "cC":
+            # The manual forbids '*' in a scan precision; softplc allows it for
+            # c and C only, where a byte count known at run time is what a
+            # binary protocol needs (a frame whose length the line told).
+            raise FormatError(star_at, f"a scan precision may be '*' only for %c and %C, not in {fmt[start:i]!r}")
         items.append(Spec(conv, flags, width, precision, length, start, fmt[start:i]))
     return items
 
@@ -201,6 +217,8 @@ def params_needed(items: list[str | Spec], scan: bool) -> list[tuple[Spec, str]]
         if not isinstance(item, Spec) or item.conv in ("ws", "char"):
             continue
         if scan:
+            if item.precision == STAR:  # the byte count, even when suppressed
+                out.append((item, "integer"))
             if item.suppressed:
                 continue
         else:

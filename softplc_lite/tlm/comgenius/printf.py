@@ -137,6 +137,15 @@ def c_bytes(p: Param, big_endian: bool, count: int) -> str:
     return words.tobytes()[:count].decode("latin-1")
 
 
+def c_low_bytes(p: Param, count: int) -> str:
+    """``count`` bytes, the low byte of each of ``count`` words (``%hc``,
+    softplc's addition: a byte buffer kept one byte a word, as ladder
+    handles bytes most easily)."""
+    if count <= 0:
+        return ""
+    return bytes(w & 0xFF for w in p.words(count)).decode("latin-1")
+
+
 def _python_compatible(spec: Spec) -> bool:
     """Does Python's ``%`` give the C99 result for this spec, whatever the
     value? Then the spec joins a merged Python format string."""
@@ -250,13 +259,15 @@ class PrintFormat:
             return percent, used
 
         getter = self._getter(spec) if c not in "cC" else None
+        one_a_word = spec.byte_per_word
 
         def convert(out: list, params) -> None:
             flags, width, precision, j = sizes(params)
             p = _take(params, j, spec)
             if c in "cC":
                 count = 1 if precision is None else precision
-                out.append(_pad("", c_bytes(p, c == "C", count), flags.replace("0", ""), width, zero_ok=False))
+                data = c_low_bytes(p, count) if one_a_word else c_bytes(p, c == "C", count)
+                out.append(_pad("", data, flags.replace("0", ""), width, zero_ok=False))
             elif c in FLOAT_CONVERSIONS:
                 out.append(c_float(getter(p), c, flags, width, precision))
             elif c == "s":

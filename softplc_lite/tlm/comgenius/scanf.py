@@ -46,7 +46,7 @@ from functools import lru_cache
 from typing import NamedTuple, Sequence
 
 from .checksum import crc16, low_bytes, sum16
-from .formats import WHITESPACE, FormatError, Spec, parse_scan
+from .formats import STAR, WHITESPACE, FormatError, Spec, parse_scan
 from .params import Param, ParamError
 
 MATCHED, MISMATCH, NEED_MORE = "matched", "mismatch", "need more input"
@@ -279,23 +279,33 @@ def _string(spec: Spec):
 
 
 def _chars(spec: Spec):
-    count = 1 if spec.precision is None else spec.precision
+    fixed = 1 if spec.precision is None else spec.precision
+    star = spec.precision == STAR
     # Words hold the bytes little endian (c) or big endian (C), whatever
     # the host's own order: array("h") uses the native one.
     swap = (spec.conv == "C") != (sys.byteorder == "big")
     store = not spec.suppressed
+    one_a_word = spec.byte_per_word
 
     def op(st: _Scan, pos: int) -> int:
+        count = fixed
+        if star:
+            count = st.param(spec).word(0)
+            if count < 0:
+                raise ParamError(f"{spec.text}: the byte count Param is {count}, below 0")
         end = pos + count
         if end > st.n:
             st.end(st.n)
         if store:
             raw = low_bytes(st.data[pos:end])
-            if count & 1:
-                raw += b"\0"
-            words = array("h", raw)
-            if swap:
-                words.byteswap()
+            if one_a_word:
+                words = array("h", list(raw))
+            else:
+                if count & 1:
+                    raw += b"\0"
+                words = array("h", raw)
+                if swap:
+                    words.byteswap()
             st.param(spec).set_words(words)
         return end
     return op
