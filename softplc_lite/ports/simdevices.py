@@ -68,7 +68,8 @@ class SimDevice:
 DeviceFactory = Callable[[dict[str, str]], SimDevice]
 DEVICES: dict[str, DeviceFactory] = {}
 # Built-in kinds defined in other modules: imported when first created.
-BUILTIN_DEVICES: dict[str, str] = {"modbus": "softplc_lite.ports.modbus_slave:create"}
+BUILTIN_DEVICES: dict[str, str] = {"modbus": "softplc_lite.ports.modbus_slave:create",
+                                   "modbus_master": "softplc_lite.ports.modbus_master:create"}
 
 
 def register_device(kind: str, factory: DeviceFactory) -> None:
