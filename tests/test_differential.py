@@ -37,6 +37,8 @@ from softplc_lite.tlm import load_modules
 SCANS = 50
 REPO = Path(__file__).resolve().parent.parent
 LAD_FILES = sorted((REPO / "programs").rglob("*.lad"))
+# What runs: a stand-alone .lad, or an app directory whose program is several files.
+PROGRAMS = sorted({p.parent if len(list(p.parent.glob("*.lad"))) > 1 else p for p in LAD_FILES})
 
 FAST = dict(deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
 
@@ -152,14 +154,16 @@ def test_fmt_round_trip_programs_dir(path):
     _round_trip(path)
 
 
-@pytest.mark.parametrize("path", LAD_FILES or [None], ids=lambda p: str(p.relative_to(REPO)) if p else "none")
+@pytest.mark.parametrize("path", PROGRAMS or [None], ids=lambda p: str(p.relative_to(REPO)) if p else "none")
 def test_programs_dir_executors_agree(path):
-    """Each stand-alone .lad under programs/ runs the same on both executors."""
+    """Each program under programs/ (a stand-alone .lad, or an app of several)
+    runs the same on both executors."""
     if path is None:
         pytest.skip("no .lad files under programs/ yet")
     app = load_app(path)
     words = [((k * 40503) & 0xFFFF, None) for k in range(SCANS)]
-    modules = lambda: load_modules(path.parent)[0]  # noqa: E731 - fresh modules for each engine
+    app_dir = path if path.is_dir() else path.parent
+    modules = lambda: load_modules(app_dir)[0]  # noqa: E731 - fresh modules for each engine
     for k, compiled, reference in run_pair(app.program, {}, words, space=(), modules=modules):
         assert fault_of(compiled) == fault_of(reference), f"scan {k}"
         assert compiled.table == reference.table, f"scan {k}\n" + table_diff(compiled.table, reference.table)

@@ -565,7 +565,7 @@ def test_bad_options(options, message):
 
 
 def test_unknown_kind_lists_modbus():
-    with pytest.raises(ValueError, match=r"unknown device kind 'nope' \(known: echo, modbus\)"):
+    with pytest.raises(ValueError, match=r"unknown device kind 'nope' \(known: echo, modbus, modbus_master\)"):
         simdevices.create_device("nope", {})
 
 

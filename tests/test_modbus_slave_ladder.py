@@ -62,6 +62,8 @@ def requests(draw) -> bytes:
     unit = draw(st.sampled_from([1] * 12 + [0, 2]))  # mostly ours; broadcasts and another slave's
     function = draw(st.sampled_from([1, 2, 3, 4, 5, 6, 15, 16] * 3 + [0, 7, 8, 17, 43, 0x81]))
     start = draw(address)
+    if function == 4 and start == 0:
+        start = 1  # input register 0 is the example program's scan counter
     if function in (1, 2):
         body = struct.pack(">HH", start, draw(st.one_of(st.integers(0, 40), st.integers(1990, 2010))))
     elif function in (3, 4):

@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 
 from ..gcpause import gc_paused
 from ..datatable import Address, DataTable, ValueKind, bit_mask
-from ..datatable.errors import AddressRangeError
+from ..datatable.errors import AddressRangeError, DataTableError
 from ..datatable.filetypes import Storage
 from . import status as S
 from .ast import AddressRef, BinOp, Branch, Const, Element, Instruction, Program, Rung, UnaryOp, walk
@@ -531,6 +531,9 @@ CHUNK_RUNGS = 200
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
+_MASKS = tuple(bit_mask(b) for b in range(16))
+
+
 def _resolver(table: DataTable, addr: Address):
     resolve = table.resolve
 
@@ -541,6 +544,44 @@ def _resolver(table: DataTable, addr: Address):
             raise address_fault(addr, e) from None
         return f.data, index, (bit_mask(bit) if bit is not None else None)
 
+    return _fast_resolver(table, addr, locate) or locate
+
+
+def _fast_resolver(table: DataTable, addr: Address, slow):
+    """The common indirect shapes, ``N12:[N13:3]`` and ``O:[N13:13]/[N13:14]``
+    (a fixed file, element and bit numbers from direct words), without the
+    general resolver: the pointer words' arrays are bound once (arrays grow
+    in place), and only an out-of-range number takes ``slow``, which faults
+    with the full message. None when ``addr`` has another shape."""
+    if addr.indexed or not isinstance(addr.file, int) or not isinstance(addr.element, Address):
+        return None
+    try:
+        f = table.file(addr.file)
+        ed, ei = table.word_ref(addr.element)
+        bd, bi = table.word_ref(addr.bit) if isinstance(addr.bit, Address) else (None, 0)
+    except (DataTableError, AddressRangeError):
+        return None
+    if f.ftype is not addr.ftype:
+        return None
+    data = f.data
+    wpe = f.ftype.words_per_element
+    offset = f.ftype.members_by_name[addr.member].offset if addr.member is not None else 0
+    masks = _MASKS
+    if bd is None:
+        mask = bit_mask(addr.bit) if addr.bit is not None else None
+
+        def locate():
+            e = ed[ei]
+            if e < 0 or (e + 1) * wpe > len(data):
+                return slow()
+            return data, e * wpe + offset, mask
+    else:
+        def locate():
+            e = ed[ei]
+            b = bd[bi]
+            if e < 0 or (e + 1) * wpe > len(data) or not 0 <= b < 16:
+                return slow()
+            return data, e * wpe + offset, masks[b]
     return locate
 
 
