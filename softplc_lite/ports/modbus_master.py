@@ -43,7 +43,7 @@ device of the open link ``name``.
 from __future__ import annotations
 
 from collections import deque
-from typing import Callable
+from collections.abc import Callable
 
 from . import simdevices, wire
 from .simdevices import SimDevice, check_options, float_option, silence_ns
@@ -75,19 +75,11 @@ def _round(n: int, model: _Model) -> list[tuple[object, Callable[[object], bool]
     on = n % 2 == 0
     bits = tuple(bool(PATTERN[(k + n) % len(PATTERN)]) for k in range(len(PATTERN)))
 
-    def wrote_registers(start: int, values: tuple[int, ...]):
+    def wrote(table: dict, start: int, values: tuple):
         def check(reply) -> bool:
             if isinstance(reply, ExceptionResponse):
                 return False
-            model.registers.update({start + k: x for k, x in enumerate(values)})
-            return True
-        return check
-
-    def wrote_coils(start: int, values: tuple[bool, ...]):
-        def check(reply) -> bool:
-            if isinstance(reply, ExceptionResponse):
-                return False
-            model.coils.update({start + k: x for k, x in enumerate(values)})
+            table.update({start + k: x for k, x in enumerate(values)})
             return True
         return check
 
@@ -112,11 +104,11 @@ def _round(n: int, model: _Model) -> list[tuple[object, Callable[[object], bool]
         return isinstance(reply, ExceptionResponse) and reply.exception_code == ILLEGAL_DATA_ADDRESS
 
     return [
-        (WriteSingleRegisterRequest(0, v), wrote_registers(0, (v,))),
-        (WriteMultipleRegistersRequest(1, regs), wrote_registers(1, regs)),
+        (WriteSingleRegisterRequest(0, v), wrote(model.registers, 0, (v,))),
+        (WriteMultipleRegistersRequest(1, regs), wrote(model.registers, 1, regs)),
         (ReadHoldingRegistersRequest(0, 8), read_registers(0)),
-        (WriteSingleCoilRequest(coil, on), wrote_coils(coil, (on,))),
-        (WriteMultipleCoilsRequest(16, bits), wrote_coils(16, bits)),
+        (WriteSingleCoilRequest(coil, on), wrote(model.coils, coil, (on,))),
+        (WriteMultipleCoilsRequest(16, bits), wrote(model.coils, 16, bits)),
         (ReadCoilsRequest(0, 32), read_coils(0, 32)),
         (ReadDiscreteInputsRequest(0, 16), answered),
         (ReadInputRegistersRequest(0, 4), answered),
@@ -226,13 +218,10 @@ def create(options: dict[str, str]) -> ModbusMaster:
 
 
 def find_master(name: str) -> ModbusMaster:
-    """The master at the far end of the open ``sim://`` link ``name``;
+    """The master at the far end of the open ``sim://`` link ``name``
+    (the newest, when several ports have opened one of that name);
     LookupError when there is none."""
-    links = wire.device_links(name)
-    device = links[-1].device if links else None
-    if not isinstance(device, ModbusMaster):
-        raise LookupError(f"no open sim:// link {name!r} to a {KIND} device")
-    return device
+    return wire.find_device(name, ModbusMaster, KIND)
 
 
 simdevices.register_device(KIND, create)

@@ -413,11 +413,7 @@ def find_slave(name: str) -> ModbusSlave:
     """The Modbus slaves at the far end of the open ``sim://`` link ``name``
     (the newest, when several ports have opened one of that name);
     LookupError when there is none."""
-    links = wire.device_links(name)
-    device = links[-1].device if links else None
-    if not isinstance(device, ModbusSlave):
-        raise LookupError(f"no open sim:// link {name!r} to a {KIND} device")
-    return device
+    return wire.find_device(name, ModbusSlave, KIND)
 
 
 simdevices.register_device(KIND, create)

@@ -279,6 +279,17 @@ def device_links(name: str) -> list[Link]:
         return list(_device_links.get(name, ()))
 
 
+def find_device(name: str, cls: type, kind: str):
+    """The device of class ``cls`` at the far end of the open ``sim://``
+    link ``name`` (the newest, when several ports have opened one of that
+    name); LookupError when there is none."""
+    links = device_links(name)
+    device = links[-1].device if links else None
+    if not isinstance(device, cls):
+        raise LookupError(f"no open sim:// link {name!r} to a {kind} device")
+    return device
+
+
 class PortEnd:
     """A port's end of a link; every method takes the port's clock reading."""
 
