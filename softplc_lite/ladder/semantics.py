@@ -214,14 +214,19 @@ class Machine:
         self.store(math.sqrt(abs(v)), d, i)
 
     def logic(self, value: int, d: array, i: int) -> None:
-        """Bitwise results: always 16 bits, never overflow."""
-        value = signed16(value)
+        """Bitwise results: always 16 bits, never overflow. (signed16 and
+        flags written out: a ladder CRC loop runs this for every byte.)"""
+        value &= 0xFFFF
+        if value > 0x7FFF:
+            value -= 0x10000
         d[i] = value
-        self.flags(False, False, value == 0, value < 0)
+        s = self.s
+        s[0] = (s[0] & -16) | ((value == 0) << 2) | ((value < 0) << 3)
 
     def clear(self, d: array, i: int) -> None:
         d[i] = 0
-        self.flags(False, False, True, False)
+        s = self.s
+        s[0] = (s[0] & -16) | 4  # Z
 
     def power(self, a, b):
         try:
