@@ -172,6 +172,15 @@ def test_programs_dir_executors_agree(path):
 # Cases the random programs found, or could find only rarely, kept as
 # regression tests: each must run the same on both executors.
 REGRESSIONS = {
+    # The compiler's fast paths for N12:[N13:3], O:[N7:1]/[N7:2] and N[N9:0]:[N9:1]
+    # (fixed shapes of indirect address) agree with the general resolver,
+    # faults included: a file number naming no file or one of another type,
+    # an element or a bit number out of range.
+    "fast-file-indirect": "DATA N9 3 = 10 2 0\nDATA N10 3 = 5 6 7\nDATA F11 1\nADD N[N9:0]:[N9:1] 1 N9:2\n"
+                          "ADD N9:1 1 N9:1\nEQU N9:1 4 MOV 11 N9:0\n",
+    "fast-file-indirect-none": "DATA N9 2 = 10 0\nDATA N10 2\nMOV N[N9:0]:[N9:1] N7:0\nADD N9:0 1 N9:0\n",
+    "fast-element-bit": "DATA N9 2 = 0 14\nXIC I:0/0 OTE O:[N9:0]/[N9:1]\nADD N9:1 1 N9:1\nXIC O:[N9:0]/[N9:1] OTE B3/0\n",
+    "fast-element-range": "DATA N9 1 = 1\nDATA N10 3\nMOV N9:0 N10:[N9:0]\nADD N9:0 1 N9:0\n",
     # An out-of-range OTL/OTU address faults even on a false rung (as OTE, XIC do).
     "otl-false-rung": "DATA N9 1 = 70\nXIC B3/1 OTL B3/[N9:0]\n",
     "otu-false-rung": "DATA N9 1 = 70\nXIC B3/1 OTU N7:[N9:0]/1\n",

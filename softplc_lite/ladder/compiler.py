@@ -553,12 +553,15 @@ def _fast_resolver(table: DataTable, addr: Address, slow):
     general resolver: the pointer words' arrays are bound once (arrays grow
     in place), and only an out-of-range number takes ``slow``, which faults
     with the full message. None when ``addr`` has another shape."""
-    if addr.indexed or not isinstance(addr.file, int) or not isinstance(addr.element, Address):
+    if addr.indexed or not isinstance(addr.element, Address):
         return None
     try:
-        f = table.file(addr.file)
         ed, ei = table.word_ref(addr.element)
         bd, bi = table.word_ref(addr.bit) if isinstance(addr.bit, Address) else (None, 0)
+        if isinstance(addr.file, Address):
+            fd, fi = table.word_ref(addr.file)
+            return _file_indirect(table, addr, slow, fd, fi, ed, ei) if bd is None else None
+        f = table.file(addr.file)
     except (DataTableError, AddressRangeError):
         return None
     if f.ftype is not addr.ftype:
@@ -582,6 +585,25 @@ def _fast_resolver(table: DataTable, addr: Address, slow):
             if e < 0 or (e + 1) * wpe > len(data) or not 0 <= b < 16:
                 return slow()
             return data, e * wpe + offset, masks[b]
+    return locate
+
+
+def _file_indirect(table: DataTable, addr: Address, slow, fd, fi, ed, ei):
+    """``N[N13:15]:[N13:11]``: the file number from a word too; the file is
+    looked up each time (files are created, never replaced), the rest as
+    the fast path above; a bit number from a word takes the general path."""
+    files = table._files
+    ftype = addr.ftype
+    wpe = ftype.words_per_element
+    offset = ftype.members_by_name[addr.member].offset if addr.member is not None else 0
+    mask = bit_mask(addr.bit) if addr.bit is not None else None
+
+    def locate():
+        f = files.get(fd[fi])
+        e = ed[ei]
+        if f is None or f.ftype is not ftype or e < 0 or (e + 1) * wpe > len(f.data):
+            return slow()
+        return f.data, e * wpe + offset, mask
     return locate
 
 
