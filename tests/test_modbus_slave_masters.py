@@ -23,6 +23,7 @@ from softplc_lite.runner import RunOptions, Runner
 
 from modbmast_apps import serial_xml, status, write_app
 from modbus_slave_app import MASTER_APP, SLAVE_APP, copy_app
+from reference_checks import crc16_modbus_ref, rtu_frame as frame
 
 _names = itertools.count()
 
@@ -31,19 +32,6 @@ def link_name() -> str:
     return f"mbs-masters-{next(_names)}"
 
 
-def crc16(data: bytes) -> int:
-    crc = 0xFFFF
-    for byte in data:
-        crc ^= byte
-        for _ in range(8):
-            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
-    return crc
-
-
-def frame(hex_text: str) -> bytes:
-    data = bytes.fromhex(hex_text)
-    crc = crc16(data)
-    return data + bytes([crc & 0xFF, crc >> 8])
 
 
 def signed(value: int) -> int:
@@ -133,7 +121,7 @@ def replies(sent: list[bytes], received: list[bytes]) -> list[bytes]:
         if len(reply) < reply_length(request, reply[1]):
             assert index == len(sent) - 1, reply.hex(" ")  # only the last may be cut short
             break
-        assert crc16(reply) == 0, reply.hex(" ")
+        assert crc16_modbus_ref(reply, 0xFFFF) == 0, reply.hex(" ")
         out.append(reply)
     assert pos == len(stream), stream[pos:].hex(" ")  # nothing after the last reply
     assert len(out) >= len(sent) - 1

@@ -44,6 +44,7 @@ from softplc_lite.runner import RunOptions, Runner
 
 from modbus_slave_app import SLAVE_APP, copy_app
 from ptypair import PtyPair, require_socat
+from reference_checks import rtu_frame as frame
 
 logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
 
@@ -56,20 +57,6 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # -- the protocol, independently of softplc_lite ---------------------------------------------------
 
-def crc16(data: bytes) -> int:
-    crc = 0xFFFF
-    for byte in data:
-        crc ^= byte
-        for _ in range(8):
-            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
-    return crc
-
-
-def frame(hex_text: str) -> bytes:
-    """The bytes of ``hex_text`` with their CRC appended, low byte first."""
-    data = bytes.fromhex(hex_text)
-    crc = crc16(data)
-    return data + bytes([crc & 0xFF, crc >> 8])
 
 
 def pack_bits(bits) -> bytes:
