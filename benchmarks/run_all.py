@@ -1,5 +1,5 @@
-"""Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports, the Modbus RTU master, MODBMAST, the watch
-view), each in its own process, and summarize.
+"""Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports, the Modbus RTU master, MODBMAST, the
+Modbus RTU slave in ladder, the watch view), each in its own process, and summarize.
 
     python benchmarks/run_all.py
 
@@ -20,7 +20,7 @@ import _common as C
 
 BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_comgenius_format",
-    "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_watch",
+    "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_watch",
 )
 
 
@@ -144,6 +144,19 @@ def main() -> int:
                      f"[{s['idle']['verdict']}], {s['mixed']['scan_10ms']['us_per_transaction']:.1f} us/transaction "
                      f"at 10 ms [{s['verdict_transaction']}] ({s['mixed']['scan_1ms']['us_per_transaction']:.1f} at "
                      f"1 ms), {s['memory']['bytes_per_request']:,} B/request [{s['memory']['verdict']}]")
+
+    mbs = load("bench_modbus_slave")
+    if mbs:
+        p, sc = mbs["pty"], mbs["scan"]
+        tps, su = p["transactions_per_s"], sc["scan_us"]
+        gaps = ", ".join(f"{r['baud']} {r['gap_ms']:.2f} ms ({r['ratio_gap_over_t35']:.2f}x)"
+                         for r in mbs["wire"]["rows"] if r["registers"] == 1)
+        lines.append(f"mbslave   pty/s: ladder {tps['ladder']:,}, at 1 ms scans {tps['ladder 1ms']:,}, pymodbus server "
+                     f"{tps['pymodbus']:,} (sync client): {p['ratios']['ladder/pymodbus']:.2f}x [{p['verdict']} >= "
+                     f"{p['target_ladder_over_pymodbus']}], {p['ratios']['ladder 1ms/pymodbus']:.2f}x; sim gap after "
+                     f"the request (vs 3.5 chars): {gaps}")
+        lines.append(f"          scan us: empty app {su['empty']:.1f}, slave idle {su['idle']:.1f}, serving read 1 "
+                     f"{su['read 1']:,.0f}, read 125 {su['read 125']:,.0f}, write 123 {su['write 123']:,.0f}")
 
     watch = load("bench_watch")
     if watch:
