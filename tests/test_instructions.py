@@ -803,3 +803,10 @@ def test_neutral_text_runs_like_mnemonic(run):
     a = run('XIC B3/0 BST XIO B3/1 NXB XIC B3/2 BND OTE O:0/0\nCPT N7:0 "N7:1 * 2 + 5"', values=values)
     b = run("XIC(B3/0)[XIO(B3/1),XIC(B3/2)]OTE(O:0/0);\nCPT(N7:0, N7:1 * 2 + 5);", values=values)
     assert a.table == b.table and a.table.read("O:0/0") == 1 and a.table.read("N7:0") == 25
+
+
+def test_a_minor_fault_after_a_jsr_in_the_same_rung_names_the_callers_rung(run):
+    # The JSR's subroutine ran rungs of file 3; the overflow after it is in file 2, rung 1.
+    e = run("MOV 1 N7:1\nJSR 3 ADD 32767 N7:1 N7:0\nFILE 3\nSBR\nMOV 2 N7:2\nMOV 3 N7:3\n")
+    assert e.table.read("S:17/0") == 1
+    assert (e.table.read("S:103"), e.table.read("S:104")) == (2, 1)

@@ -341,6 +341,9 @@ class Engine:
         rungs = compiled.rungs
         m = self.machine
         saved_zone = zone[0]
+        # A JSR runs inside its caller's rung: where the caller stands is put
+        # back on return, so a minor fault later in that rung names it.
+        saved_at = (m.file, m.rung)
         zone[0] = True
         i = 0
         count = len(rungs)
@@ -375,6 +378,7 @@ class Engine:
             raise fault from exc
         finally:
             zone[0] = saved_zone
+            m.file, m.rung = saved_at
 
     def _jsr(self, number: int) -> None:
         self._depth += 1
