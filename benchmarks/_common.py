@@ -134,6 +134,17 @@ def write_results(name: str, figures: dict) -> Path:
     return path
 
 
+def save_figures(name: str, figures: dict, quick: bool, json_path: str | None) -> None:
+    """What every benchmark does at its end: the results file (not for a
+    --quick run) and, when asked, a copy of the figures at ``json_path``."""
+    if not quick:
+        print(f"wrote {write_results(name, figures)}")
+    if json_path:
+        doc = {"benchmark": name, "environment": environment(), **figures}
+        Path(json_path).write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
+        print(f"wrote {json_path}")
+
+
 def summarize_ns(samples: list[int]) -> dict:
     return {
         "best_ns": min(samples),

@@ -102,7 +102,6 @@ import argparse
 import cProfile
 import gc
 import io
-import json
 import logging
 import pstats
 import shutil
@@ -828,12 +827,7 @@ def main() -> int:
           f"{m1['us_per_transaction'] * (1 - sh['simulated_slaves']):.1f} us per transaction")
     print(f"  3c. memory: {mem['bytes_per_request']:,} bytes per request [{mem['verdict']} <= "
           f"{TARGET_BYTES_PER_REQUEST:,}]")
-    if not quick:
-        print(f"wrote {C.write_results('bench_modbmast', figures)}")
-    if args.json:
-        doc = {"benchmark": "bench_modbmast", "environment": C.environment(), **figures}
-        Path(args.json).write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
-        print(f"wrote {args.json}")
+    C.save_figures("bench_modbmast", figures, quick, args.json)
     return 0
 
 

@@ -48,11 +48,9 @@ reported, not failed); exits 0, or 1 when socat is missing or a check fails.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 import time
-from pathlib import Path
 
 import _common as C
 
@@ -173,12 +171,7 @@ def main() -> int:
           + ", ".join(f"{k} {su[k]:,.0f} us ({scan['ratio_over_idle'][k]:.0f}x idle)" for k in KINDS))
     if left:
         print(f"warning: socat processes left: {left}", file=sys.stderr)
-    if not quick:
-        print(f"wrote {C.write_results('bench_modbus_slave', figures)}")
-    if args.json:
-        doc = {"benchmark": "bench_modbus_slave", "environment": C.environment(), **figures}
-        Path(args.json).write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
-        print(f"wrote {args.json}")
+    C.save_figures("bench_modbus_slave", figures, quick, args.json)
     return 0
 
 
