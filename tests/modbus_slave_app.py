@@ -39,6 +39,14 @@ def copy_app(source: Path, target: Path, baud: int | None = None) -> Path:
     return target
 
 
+def slave_runner(target: Path, baud: int | None = None, **options) -> Runner:
+    """A copy of the slave app at ``target``, run fresh by a Runner in RUN
+    (no scan yet); ``options`` are RunOptions fields (executor, sets, ports)."""
+    runner = Runner(load_app(copy_app(SLAVE_APP, target, baud)), RunOptions(fresh=True, **options))
+    runner.engine.set_mode(Mode.RUN)
+    return runner
+
+
 def link_name(prefix: str = "mbs") -> str:
     return f"{prefix}{next(_links)}"
 
@@ -50,15 +58,13 @@ class WireSlave:
     def __init__(self, tmp_path: Path, executor: str = "compiled", baud: int = 19200, sets: tuple[str, ...] = (),
                  name: str | None = None) -> None:
         self.link = link_name()
-        app = copy_app(SLAVE_APP, tmp_path / (name or self.link), baud)
-        self.runner = Runner(load_app(app), RunOptions(fresh=True, executor=executor, sets=sets,
-                                                       ports=(f"0=sim://{self.link}",)))
+        self.runner = slave_runner(tmp_path / (name or self.link), baud, executor=executor, sets=sets,
+                                   ports=(f"0=sim://{self.link}",))
         self.engine = self.runner.engine
         self.table = self.engine.table
         self.port = serial.serial_for_url(f"sim://{self.link}", baudrate=baud)
         self.port.set_clock(lambda: self.engine.clock.now_ms * 1_000_000)
         self.char_ns = char_time_ns(baud)
-        self.engine.set_mode(Mode.RUN)
         self.engine.scan()  # first pass: file 50 builds the CRC table
 
     def transact(self, frame: bytes, limit_ms: int = 400) -> bytes | None:

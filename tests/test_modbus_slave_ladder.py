@@ -18,9 +18,9 @@ from softplc_lite.datatable.table import to_signed
 from softplc_lite.ladder.engine import Mode
 from softplc_lite.modbus.packing import pack_bits
 from softplc_lite.ports.modbus_master import find_master
-from softplc_lite.ports.modbus_slave import ModbusSlave, initial_value, respond, with_crc
+from softplc_lite.ports.modbus_slave import ModbusSlave, respond, with_crc
 
-from modbus_slave_app import SLAVE_APP, WireSlave, copy_app
+from modbus_slave_app import WireSlave, slave_runner
 
 SIZE = 200  # every table of the reference slave; the ladder's limits are set to match
 
@@ -235,17 +235,10 @@ def test_the_reply_waits_for_the_quiet_line_and_no_longer_than_a_scan_or_two(tmp
 def test_both_executors_serve_the_simulated_master_alike(tmp_path):
     tables = []
     for executor in ("compiled", "reference"):
-        s = WireSlave(tmp_path, executor=executor, name=executor)
-        s.port.close()  # the test's end goes; a simulated master takes the line instead
-        s.engine.close()
-        from softplc_lite.app import load_app
-        from softplc_lite.runner import RunOptions, Runner
-
         link = f"exec-{executor}"
-        r = Runner(load_app(tmp_path / executor), RunOptions(
-            fresh=True, executor=executor, ports=(f"0=sim://{link}?device=modbus_master&period_ms=5",)))
+        r = slave_runner(tmp_path / executor, executor=executor,
+                         ports=(f"0=sim://{link}?device=modbus_master&period_ms=5",))
         try:
-            r.engine.set_mode(Mode.RUN)
             r.engine.run(1500)
             master = find_master(link)
             assert master.sent > 80 and master.bad == 0 and master.timeouts == 0, master
@@ -260,12 +253,8 @@ def test_both_executors_serve_the_simulated_master_alike(tmp_path):
 def test_the_app_out_of_the_box(tmp_path):
     """softplc run programs/modbus_slave: a simulated master polls it; every
     reply is right."""
-    from softplc_lite.app import load_app
-    from softplc_lite.runner import RunOptions, Runner
-
-    r = Runner(load_app(copy_app(SLAVE_APP, tmp_path / "app")), RunOptions(fresh=True))
+    r = slave_runner(tmp_path / "app")
     try:
-        r.engine.set_mode(Mode.RUN)
         r.engine.run(3000)
         master = find_master("modbus-slave")
         assert master.sent == 150 and master.bad == 0 and master.timeouts == 0
@@ -281,18 +270,13 @@ def test_a_request_that_arrives_whole_between_two_scans_is_served(tmp_path):
     """On a fast line (a pty, a TCP serial server) the next request can be
     complete before the slave's next scan. Same length as the last one, the
     receive count looks unchanged: the slave must still see a new frame."""
-    from softplc_lite.app import load_app
-    from softplc_lite.runner import RunOptions, Runner
-
-    link = "instant-line"
-    r = Runner(load_app(copy_app(SLAVE_APP, tmp_path / "app")),
-               RunOptions(fresh=True, ports=(f"0=sim://{link}?rate=unlimited",)))
     import serial
 
+    link = "instant-line"
+    r = slave_runner(tmp_path / "app", ports=(f"0=sim://{link}?rate=unlimited",))
     master = serial.serial_for_url(f"sim://{link}?rate=unlimited", baudrate=19200)
     master.set_clock(lambda: r.engine.clock.now_ms * 1_000_000)
     try:
-        r.engine.set_mode(Mode.RUN)
         r.engine.scan()
         for k in range(5):
             r.table.write("N10:0", 100 + k)
