@@ -67,8 +67,6 @@ import time
 
 import _common as C
 
-if str(C.REPO / "tests") not in sys.path:
-    sys.path.insert(1, str(C.REPO / "tests"))  # for ptypair (the tests' socat helper)
 
 import serial  # noqa: E402
 
@@ -76,7 +74,8 @@ from ptypair import PtyPair, SocatMissing  # noqa: E402
 from softplc_lite.datatable import DataTable  # noqa: E402
 from softplc_lite.ladder import Engine, Mode, load_text  # noqa: E402
 from softplc_lite.ladder.engine import SimulatedClock  # noqa: E402
-from softplc_lite.tlm.comgenius import ComGenius, urlhandler  # noqa: E402
+from softplc_lite.ports import urlhandler  # noqa: E402
+from softplc_lite.tlm.comgenius import ComGenius  # noqa: E402
 from softplc_lite.tlm.comgenius.config import parse_config  # noqa: E402
 from softplc_lite.tlm.comgenius.params import ValueParam  # noqa: E402
 from softplc_lite.tlm.comgenius.printf import format_text  # noqa: E402
