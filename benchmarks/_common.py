@@ -18,9 +18,11 @@ HERE = Path(__file__).resolve().parent
 RESULTS = HERE / "results"
 REPO = HERE.parent
 
-# Let the scripts run from a checkout even when the package is not installed.
-if str(REPO) not in sys.path:
-    sys.path.insert(1, str(REPO))
+# Let the scripts run from a checkout even when the package is not installed,
+# and import the tests' helpers (ptypair, modbus_peer, the apps' test helpers).
+for _path in (REPO, REPO / "tests"):
+    if str(_path) not in sys.path:
+        sys.path.insert(1, str(_path))
 
 # -- the standard table: 100 N x 1000, 20 ST x 1000, 10 F x 1000 ---------------
 

@@ -114,8 +114,6 @@ from pathlib import Path
 
 import _common as C
 
-if str(C.REPO / "tests") not in sys.path:
-    sys.path.insert(1, str(C.REPO / "tests"))  # ptypair, modbus_peer, modbmast_apps (the tests' helpers)
 
 from modbmast_apps import serial_xml, write_app
 from modbus_peer import PeerProcess

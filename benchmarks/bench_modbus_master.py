@@ -60,8 +60,6 @@ import time
 
 import _common as C
 
-if str(C.REPO / "tests") not in sys.path:
-    sys.path.insert(1, str(C.REPO / "tests"))  # ptypair, modbus_peer (the tests' helpers)
 
 from pymodbus_clients import async_reads, sync_reads  # noqa: E402
 

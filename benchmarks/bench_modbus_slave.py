@@ -54,8 +54,6 @@ import time
 
 import _common as C
 
-if str(C.REPO / "tests") not in sys.path:
-    sys.path.insert(1, str(C.REPO / "tests"))  # ptypair, modbus_peer, modbus_slave_app (the tests' helpers)
 
 from modbus_slave_common import MS, Apps, CheckFailed, frames, transact, wire_slave
 from modbus_slave_scan import IDLE_SCANS, KINDS, SCAN_ROUNDS, SCAN_TX, bench_scan

@@ -2,7 +2,7 @@
 holds, the request and reply frames, the app directories, and the slave on
 simulated time (``WireSlave``) with a transaction timed scan by scan.
 
-The scripts are run as ``python benchmarks/NAME.py``; this module puts
+The scripts are run as ``python benchmarks/NAME.py``; importing _common puts
 tests/ on ``sys.path`` for the tests' helpers (ptypair, modbus_peer,
 modbus_slave_app).
 """
@@ -11,16 +11,11 @@ from __future__ import annotations
 
 import shutil
 import struct
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-import _common as C
-
-if str(C.REPO / "tests") not in sys.path:
-    sys.path.insert(1, str(C.REPO / "tests"))  # ptypair, modbus_peer, modbus_slave_app (the tests' helpers)
-
+import _common  # noqa: F401  (tests/ on sys.path)
 from modbus_slave_app import WireSlave
 
 from softplc_lite.ports.modbus_slave import with_crc

@@ -51,8 +51,6 @@ from pathlib import Path
 
 import _common as C
 
-if str(C.REPO / "tests") not in sys.path:
-    sys.path.insert(1, str(C.REPO / "tests"))  # ptypair, modbus_peer, modbus_slave_app (the tests' helpers)
 
 import serial
 from modbus_peer import PeerProcess
