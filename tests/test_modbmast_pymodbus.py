@@ -140,6 +140,7 @@ def test_every_function_against_pymodbus_and_a_slave_that_comes_back(tmp_path, l
         assert [t.read(f"N9:{k}") for k in (90, 91)] == [11, 22]
         assert [t.read(f"N7:{k}") for k in (50, 51)] in ([signed(initial_value(k)) for k in (80, 81)],)
         # an exception, a missing slave, the fault map, the status blocks
+        runner.engine.scan()  # slave 3 may have gone Not Present after this scan's ladder copied the map
         s1, s3 = status(runner, 1, 1), status(runner, 1, 3)
         assert s1.exceptions >= 1 and s1.present  # 198..201 of 0..199: exception 02, a reply all the same
         assert s3.words()[3:] == (3, NO_REPLY) and not s3.present
