@@ -283,20 +283,36 @@ def _file_number(sc: _Scanner, ftype: FileType) -> Part:
             f"{ftype.title} ({ftype.letter}) files need a file number 3..{MAX_FILE_NUMBER}, "
             f"as in {_example(ftype)}"
         )
-    number = int(digits)
+    number = _to_int(digits)
     if ftype.fixed_number is not None:
         if number != ftype.fixed_number:
             raise sc.error(
                 f"the {ftype.title} file is {ftype.letter}{ftype.fixed_number}, not "
-                f"{ftype.letter}{digits}", pos,
+                f"{ftype.letter}{_shown(digits)}", pos,
             )
         return number
     if number < 3 or number > MAX_FILE_NUMBER:
         raise sc.error(
-            f"file number {digits} out of range: {ftype.letter} files are numbered "
+            f"file number {_shown(digits)} out of range: {ftype.letter} files are numbered "
             f"3..{MAX_FILE_NUMBER} (0, 1, 2 are O, I and S)", pos,
         )
     return number
+
+
+# No address number needs more digits than this; a longer run of digits is
+# out of range without being converted (Python refuses to convert more than
+# 4,300 digits, and converting is quadratic in the digits).
+_MAX_DIGITS = 9
+
+
+def _to_int(digits: str, base: int = 10) -> int:
+    """``digits`` as an int, or a value past every limit when too long."""
+    return int(digits, base) if len(digits) <= _MAX_DIGITS else 10 ** _MAX_DIGITS
+
+
+def _shown(digits: str) -> str:
+    """A number as a message quotes it: never thousands of characters."""
+    return digits if len(digits) <= 20 else f"{digits[:8]}...({len(digits)} digits)"
 
 
 def _indirect(sc: _Scanner) -> "Address":
@@ -322,11 +338,11 @@ def _number(sc: _Scanner, what: str, octal: bool, limit: int) -> int:
         bad = next((d for d in digits if d in "89"), None)
         if bad:
             raise sc.error(f"I/O {what}s are octal; '{bad}' is not an octal digit in '{digits}'", pos)
-        value = int(digits, 8)
+        value = _to_int(digits, 8)
     else:
-        value = int(digits)
+        value = _to_int(digits)
     if value > limit:
-        shown = f"{digits} (octal, = {value})" if octal else digits
+        shown = f"{digits} (octal, = {value})" if octal and len(digits) <= _MAX_DIGITS else _shown(digits)
         top = format(limit, "o") if octal else str(limit)
         raise sc.error(f"{what} {shown} out of range 0..{top}", pos)
     return value

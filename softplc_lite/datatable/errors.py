@@ -25,7 +25,8 @@ class AddressError(DataTableError):
         self.text = text
         self.position = max(0, min(position, len(text)))
         self.reason = reason
-        super().__init__(f"bad address '{text}': {reason}")
+        shown = text if len(text) <= 60 else f"{text[:40]}...({len(text)} characters)"
+        super().__init__(f"bad address '{shown}': {reason}")
 
     @property
     def column(self) -> int:

@@ -40,6 +40,7 @@ from .ast import (
     UnaryOp,
 )
 from .errors import LadderError
+from .limits import MAX_CONSTANT, MAX_NUMBER_DIGITS, limit_problem
 
 # -- the post-lexer ---------------------------------------------------------------
 
@@ -142,11 +143,21 @@ class _RungDraft:
 
 
 def _number(tok: Token) -> int | float:
-    if tok.type == "HEX":
-        return int(tok, 16)
-    if tok.type == "INT":
-        return int(tok)
-    return float(tok)
+    """A numeric token's value; NumberRangeError for one no element can hold
+    (checked on the text first: Python converts at most 4,300 digits)."""
+    text = str(tok)
+    if tok.type in ("HEX", "INT") and len(text) > MAX_NUMBER_DIGITS:
+        raise _NumberRangeError(tok, f"{text[:12]}... ({len(text)} {'characters' if tok.type == 'HEX' else 'digits'})")
+    value: int | float = int(text, 16) if tok.type == "HEX" else int(text) if tok.type == "INT" else float(text)
+    if not abs(value) <= MAX_CONSTANT:  # also catches inf from 1e999
+        raise _NumberRangeError(tok, text if len(text) <= 30 else f"{text[:12]}... ({len(text)} characters)")
+    return value
+
+
+class _NumberRangeError(Exception):
+    def __init__(self, tok: Token, shown: str) -> None:
+        self.tok = tok
+        self.shown = shown
 
 
 _CALLS = ("SQR", "ABS", "NEG", "FRD", "TOD", "LN", "LOG", "SIN", "COS", "TAN", "ASN", "ACS", "ATN", "DEG", "RAD")
@@ -177,6 +188,14 @@ class _ToAst(Transformer):
         line = item.line
         column = item.column + column_offset if line == 1 else item.column
         return Pos(source, line + line_offset, column)
+
+    def _small_int(self, tok: Token, what: str) -> int:
+        """A file number or element count; one too long to be either is
+        refused here, before Python is asked to convert thousands of digits."""
+        text = str(tok)
+        if len(text) > 9:
+            raise LadderError(self._pos(tok), f"{what} {text[:12]}... ({len(text)} digits) is out of range")
+        return int(text)
 
     # operands ------------------------------------------------------------------
     def _address(self, tok: Token) -> AddressRef:
@@ -297,7 +316,7 @@ class _ToAst(Transformer):
     def file_header(self, items):
         number = _tokens(items, "INT")[0]
         name = _tokens(items, "NAME")
-        return _Header(int(number), str(name[0]) if name else None, self._pos(items[0]))
+        return _Header(self._small_int(number, "program file number"), str(name[0]) if name else None, self._pos(items[0]))
 
     def data_decl(self, items):
         name, size = _tokens(items, "NAME", "INT")[:2]
@@ -308,7 +327,7 @@ class _ToAst(Transformer):
                     values.append(_unquote(str(v)))
             else:
                 values.append(v.value)
-        return DataDecl(str(name).upper(), int(size), values, self._pos(items[0]))
+        return DataDecl(str(name).upper(), self._small_int(size, f"DATA {name}: size"), values, self._pos(items[0]))
 
     @v_args(inline=True)
     def symbol_decl(self, name, addr, *_comment_nl):
@@ -380,12 +399,21 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
     except VisitError as e:
         if isinstance(e.orig_exc, LadderError):
             raise e.orig_exc from None
+        if isinstance(e.orig_exc, _NumberRangeError):
+            raise _range_error(e.orig_exc, builder) from None
         raise
+    except _NumberRangeError as e:
+        raise _range_error(e, builder) from None
     finally:
         builder.context = saved
     if isinstance(result, Token):  # a bare number as a whole expression
         return builder._atomize(result)
     return result
+
+
+def _range_error(e: _NumberRangeError, builder: "_ToAst") -> LadderError:
+    return LadderError(builder._pos(e.tok), f"number {e.shown} is out of range: no data table element holds "
+                       f"a value beyond +-{MAX_CONSTANT:.8g}")
 
 
 def parse_expression(text: str, pos: Pos) -> Operand:
@@ -444,6 +472,9 @@ def parse_program(
             if item.comment:
                 rung_comment = f"{rung_comment}\n{item.comment}" if rung_comment else item.comment
             elements = item.elements if item.elements is not None else _group(item.tokens, instructions, item.pos)
+            problem = limit_problem(elements)
+            if problem is not None:
+                raise LadderError(problem[0].pos, problem[1])
             file_for_rungs(item.pos).rungs.append(Rung(elements, rung_comment, item.pos))
         comments = []
     return program

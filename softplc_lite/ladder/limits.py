@@ -1,0 +1,64 @@
+"""The documented limits of the ladder language (docs/language.md, "Limits").
+
+Every stage after the parser (validate, compile, the reference interpreter,
+fmt, the watch view) walks rungs and expressions recursively; the parser
+refuses anything deeper than these limits, with the file, line and column,
+so no later stage can reach Python's recursion limit or CPython's own limits
+on generated code (200 nested parentheses). The figures are softplc's
+choices, far above what real ladder uses; tests/test_hardening.py runs
+every stage at exactly these depths.
+"""
+
+from __future__ import annotations
+
+from .ast import BinOp, Branch, Call, Instruction, UnaryOp
+
+MAX_BRANCH_DEPTH = 32  # branches inside branches
+MAX_EXPRESSION_DEPTH = 64  # operators and functions applied to each other's results
+MAX_CONSTANT = 3.4028234663852886e38  # the largest F element; no element holds a larger value
+MAX_NUMBER_DIGITS = 40  # a literal with more digits is out of range before it is converted
+
+_EXPRESSION_NODES = (BinOp, UnaryOp, Call)
+
+
+def expression_depth(node) -> int:
+    """Operator levels in an expression tree (an address or constant is 0);
+    iterative, so any depth is measured safely."""
+    deepest = 0
+    stack = [(node, 0)]
+    while stack:
+        node, depth = stack.pop()
+        if not isinstance(node, _EXPRESSION_NODES):
+            continue
+        depth += 1
+        deepest = max(deepest, depth)
+        if isinstance(node, BinOp):
+            stack.append((node.left, depth))
+            stack.append((node.right, depth))
+        elif isinstance(node, UnaryOp):
+            stack.append((node.operand, depth))
+        else:
+            stack.append((node.arg, depth))
+    return deepest
+
+
+def limit_problem(elements) -> tuple[object, str] | None:
+    """The first element of a rung over a limit, and what is wrong; None
+    when the rung is within every limit. Iterative."""
+    stack = [(elements, 0)]
+    while stack:
+        series, depth = stack.pop()
+        for el in series:
+            if isinstance(el, Branch):
+                if depth + 1 > MAX_BRANCH_DEPTH:
+                    return el, (f"branches nested more than {MAX_BRANCH_DEPTH} levels deep "
+                                f"(the limit is {MAX_BRANCH_DEPTH})")
+                stack.extend((leg, depth + 1) for leg in el.legs)
+            elif isinstance(el, Instruction):
+                for op in el.operands:
+                    if isinstance(op, _EXPRESSION_NODES):
+                        levels = expression_depth(op)
+                        if levels > MAX_EXPRESSION_DEPTH:
+                            return op, (f"expression nested {levels} levels deep; the limit is "
+                                        f"{MAX_EXPRESSION_DEPTH} (split it over several CPT instructions)")
+    return None
