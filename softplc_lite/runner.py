@@ -2,8 +2,10 @@
 
 Start: program initial values (DATA, timer/counter presets); then the
 retentive snapshot if there is one (unless fresh), otherwise the app's
-datatable.json; then --load files and --set values. Stop: save the
-snapshot. While running, the snapshot is also saved every few seconds.
+datatable.json; then --load files and --set values. While running, the
+snapshot is saved between scans every [retentive] save_ms (retentive.py);
+storage trouble (a save, a --record trace) is a minor fault, not a stop.
+Stop: the final save (``finish``).
 """
 
 from __future__ import annotations
@@ -18,10 +20,11 @@ from typing import Callable
 from .app import App
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
+from .ladder import status as S
 from .ladder.engine import Engine, Mode, RealClock, SimulatedClock
 from .ports import parse_port_overrides
-
-SAVE_EVERY_S = 5.0
+from .ports.recorder import MAX_PENDING
+from .retentive import Retentive, StorageFaults
 
 
 def parse_assignment(text: str, symbols=None) -> tuple[object, object]:
@@ -32,9 +35,12 @@ def parse_assignment(text: str, symbols=None) -> tuple[object, object]:
     name, _, raw = text.partition("=")
     name = name.strip()
     addr = symbols[name].address if symbols and name in symbols else parse_address(name)
+    problem = jsonio.json_limit_problem(raw)
+    if problem is not None:
+        raise DataTableError(f"--set {name}: the value at {problem}")
     try:
         value = json.loads(raw)
-    except json.JSONDecodeError:
+    except (ValueError, RecursionError):
         value = raw
     return addr, value
 
@@ -70,6 +76,10 @@ class Runner:
                              modules=app.modules, module_options=options.module_options())
         for warning in self.engine.module_warnings:
             self.log(f"warning: {warning}")
+        self.faults = StorageFaults(self.engine.s, self.log)
+        self.recorder = self.engine.recorder  # kept: the engine lets go of it when it closes
+        if self.recorder is not None:
+            self.recorder.on_problem = self._record_problem
         self.restored_from: Path | None = None
         path = app.snapshot_path
         if path is not None and not options.fresh:
@@ -86,16 +96,51 @@ class Runner:
         for text in options.sets:
             addr, value = parse_assignment(text, app.program.symbols)
             self.table.write(addr, value)
-        self._last_save = time.monotonic()
+        # Removes the temp files of a save a killed run left; saves from the first scan on.
+        self.retentive = Retentive(path, settings.save_ms, self.faults) if path is not None else None
 
     @property
     def realtime(self) -> bool:
         return self.options.realtime
 
     def save(self) -> None:
-        if self.app.snapshot_path is not None:
-            snapshot.save(self.table, self.app.snapshot_path)
-        self._last_save = time.monotonic()
+        """The final save (durable) once scanning has stopped; OSError, with
+        the path and the reason, when it fails (``finish`` reports instead)."""
+        problem = self.retentive.finish(self.table) if self.retentive is not None else None
+        if problem is not None:
+            raise OSError(problem)
+
+    def finish(self) -> list[str]:
+        """The end of a run, after ``engine.close()``: the final save, and
+        whether the --record trace is complete. Each problem is logged as an
+        error (with its path and reason) and returned; the minor fault is
+        set in the table (S:17/4, S:102)."""
+        problems = []
+        if self.retentive is not None:
+            problem = self.retentive.finish(self.table)
+            if problem is not None:
+                problems.append(problem)
+        rec = self.recorder
+        if rec is not None and not rec.complete:
+            lost = f"; {rec.dropped} events were not recorded" if rec.dropped else ""
+            problems.append(f"--record: the trace {rec.path} is incomplete: "
+                            f"{rec.problem or 'it could not be written for a while'}{lost}")
+        for problem in problems:
+            self.log(f"error: {problem}")
+        return problems
+
+    def _record_problem(self, problem: str | None) -> None:
+        """The recorder's report, from the scan thread: a failed trace write,
+        or (None) the first good one after."""
+        rec = self.recorder
+        if problem is None:
+            lost = f" ({rec.dropped} events were not recorded; a comment in the trace says where)" \
+                if rec.dropped else ""
+            self.faults.ok("record", f"--record: {rec.path} is written again{lost}")
+        else:
+            self.faults.failed("record", S.MINOR_CODE_RECORD, f"--record: {problem}",
+                               f"; the run goes on, the trace waits in memory (up to "
+                               f"{MAX_PENDING // (1024 * 1024)} MB) and is written when the file takes it")
 
     def run(self, scans: int | None = None, on_scan: Callable[[Engine], None] | None = None) -> None:
         """Run in RUN mode for ``scans`` scans, or until Ctrl-C (then return
@@ -105,6 +150,8 @@ class Runner:
             engine.set_mode(Mode.RUN)
         period = engine.settings.scan_ms / 1000 if self.realtime else 0.0
         next_at = time.monotonic()
+        retentive = self.retentive
+        save_at = retentive.due if retentive is not None else float("inf")
         done = 0
         try:
             while scans is None or done < scans:
@@ -115,8 +162,9 @@ class Runner:
                 if engine.mode is Mode.FAULTED:
                     break
                 now = time.monotonic()
-                if now - self._last_save >= SAVE_EVERY_S and self.app.snapshot_path is not None:
-                    self.save()
+                if now >= save_at:  # between two scans: the snapshot is one whole scan's table
+                    retentive.tick(self.table, now)
+                    save_at = retentive.due
                 if period > 0:
                     next_at += period
                     delay = next_at - time.monotonic()

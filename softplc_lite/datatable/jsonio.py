@@ -21,9 +21,12 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from array import array
 from typing import Any
 
+from ..errors import LocatedError
+from ..textfile import read_text
 from .errors import DataTableError
 from .files import DataFile
 from .filetypes import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, FileType
@@ -103,12 +106,69 @@ def dumps(table: DataTable) -> str:
 # -- import -----------------------------------------------------------------
 
 
-def loads(text: str, source: str = "<json>") -> dict[str, Any]:
-    """Parse JSON text, reporting a syntax error with source, line and column."""
+# JSON numbers with more digits than this hold no data table value; they are
+# refused before Python converts them (it converts at most 4,300 digits, in
+# quadratic time). Nesting deeper than MAX_JSON_DEPTH is refused as well: no
+# data table document nests more than three levels.
+MAX_JSON_DIGITS = 40
+MAX_JSON_DEPTH = 100
+_JSON_TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"|[-0-9][0-9]{%d,}|[\[\]{}]' % MAX_JSON_DIGITS)
+
+
+class _HugeNumber(ValueError):
+    pass
+
+
+def _json_int(text: str) -> int:
+    if len(text.lstrip("-")) > MAX_JSON_DIGITS:
+        raise _HugeNumber(text)
+    return int(text)
+
+
+def parse_json(text: str, source: str = "<json>") -> Any:
+    """Any JSON value, with the errors a user can act on: a syntax error at
+    its line and column, a number too long or nesting too deep located too;
+    never a RecursionError or Python's int-conversion ValueError."""
+    problem = json_limit_problem(text)
+    if problem is not None:
+        raise DataTableJSONError(f"{source}:{problem}")
     try:
-        doc = json.loads(text)
+        return json.loads(text, parse_int=_json_int)
     except json.JSONDecodeError as e:
         raise DataTableJSONError(f"{source}:{e.lineno}:{e.colno}: {e.msg}") from None
+    except (_HugeNumber, RecursionError):  # a case json_limit_problem missed: still a clear error
+        raise DataTableJSONError(f"{source}: a number longer than {MAX_JSON_DIGITS} digits or nesting "
+                                 f"deeper than {MAX_JSON_DEPTH} levels") from None
+
+
+def json_limit_problem(text: str) -> str | None:
+    """``line:column: message`` for the first number too long or bracket too
+    deep (outside strings), else None."""
+    depth = 0
+    for m in _JSON_TOKEN.finditer(text):
+        token = m.group()
+        if token[0] == '"':
+            continue
+        if token in "[{":
+            depth += 1
+            if depth <= MAX_JSON_DEPTH:
+                continue
+            message = f"nested more than {MAX_JSON_DEPTH} levels deep"
+        elif token in "]}":
+            depth -= 1
+            continue
+        else:
+            message = (f"number {token[:12]}... has {len(token.lstrip('-'))} digits; no data table element holds "
+                       f"a number of more than {MAX_JSON_DIGITS} digits")
+        line = text.count("\n", 0, m.start()) + 1
+        column = m.start() - (text.rfind("\n", 0, m.start()) + 1) + 1
+        return f"{line}:{column}: {message}"
+    return None
+
+
+def loads(text: str, source: str = "<json>") -> dict[str, Any]:
+    """Parse JSON text, reporting a syntax error with source, line and column."""
+    doc = parse_json(text, source)
     if not isinstance(doc, dict):
         raise DataTableJSONError(
             f"{source}: expected an object of files such as {{\"N7\": [1, 2]}}, "
@@ -131,8 +191,9 @@ def load_text(table: DataTable, text: str, source: str = "<json>") -> None:
 
 def load_file(table: DataTable, path: str) -> None:
     try:
-        with open(path, encoding="utf-8") as fh:
-            text = fh.read()
+        text = read_text(path)
+    except LocatedError as e:
+        raise DataTableJSONError(e.report()) from None
     except OSError as e:
         raise DataTableJSONError(f"{path}: cannot read: {e.strerror}") from None
     load_text(table, text, path)
@@ -164,8 +225,9 @@ def _file_key(key: str, source: str) -> tuple[FileType, int]:
         )
     if not digits and ftype.fixed_number is not None:
         return ftype, ftype.fixed_number
-    if not digits.isdigit():
-        raise DataTableJSONError(f"{source}: key {key!r}: expected a file name such as N7 or ST9")
+    if not digits.isdigit() or not digits.isascii() or len(digits) > 5:
+        shown = key if len(key) <= 30 else key[:20] + "..."
+        raise DataTableJSONError(f"{source}: key {shown!r}: expected a file name such as N7 or ST9")
     return ftype, int(digits)
 
 
