@@ -12,22 +12,26 @@ An app directory holds:
 
 from __future__ import annotations
 
+import re
 import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from .datatable import DataTableError
+from .datatable import DataTableError, jsonio
+from .errors import LocatedError
 from .display import Display, parse_display
 from .ladder.ast import Pos, Program, walk
 from .ladder.errors import LadderError
 from .ladder.instructions import BUILTIN, InstructionSet
 from .ladder.parser import parse_program, syntax_problems
-from .ladder.semantics import Settings
+from .ladder.semantics import MAX_JSR_DEPTH, Settings
 from .ladder.validate import check
+from .ladder.engine import layout_problems
 from .ports import claim_conflicts
 from .tlm.api import TLM, find_file
 from .tlm.errors import ModuleError
 from .tlm.registry import configure_modules, installed, instruction_set, load_module, load_modules
+from .textfile import read_text
 
 SETTINGS_FILE = "softplc.toml"
 DATATABLE_FILE = "datatable.json"
@@ -106,40 +110,94 @@ def read_settings_file(path: Path) -> dict:
     if not path.exists():
         return {}
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        text = read_text(path)
+    except LocatedError as e:
+        raise AppError([e]) from None
+    except OSError as e:
+        raise AppError(f"{path}: cannot read: {e.strerror}") from None
+    try:
+        doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise AppError(f"{path}: {e}") from None
+    except ValueError:  # an integer past Python's 4,300-digit conversion limit
+        m = re.search(r"[0-9_]{4000,}", text)
+        line = text.count("\n", 0, m.start()) + 1 if m else 0
+        raise AppError([LocatedError("a number too long to be any setting", str(path), line)]) from None
+    doc["__text__"] = text  # for locating a bad value (load_settings); not a section
+    return doc
+
+
+# softplc.toml settings: section -> key -> allowed values (a tuple of choices,
+# or an inclusive integer range). The ranges are what the engine can honour:
+# S:8 and S:28 are 16-bit words, and the JSR nesting the engine runs without
+# reaching Python's own recursion limit (docs/engine.md).
+SETTING_RULES: dict[str, dict[str, tuple | range]] = {
+    "math": {"overflow": ("clamp", "wrap"), "divide_by_zero": ("overflow", "fault")},
+    "scan": {"scan_ms": range(0, 32768), "watchdog_ms": range(1, 32768), "jsr_depth": range(1, MAX_JSR_DEPTH + 1)},
+    "retentive": {"save_ms": range(0, 3_600_001)},
+}
+
+
+def _setting_line(text: str, section: str, key: str | None = None) -> int:
+    """The line of ``[section]`` (or of ``key`` inside it) in a TOML text, 0
+    when not found: tomllib gives no positions for valid documents."""
+    current = None
+    for number, line in enumerate(text.splitlines(), 1):
+        stripped = line.strip()
+        if stripped.startswith("[") and "]" in stripped:
+            current = stripped[1:stripped.index("]")].strip().strip('"')
+            if key is None and current == section:
+                return number
+            continue
+        if key is not None and current == section and "=" in stripped:
+            if stripped.split("=", 1)[0].strip().strip('"') == key:
+                return number
+    return 0
 
 
 def load_settings(path: Path, doc: dict | None = None) -> Settings:
-    """The engine settings of softplc.toml (``doc``: the file already read)."""
+    """The engine settings of softplc.toml (``doc``: the file already read).
+    Every problem is listed, each with the file and line."""
     settings = Settings()
     if doc is None:
         doc = read_settings_file(path)
-    allowed = {
-        "math": {"overflow": ("clamp", "wrap"), "divide_by_zero": ("overflow", "fault")},
-        "scan": {"scan_ms": int, "watchdog_ms": int, "jsr_depth": int},
-    }
+    text = doc.get("__text__", "")
+    problems: list[LocatedError] = []
+
+    def problem(message: str, section: str, key: str | None = None) -> None:
+        problems.append(LocatedError(message, str(path), _setting_line(text, section, key)))
+
     known = {f.name for f in fields(Settings)}
     for section, values in doc.items():
-        if section == "display":  # read by load_display, once the program's symbols are known
+        if section in ("display", "__text__"):  # [display] is read by load_display, once the symbols are known
             continue
-        if section not in allowed or not isinstance(values, dict):
-            raise AppError(f"{path}: unknown section [{section}] (expected "
-                           f"{', '.join(f'[{s}]' for s in [*allowed, 'display'])})")
+        if section not in SETTING_RULES or not isinstance(values, dict):
+            problem(f"unknown section [{section}] (expected "
+                    f"{', '.join(f'[{s}]' for s in [*SETTING_RULES, 'display'])})", section)
+            continue
         for key, value in values.items():
-            rule = allowed[section].get(key)
+            rule = SETTING_RULES[section].get(key)
             if rule is None or key not in known:
-                raise AppError(f"{path}: [{section}] has no setting {key!r} "
-                               f"(settings: {', '.join(allowed[section])})")
-            if isinstance(rule, tuple):
+                problem(f"[{section}] has no setting {key!r} (settings: {', '.join(SETTING_RULES[section])})",
+                        section, key)
+            elif isinstance(rule, tuple):
                 if value not in rule:
-                    raise AppError(f"{path}: [{section}] {key} = {value!r}; expected one of "
-                                   f"{', '.join(repr(r) for r in rule)}")
-            elif not isinstance(value, int) or isinstance(value, bool) or value < (0 if key == "scan_ms" else 1):
-                raise AppError(f"{path}: [{section}] {key} = {value!r}; expected a positive integer")
-            setattr(settings, key, value)
+                    problem(f"[{section}] {key} = {_short(value)}; expected one of "
+                            f"{', '.join(repr(r) for r in rule)}", section, key)
+            elif not isinstance(value, int) or isinstance(value, bool) or value not in rule:
+                problem(f"[{section}] {key} = {_short(value)}; expected an integer from "
+                        f"{rule.start} to {rule.stop - 1}", section, key)
+            else:
+                setattr(settings, key, value)
+    if problems:
+        raise AppError(problems)
     return settings
+
+
+def _short(value: object) -> str:
+    """A config value for a message, never thousands of characters long."""
+    text = repr(value) if not isinstance(value, int) or abs(value) < 10 ** 30 else f"<{value.bit_length()}-bit integer>"
+    return text if len(text) <= 60 else text[:57] + "..."
 
 
 def load_display(path: Path, symbols=None, doc: dict | None = None) -> Display:
@@ -152,6 +210,21 @@ def load_display(path: Path, symbols=None, doc: dict | None = None) -> Display:
         return parse_display(doc["display"], str(path), symbols)
     except DataTableError as e:
         raise AppError(str(e)) from None
+
+
+def display_problems(display: Display, table, path: Path, doc: dict) -> list[LocatedError]:
+    """[display] values that the table a run starts with cannot show (an
+    element past its file's end): located in softplc.toml."""
+    text = doc.get("__text__", "")
+    found = []
+    for kind in ("status", "summary"):
+        for item in getattr(display, kind):
+            try:
+                item.read(table)
+            except DataTableError as e:
+                found.append(LocatedError(f"[display] {kind} {item.label!r}: {e}", str(path),
+                                          _setting_line(text, "display", kind) or _setting_line(text, "display")))
+    return found
 
 
 def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
@@ -180,13 +253,32 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
     parsed, errors = parse_files(files, path, instructions)
     resolved, problems = check(parsed, instructions)
     errors += problems
-    if errors or config_problems:
-        raise AppError(config_problems + sorted(errors, key=lambda e: (e.pos.source, e.pos.line, e.pos.column)))
-    warnings += [w.report() for w in _module_checks(resolved, modules)]
-    settings_doc = read_settings_file(path / SETTINGS_FILE) if is_dir else {}
-    settings = load_settings(path / SETTINGS_FILE, settings_doc)
-    display = load_display(path / SETTINGS_FILE, resolved.symbols, settings_doc)
+    if not errors:
+        # What run would refuse when it builds the table (N9 beside ST9, a
+        # DATA string that is not UCS-2): check reports it first, located.
+        table, layout = layout_problems(resolved, modules)
+        errors += layout
+    settings_problems: list = []
+    settings, display = Settings(), Display()
+    if is_dir:
+        try:
+            settings_doc = read_settings_file(path / SETTINGS_FILE)
+            settings = load_settings(path / SETTINGS_FILE, settings_doc)
+            if not errors:
+                display = load_display(path / SETTINGS_FILE, resolved.symbols, settings_doc)
+                settings_problems += display_problems(display, table, path / SETTINGS_FILE, settings_doc)
+        except AppError as e:
+            settings_problems += e.errors or [LocatedError(str(e))]
     table_json = path / DATATABLE_FILE if is_dir and (path / DATATABLE_FILE).exists() else None
+    if table_json is not None and not errors:
+        try:  # what a run without a snapshot loads: check it as well
+            jsonio.load_file(table, str(table_json))
+        except DataTableError as e:
+            settings_problems.append(LocatedError(str(e)))
+    if errors or config_problems or settings_problems:
+        raise AppError(config_problems + settings_problems
+                       + sorted(errors, key=lambda e: (e.pos.source, e.pos.line, e.pos.column)))
+    warnings += [w.report() for w in _module_checks(resolved, modules)]
     if state_dir is not None:
         state = Path(state_dir)
     else:

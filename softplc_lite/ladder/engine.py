@@ -18,11 +18,12 @@ import traceback
 from dataclasses import dataclass
 from typing import Callable
 
-from ..datatable import DataTable
+from ..datatable import DataTable, DataTableError
 from ..datatable.table import to_signed
 from . import status as S
-from .ast import MAIN_FILE, AddressRef, Program, address_refs, walk
+from .ast import MAIN_FILE, AddressRef, Pos, Program, address_refs, walk
 from .compiler import RET, EndScan, compile_file, describe
+from .errors import LadderError
 from .interpreter import interpret_file
 from .semantics import Machine, MajorFault, Settings, source_units
 
@@ -104,44 +105,97 @@ _EndScan = EndScan  # TND: end this scan now (defined with RET/TND so both execu
 Hook = Callable[["Engine"], None]
 
 
-def reference_program(program: Program, table: DataTable) -> None:
-    """Grow the table to everything the program names (and COP/FLL blocks)."""
+def reference_program(program: Program, table: DataTable, problems: list | None = None) -> None:
+    """Grow the table to everything the program names (and COP/FLL blocks).
+    With ``problems``, what the table refuses is listed there, located at
+    the declaration or instruction (softplc check), instead of raised."""
     for decl in program.data:
         letter = "ST" if decl.file.startswith("ST") else decl.file[:1]
-        table.create_file(letter, int(decl.file[len(letter):]), decl.size)
+        with _located(decl.pos, problems):
+            table.create_file(letter, int(decl.file[len(letter):]), decl.size)
     for pfile in program.files.values():
         for rung in pfile.rungs:
             for ins in walk(rung.elements):
-                for op in ins.operands:
-                    for ref in address_refs(op):
-                        table.reference(ref.address)
-                if ins.mnemonic in ("COP", "FLL") and ins.operands[1].address.is_direct:
-                    n = ins.operands[2].value
-                    dest = ins.operands[1].address
-                    for ref in ins.operands[:2]:
-                        if isinstance(ref, AddressRef) and ref.address.is_direct:
-                            # a COP source in another storage (F vs words) spans the same bytes
-                            count = source_units(n, ref.address.ftype, dest.ftype)
-                            table.reference(ref.address.with_element(ref.address.element + count - 1))
+                with _located(ins.pos, problems):
+                    _reference_instruction(ins, table)
 
 
-def initial_values(program: Program, table: DataTable) -> None:
+def _reference_instruction(ins, table: DataTable) -> None:
+    for op in ins.operands:
+        for ref in address_refs(op):
+            table.reference(ref.address)
+    if ins.mnemonic in ("COP", "FLL") and ins.operands[1].address.is_direct:
+        n = ins.operands[2].value
+        dest = ins.operands[1].address
+        for ref in ins.operands[:2]:
+            if isinstance(ref, AddressRef) and ref.address.is_direct:
+                # a COP source in another storage (F vs words) spans the same bytes
+                count = source_units(n, ref.address.ftype, dest.ftype)
+                table.reference(ref.address.with_element(ref.address.element + count - 1))
+
+
+def initial_values(program: Program, table: DataTable, problems: list | None = None) -> None:
     """What a download sets: DATA initial values, and the preset and
     accumulator operands of TON/TOF/RTO/CTU/CTD (as RSLogix 5 does)."""
     for decl in program.data:
         letter = "ST" if decl.file.startswith("ST") else decl.file[:1]
         for k, v in enumerate(decl.values):
             addr = f"{decl.file}:{k}"
-            if isinstance(v, int) and letter != "F" and v > 32767:
-                table.write_word(addr, v)
-            else:
-                table.write(addr, v)
+            with _located(decl.pos, problems, f"DATA {decl.file} value {k + 1}: "):
+                if isinstance(v, int) and letter != "F" and v > 32767:
+                    table.write_word(addr, v)
+                else:
+                    table.write(addr, v)
     for pfile in program.files.values():
         for rung in pfile.rungs:
             for ins in walk(rung.elements):
                 if ins.mnemonic in ("TON", "TOF", "RTO", "CTU", "CTD") and ins.operands[0].address.is_direct:
                     pre, acc = ins.operands[-2], ins.operands[-1]
-                    table.write(ins.operands[0].address, {"PRE": pre.value, "ACC": acc.value})
+                    with _located(ins.pos, problems):
+                        table.write(ins.operands[0].address, {"PRE": pre.value, "ACC": acc.value})
+
+
+def layout_problems(program: Program, modules=()) -> tuple[DataTable, list[LadderError]]:
+    """Build the data table a run would start with (files, sizes, initial
+    values, module blocks) and list, located, everything it refuses: so that
+    ``softplc check`` reports first whatever ``softplc run`` would refuse."""
+    table = DataTable()
+    problems: list[LadderError] = []
+    reference_program(program, table, problems)
+    initial_values(program, table, problems)
+    for module in modules:
+        where = Pos(f"{module.config_file or module.name} ({module.name})", 0, 0)
+        for address in module.config_references():
+            with _located(where, problems):
+                table.reference(address)
+    owner = {spec.mnemonic: m for m in modules for spec in m.instructions()}
+    if owner:
+        for pfile in program.files.values():
+            for rung in pfile.rungs:
+                for ins in walk(rung.elements):
+                    module = owner.get(ins.mnemonic)
+                    if module is not None:
+                        with _located(ins.pos, problems):
+                            for address in module.references(ins):
+                                table.reference(address)
+    return table, problems
+
+
+class _located:
+    """Raise a DataTableError as is, or (with a problems list) add it there
+    as a LadderError at ``pos``."""
+
+    def __init__(self, pos, problems: list | None, prefix: str = "") -> None:
+        self.pos, self.problems, self.prefix = pos, problems, prefix
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind, exc, tb) -> bool:
+        if exc is None or self.problems is None or not isinstance(exc, DataTableError):
+            return False
+        self.problems.append(LadderError(self.pos, f"{self.prefix}{exc}"))
+        return True
 
 
 class Engine:
@@ -311,7 +365,8 @@ class Engine:
         self._deadline = start + watchdog_ms / 1000
         try:
             self._depth = 0
-            self.run_file(MAIN_FILE)
+            if MAIN_FILE in self.files:  # a program with no rungs scans as an empty PLC does
+                self.run_file(MAIN_FILE)
         except _EndScan:
             pass
         except MajorFault as fault:

@@ -34,6 +34,12 @@ def signed16(v: int) -> int:
     return v - 0x10000 if v & 0x8000 else v
 
 
+# The deepest JSR nesting a jsr_depth setting may ask for: deep enough for any
+# real program, shallow enough that the engine reaches fault 30 long before
+# Python's recursion limit (tests/test_hardening.py runs it at this depth).
+MAX_JSR_DEPTH = 64
+
+
 @dataclass
 class Settings:
     """App settings (``softplc.toml``), with PLC-5 defaults."""
@@ -43,6 +49,7 @@ class Settings:
     watchdog_ms: int = S.DEFAULT_WATCHDOG_MS
     scan_ms: int = 10  # simulated time per scan
     jsr_depth: int = 32
+    save_ms: int = 100  # [retentive] save_ms: wall-clock ms between retentive snapshot saves
 
 
 class MajorFault(Exception):

@@ -25,6 +25,7 @@ MINOR_OVERFLOW_BIT = 0  # math overflow (also S:0/1)
 MINOR_DIV_ZERO_BIT = 1  # division by zero
 MINOR_STRING_BIT = 2  # string instruction error (length, index)
 MINOR_MODULE_BIT = 3  # a module (TLM) instruction without a CONTROL failed (STRPRINT)
+MINOR_STORAGE_BIT = 4  # a retentive save or a --record trace write failed (cleared when one succeeds again)
 
 # softplc additions (words 100..109)
 SCAN_COUNT_LOW = 100  # S:100/S:101 scans since RUN, 32-bit, low word first
@@ -56,3 +57,5 @@ MINOR_CODE_FORMAT = 5  # an illegal format string (e.g. %k)
 MINOR_CODE_PARAM = 6  # a Param missing, of the wrong kind, or past the end of its file
 MINOR_CODE_PORT = 7  # a module instruction names a port that is not configured or is down
 MINOR_CODE_OPERAND = 8  # a module instruction operand out of its range (e.g. a slave id past 247)
+MINOR_CODE_SAVE = 9  # the retentive snapshot could not be saved (read-only directory, disk full)
+MINOR_CODE_RECORD = 10  # a --record trace could not be written

@@ -81,6 +81,12 @@ class TLM:
         engine grows those files as it does for COP."""
         return []
 
+    def config_references(self) -> list:
+        """Addresses the module's configuration makes exist in the data table
+        when it attaches (MODBMAST's data blocks). ``softplc check`` builds the
+        table a run would start with from these and references()."""
+        return []
+
     def create(self, instr: Instruction, ctx: "InstructionContext") -> Instance:
         raise NotImplementedError(f"module {self.name} cannot run {instr.mnemonic}")
 

@@ -92,6 +92,18 @@ class Modbmast(TLM):
         return [d.port for d in self.drivers]
 
     # -- the driver -------------------------------------------------------------------------
+    def config_references(self) -> list:
+        """The first and last word of every data block of the XML config."""
+        found = []
+        for pc in self.config.ports.values():
+            for slave in pc.slaves.values():
+                for request in slave.requests:
+                    for block in request.to_blocks + request.from_blocks:
+                        if block.address is not None:
+                            found.append(block.address)
+                            found.append(block.address.with_element(block.address.element + block.words - 1))
+        return found
+
     def attach(self, engine, options: Mapping[str, object]) -> list[str]:
         """Open the ports and start their scan lists. ``options``: "ports"
         {num: device or URL}, "recorder", "replay" (see tlm.api)."""
@@ -105,13 +117,8 @@ class Modbmast(TLM):
 
         register()
         config, table = self.config, engine.table
-        for pc in config.ports.values():  # the files the blocks reach exist before anything is bound
-            for slave in pc.slaves.values():
-                for request in slave.requests:
-                    for block in request.to_blocks + request.from_blocks:
-                        if block.address is not None:
-                            table.reference(block.address)
-                            table.reference(block.address.with_element(block.address.element + block.words - 1))
+        for address in self.config_references():  # the files the blocks reach exist before anything is bound
+            table.reference(address)
         overrides = dict(self.options.get("ports") or {})
         replay = self.options.get("replay")
         self.status = {n: {sid: SlaveStatus() for sid in pc.slaves} for n, pc in config.ports.items()}
