@@ -1,7 +1,9 @@
 """The ``softplc`` command.
 
 Exit codes: 0 ok; 1 a program, config or data error (reported with
-file:line:col, no traceback); 2 usage error; 3 the PLC faulted.
+file:line:col, no traceback); 2 usage error; 3 the PLC faulted; 4 an
+internal error in softplc itself (a bug, reported in one line, never as a
+traceback); 130 interrupted.
 """
 
 from __future__ import annotations
@@ -27,7 +29,27 @@ from .ladder.fmt import STYLES, format_program
 from .runner import RunOptions, Runner
 from .errors import LocatedError
 
-EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT = 0, 1, 2, 3
+EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT, EXIT_INTERNAL = 0, 1, 2, 3, 4
+
+# --scan-ms: simulated ms per scan, or the --realtime period (0: free-running).
+# S:8 and S:9 hold a scan time in a 16-bit word, hence the top.
+SCAN_MS_RANGE = range(0, 32768)
+
+
+def int_in(valid: range, what: str):
+    """An argparse type: an integer in ``valid``, else a usage error."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text) if len(text) <= 19 else None
+        except ValueError:
+            value = None
+        if value is None or value not in valid:
+            span = f"{valid.start} or more" if valid.stop > 10 ** 12 else f"from {valid.start} to {valid.stop - 1}"
+            raise argparse.ArgumentTypeError(f"expected an integer {span}, not {text[:20]!r}")
+        return value
+    parse.__name__ = what  # argparse names the type in its messages
+    return parse
+
 
 
 def _cmd_address(args: argparse.Namespace) -> int:
@@ -74,8 +96,6 @@ def _print_values(table: DataTable, addresses: list[str], symbols=None) -> None:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    if args.scans is not None and args.scans < 0:
-        raise SystemExit("softplc run: error: --scans must be 0 or more")
     app = load_app(args.app, args.state)
     _print_warnings(app.warnings)
     options = RunOptions(
@@ -89,7 +109,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     finally:
         runner.engine.close()
     engine = runner.engine
-    runner.save()
+    storage_problems = runner.finish()  # the final save; a failure is reported, and the output still printed
     if args.dump:
         Path(args.dump).write_text(jsonio.dumps(runner.table), encoding="utf-8")
     if app.display:
@@ -101,7 +121,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if engine.mode is Mode.FAULTED:
         print(f"softplc: {app.name}: {engine.fault}", file=sys.stderr)
         return EXIT_FAULT
-    return EXIT_OK
+    return EXIT_ERROR if storage_problems else EXIT_OK
 
 
 def _run_with_status(runner: Runner, app, scans: int | None) -> None:
@@ -185,9 +205,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("run", help="run an app (directory or .lad file) in RUN mode")
     r.add_argument("app", metavar="APP", help="app directory or .lad file")
-    r.add_argument("--scans", type=int, metavar="N", help="stop after N scans (default: run until Ctrl-C)")
-    r.add_argument("--scan-ms", type=int, metavar="MS",
-                   help="simulated ms per scan (default 10), or with --realtime the scan period (0 = free-running)")
+    r.add_argument("--scans", type=int_in(range(0, 2 ** 63), "--scans"), metavar="N", help="stop after N scans (default: run until Ctrl-C)")
+    r.add_argument("--scan-ms", type=int_in(SCAN_MS_RANGE, "--scan-ms"), metavar="MS",
+                   help="simulated ms per scan (default 10), or with --realtime the scan period "
+                   "(0 = free-running); 0..32767")
     r.add_argument("--realtime", action="store_true", help="use the wall clock instead of simulated time")
     r.add_argument("--state", metavar="DIR", help="keep the retentive snapshot in DIR (default APP/.softplc)")
     r.add_argument("--fresh", action="store_true", help="ignore the retentive snapshot")
@@ -211,7 +232,8 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--break-when", action="append", default=[], metavar="EXPR",
                    help='stop running when EXPR becomes true, e.g. "N7:0 > 100" or R6:0/ER')
     w.add_argument("--realtime", action="store_true", help="use the wall clock instead of simulated time")
-    w.add_argument("--scan-ms", type=int, metavar="MS", help="simulated ms per scan (default from the app)")
+    w.add_argument("--scan-ms", type=int_in(SCAN_MS_RANGE, "--scan-ms"), metavar="MS",
+                   help="simulated ms per scan (default from the app; 0..32767)")
     w.add_argument("--state", metavar="DIR", help="keep the retentive snapshot in DIR (default APP/.softplc)")
     w.add_argument("--fresh", action="store_true", help="ignore the retentive snapshot")
     w.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE", help="set a value at start")
@@ -263,6 +285,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_ERROR
     except KeyboardInterrupt:
         return 130
+    except (Exception, RecursionError, MemoryError) as e:  # a bug: one line, never a traceback
+        text = str(e)
+        text = text if len(text) <= 300 else text[:300] + "..."
+        print(f"softplc: internal error: {type(e).__name__}: {text} (a bug in softplc; please report it "
+              f"with the command that caused it)", file=sys.stderr)
+        return EXIT_INTERNAL
 
 
 if __name__ == "__main__":
