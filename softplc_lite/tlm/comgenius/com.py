@@ -109,14 +109,15 @@ class ComPrint(_Controlled):
             return True
         port, index, fmt = found
         try:
-            out = compile_print(fmt).render(self.params())
+            out = compile_print(fmt).render(self.params(), port.tx_size)
         except FormatError as e:
             return self._error(ctl, f"format {index}: {e}")
         except ParamError as e:
             return self._error(ctl, f"format {index}: {e.reason}")
         data = port.encoding.encode(out)
         if len(data) > port.tx_size:
-            return self._error(ctl, f"format {index}: {len(data)} bytes never fit the {port.tx_size}-byte "
+            size = f"{len(data)} bytes" if len(out) <= port.tx_size else f"more than {port.tx_size} bytes"
+            return self._error(ctl, f"format {index}: {size} never fit the {port.tx_size}-byte "
                                     f"transmit buffer of port {port.number}")
         self.pending = (port, data)
         return self.step(ctl)

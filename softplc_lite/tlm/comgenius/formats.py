@@ -79,10 +79,18 @@ class Spec:
         return None
 
 
-def _digits(fmt: str, i: int) -> tuple[int | None, int]:
+# The largest width or precision a format may write: what a ``*`` can take
+# from a 16-bit word. A larger one could only ask for more output than any
+# STRING (82 characters) or transmit buffer holds, at the cost of building it.
+MAX_FIELD = 32767
+
+
+def _digits(fmt: str, i: int, start: int) -> tuple[int | None, int]:
     j = i
     while j < len(fmt) and "0" <= fmt[j] <= "9":
         j += 1
+    if j - i > 5 or (j > i and int(fmt[i:j]) > MAX_FIELD):
+        raise FormatError(start, f"{fmt[start:j][:20]!r}: a width or precision is at most {MAX_FIELD}")
     return (int(fmt[i:j]) if j > i else None), j
 
 
@@ -126,7 +134,7 @@ def parse_print(fmt: str) -> list[str | Spec]:
             width: int | None = STAR
             i += 1
         else:
-            width, i = _digits(fmt, i)
+            width, i = _digits(fmt, i, start)
         precision: int | None = None
         if i < n and fmt[i] == ".":
             i += 1
@@ -134,7 +142,7 @@ def parse_print(fmt: str) -> list[str | Spec]:
                 precision = STAR
                 i += 1
             else:
-                precision, i = _digits(fmt, i)
+                precision, i = _digits(fmt, i, start)
                 precision = precision or 0
         length, conv, i = _length_and_conversion(fmt, start, i, "lLh", PRINT_CONVERSIONS,
                                                  f"print conversions: {' '.join(PRINT_CONVERSIONS)}")
@@ -183,7 +191,7 @@ def parse_scan(fmt: str) -> list[str | Spec]:
             if fmt[i] not in flags:
                 flags += fmt[i]
             i += 1
-        width, i = _digits(fmt, i)
+        width, i = _digits(fmt, i, start)
         if i < n and fmt[i] == "*":
             raise FormatError(i, "a scan width may not be '*'")
         precision: int | None = None
@@ -194,7 +202,7 @@ def parse_scan(fmt: str) -> list[str | Spec]:
                 precision, star_at = STAR, i
                 i += 1
             else:
-                precision, i = _digits(fmt, i)
+                precision, i = _digits(fmt, i, start)
                 precision = precision or 0
         length, conv, i = _length_and_conversion(
             fmt, start, i, "lLhH", SCAN_CONVERSIONS,

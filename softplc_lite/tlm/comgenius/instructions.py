@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from typing import Callable, Sequence
 
-from ...datatable import ValueKind
+from ...datatable import STRING_CHARS, ValueKind
 from ...ladder import status as S
 from ...ladder.ast import AddressRef, Const, Instruction
 from ...ladder.errors import LadderError
@@ -122,7 +122,7 @@ class StrPrint:
             self._fail(S.MINOR_CODE_FORMAT_INDEX, self.format.problem(index))
             return c
         try:
-            out = compile_print(text).render(self.params())
+            out = compile_print(text).render(self.params(), STRING_CHARS)
         except FormatError as e:
             self._fail(S.MINOR_CODE_FORMAT, f"format {index}: {e}")
             return c

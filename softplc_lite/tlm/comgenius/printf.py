@@ -276,12 +276,24 @@ class PrintFormat:
                 out.append(c_integer(getter(p), c, flags, width, precision))
         return convert, used
 
-    def render(self, params: Sequence[Param]) -> str:
+    def render(self, params: Sequence[Param], limit: int | None = None) -> str:
         """The output characters. Raises ParamError (too few Params, a Param
-        of the wrong kind, words past the end of a file)."""
+        of the wrong kind, words past the end of a file). With ``limit``
+        (the size of what the output goes to), rendering stops once the
+        output is longer: the result is then ``limit + 1`` characters, enough
+        to tell it does not fit, and no conversion after that is built."""
+        if limit is not None and len(params) < self.params_used:
+            self.render(params)  # too few Params: the same ParamError as without a limit
         out: list[str] = []
         append = out.append
+        size, counted = 0, 0
         for op in self.ops:
+            if limit is not None:
+                while counted < len(out):
+                    size += len(out[counted])
+                    counted += 1
+                if size > limit:
+                    return "".join(out)[:limit + 1]
             if op.__class__ is str:
                 append(op)
             elif op.__class__ is tuple:
@@ -296,7 +308,8 @@ class PrintFormat:
                                      f"({' '.join(s.text for s in spec)})") from None
             else:
                 op(out, params)
-        return "".join(out)
+        text = "".join(out)
+        return text if limit is None else text[:limit + 1]
 
 
 @lru_cache(maxsize=4096)
