@@ -400,3 +400,40 @@ def test_bad_baud_rate_frees_the_link():
     with pytest.raises(ValueError, match="invalid baudrate: 0"):
         serial.serial_for_url(f"sim://{name}?device=echo", baudrate=0)
     assert name not in wire.link_names()
+
+
+def test_a_port_collected_while_the_registry_is_locked_does_not_deadlock():
+    """Issue 15: a sim:// port left in a reference cycle (a Runner whose
+    start failed) was closed by its finalizer, which took the link
+    registry's lock; when the collection ran inside an allocation made under
+    that lock (opening another link), the process hung. The finalizer now
+    takes no lock and the next registry operation releases the end."""
+    import gc
+    import threading
+
+    from softplc_lite.ports import wire
+
+    def body(result: list) -> None:
+        port = serial.serial_for_url("sim://collected-under-lock", baudrate=9600)
+        cycle: list = [port]
+        cycle.append(cycle)
+        port._cycle = cycle  # only the collector frees it
+        del port, cycle
+        gc.disable()
+        try:
+            with wire._registry_lock:  # where open_device_end stands when an allocation starts a collection
+                gc.collect()
+        finally:
+            gc.enable()
+        result.append(wire.link_names())
+        again = serial.serial_for_url("sim://collected-under-lock", baudrate=9600)  # the name is free again
+        result.append(wire.link_names())
+        again.close()
+
+    result: list = []
+    worker = threading.Thread(target=body, args=(result,), daemon=True)
+    worker.start()
+    worker.join(10)
+    assert not worker.is_alive(), "deadlock: a finalizer waited for the registry lock its own thread held"
+    assert "collected-under-lock" not in result[0]
+    assert "collected-under-lock" in result[1]

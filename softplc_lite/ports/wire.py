@@ -228,11 +228,23 @@ _links: dict[str, Link] = {}  # port-to-port links, by name
 # may run the same app side by side; the newest is last.
 _device_links: dict[str, list[Link]] = {}
 _registry_lock = threading.Lock()
+# Port ends whose Serial object was garbage-collected while open. A finalizer
+# may run inside any allocation, including one made while this thread holds
+# _registry_lock, so it takes no lock: it queues the end here (a deque append
+# is atomic) and the next registry operation, holding the lock, releases it.
+_closing: deque["PortEnd"] = deque()
+
+
+def _release_closing() -> None:
+    """Release the ends finalizers queued; the caller holds _registry_lock."""
+    while _closing:
+        _closing.popleft()._release()
 
 
 def open_port_end(name: str) -> "PortEnd":
     """Become one end of the port-to-port link ``name`` (created on first use)."""
     with _registry_lock:
+        _release_closing()
         if _device_links.get(name):
             device = _device_links[name][-1].device
             raise SerialException(f"link {name} already has two ends (a port and a {device.name} device)")
@@ -252,6 +264,7 @@ def open_port_end(name: str) -> "PortEnd":
 def open_device_end(name: str, device: "SimDevice") -> "PortEnd":
     """A new link ``name`` between the calling port (end 0) and ``device`` (end 1)."""
     with _registry_lock:
+        _release_closing()
         if name in _links:
             raise SerialException(f"link {name} is in use between two ports; a device link needs another name")
         link = Link(name)
@@ -270,12 +283,14 @@ def open_device_end(name: str, device: "SimDevice") -> "PortEnd":
 def link_names() -> list[str]:
     """Names of the links open now (for diagnostics and tests)."""
     with _registry_lock:
+        _release_closing()
         return sorted(set(_links) | set(_device_links))
 
 
 def device_links(name: str) -> list[Link]:
     """The open device links named ``name``, oldest first."""
     with _registry_lock:
+        _release_closing()
         return list(_device_links.get(name, ()))
 
 
@@ -363,19 +378,28 @@ class PortEnd:
             self._out.abort(now)
 
     def close(self) -> None:
-        link = self.link
         with _registry_lock:
-            with link.lock:
-                if link.ports[self.index] is self:
-                    link.ports[self.index] = None
-            if link.ports == [None, None]:
-                if _links.get(link.name) is link:
-                    del _links[link.name]
-                same = _device_links.get(link.name, [])
-                if link in same:
-                    same.remove(link)
-                    if not same:
-                        del _device_links[link.name]
+            _release_closing()
+            self._release()
+
+    def close_later(self) -> None:
+        """Close from a finalizer: no lock is taken here (see _closing)."""
+        _closing.append(self)
+
+    def _release(self) -> None:
+        """Leave the link; the caller holds _registry_lock."""
+        link = self.link
+        with link.lock:
+            if link.ports[self.index] is self:
+                link.ports[self.index] = None
+        if link.ports == [None, None]:
+            if _links.get(link.name) is link:
+                del _links[link.name]
+            same = _device_links.get(link.name, [])
+            if link in same:
+                same.remove(link)
+                if not same:
+                    del _device_links[link.name]
 
 
 class DeviceEnd:
@@ -440,6 +464,18 @@ class ClockedSerial(SerialBase):
         if getattr(self, "is_open", False):
             self.is_open = False
             self._close_port()
+
+    def __del__(self) -> None:
+        # io.IOBase's finalizer calls close(), which takes the link registry's
+        # lock; a finalizer can run inside any allocation, even one made while
+        # that lock is held (a deadlock once seen), so it releases lock-free.
+        if getattr(self, "is_open", False):
+            self.is_open = False
+            self._close_from_finalizer()
+
+    def _close_from_finalizer(self) -> None:
+        """Release what the port holds without taking a lock."""
+        self._close_port()
 
     def _reconfigure_port(self) -> None:
         if not isinstance(self._baudrate, numbers.Integral) or not 0 < self._baudrate < 2 ** 32:

@@ -76,6 +76,11 @@ class Serial(wire.ClockedSerial):
             self._end.close()
             self._end = None
 
+    def _close_from_finalizer(self) -> None:
+        if self._end is not None:
+            self._end.close_later()  # released by the next registry operation
+            self._end = None
+
     def _configure(self) -> None:
         self._end.set_rts(bool(self._rts_state), self._clock())  # pyserial raises RTS on open
         self._end.configure(self._baudrate, self._bytesize, self._parity, self._stopbits, self._unlimited)
