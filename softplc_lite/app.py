@@ -86,9 +86,12 @@ def parse_files(files: list[Path], base: Path, instructions: InstructionSet = BU
     errors: list[LadderError] = []
     for f in files:
         try:
-            text = f.read_text(encoding="utf-8")
-        except (OSError, UnicodeDecodeError) as e:
-            errors.append(LadderError(Pos(str(f), 1, 1), f"cannot read: {e}"))
+            text = read_text(f)
+        except LocatedError as e:
+            errors.append(LadderError(Pos(_display(f, base), e.line, e.column), e.message))
+            continue
+        except OSError as e:
+            errors.append(LadderError(Pos(_display(f, base), 1, 1), f"cannot read: {e.strerror or e}"))
             continue
         try:
             parse_program(text, _display(f, base), instructions, program=program)

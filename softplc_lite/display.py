@@ -29,7 +29,7 @@ from .datatable import DataTable, DataTableError, parse_address
 from .datatable.address import Address
 from .datatable.display import format_value
 
-_BLOCK = re.compile(r"#\s*(\S+)\s+([0-9]+)$")
+_BLOCK = re.compile(r"#\s*(\S+)\s+([0-9]{1,6})$")
 
 
 @dataclass(frozen=True)

@@ -83,8 +83,8 @@ def test_read_trace_missing_or_binary_file(tmp_path: Path):
     assert info.value.path == str(tmp_path / "missing.trace")
     assert "cannot read trace file: No such file or directory" in str(info.value)
     binary = tmp_path / "bin.trace"
-    binary.write_bytes(b"\xff\xfe\x00")
-    with pytest.raises(TraceError, match="cannot read trace file"):
+    binary.write_bytes(b"# softplc_lite port trace 1\n\xff\xfe\x00")
+    with pytest.raises(TraceError, match=r"bin.trace:2:1: byte 0xff is not UTF-8 text"):
         read_trace(binary)
 
 

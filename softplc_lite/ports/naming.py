@@ -32,7 +32,7 @@ from typing import Iterable, Mapping
 from .errors import PortError
 
 COM_NAME = re.compile(r"COM([1-9][0-9]?)", re.IGNORECASE)  # COM1..COM99
-_OVERRIDE = re.compile(r"^\s*(?:([A-Za-z][A-Za-z0-9_]*)\s*:\s*)?([0-9]+)\s*=\s*(\S.*?)\s*$")
+_OVERRIDE = re.compile(r"^\s*(?:([A-Za-z][A-Za-z0-9_]*)\s*:\s*)?([0-9]{1,6})\s*=\s*(\S.*?)\s*$")
 
 
 def default_com_device(n: int, platform: str = sys.platform) -> str:

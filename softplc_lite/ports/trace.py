@@ -39,6 +39,8 @@ import re
 from dataclasses import dataclass, field
 from typing import IO, Sequence
 
+from ..errors import LocatedError
+from ..textfile import read_text
 from .errors import PortError
 
 HEADER = "# softplc_lite port trace 1"
@@ -47,8 +49,8 @@ MAX_PORT = 35
 DIRECTIONS = ("TX", "RX")
 
 _HEADER = re.compile(r"^\s*#\s*softplc_lite port trace\s+(\S+)\s*$")
-_TIME = re.compile(r"^\d+(\.\d+)?$")
-_PORT = re.compile(r"^(?:([A-Za-z][A-Za-z0-9_]*):)?(\d+)$")
+_TIME = re.compile(r"^[0-9]{1,15}(\.[0-9]{1,9})?$")
+_PORT = re.compile(r"^(?:([A-Za-z][A-Za-z0-9_]*):)?([0-9]{1,6})$")
 _HEX = re.compile(r"^[0-9A-Fa-f]{2}$")
 _FIELD = re.compile(r"\S+")
 
@@ -141,11 +143,11 @@ def read_trace(path: str | os.PathLike) -> list[TraceEvent]:
     or parsed raises ``TraceError`` naming it."""
     name = os.fspath(path)
     try:
-        with open(name, encoding="utf-8-sig") as f:
-            text = f.read()
-    except (OSError, UnicodeDecodeError) as e:
-        reason = e.strerror if isinstance(e, OSError) and e.strerror else str(e)
-        raise TraceError(f"cannot read trace file: {reason}", name) from e
+        text = read_text(name)
+    except LocatedError as e:
+        raise TraceError(e.message, name, e.line, e.column) from None
+    except OSError as e:
+        raise TraceError(f"cannot read trace file: {e.strerror or e}", name) from e
     return parse_trace(text, name)
 
 

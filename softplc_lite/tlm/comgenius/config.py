@@ -69,6 +69,10 @@ def _int_field(text: str, name: str, lo: int, hi: int | None, err) -> int:
     text = text.strip()
     if not re.fullmatch(r"[0-9]+", text):
         raise err(f"{name} must be a number, not {text!r}")
+    if len(text) > 9:  # past every range, and too long to convert cheaply (Python stops at 4,300 digits)
+        shown = f"{text[:9]}... ({len(text)} digits)"
+        raise err(f"{name} {shown} is out of range ({lo}..{hi})" if hi is not None
+                  else f"{name} {shown} is too large")
     value = int(text)
     if value < lo or (hi is not None and value > hi):
         raise err(f"{name} {value} is out of range ({lo}..{hi})" if hi is not None
