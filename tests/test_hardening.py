@@ -294,3 +294,25 @@ def test_an_internal_error_is_one_line_and_exit_code_4(capsys, monkeypatch):
     err = capsys.readouterr().err
     assert code == cli.EXIT_INTERNAL == 4
     assert err.startswith("softplc: internal error: ZeroDivisionError: planted") and "Traceback" not in err
+
+
+@pytest.mark.parametrize("files, args, says", [
+    ({"MODULES_LST": "COMGENIUS\n", "COMGENIUS_LST": f"[DRIVER]\nRETRY_MS={HUGE}\n"}, (),
+     "COMGENIUS.LST:2: [DRIVER]: RETRY_MS 999999999... (5000 digits) is too large"),
+    ({"MODULES_LST": "COMGENIUS\n", "COMGENIUS_LST": "[PORTS]\n0, loop://, ISO-8859-1, 9600, 8, N, 1, 250\n"},
+     ("--port", f"{HUGE}=loop://"), "--port"),
+    ({"softplc_toml": f'[display]\nsummary = {{ a = "#N7:0 {HUGE}" }}\n'}, (), "softplc.toml"),
+    ({"main.lad": b"MOV 1 N7:0\nMOV 2 N7:1 // caf\xe9\n"}, (), "main.lad:2:18: byte 0xe9 is not UTF-8 text"),
+], ids=short)
+def test_other_numbers_and_encodings_are_clear_errors(tmp_path, capsys, files, args, says):
+    lad = files.pop("main.lad", "MOV 1 N7:0\n")
+    app = make_app(tmp_path, lad, **files)
+    code, _, err = run_cli(capsys, "run", str(app), "--fresh", "--scans", "1", *args)
+    assert code in (cli.EXIT_ERROR, cli.EXIT_USAGE) and says in err, err
+
+
+def test_a_utf8_bom_is_accepted(tmp_path, capsys):
+    app = make_app(tmp_path, b"\xef\xbb\xbfMOV 1 N7:0\n", softplc_toml=b"\xef\xbb\xbf[scan]\nscan_ms = 5\n",
+                   datatable_json=b'\xef\xbb\xbf{"N7": [0, 7]}')
+    code, out, _ = run_cli(capsys, "run", str(app), "--fresh", "--scans", "1", "--print", "N7:1")
+    assert code == 0 and out == "N7:1 = 7\n"
