@@ -316,3 +316,8 @@ def test_a_utf8_bom_is_accepted(tmp_path, capsys):
                    datatable_json=b'\xef\xbb\xbf{"N7": [0, 7]}')
     code, out, _ = run_cli(capsys, "run", str(app), "--fresh", "--scans", "1", "--print", "N7:1")
     assert code == 0 and out == "N7:1 = 7\n"
+
+
+def test_a_huge_address_is_quoted_short(capsys):
+    code, _, err = run_cli(capsys, "address", "N7:" + HUGE)
+    assert code == cli.EXIT_ERROR and "(5003 characters)" in err and len(err) < 500

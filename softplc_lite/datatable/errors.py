@@ -34,7 +34,12 @@ class AddressError(DataTableError):
 
     def context(self) -> str:
         """The address with a caret under the problem, like lark's get_context."""
-        return f"{self.text}\n{' ' * self.position}^"
+        text, at = self.text, self.position
+        if len(text) > 80:  # a window around the problem, not thousands of characters
+            start = max(0, at - 40)
+            text, at = ("..." if start else "") + text[start:start + 80] + ("..." if start + 80 < len(text) else ""), \
+                at - start + (3 if start else 0)
+        return f"{text}\n{' ' * at}^"
 
 
 class AddressRangeError(DataTableError):
