@@ -267,7 +267,7 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
         try:
             settings_doc = read_settings_file(path / SETTINGS_FILE)
             settings = load_settings(path / SETTINGS_FILE, settings_doc)
-            if not errors:
+            if not errors and not config_problems:  # else its addresses may only be missing as a consequence
                 display = load_display(path / SETTINGS_FILE, resolved.symbols, settings_doc)
                 settings_problems += display_problems(display, table, path / SETTINGS_FILE, settings_doc)
         except AppError as e:
