@@ -321,3 +321,13 @@ def test_a_utf8_bom_is_accepted(tmp_path, capsys):
 def test_a_huge_address_is_quoted_short(capsys):
     code, _, err = run_cli(capsys, "address", "N7:" + HUGE)
     assert code == cli.EXIT_ERROR and "(5003 characters)" in err and len(err) < 500
+
+
+def test_a_break_when_condition_has_the_expression_limit_too(tmp_path, capsys):
+    from softplc_lite.ladder.ast import Pos
+    from softplc_lite.ladder.errors import LadderError
+    from softplc_lite.ladder.parser import parse_expression
+
+    with pytest.raises(LadderError, match=f"nested 501 levels deep; the limit is {MAX_EXPRESSION_DEPTH}"):
+        parse_expression("NOT " * 500 + "N7:0 > 1", Pos("--break-when", 1, 1))
+    assert parse_expression("(" * 5000 + "N7:0" + ")" * 5000 + " > 1", Pos("--break-when", 1, 1)).op == ">"

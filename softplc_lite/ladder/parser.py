@@ -40,7 +40,7 @@ from .ast import (
     UnaryOp,
 )
 from .errors import LadderError
-from .limits import MAX_CONSTANT, MAX_NUMBER_DIGITS, limit_problem
+from .limits import MAX_CONSTANT, MAX_EXPRESSION_DEPTH, MAX_NUMBER_DIGITS, expression_depth, limit_problem
 
 # -- the post-lexer ---------------------------------------------------------------
 
@@ -419,7 +419,12 @@ def _range_error(e: _NumberRangeError, builder: "_ToAst") -> LadderError:
 def parse_expression(text: str, pos: Pos) -> Operand:
     """Parse a CPT/CMP expression given as a quoted mnemonic operand; errors
     point into the original file (``pos`` is where the text starts)."""
-    return _parse_tree(text, pos.source, "expr", pos.line - 1, pos.column)
+    tree = _parse_tree(text, pos.source, "expr", pos.line - 1, pos.column)
+    levels = expression_depth(tree)
+    if levels > MAX_EXPRESSION_DEPTH:  # the same limit as in a rung (a --break-when condition, too)
+        raise LadderError(getattr(tree, "pos", pos), f"expression nested {levels} levels deep; the limit is "
+                          f"{MAX_EXPRESSION_DEPTH} (split it over several CPT instructions)")
+    return tree
 
 
 # -- assembling the program ------------------------------------------------------------
