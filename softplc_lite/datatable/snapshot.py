@@ -9,11 +9,19 @@ File format (little-endian throughout)::
 A short file, a wrong length, a bad CRC or a missing trailer is reported as
 :class:`SnapshotError`; nothing half-read is ever returned.
 
-Saving writes ``NAME.tmp``, fsyncs it, hard-links the current snapshot to
-``NAME.prev`` (the previous good one), renames the temp file over ``NAME``
+:func:`save` writes ``NAME.tmp``, fsyncs it, hard-links the current snapshot
+to ``NAME.prev`` (the previous good one), renames the temp file over ``NAME``
 and fsyncs the directory. At every instant ``NAME`` is either the complete
 old snapshot or the complete new one, so a process killed during a save
 leaves a loadable snapshot.
+
+A running PLC saves with :func:`write` instead (softplc_lite/retentive.py):
+the bytes :func:`encode` made between two scans, to ``NAME`` through the same
+temp file and rename, without fsync for the frequent saves (a killed process
+does not lose the page cache) and with fsync for the durable ones, which
+also become ``NAME.prev``: the newest snapshot known to be on disk, for
+after a power loss. :func:`remove_stale` deletes the temp files a killed
+process left.
 """
 
 from __future__ import annotations
@@ -105,24 +113,74 @@ def save(table: DataTable, path: str | os.PathLike[str]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
     prev = path.with_name(path.name + ".prev")
-    data = encode(table)
+    _write_tmp(encode(table), tmp, durable=True)
+    if path.exists():
+        # A hard link, not a rename: NAME must never be missing, even for an
+        # instant, or a kill right then would leave no current snapshot.
+        _link_as(path, prev)
+    os.replace(tmp, path)
+    _fsync_dir(path.parent)
+
+
+def write(data: bytes, path: str | os.PathLike[str], durable: bool) -> None:
+    """Put encoded snapshot bytes at ``path`` atomically: ``NAME.tmp``, then
+    a rename over ``NAME``, so ``NAME`` is always a complete snapshot.
+
+    ``durable``: fsync the temp file before the rename, then make ``NAME.prev``
+    a hard link to the new ``NAME`` and fsync the directory, so that both
+    names hold this snapshot on disk, whatever a power loss does to later
+    non-durable writes. Not durable: no fsync, ``NAME.prev`` left alone (it
+    stays the last durable snapshot). Creates the directory when missing.
+    Raises OSError; a failed write leaves ``NAME`` and ``NAME.prev`` as they
+    were (and perhaps a partial ``NAME.tmp``, truncated by the next write).
+    """
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        _write_tmp(data, tmp, durable)
+    except FileNotFoundError:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        _write_tmp(data, tmp, durable)
+    os.replace(tmp, path)
+    if durable:
+        _link_as(path, path.with_name(path.name + ".prev"))
+        _fsync_dir(path.parent)
+
+
+def remove_stale(path: str | os.PathLike[str]) -> list[Path]:
+    """Delete ``NAME.tmp`` and ``NAME.prev.tmp`` (what a process killed in
+    the middle of a save leaves); the ones removed. Never raises: a file
+    that cannot be removed is left for the next save to overwrite."""
+    path = Path(path)
+    removed = []
+    for stale in (path.with_name(path.name + ".tmp"), path.with_name(path.name + ".prev.tmp")):
+        try:
+            stale.unlink()
+        except OSError:
+            continue
+        removed.append(stale)
+    return removed
+
+
+def _write_tmp(data: bytes, tmp: Path, durable: bool) -> None:
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
     try:
         view = memoryview(data)
         while view:
             view = view[os.write(fd, view):]
-        os.fsync(fd)
+        if durable:
+            os.fsync(fd)
     finally:
         os.close(fd)
-    if path.exists():
-        # A hard link, not a rename: NAME must never be missing, even for an
-        # instant, or a kill right then would leave no current snapshot.
-        prev_tmp = path.with_name(path.name + ".prev.tmp")
-        prev_tmp.unlink(missing_ok=True)
-        os.link(path, prev_tmp)
-        os.replace(prev_tmp, prev)
-    os.replace(tmp, path)
-    _fsync_dir(path.parent)
+
+
+def _link_as(path: Path, name: Path) -> None:
+    """Make ``name`` another name of ``path``'s file, atomically (through
+    ``name.tmp``): ``name`` is never missing or partial."""
+    link_tmp = name.with_name(name.name + ".tmp")
+    link_tmp.unlink(missing_ok=True)
+    os.link(path, link_tmp)
+    os.replace(link_tmp, name)
 
 
 def _fsync_dir(directory: Path) -> None:
