@@ -88,16 +88,37 @@ def rung_power(rung: Rung, table: DataTable) -> Power:
 
 
 def _series(elements: list[Element], c: bool, table: DataTable, states: dict[int, ElementPower]) -> bool:
-    for el in elements:
-        if isinstance(el, Branch):
-            legs = tuple(_series(leg, c, table, states) for leg in el.legs)
-            out = any(legs)
-            states[id(el)] = ElementPower(c, out, out, legs=legs)
-        else:
-            state = states[id(el)] = _instruction(el, c, table)
-            out = state.power_out
-        c = out
-    return c
+    """The power out of a series entered with ``c``; every element's state
+    into ``states``. A stack, not recursion: nesting has no depth limit here."""
+    # per open branch: (branch, its power in, its legs' power out so far, the series it is in, where it goes on)
+    open_branches: list[tuple[Branch, bool, list[bool], list[Element], int]] = []
+    series, i = elements, 0
+    while True:
+        if i < len(series):
+            el = series[i]
+            i += 1
+            if not isinstance(el, Branch):
+                state = states[id(el)] = _instruction(el, c, table)
+                c = state.power_out
+            elif el.legs:
+                open_branches.append((el, c, [], series, i))
+                series, i = el.legs[0], 0
+            else:
+                states[id(el)] = ElementPower(c, False, False, legs=())
+                c = False
+            continue
+        if not open_branches:
+            return c
+        branch, c_in, outs, parent, after = open_branches[-1]
+        outs.append(c)
+        if len(outs) < len(branch.legs):
+            series, i, c = branch.legs[len(outs)], 0, c_in
+            continue
+        open_branches.pop()
+        legs = tuple(outs)
+        out = any(legs)
+        states[id(branch)] = ElementPower(c_in, out, out, legs=legs)
+        series, i, c = parent, after, out
 
 
 # What a failed read raises: an address outside the table, a value of the

@@ -32,18 +32,25 @@ A rung at 64 columns (I:0/0 forced, a timer timing)::
   ``>>`` at the right and the next row starts with ``>>``; a branch too wide
   for a row wraps inside its legs the same way, and a box's contents wrap
   inside the box. Nothing is cut off;
+* a branch nested deeper than MAX_DEPTH levels, or left too few columns
+  for its legs (MIN_LEG), is one ``BST`` box saying what it holds
+  (``2 legs, 12 levels, 13 instructions``), with its power;
 * colour: energized wires, true instructions and energized outputs bold
   green, faults bold red, ``F`` yellow. Plain text shows values, not power.
 
 Layout works on blocks: lines of (text, style) runs, all one width, with
 the row the rung wire runs through (``wire``), composed side by side
-(series) and stacked (branches, wrapped rows).
+(series) and stacked (branches, wrapped rows). Laying out a rung takes
+time linear in its size (times the nesting depth drawn, at most
+MAX_DEPTH), and a long rung is laid out only as far as it is drawn (see
+``_Layout``).
 """
 
 from __future__ import annotations
 
 import copy
 import io
+import itertools
 import json
 from collections.abc import Callable, Iterable, Mapping
 
@@ -91,14 +98,17 @@ _STATUS_BITS = {"T": ("EN", "TT", "DN"), "C": ("CU", "CD", "DN", "OV", "UN"), "R
 _STRUCTS = (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL)
 
 Run = tuple[str, "Style | None"]
-Line = list[Run]
+Line = list  # of Runs, and of Lines: composing blocks nests their lines instead of copying them
 
 
 # -- blocks -------------------------------------------------------------------------------
 
 
 class _Block:
-    """Lines of runs, each ``width`` cells; ``wire`` is the row the rung wire
+    """Lines, each ``width`` cells: a line is a list of runs (text, style)
+    and of lines (a block's lines go into the lines of the block around it
+    as they are, so composing costs a few items a line, not a copy of every
+    run: ``_runs`` flattens them); ``wire`` is the row the rung wire
     enters by, ``exit`` the row it leaves by (lower than ``wire`` only for a
     series wrapped inside a branch leg); ``out`` whether the wire leaving
     it has power."""
@@ -125,8 +135,21 @@ def _blank(n: int) -> Run:
     return (" " * n, None)
 
 
+def _runs(line: Line) -> Iterable[Run]:
+    """A line's runs in order, its nested lines flattened (no recursion)."""
+    stack = [iter(line)]
+    while stack:
+        for item in stack[-1]:
+            if isinstance(item, list):
+                stack.append(iter(item))
+                break
+            yield item
+        else:
+            stack.pop()
+
+
 def _width(line: Line) -> int:
-    return sum(cell_len(text) for text, _ in line)
+    return sum(cell_len(text) for text, _ in _runs(line))
 
 
 def _centered(line: Line, width: int) -> Line:
@@ -147,7 +170,7 @@ def _side_by_side(blocks: list[_Block]) -> _Block:
         top = above - b.wire
         for r, line in enumerate(lines):
             k = r - top
-            line.extend(b.lines[k] if 0 <= k < len(b.lines) else [_blank(b.width)])
+            line.append(b.lines[k] if 0 <= k < len(b.lines) else _blank(b.width))
     return _Block(lines, above, sum(b.width for b in blocks), blocks[-1].out)
 
 
@@ -160,17 +183,25 @@ def _with_edges(block: _Block, left: tuple[str, str, Style | None] | None,
             return []
         return [(edge[0], edge[2])] if r == wire_row else [(edge[1], None)]
 
-    lines = [[*run(left, r, block.wire), *line, *run(right, r, block.exit)] for r, line in enumerate(block.lines)]
+    lines = [[*run(left, r, block.wire), line, *run(right, r, block.exit)] for r, line in enumerate(block.lines)]
     extra = sum(cell_len(e[0]) for e in (left, right) if e is not None)
     return _Block(lines, block.wire, block.width + extra, block.out, block.exit)
 
 
 def _stacked(blocks: list[_Block]) -> _Block:
-    """Rows of one width under each other: the wire enters by the first
-    row and leaves by the last."""
-    lines = [line for b in blocks for line in b.lines]
-    exit = len(lines) - len(blocks[-1].lines) + blocks[-1].exit
-    return _Block(lines, blocks[0].wire, blocks[0].width, blocks[-1].out, exit)
+    """Rows under each other (padded to the widest: only a row holding an
+    element wider than the others' width is wider): the wire enters by the
+    first row and leaves by the last."""
+    width = max(b.width for b in blocks)
+    last = blocks[-1]
+    lines = []
+    for b in blocks:
+        for r, line in enumerate(b.lines):
+            if b.width < width:  # the wire leaving the last row goes on to the right
+                line = [line, _wire(width - b.width, b.out) if b is last and r == b.exit else _blank(width - b.width)]
+            lines.append(line)
+    exit = len(lines) - len(last.lines) + last.exit
+    return _Block(lines, blocks[0].wire, width, last.out, exit)
 
 
 # -- what the view needs to know ---------------------------------------------------------------
@@ -222,10 +253,21 @@ class _Context:
             return ("?", FAULT)
 
     def is_output(self, element: Element) -> bool:
-        if isinstance(element, Branch):
-            return all(leg and self.is_output(leg[-1]) for leg in element.legs)
-        spec = self.instructions.lookup(element.mnemonic)
-        return spec is None or spec.output
+        """An output instruction, or a branch whose every leg ends in one
+        (looked at without recursion, whatever the nesting)."""
+        stack = [element]
+        while stack:
+            el = stack.pop()
+            if isinstance(el, Branch):
+                for leg in el.legs:
+                    if not leg:
+                        return False
+                    stack.append(leg[-1])
+            else:
+                spec = self.instructions.lookup(el.mnemonic)
+                if spec is not None and not spec.output:
+                    return False
+        return True
 
 
 def _value_text(value) -> str:
@@ -275,10 +317,16 @@ def _bit_cell(ins: Instruction, ctx: _Context) -> _Block:
 def _box_cell(ins: Instruction, budget: int, ctx: _Context) -> _Block:
     state = ctx.state(ins)
     p_in, p_out = (state.power_in, state.power_out) if state else (False, False)
-    title = ins.mnemonic
     title_style = FAULT if state is not None and state.fault else _power_style(state is not None and state.is_true)
+    return _box(ins.mnemonic, title_style, _box_items(ins, ctx), budget, p_in, p_out)
+
+
+def _box(title: str, title_style: Style | None, groups: list[list[Line]], budget: int, p_in: bool,
+         p_out: bool) -> _Block:
+    """A box with ``title`` in its top border and ``groups`` flowed inside,
+    at most ``budget`` wide (BOX_MAX inside) unless its title needs more."""
     least = cell_len(title) + 2
-    lines = _flow(_box_items(ins, ctx), max(least, min(BOX_MAX, budget - 4))) or [[]]
+    lines = _flow(groups, max(least, min(BOX_MAX, budget - 4))) or [[]]
     inner = max(least, *(_width(line) for line in lines))
     top = [_blank(1), ("+-", None), (title, title_style), ("-" * (inner - cell_len(title) - 1) + "+", None), _blank(1)]
     body = []
@@ -412,13 +460,14 @@ def _chunks(item: Line, width: int) -> list[Line]:
     there is one."""
     chars = [(ch, style) for text, style in item for ch in text]
     out = []
-    while chars:
-        cut = min(len(chars), width)
-        if cut < len(chars):
-            space = max((k for k in range(1, cut) if chars[k][0] == " "), default=None)
+    at, n = 0, len(chars)
+    while at < n:
+        cut = min(n - at, width)
+        if cut < n - at:
+            space = max((k for k in range(1, cut) if chars[at + k][0] == " "), default=None)
             cut = space + 1 if space is not None else cut
-        out.append(_merged(chars[:cut]))
-        chars = chars[cut:]
+        out.append(_merged(chars[at:at + cut]))
+        at += cut
     return out
 
 
@@ -433,85 +482,247 @@ def _merged(chars: list[Run]) -> Line:
 
 
 # -- series, branches, rows ----------------------------------------------------------------------
+#
+# A series is laid out at a budget (the columns it may take): side by side
+# when its elements fit, else wrapped into rows, its too-wide elements laid
+# out again narrower. Deciding that needs the elements' widths at a budget,
+# and a branch's width needs its legs' (a budget 4 narrower), and so on down.
+# Building every candidate block to measure it would lay a subtree out
+# again at every level above it that wraps: twice per level, exponential in
+# the nesting depth. So _Layout measures first (widths only, memoized per
+# element and budget) and builds each element's block once, at the budget
+# its series chose. Branches nested deeper than MAX_DEPTH, or left fewer
+# than MIN_LEG columns a leg, are drawn as one box that sums them up, so the
+# drawn depth, and with it the work per element, is bounded.
+
+MAX_DEPTH = 32  # branch levels drawn; deeper branches are summed up in a box
+MIN_LEG = 16  # columns a branch's legs need at least; with fewer it is summed up in a box
 
 
-def _element_block(el: Element, budget: int, ctx: _Context) -> _Block:
-    if isinstance(el, Branch):
-        return _branch_block(el, budget, ctx)
-    if el.mnemonic in _GLYPHS and len(el.operands) == 1:
-        return _bit_cell(el, ctx)
-    return _box_cell(el, budget, ctx)
+class _Layout:
+    """The blocks of one rung: measure (``width``) and build (``block``)
+    elements; ``level`` is the number of branches around an element."""
 
+    def __init__(self, ctx: _Context, elements: list[Element]) -> None:
+        self.ctx = ctx
+        self.elements = elements
+        self._widths: dict[tuple[int, int], int] = {}
+        self._cells: dict[tuple[int, int], _Block] = {}
+        self._sizes: dict[int, tuple[int, int]] | None = None
 
-def _branch_block(branch: Branch, budget: int, ctx: _Context) -> _Block:
-    """Legs stacked between ``+`` connectors: the left bus joins where the
-    legs' wires enter, the right bus where they leave (and, when the first
-    leg wraps, the branch's own wire row, where the rung goes on)."""
-    state = ctx.state(branch)
-    p_in, p_out = (state.power_in, state.power_out) if state else (False, False)
-    legs = [_leg_block(leg, budget - 4, p_in, ctx) for leg in branch.legs]
-    inner = max(leg.width for leg in legs)
-    lines: list[Line] = []
-    entries, exits = [], []
-    for leg in legs:
-        entries.append(len(lines) + leg.wire)
-        exits.append(len(lines) + leg.exit)
-        for r, line in enumerate(leg.lines):
-            pad = _wire(inner - leg.width, leg.out) if r == leg.exit else _blank(inner - leg.width)
-            lines.append([*line, pad])
-    joins = {*exits, entries[0]}
-    top, bottom = min(joins), max(joins)
-    joined = []
-    for r, line in enumerate(lines):
-        left = "+" if r in entries else "|" if entries[0] < r < entries[-1] else " "
-        right = "+" if r in joins else "|" if top < r < bottom else " "
-        joined.append([(left, _power_style(p_in and left != " ")), *line,
-                       (right, _power_style(p_out and right != " "))])
-    block = _Block(joined, entries[0], inner + 2, p_out)
-    return _with_edges(block, ("-", " ", _power_style(p_in)), ("-", " ", _power_style(p_out)))
+    # -- measuring
+    def width(self, el: Element, budget: int, level: int) -> int:
+        key = (id(el), budget)
+        w = self._widths.get(key)
+        if w is None:
+            if self._drawn(el, budget, level):
+                w = 4 + max(self._leg_plan(leg, budget - 4, level + 1)[0] for leg in el.legs)
+            else:
+                w = self._cell(el, budget, level).width
+            self._widths[key] = w
+        return w
 
+    def _drawn(self, el: Element, budget: int, level: int) -> bool:
+        """A branch drawn as legs (else a single cell: an instruction, or a
+        branch summed up)."""
+        return isinstance(el, Branch) and bool(el.legs) and level < MAX_DEPTH and budget - 4 >= MIN_LEG
 
-def _leg_block(leg: list[Element], budget: int, power_in: bool, ctx: _Context) -> _Block:
-    """One leg of a branch: its series side by side, or, when that is wider
-    than ``budget``, wrapped into rows a column clear of the buses."""
-    if not leg:
-        return _wire_block(2, power_in)
-    blocks = [_element_block(el, budget, ctx) for el in leg]
-    if sum(b.width for b in blocks) <= budget:
-        return _side_by_side(blocks)
-    rows = _rows(leg, blocks, len(leg), budget - 2, power_in, ctx, rails=False)
-    return _with_edges(rows, ("-", " ", _power_style(power_in)), ("-", " ", _power_style(rows.out)))
+    def _leg_plan(self, leg: list[Element], budget: int, level: int) -> tuple[int, list[int], bool]:
+        """(width, each element's budget, wrapped) of a branch leg."""
+        if not leg:
+            return 2, [], False
+        widths = [self.width(el, budget, level) for el in leg]
+        if sum(widths) <= budget:
+            return sum(widths), [budget] * len(leg), False
+        budgets, widths = self._narrowed(leg, widths, budget, budget - 2, 0, level)
+        return _rows_width(widths, budget - 2, 0) + 2, budgets, True
 
+    def _narrowed(self, elements: list[Element], widths: list[int], budget: int, width: int, rail: int,
+                  level: int) -> tuple[list[int], list[int]]:
+        """A series that does not fit rows of ``width``: its elements wider
+        than a row between ``>>`` markers are laid out that narrow."""
+        budgets = [budget] * len(elements)
+        if sum(widths) > width - 2 * rail:
+            narrow = width - 2 * len(CONTINUED)
+            widths = list(widths)
+            for k, el in enumerate(elements):
+                if widths[k] > narrow:
+                    budgets[k], widths[k] = narrow, self.width(el, narrow, level)
+        return budgets, widths
 
-def _rows(elements: list[Element], blocks: list[_Block], split: int, width: int, power_in: bool,
-          ctx: _Context, rails: bool) -> _Block:
-    """A series laid out in rows of exactly ``width`` cells, wrapped between
-    elements with ``>>`` markers; the wire is filled out before element
-    ``split`` (outputs go to the right). With ``rails``, the first row starts
-    at the left rail and the last row ends at the right rail."""
-    rail = 1 if rails else 0
-    if sum(b.width for b in blocks) > width - 2 * rail:
+    # -- building
+    def block(self, el: Element, budget: int, level: int) -> _Block:
+        if self._drawn(el, budget, level):
+            return self._branch(el, budget, level)
+        return self._cell(el, budget, level)
+
+    def _cell(self, el: Element, budget: int, level: int) -> _Block:
+        """An instruction's block, or a branch summed up; kept, as measuring
+        builds them."""
+        bit = isinstance(el, Instruction) and el.mnemonic in _GLYPHS and len(el.operands) == 1
+        key = (id(el), -1 if bit else budget)
+        cell = self._cells.get(key)
+        if cell is None:
+            if bit:
+                cell = _bit_cell(el, self.ctx)
+            elif isinstance(el, Branch):
+                cell = self._summary(el, budget)
+            else:
+                cell = _box_cell(el, budget, self.ctx)
+            self._cells[key] = cell
+        return cell
+
+    def _summary(self, branch: Branch, budget: int) -> _Block:
+        """A branch too deep for the width (or for MAX_DEPTH): a box saying
+        what it holds, with its power."""
+        if self._sizes is None:
+            self._sizes = _branch_sizes(self.elements)
+        levels, count = self._sizes.get(id(branch), (1, 0))
+        state = self.ctx.state(branch)
+        p_in, p_out = (state.power_in, state.power_out) if state else (False, False)
+        legs = len(branch.legs)
+        items = [[(f"{legs} leg{'s' if legs != 1 else ''},", None)],
+                 [(f"{levels} level{'s' if levels != 1 else ''},", None)],
+                 [(f"{count} instruction{'s' if count != 1 else ''}", None)]]
+        return _box("BST", _power_style(p_out), [items], budget, p_in, p_out)
+
+    def _branch(self, branch: Branch, budget: int, level: int) -> _Block:
+        """Legs stacked between ``+`` connectors: the left bus joins where
+        the legs' wires enter, the right bus where they leave (and, when the
+        first leg wraps, the branch's own wire row, where the rung goes on)."""
+        state = self.ctx.state(branch)
+        p_in, p_out = (state.power_in, state.power_out) if state else (False, False)
+        legs = [self._leg(leg, budget - 4, p_in, level + 1) for leg in branch.legs]
+        inner = max(leg.width for leg in legs)
+        lines: list[Line] = []
+        entries, exits = [], []
+        for leg in legs:
+            entries.append(len(lines) + leg.wire)
+            exits.append(len(lines) + leg.exit)
+            for r, line in enumerate(leg.lines):
+                pad = _wire(inner - leg.width, leg.out) if r == leg.exit else _blank(inner - leg.width)
+                lines.append([line, pad])
+        entered = set(entries)
+        joins = {*exits, entries[0]}
+        top, bottom = min(joins), max(joins)
+        in_run, out_run = ("-", _power_style(p_in)), ("-", _power_style(p_out))
+        joined = []
+        for r, line in enumerate(lines):
+            left = "+" if r in entered else "|" if entries[0] < r < entries[-1] else " "
+            right = "+" if r in joins else "|" if top < r < bottom else " "
+            on_wire = r == entries[0]
+            joined.append([in_run if on_wire else (" ", None), (left, _power_style(p_in and left != " ")), line,
+                           (right, _power_style(p_out and right != " ")), out_run if on_wire else (" ", None)])
+        return _Block(joined, entries[0], inner + 4, p_out)
+
+    def _leg(self, leg: list[Element], budget: int, power_in: bool, level: int) -> _Block:
+        """One leg of a branch: its series side by side, or, when that is
+        wider than ``budget``, wrapped into rows a column clear of the buses."""
+        _, budgets, wrapped = self._leg_plan(leg, budget, level)
+        if not leg:
+            return _wire_block(2, power_in)
+        if not wrapped:
+            return _side_by_side([self.block(el, budget, level) for el in leg])
+        rows = self.rows(leg, budgets.__getitem__, len(leg), budget - 2, power_in, rails=False, level=level)
+        return _with_edges(rows, ("-", " ", _power_style(power_in)), ("-", " ", _power_style(rows.out)))
+
+    def rung(self, width: int, max_lines: int | None = None) -> _Block:
+        """The rung's elements between the rails, in rows of ``width``; with
+        ``max_lines``, only the rows that start within that many lines (a
+        long rung is measured and built only as far as it is seen)."""
+        elements = self.elements
+        full = width - 2
         narrow = width - 2 * len(CONTINUED)
-        blocks = [_element_block(el, narrow, ctx) if b.width > narrow else b for el, b in zip(elements, blocks)]
-    rows = _pack([b.width for b in blocks], width, rail)
-    out_rows = []
-    for k, indices in enumerate(rows):
-        first, last = k == 0, k == len(rows) - 1
-        left_w = rail if first else len(CONTINUED)
+        fits = _fits((self.width(el, full, 0) for el in elements), width - 2)
+
+        def budget(i: int) -> int:
+            return full if fits or self.width(elements[i], full, 0) <= narrow else narrow
+
+        return self.rows(elements, budget, _outputs_start(elements, self.ctx), width, True, True, 0, max_lines)
+
+    def rows(self, elements: list[Element], budget: Callable[[int], int], split: int, width: int, power_in: bool,
+             rails: bool, level: int, max_lines: int | None = None) -> _Block:
+        """A series laid out in rows of ``width`` cells (wider only where one
+        element is), wrapped between elements with ``>>`` markers; element
+        ``i`` at ``budget(i)``; the wire is filled out before element
+        ``split`` (outputs go to the right). With ``rails``, the first row
+        starts at the left rail and the last row ends at the right rail.
+        With ``max_lines``: the rows up to the one that reaches that many
+        lines; the elements after them are not looked at."""
+        rail = 1 if rails else 0
+        blocks: dict[int, _Block] = {}
+
+        def block(i: int) -> _Block:
+            b = blocks.get(i)
+            if b is None:
+                b = blocks[i] = self.block(elements[i], budget(i), level)
+            return b
+
+        out_rows = []
+        lines = 0
+        for indices, last in _packed(lambda i: self.width(elements[i], budget(i), level), len(elements),
+                                     width, rail):
+            first = not out_rows
+            left_w = rail if first else len(CONTINUED)
+            right_w = rail if last else len(CONTINUED)
+            parts = [block(i) for i in indices]
+            room = width - left_w - right_w - sum(b.width for b in parts)
+            if room > 0:
+                at = next((n for n, i in enumerate(indices) if i >= split), len(indices)) if last else len(indices)
+                before = indices[at] - 1 if at < len(indices) else (indices[-1] if indices else -1)
+                on = block(before).out if before >= 0 else power_in
+                parts.insert(at, _wire_block(room, on))
+            row = _side_by_side(parts) if parts else _wire_block(0, power_in)
+            arriving = block(indices[0] - 1).out if indices and indices[0] > 0 else power_in
+            left = _RAIL if first and rails else None if first else _continued(arriving)
+            right = _RAIL if last and rails else None if last else _continued(row.out)
+            out_rows.append(_with_edges(row, left, right))
+            lines += len(row.lines)
+            if max_lines is not None and lines >= max_lines:
+                break
+        return _stacked(out_rows)
+
+
+def _branch_sizes(elements: list[Element]) -> dict[int, tuple[int, int]]:
+    """id(branch) -> (levels of branches it holds, itself included;
+    instructions in it), for every branch in ``elements``; no recursion,
+    whatever the depth."""
+    sizes: dict[int, tuple[int, int]] = {}
+    stack: list[tuple[Branch, bool]] = [(el, False) for el in elements if isinstance(el, Branch)]
+    while stack:
+        branch, children_done = stack.pop()
+        if id(branch) in sizes:
+            continue
+        inner = [el for leg in branch.legs for el in leg if isinstance(el, Branch)]
+        if not children_done:
+            stack.append((branch, True))
+            stack.extend((b, False) for b in inner if id(b) not in sizes)
+            continue
+        levels = 1 + max((sizes[id(b)][0] for b in inner), default=0)
+        count = sum(len(leg) for leg in branch.legs) - len(inner) + sum(sizes[id(b)][1] for b in inner)
+        sizes[id(branch)] = (levels, count)
+    return sizes
+
+
+def _rows_width(widths: list[int], width: int, rail: int) -> int:
+    """The width of :meth:`_Layout.rows` for elements this wide."""
+    widest = width
+    for k, (indices, last) in enumerate(_packed(widths.__getitem__, len(widths), width, rail)):
+        left_w = rail if k == 0 else len(CONTINUED)
         right_w = rail if last else len(CONTINUED)
-        room = width - left_w - right_w - sum(blocks[i].width for i in indices)
-        parts = [blocks[i] for i in indices]
-        if room > 0:
-            at = next((n for n, i in enumerate(indices) if i >= split), len(indices)) if last else len(indices)
-            before = indices[at] - 1 if at < len(indices) else (indices[-1] if indices else -1)
-            on = blocks[before].out if before >= 0 else power_in
-            parts.insert(at, _wire_block(room, on))
-        row = _side_by_side(parts) if parts else _wire_block(0, power_in)
-        arriving = blocks[indices[0] - 1].out if indices and indices[0] > 0 else power_in
-        left = _RAIL if first and rails else None if first else _continued(arriving)
-        right = _RAIL if last and rails else None if last else _continued(row.out)
-        out_rows.append(_with_edges(row, left, right))
-    return _stacked(out_rows)
+        widest = max(widest, left_w + right_w + sum(widths[i] for i in indices))
+    return widest
+
+
+def _fits(widths: Iterable[int], limit: int) -> bool:
+    """Whether the widths add up to at most ``limit`` (looked at only until
+    they do not)."""
+    total = 0
+    for w in widths:
+        total += w
+        if total > limit:
+            return False
+    return True
 
 
 _RAIL = ("|", "|", None)
@@ -521,27 +732,38 @@ def _continued(on: bool) -> tuple[str, str, Style | None]:
     return (CONTINUED, " " * len(CONTINUED), _power_style(on))
 
 
-def _pack(widths: list[int], width: int, rail: int) -> list[list[int]]:
-    """Element indices per row: as many as fit, leaving room for the
-    ``>>`` markers; the last row ends at the rail instead."""
-    rows: list[list[int]] = []
+def _packed(width_of: Callable[[int], int], n: int, width: int, rail: int) -> Iterable[tuple[list[int], bool]]:
+    """The indices of the elements on each row, and whether it is the last
+    row: as many as fit, leaving room for the ``>>`` markers; the last row
+    ends at the rail instead. Widths are asked for in order, and only one
+    row's worth beyond the rows taken."""
     row: list[int] = []
     used = 0
-    i, n = 0, len(widths)
+    first = True
+    i = 0
+    ahead, ahead_sum = 0, 0  # the widths of elements i..ahead-1 add up to ahead_sum
     while i < n:
-        left = rail if not rows else len(CONTINUED)
-        if used + sum(widths[i:]) <= width - left - rail:
+        left = rail if first else len(CONTINUED)
+        limit = width - left - rail - used
+        while ahead < n and ahead_sum <= limit:
+            ahead_sum += width_of(ahead)
+            ahead += 1
+        if ahead == n and ahead_sum <= limit:  # the rest fits on this row: the last
             row.extend(range(i, n))
             break
-        if not row or used + widths[i] <= width - left - len(CONTINUED):
+        w = width_of(i)
+        if not row or used + w <= width - left - len(CONTINUED):
             row.append(i)
-            used += widths[i]
+            used += w
+            if ahead > i:
+                ahead_sum -= w
+            else:
+                ahead = i + 1
             i += 1
         else:
-            rows.append(row)
-            row, used = [], 0
-    rows.append(row)
-    return rows
+            yield row, False
+            row, used, first = [], 0, False
+    yield row, True
 
 
 def _outputs_start(elements: list[Element], ctx: _Context) -> int:
@@ -555,7 +777,7 @@ def _outputs_start(elements: list[Element], ctx: _Context) -> int:
 
 
 def _segments(line: Line) -> Iterable[Segment]:
-    for text, style in line:
+    for text, style in _runs(line):
         if text:
             yield Segment(text, style)
 
@@ -575,12 +797,11 @@ def _paragraphs(comment: str) -> list[str]:
     return paragraphs
 
 
-def _wrapped(console: Console, text: str, width: int, indent: int, style: Style) -> RenderResult:
+def _wrapped(console: Console, text: str, width: int, indent: int, style: Style) -> Iterable[list[Segment]]:
+    """``text`` wrapped to ``width``, indented: one list of segments a line."""
     for line in Text(text, style=style).wrap(console, max(10, width - indent)):
         line.rstrip()
-        yield Segment(" " * indent)
-        yield from line.render(console)
-        yield Segment.line()
+        yield [Segment(" " * indent), *line.render(console)]
 
 
 class RungView:
@@ -594,11 +815,14 @@ class RungView:
     text, e.g. ``{"I:0/0"}``), marked ``F``; ``tli_status`` shows the
     CONTROL status line of plug-in module instructions (COMSCAN...);
     ``instructions`` the app's instruction set (``app.instructions``), for
-    module instructions' operand names."""
+    module instructions' operand names; ``max_lines``: draw only the top
+    of the rung, that many lines (a long rung is then laid out only as far
+    as it is drawn)."""
 
     def __init__(self, rung: Rung, number: int, table: DataTable, power: Power | None = None,
                  symbols: Mapping[str, object] | None = None, selected: bool = False, breakpoint: bool = False,
-                 forced=frozenset(), tli_status: bool = True, instructions: InstructionSet | None = None) -> None:
+                 forced=frozenset(), tli_status: bool = True, instructions: InstructionSet | None = None,
+                 max_lines: int | None = None) -> None:
         self.rung = rung
         self.number = number
         self.table = table
@@ -609,27 +833,36 @@ class RungView:
         self.forced = forced
         self.tli_status = tli_status
         self.instructions = instructions or BUILTIN
+        self.max_lines = max_lines
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
-        width = max(options.max_width, 20)
-        power = self.power if self.power is not None else rung_power(self.rung, self.table)
-        ctx = _Context(self.table, power, self.names, self.forced, self.instructions, self.tli_status)
-        yield Segment(">" if self.selected else " ", SELECTED if self.selected else None)
-        yield Segment("*" if self.breakpoint else " ", BREAKPOINT)
-        yield Segment(f" Rung {self.number}", SELECTED if self.selected else HEADER)
-        yield Segment.line()
-        for paragraph in _paragraphs(self.rung.comment or ""):
-            yield from _wrapped(console, paragraph, width, COMMENT_INDENT, COMMENT)
-        for fault in dict.fromkeys(power.faults()):
-            yield from _wrapped(console, f"! {fault}", width, COMMENT_INDENT, FAULT)
-        for line in self._body(width, ctx).lines:
-            yield from _segments(line)
+        lines = self._lines(console, max(options.max_width, 20))
+        if self.max_lines is not None:
+            lines = itertools.islice(lines, max(self.max_lines, 0))
+        for line in lines:
+            yield from line
             yield Segment.line()
 
-    def _body(self, width: int, ctx: _Context) -> _Block:
-        elements = self.rung.elements
-        blocks = [_element_block(el, width - 2, ctx) for el in elements]
-        return _rows(elements, blocks, _outputs_start(elements, ctx), width, True, ctx, rails=True)
+    def _lines(self, console: Console, width: int) -> Iterable[list[Segment]]:
+        power = self.power if self.power is not None else rung_power(self.rung, self.table)
+        ctx = _Context(self.table, power, self.names, self.forced, self.instructions, self.tli_status)
+        yield [Segment(">" if self.selected else " ", SELECTED if self.selected else None),
+               Segment("*" if self.breakpoint else " ", BREAKPOINT),
+               Segment(f" Rung {self.number}", SELECTED if self.selected else HEADER)]
+        used = 1
+        for paragraph in _paragraphs(self.rung.comment or ""):
+            for line in _wrapped(console, paragraph, width, COMMENT_INDENT, COMMENT):
+                yield line
+                used += 1
+        for fault in dict.fromkeys(power.faults()):
+            for line in _wrapped(console, f"! {fault}", width, COMMENT_INDENT, FAULT):
+                yield line
+                used += 1
+        if self.max_lines is not None and used >= self.max_lines:
+            return
+        rest = None if self.max_lines is None else self.max_lines - used
+        for line in _Layout(ctx, self.rung.elements).rung(width, rest).lines:
+            yield list(_segments(line))
 
 
 class ProgramFileView:
@@ -661,20 +894,26 @@ class ProgramFileView:
         self.drawn = 0
         self.last_drawn: int | None = None
 
-    def rung_view(self, number: int) -> RungView:
+    def rung_view(self, number: int, max_lines: int | None = None) -> RungView:
         rung = self.pfile.rungs[number]
         marked = number in self.breakpoints or (self.pfile.number, number) in self.breakpoints
         return RungView(rung, number, self.table, power=self.power_of(rung, self.table), symbols=self.names,
                         selected=number == self.selected, breakpoint=marked, forced=self.forced,
-                        tli_status=self.tli_status, instructions=self.instructions)
+                        tli_status=self.tli_status, instructions=self.instructions, max_lines=max_lines)
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         self.drawn, self.last_drawn = 0, None
         height = self.height
         used = 0
         unbounded = options.update(height=None)
+        if not self.pfile.rungs:
+            yield Segment("   (no rungs)", COMMENT)
+            yield Segment.line()
+            return
         for number in range(max(0, self.first), len(self.pfile.rungs)):
-            lines = console.render_lines(self.rung_view(number), unbounded, pad=False)
+            # one line more than is left: a rung that gets it does not fit
+            room = None if height is None else height - used + 1
+            lines = console.render_lines(self.rung_view(number, room), unbounded, pad=False)
             if height is not None and used + len(lines) > height:
                 if self.drawn:
                     # fill the rest with the top of the next rung (not counted

@@ -1,0 +1,207 @@
+"""The watch view against sizes that once hung or crashed it (issue 15):
+deep, wide and long rungs, huge snapshot sizes, an app with no rungs,
+watch files too big or not text, expressions nested too deep. Layout is
+checked through the library, the command line through the real
+``softplc`` command (a subprocess with a timeout)."""
+
+from __future__ import annotations
+
+import gc
+import io
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from rich.cells import cell_len
+from rich.console import Console
+
+from softplc_lite.datatable import DataTable, parse_address
+from softplc_lite.ladder import validate
+from softplc_lite.ladder.ast import AddressRef, Branch, Instruction, Rung, address_refs, walk
+from softplc_lite.watch import rungs
+from softplc_lite.watch.power import rung_power
+from softplc_lite.watch.rungs import RungView
+
+from ladder_strategies import programs
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+# -- helpers ------------------------------------------------------------------------------------
+
+
+def ins(mnemonic: str, address: str) -> Instruction:
+    return Instruction(mnemonic, [AddressRef(parse_address(address))])
+
+
+def nested(depth: int, second_leg: bool = True) -> Rung:
+    """``XIC B3/0 BST XIC B3/3 NXB ... XIC B3/1 BND ... OTE B3/2``: ``depth``
+    branches, each holding the next in its last leg (with
+    ``second_leg=False``, each branch has that one leg only: the checker
+    refuses it, but the library can build it)."""
+    inner: list = [ins("XIC", "B3/1")]
+    for _ in range(depth):
+        inner = [Branch([[ins("XIC", "B3/3")], inner] if second_leg else [inner])]
+    return Rung([ins("XIC", "B3/0"), *inner, ins("OTE", "B3/2")])
+
+
+def table_for(*rungs_: Rung) -> DataTable:
+    table = DataTable()
+    for rung in rungs_:
+        for instruction in walk(rung.elements):
+            for op in instruction.operands:
+                for ref in address_refs(op):
+                    table.reference(ref.address)
+    return table
+
+
+def draw(rung: Rung, width: int, table: DataTable | None = None, **view) -> list[str]:
+    """The rung's lines at ``width`` (no colour, trailing spaces kept)."""
+    console = Console(width=width, color_system=None, file=io.StringIO(), record=True)
+    console.print(RungView(rung, 0, table or table_for(rung), **view))
+    return console.export_text().splitlines()
+
+
+def layout(rung: Rung, width: int, table: DataTable) -> rungs._Block:
+    """The rung's body block itself: its width is not cut to a console's."""
+    ctx = rungs._Context(table, rung_power(rung, table), rungs._SymbolNames(None), frozenset(), rungs.BUILTIN, True)
+    return rungs._Layout(ctx, rung.elements).rung(width)
+
+
+def best_time(fn, repeat: int = 5, number: int = 3) -> float:
+    """The fastest of ``repeat`` timings of ``number`` calls, per call; the
+    garbage collector off meanwhile (its passes cost what the whole test
+    process holds, not what ``fn`` does)."""
+    best = float("inf")
+    gc.collect()
+    gc.disable()
+    try:
+        for _ in range(repeat):
+            start = time.perf_counter()
+            for _ in range(number):
+                fn()
+            best = min(best, (time.perf_counter() - start) / number)
+    finally:
+        gc.enable()
+    return best
+
+
+def softplc(*args: str, timeout: float = 60, **kw) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=ROOT, capture_output=True, text=True,
+                          timeout=timeout, check=False, stdin=subprocess.DEVNULL, **kw)
+
+
+def app(tmp_path: Path, text: str, name: str = "app") -> Path:
+    directory = tmp_path / name
+    directory.mkdir()
+    (directory / "main.lad").write_text(text, encoding="utf-8")
+    return directory
+
+
+# -- layout: linear in the rung's size -----------------------------------------------------------
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("width", [64, 100])
+@pytest.mark.parametrize("second_leg", [True, False])
+def test_deep_rung_layout_grows_linearly(width, second_leg):
+    # Each level used to be laid out twice (at its budget, then narrower)
+    # once the rung stopped fitting: 14 levels took 5 s at 64 columns, 16
+    # levels 22 s, 23 levels at 100 columns never finished.
+    times = {}
+    for depth in (8, 16, 32):
+        rung = nested(depth, second_leg)
+        table = table_for(rung)
+        times[depth] = best_time(lambda: draw(rung, width, table), repeat=9, number=5)
+    # twice the levels is twice the instructions: about twice the time;
+    # generous bounds for a noisy machine (exponential growth is 2**8 a step)
+    assert times[16] < 6 * times[8], times
+    assert times[32] < 6 * times[16], times
+
+
+@pytest.mark.timeout(60)
+def test_a_32_level_rung_renders_quickly_with_its_outer_instructions():
+    text = "XIC B3/0 " + "BST XIC B3/3 NXB " * 32 + "XIC B3/1 " + "BND " * 32 + "OTE B3/2\n"
+    from softplc_lite.ladder import load_text
+
+    rung = load_text(text).main.rungs[0]
+    table = table_for(rung)
+    start = time.perf_counter()
+    lines = draw(rung, 100, table)
+    elapsed = time.perf_counter() - start
+    assert elapsed < 1.0
+    assert lines[0].rstrip() == "   Rung 0"
+    assert lines[1].startswith("| B3/0 ") and lines[2].startswith("|-] [--")  # the first contact, at the rail
+    assert "B3/2" in lines[-3] and "( )--|" in lines[-2]  # the coil, at the right rail
+    # levels too deep for 100 columns are summed up in one box, with what it holds
+    assert any("+-BST-" in line for line in lines)
+    assert any("levels," in line for line in lines)
+    assert all(cell_len(line) == 100 for line in lines[1:])  # nothing cut off, every row as wide
+
+
+@pytest.mark.timeout(60)
+@pytest.mark.parametrize("width", [40, 100, 1000])
+@pytest.mark.parametrize("second_leg", [True, False])
+def test_200_levels_built_by_the_library_render_quickly(width, second_leg):
+    rung = nested(200, second_leg)
+    table = table_for(rung)
+    start = time.perf_counter()
+    lines = draw(rung, width, table)
+    assert time.perf_counter() - start < 5.0
+    assert "B3/0" in lines[1] and any("B3/2" in line for line in lines) and lines[-1].endswith("|")
+    block = layout(rung, width, table)
+    assert {rungs._width(line) for line in block.lines} == {width}
+
+
+def test_power_flow_of_a_very_deep_rung_needs_no_recursion():
+    rung = nested(5000, second_leg=False)
+    table = DataTable()
+    table.write("B3/0", 1)
+    table.write("B3/1", 1)
+    power = rung_power(rung, table)  # RecursionError before
+    assert power.out is True
+    innermost = rung.elements[1]
+    for _ in range(4999):
+        innermost = innermost.legs[0][0]
+    assert power[innermost].power_in is True and power[innermost].legs == (True,)
+
+
+@pytest.mark.timeout(60)
+def test_many_legs_and_long_rungs_render_quickly():
+    legs = Rung([ins("XIC", "B3/0"), Branch([[ins("XIC", f"B3/{k}")] for k in range(300)]), ins("OTE", "B3/2")])
+    long = Rung([ins("XIC", f"B3/{k}") for k in range(1999)] + [ins("OTE", "O:0/0")])
+    for rung in (legs, long):
+        table = table_for(rung)
+        for width in (40, 100, 1000):
+            assert best_time(lambda: draw(rung, width, table), repeat=1, number=1) < 2.0
+    # the 300 legs: the bus down the left joins every one of them
+    lines = draw(legs, 100)
+    assert sum(line[:9] == "|       +" and "] [" in line for line in lines) == 299
+
+
+def test_a_long_rung_is_laid_out_only_as_far_as_it_is_drawn():
+    long = Rung([ins("XIC", f"B3/{k}") for k in range(3000)] + [ins("OTE", "O:0/0")])
+    table = table_for(long)
+    full = draw(long, 100, table)
+    top = draw(long, 100, table, max_lines=20)
+    assert top == full[:20]
+    # what is left to do for all 3,000 is the power flow (one table read each)
+    assert best_time(lambda: draw(long, 100, table, max_lines=20), repeat=3, number=1) * 4 < \
+        best_time(lambda: draw(long, 100, table), repeat=3, number=1)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=list(HealthCheck))
+@given(programs(max_rungs=4, subroutines=False), st.integers(40, 140))
+def test_every_rung_line_is_exactly_the_width(program, width):
+    # Widths are measured apart from building the blocks: the two must agree,
+    # or the buses and the right rail would not line up.
+    program = validate(program)
+    rungs_ = program.main.rungs
+    table = table_for(*rungs_)
+    for rung in rungs_:
+        block = layout(rung, width, table)
+        assert {rungs._width(line) for line in block.lines} == {width}
