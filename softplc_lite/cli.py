@@ -239,11 +239,14 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE", help="set a value at start")
     w.add_argument("--port", action="append", default=[], metavar="N=DEVICE", help="as for run")
     w.add_argument("--replay", metavar="TRACE", help="play every port back from a recorded TRACE file")
-    w.add_argument("--scans", type=int, default=0, metavar="N", help="with --snapshot: scans to run first")
+    w.add_argument("--scans", type=int_in(range(0, 2 ** 63), "--scans"), default=0, metavar="N",
+                   help="with --snapshot: scans to run first (0 or more; default 0)")
     w.add_argument("--snapshot", metavar="FILE", help="render the view after --scans N scans to FILE "
                    "(.svg: an SVG picture; otherwise text) and exit; needs no terminal")
-    w.add_argument("--width", type=int, default=100, metavar="COLS", help="--snapshot width (default 100)")
-    w.add_argument("--height", type=int, default=40, metavar="ROWS", help="--snapshot height (default 40)")
+    w.add_argument("--width", type=int_in(range(40, 1001), "--width"), default=100, metavar="COLS",
+                   help="--snapshot width, 40..1000 (default 100)")
+    w.add_argument("--height", type=int_in(range(12, 1001), "--height"), default=40, metavar="ROWS",
+                   help="--snapshot height, 12..1000 (default 40)")
     w.set_defaults(func=_cmd_watch)
 
     c = sub.add_parser("check", help="parse and validate an app; list every problem")

@@ -205,3 +205,130 @@ def test_every_rung_line_is_exactly_the_width(program, width):
     for rung in rungs_:
         block = layout(rung, width, table)
         assert {rungs._width(line) for line in block.lines} == {width}
+
+
+# -- the command line: sizes ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("args, message", [
+    (("--width", "100000", "--height", "100000"), "argument --width: expected an integer from 40 to 1000, not '100000'"),
+    (("--width", "39"), "argument --width: expected an integer from 40 to 1000, not '39'"),
+    (("--width", "1001"), "argument --width: expected an integer from 40 to 1000"),
+    (("--height", "100000"), "argument --height: expected an integer from 12 to 1000, not '100000'"),
+    (("--height", "11"), "argument --height: expected an integer from 12 to 1000, not '11'"),
+    (("--width", "wide"), "argument --width: expected an integer from 40 to 1000, not 'wide'"),
+    (("--scans", "-1"), "argument --scans: expected an integer 0 or more, not '-1'"),
+])
+def test_snapshot_size_and_scans_out_of_range_are_usage_errors(tmp_path, args, message):
+    # --width 100000 --height 100000 used to render ten billion cells: it never finished
+    out = tmp_path / "view.txt"
+    proc = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                   "--snapshot", str(out), *args, timeout=30)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.startswith("usage: softplc watch")
+    assert f"softplc watch: error: {message}" in proc.stderr
+    assert "Traceback" not in proc.stderr and proc.stdout == ""
+    assert not out.exists() and not (tmp_path / "state").exists()  # nothing ran
+
+
+@pytest.mark.parametrize("width, height", [(40, 12), (1000, 1000)])
+def test_snapshots_at_the_ends_of_the_size_range(tmp_path, width, height):
+    out = tmp_path / "view.txt"
+    start = time.monotonic()
+    proc = softplc("watch", "programs/modbus_master", "--fresh", "--state", str(tmp_path / "state"), "--scans", "20",
+                   "--snapshot", str(out), "--width", str(width), "--height", str(height))
+    assert proc.returncode == 0, proc.stderr
+    assert time.monotonic() - start < 30
+    lines = out.read_text(encoding="utf-8").splitlines()
+    assert len(lines) == height and {cell_len(line) for line in lines} == {width}
+
+
+def test_help_gives_the_size_ranges():
+    proc = softplc("watch", "--help")
+    assert proc.returncode == 0
+    text = " ".join(proc.stdout.split())
+    assert "--width COLS --snapshot width, 40..1000 (default 100)" in text
+    assert "--height ROWS --snapshot height, 12..1000 (default 40)" in text
+    assert "(0 or more; default 0)" in text
+
+
+def test_render_refuses_a_size_out_of_range(tmp_path):
+    from softplc_lite.app import load_app
+    from softplc_lite.runner import RunOptions
+    from softplc_lite.watch.cli import render
+    from softplc_lite.watch.session import WatchOptions, WatchSession
+
+    session = WatchSession(load_app(ROOT / "programs" / "blinker", tmp_path), WatchOptions(run=RunOptions(fresh=True)))
+    try:
+        with pytest.raises(ValueError, match="--width: expected an integer from 40 to 1000, not 100000"):
+            render(session, 100000, 100000)
+        with pytest.raises(ValueError, match="--height"):
+            render(session, 80, 5)
+        assert render(session, 80, 24).export_text().count("\n") == 24
+    finally:
+        session.quit()
+
+
+# -- a program with no rungs ---------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("scans", ["0", "3"])
+def test_snapshot_of_a_program_with_no_rungs(tmp_path, scans):
+    # IndexError before: the session took the first of no program files
+    empty = app(tmp_path, "// nothing\n", "empty")
+    out = tmp_path / "view.txt"
+    proc = softplc("watch", str(empty), "--state", str(tmp_path / "state"), "--scans", scans, "--snapshot", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr
+    text = out.read_text(encoding="utf-8")
+    assert " no program file" in text and "(no rungs)" in text
+    assert " empty " in text.splitlines()[0]
+
+
+def test_the_keys_on_a_program_with_no_rungs(tmp_path):
+    """Every key of the interactive view (through its real key handling and
+    drawing loop, onto a recording console) on an app without rungs."""
+    from softplc_lite.app import load_app
+    from softplc_lite.runner import RunOptions
+    from softplc_lite.watch.screen import WatchScreen, rung_view
+    from softplc_lite.watch.session import WatchOptions, WatchSession
+    from softplc_lite.watch.terminal import ViewLoop
+
+    empty = app(tmp_path, "// nothing\n", "empty")
+    session = WatchSession(load_app(empty, tmp_path / "state"), WatchOptions(run=RunOptions(fresh=True)))
+    screens = []
+
+    def draw_(screen) -> None:
+        console = Console(width=100, height=30, record=True, file=io.StringIO(), color_system=None)
+        console.print(screen)
+        screens.append(console.export_text())
+
+    loop = ViewLoop(session, WatchScreen(session, rung_view), draw_)
+    try:
+        for k in ["j", "k", "down", "up", "pgdown", "pgup", "f", "f", "b", "g", "7", "\r", "n", " ", "\x7f", "\x7f",
+                  "n", "+", "-", "r", "p", "F", "B", "3", "/", "1", "=", "1", "\r", "U", "B", "3", "/", "1", "\r"]:
+            loop.tick(k)
+            assert "(no rungs)" in screens[-1] and " no program file" in screens[-1]
+        assert session.selected == 0 and session.top == 0 and session.file is None
+        assert session.message == "force removed: B3/1"
+        session.toggle_breakpoint()
+        assert session.message == "no rung to set a breakpoint on"
+        session.next_file()
+        assert session.message == "no program file"
+        assert session.engine.scans >= 2
+        loop.tick("q")
+        assert loop.done
+    finally:
+        session.quit()
+
+
+def test_the_rung_views_with_an_empty_program_file():
+    from softplc_lite.ladder.ast import ProgramFile
+    from softplc_lite.watch.rungs import ProgramFileView
+
+    view = ProgramFileView(ProgramFile(2, None, []), DataTable(), height=20, selected=0, first=3)
+    console = Console(width=80, record=True, file=io.StringIO(), color_system=None)
+    console.print(view)
+    assert console.export_text().strip() == "(no rungs)"
+    assert view.drawn == 0 and view.last_drawn is None
+    assert view.rungs_that_fit(80, 20) == 0

@@ -15,6 +15,9 @@ from .session import WatchOptions, WatchSession
 from .watchlist import read_watch_file
 
 EXIT_USAGE = 2
+# The snapshot's size (--width, --height; the command line checks them too).
+SNAPSHOT_WIDTH = range(40, 1001)
+SNAPSHOT_HEIGHT = range(12, 1001)
 
 
 def watch_command(args) -> int:
@@ -24,8 +27,10 @@ def watch_command(args) -> int:
               "render the view to a file instead: softplc watch APP --scans N --snapshot view.txt "
               "(or view.svg)", file=sys.stderr)
         return EXIT_USAGE
-    if args.scans < 0 or args.width < 40 or args.height < 12:
-        raise SystemExit("softplc watch: error: --scans must be 0 or more, --width at least 40, --height at least 12")
+    problem = size_problem(args.width, args.height) or (args.scans < 0 and "--scans: expected 0 or more")
+    if problem:  # the parser checks these: for callers that build ``args`` themselves
+        print(f"softplc watch: error: {problem}", file=sys.stderr)
+        return EXIT_USAGE
     app = load_app(args.app, args.state)
     watch = list(args.watch) + (read_watch_file(args.watch_file) if args.watch_file else [])
     run = RunOptions(scan_ms=args.scan_ms, realtime=args.realtime, fresh=args.fresh, sets=tuple(args.set),
@@ -47,11 +52,23 @@ def watch_command(args) -> int:
         session.quit()
 
 
+def size_problem(width: int, height: int) -> str | None:
+    """What is wrong with a snapshot size, None when it is in range."""
+    for name, value, valid in (("--width", width, SNAPSHOT_WIDTH), ("--height", height, SNAPSHOT_HEIGHT)):
+        if value not in valid:
+            return f"{name}: expected an integer from {valid.start} to {valid.stop - 1}, not {value}"
+    return None
+
+
 def render(session: WatchSession, width: int, height: int, measured: bool = False) -> Console:
     """The view of ``session`` at ``width`` x ``height``, recorded (export it
     with ``export_text()`` or ``save_svg()``). The status bar shows the
     status file's scan times (S:8, S:9) unless ``measured``: on simulated
-    time a snapshot is then the same on every machine."""
+    time a snapshot is then the same on every machine. The size must be in
+    SNAPSHOT_WIDTH x SNAPSHOT_HEIGHT (ValueError otherwise)."""
+    problem = size_problem(width, height)
+    if problem:
+        raise ValueError(problem)
     console = Console(width=width, height=height, record=True, color_system="truecolor", force_terminal=True,
                       file=io.StringIO(), legacy_windows=False)
     console.print(WatchScreen(session, rung_view, measured=measured))

@@ -98,7 +98,9 @@ class RungsPanel:
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         s = self.session
         height = options.height or console.height
-        yield Text(f" program file {s.file}  rung {s.selected} of {len(s.rungs)}", style="bold underline")
+        where = f" program file {s.file}  rung {s.selected} of {len(s.rungs)}" if s.file is not None else \
+            " no program file"
+        yield Text(where, style="bold underline")
         view = self.view_factory(s, height - 1)
         yield view
         last = getattr(view, "last_drawn", None)
@@ -145,9 +147,11 @@ class WatchScreen:
 
 def rung_view(session: WatchSession, height: int):
     """The rungs of the session's shown file that fit ``height`` lines."""
+    from ..ladder.ast import ProgramFile
     from .rungs import ProgramFileView
 
     s = session
-    return ProgramFileView(s.app.program.files[s.file], s.engine.table, symbols=s.app.program.symbols,
+    pfile = s.app.program.files[s.file] if s.file is not None else ProgramFile(2, None, [])  # none: "(no rungs)"
+    return ProgramFileView(pfile, s.engine.table, symbols=s.app.program.symbols,
                            first=s.top, selected=s.selected, breakpoints=frozenset(s.breaks.rungs),
                            forced=frozenset(s.forces.forces), height=height, instructions=s.app.instructions)

@@ -55,7 +55,8 @@ class WatchSession:
         self.running = False
         self.speed = min(max(options.speed, 0), len(SPEEDS) - 1)
         self.files = sorted(app.program.files)
-        self.file = self.files[0] if 2 not in self.files else 2
+        # the shown program file: 2 (the main one), else the first; None when there is none
+        self.file: int | None = 2 if 2 in self.files else self.files[0] if self.files else None
         self.selected = 0  # selected rung of the shown file
         self.top = 0  # first rung shown
         self.message = ""
@@ -164,8 +165,9 @@ class WatchSession:
 
     # -- navigation ---------------------------------------------------------------------------
     @property
-    def rungs(self):
-        return self.app.program.files[self.file].rungs
+    def rungs(self) -> list:
+        """The shown file's rungs (none when the program has no file)."""
+        return self.app.program.files[self.file].rungs if self.file is not None else []
 
     def move(self, delta: int) -> None:
         self.selected = max(0, min(len(self.rungs) - 1, self.selected + delta))
@@ -177,11 +179,17 @@ class WatchSession:
         self.top = self.selected
 
     def next_file(self) -> None:
+        if not self.files:
+            self.message = "no program file"
+            return
         k = self.files.index(self.file)
         self.file = self.files[(k + 1) % len(self.files)]
         self.selected = self.top = 0
 
     def toggle_breakpoint(self) -> None:
+        if not self.rungs:
+            self.message = "no rung to set a breakpoint on"
+            return
         on = self.breaks.toggle(self.file, self.selected)
         self.message = f"breakpoint {'set' if on else 'cleared'}: file {self.file} rung {self.selected}"
 
