@@ -85,32 +85,36 @@ class StorageFaults:
 
 
 class _QuickHandover:
-    """While a save is being written, the interpreter's switch interval is
-    ``HANDOVER_S`` instead of its 5 ms default. The writer thread gives up
-    the GIL at each system call (open, write, rename...) and needs it back
-    for the next line; against a scan thread that never sleeps it would
-    wait a whole interval each time, and a save that takes 0.3 ms of file
-    work would take 20-50 ms. The scan thread loses the GIL the same
-    number of times either way, only sooner. Shared by every writer of the
-    process (a count under a lock the scan thread never takes)."""
+    """While a save is waiting or being written, the interpreter's thread
+    switch interval is ``HANDOVER_S`` instead of its 5 ms default.
+
+    The writer thread gives up the GIL at each system call (open, write,
+    rename...) and needs it back for the next line, and first to start at
+    all; against a scan thread that never sleeps it would wait a whole
+    interval each time, and a save of 0.2 ms of file work would take 10-50
+    ms. The scan thread loses the GIL the same number of times either way,
+    only sooner. The scan thread lowers the interval when it hands a job
+    over (``begin``); the writer puts it back when it has nothing left to
+    write and no other writer of the process is busy (``end``). No lock:
+    ``set.add``/``discard`` are atomic; two runners saving at once in one
+    process can at worst put the interval back while the other one writes,
+    which only makes that write slower."""
 
     def __init__(self) -> None:
-        self._lock = threading.Lock()
-        self._users = 0
-        self._saved = 0.005
+        self._busy: set[int] = set()
+        self._normal = sys.getswitchinterval()
 
-    def __enter__(self) -> None:
-        with self._lock:
-            if self._users == 0:
-                self._saved = sys.getswitchinterval()
-                sys.setswitchinterval(min(self._saved, HANDOVER_S))
-            self._users += 1
+    def begin(self, writer: object) -> None:
+        self._busy.add(id(writer))
+        current = sys.getswitchinterval()
+        if current > HANDOVER_S:
+            self._normal = current
+            sys.setswitchinterval(HANDOVER_S)
 
-    def __exit__(self, *exc) -> None:
-        with self._lock:
-            self._users -= 1
-            if self._users == 0:
-                sys.setswitchinterval(self._saved)
+    def end(self, writer: object) -> None:
+        self._busy.discard(id(writer))
+        if not self._busy:
+            sys.setswitchinterval(self._normal)
 
 
 _handover = _QuickHandover()
@@ -159,6 +163,7 @@ class SnapshotWriter:
         self._latest = job
         if not self._woken:
             self._woken = True
+            _handover.begin(self)
             self._wake.put(None)
 
     def stop(self, timeout: float = WRITER_JOIN_S) -> bool:
@@ -174,19 +179,22 @@ class SnapshotWriter:
         while True:
             self._wake.get()
             self._woken = False
-            if self._stopping:
-                return
             job = self._latest
-            if job is None or job.seq <= written:
+            if self._stopping or job is None or job.seq <= written:
+                if not self._woken:
+                    _handover.end(self)
+                if self._stopping:
+                    return
                 continue
             written = self.taken = job.seq
             try:
-                with _handover:
-                    self._write(job.data, self.path, job.durable)
+                self._write(job.data, self.path, job.durable)
                 error = None
             except Exception as e:  # noqa: BLE001 - reported as a minor fault; the thread must live on
                 error = describe_os_error(e)
             self.result = WriteResult(job.seq, job.taken_at, time.monotonic(), job.durable, error)
+            if not self._woken and self._latest is job:  # nothing new: the interval goes back
+                _handover.end(self)
 
 
 class Retentive:
