@@ -22,7 +22,6 @@ scanning. docs/engine.md has the whole story.
 from __future__ import annotations
 
 import collections
-import os
 import queue
 import sys
 import threading

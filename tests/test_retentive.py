@@ -237,10 +237,25 @@ def test_an_unusable_state_directory_keeps_the_plc_running_and_exits_1(tmp_path)
     assert dump.exists() and "Traceback" not in p.stderr
     snap = state / "datatable.snap"
     warnings = [line for line in p.stderr.splitlines() if line.startswith("warning:")]
-    assert warnings == [f"warning: cannot save the retentive snapshot {snap}: Not a directory ({snap}.tmp); the "
-                        f"PLC keeps running and tries again every 100 ms (minor fault S:17/4, code 9)"]
+    assert warnings == [(f"warning: cannot save the retentive snapshot {snap}: Not a directory ({snap}.tmp); the "
+                         f"PLC keeps running and tries again every 100 ms (minor fault S:17/4, code 9)")]
     assert p.stderr.splitlines()[-1] == (f"error: cannot save the retentive snapshot {snap} at the end of the run: "
                                          f"Not a directory ({snap}.tmp)")
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into a read-only directory anyway (CI runs as root)")
+def test_a_read_only_state_directory_is_a_minor_fault(tmp_path):
+    app = make_app(tmp_path / "app")
+    state = tmp_path / "state"
+    state.mkdir()
+    state.chmod(0o555)
+    try:
+        p = softplc("run", str(app), "--state", str(state), "--realtime", "--scan-ms", "5", "--scans", "60",
+                    "--print", "N7:0", "--print", "S:17", "--print", "S:102")
+    finally:
+        state.chmod(0o755)
+    assert p.returncode == 1 and p.stdout == "N7:0 = 60\nS:17 = 16\nS:102 = 9\n", p.stderr
+    assert p.stderr.count("Permission denied") == 2  # the warning once, and the final save's error
 
 
 def test_record_to_a_full_device_is_a_minor_fault_and_the_run_goes_on(tmp_path):
