@@ -171,6 +171,7 @@ class SnapshotWriter:
         self._stopping = True
         self._wake.put(None)
         self._thread.join(timeout)
+        _handover.end(self)  # also after a submit cut short (Ctrl-C) that the thread never saw
         return not self._thread.is_alive()
 
     def _loop(self) -> None:
