@@ -332,3 +332,61 @@ def test_the_rung_views_with_an_empty_program_file():
     assert console.export_text().strip() == "(no rungs)"
     assert view.drawn == 0 and view.last_drawn is None
     assert view.rungs_that_fit(80, 20) == 0
+
+
+# -- watch files, watch lists, forces, history -----------------------------------------------------
+
+
+def test_a_watch_file_of_100000_lines_is_refused_at_the_line_past_the_limit(tmp_path):
+    from softplc_lite.watch.watchlist import WATCH_MAX
+
+    watch = tmp_path / "big.watch"
+    watch.write_text("# N7 words\n" + "".join(f"N7:{k % 1000}\n" for k in range(100_000)), encoding="utf-8")
+    start = time.monotonic()
+    proc = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                   "--watch-file", str(watch), "--snapshot", str(tmp_path / "view.txt"))
+    assert time.monotonic() - start < 30
+    assert proc.returncode == 1
+    assert proc.stderr.strip() == (f"error: {watch}:{WATCH_MAX + 2}:1: one address too many: the watch list holds "
+                                   f"at most {WATCH_MAX} (--watch and --watch-file together)")
+
+
+def test_watch_file_problems_are_located(tmp_path):
+    def run(raw: bytes, *extra: str) -> subprocess.CompletedProcess:
+        watch = tmp_path / "list.watch"
+        watch.write_bytes(raw)
+        return softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"), *extra,
+                       "--watch-file", str(watch), "--snapshot", str(tmp_path / "view.txt"))
+
+    where = tmp_path / "list.watch"
+    binary = run(b"N7:0\nC5:0.ACC  # counts\n\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR")
+    assert binary.returncode == 1 and "Traceback" not in binary.stderr
+    assert binary.stderr.strip() == (f"error: {where}:3:1: byte 0x89 is not UTF-8 text (the file must be saved "
+                                     "as UTF-8)")
+    bad = run(b"# watch\nN7:0\n    N7:x  # a typo\n")
+    assert bad.returncode == 1
+    assert bad.stderr.startswith(f"error: {where}:3:8: bad address 'N7:x'")
+    huge = run(b"#" * (2 << 20))
+    assert huge.returncode == 1
+    assert huge.stderr.strip() == (f"error: {where}: larger than 1024 KiB: a watch file lists at most 256 addresses, "
+                                   "one a line")
+    full = run(b"N7:0\nN7:1\n", *[a for k in range(255) for a in ("--watch", f"N7:{k}")])
+    assert full.returncode == 1 and f"{where}:2:1: one address too many" in full.stderr
+    fine = run(b"\xef\xbb\xbfN7:0\r\nLamp # a symbol\r\n\r\n")  # a BOM, CR LF line ends, a symbol
+    assert fine.returncode == 0, fine.stderr
+    text = (tmp_path / "view.txt").read_text(encoding="utf-8")
+    assert "N7:0 " in text and "Lamp " in text
+
+
+def test_too_many_watch_addresses_and_long_arguments_give_short_errors(tmp_path):
+    many = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                   *[a for k in range(300) for a in ("--watch", f"N7:{k}")], "--snapshot", str(tmp_path / "v.txt"))
+    assert many.returncode == 1
+    assert many.stderr.strip() == "error: --watch: 300 addresses; the watch list holds at most 256"
+    long = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                   "--break-when", "N7:0 + " * 10_000 + "1 > 2", "--snapshot", str(tmp_path / "v.txt"))
+    assert long.returncode == 1 and "Traceback" not in long.stderr
+    assert len(long.stderr) < 400, long.stderr[:400]
+    force = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                    "--force", "B3/0=" + "1" * 50_000, "--snapshot", str(tmp_path / "v.txt"))
+    assert force.returncode == 1 and len(force.stderr) < 400, force.stderr[:400]

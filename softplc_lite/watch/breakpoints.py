@@ -28,6 +28,14 @@ from ..ladder.expr import evaluate
 from ..ladder.parser import parse_expression
 
 
+def quoted(text: str, limit: int = 60) -> str:
+    """``text`` quoted for a message, its middle left out past ``limit``
+    characters (a command-line argument can be a megabyte long)."""
+    if len(text) > limit:
+        text = f"{text[:limit // 2]}...{text[-(limit // 3):]}"
+    return repr(text)
+
+
 @dataclass(frozen=True)
 class Hit:
     scan: int
@@ -69,7 +77,7 @@ class Condition:
         try:
             self.node = _resolve(parse_expression(text, Pos("--break-when", 1, 1)), symbols or {})
         except LadderError as e:
-            raise DataTableError(f"--break-when {text!r}: {e.message if hasattr(e, 'message') else e}") from None
+            raise DataTableError(f"--break-when {quoted(text)}: {e.message if hasattr(e, 'message') else e}") from None
         self.was = False
 
     def value(self, table: DataTable) -> bool:

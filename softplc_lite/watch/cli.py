@@ -12,7 +12,7 @@ from ..app import load_app
 from ..runner import RunOptions
 from .screen import WatchScreen, rung_view
 from .session import WatchOptions, WatchSession
-from .watchlist import read_watch_file
+from .watchlist import WATCH_MAX, read_watch_file
 
 EXIT_USAGE = 2
 # The snapshot's size (--width, --height; the command line checks them too).
@@ -32,7 +32,9 @@ def watch_command(args) -> int:
         print(f"softplc watch: error: {problem}", file=sys.stderr)
         return EXIT_USAGE
     app = load_app(args.app, args.state)
-    watch = list(args.watch) + (read_watch_file(args.watch_file) if args.watch_file else [])
+    watch = list(args.watch)
+    if args.watch_file:
+        watch += read_watch_file(args.watch_file, app.program.symbols, room=max(0, WATCH_MAX - len(watch)))
     run = RunOptions(scan_ms=args.scan_ms, realtime=args.realtime, fresh=args.fresh, sets=tuple(args.set),
                      ports=tuple(args.port), replay=args.replay)
     options = WatchOptions(run=run, watch=tuple(watch), forces=tuple(args.force), break_when=tuple(args.break_when))

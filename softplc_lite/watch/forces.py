@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from ..datatable import DataTable, DataTableError, bit_mask, parse_address
 from ..datatable.address import Address
+from .breakpoints import quoted
 
 
 class ForceError(DataTableError):
@@ -35,14 +36,14 @@ def parse_force(text: str, symbols=None) -> Force:
     name, eq, value = text.partition("=")
     name, value = name.strip(), value.strip()
     if not eq or value not in ("0", "1"):
-        raise ForceError(f"--force {text!r}: expected ADDR=1 or ADDR=0, e.g. --force I:0/0=1")
+        raise ForceError(f"--force {quoted(text)}: expected ADDR=1 or ADDR=0, e.g. --force I:0/0=1")
     address = symbols[name].address if symbols and name in symbols else parse_address(name)
     return Force(_bit_address(address, text), value == "1")
 
 
 def _bit_address(address: Address, text: str) -> Address:
     if address.bit is None or not address.is_direct:
-        raise ForceError(f"--force {text!r}: only a direct bit address can be forced (e.g. O:0/0, B3/5, N7:0/3)")
+        raise ForceError(f"--force {quoted(text)}: only a direct bit address can be forced (e.g. O:0/0, B3/5, N7:0/3)")
     return address
 
 

@@ -4,6 +4,7 @@ small trend (sparkline) of each numeric value over the last scans."""
 from __future__ import annotations
 
 from collections import deque
+from pathlib import Path
 
 from rich.console import Console, ConsoleOptions, RenderResult
 from rich.table import Table
@@ -11,9 +12,14 @@ from rich.text import Text
 
 from ..datatable import DataTable, DataTableError, ValueKind, parse_address
 from ..datatable.display import format_value
+from ..datatable.errors import AddressError
+from ..errors import LocatedError
+from ..textfile import decode_text
 
 BARS = "▁▂▃▄▅▆▇█"
 TREND = 24  # samples kept per address
+WATCH_MAX = 256  # addresses in the watch list, --watch and --watch-file together
+WATCH_FILE_BYTES = 1 << 20  # the largest watch file read (1 MiB)
 
 
 def sparkline(values: list[float]) -> str:
@@ -74,6 +80,8 @@ class WatchList:
     """Addresses given with --watch (or a watch file), sampled every scan."""
 
     def __init__(self, addresses: list[str], symbols=None) -> None:
+        if len(addresses) > WATCH_MAX:
+            raise DataTableError(f"--watch: {len(addresses)} addresses; the watch list holds at most {WATCH_MAX}")
         self.items = [WatchItem(a, symbols) for a in addresses]
 
     def sample(self, table: DataTable, trend: bool = True) -> None:
@@ -95,12 +103,35 @@ class WatchList:
         yield table
 
 
-def read_watch_file(path: str) -> list[str]:
-    """A watch file: one address (or symbol) a line; ``#`` starts a comment."""
+def read_watch_file(path: str | Path, symbols=None, room: int = WATCH_MAX) -> list[str]:
+    """A watch file: one address (or symbol) a line; ``#`` starts a comment.
+
+    Every problem is a LocatedError naming the file, line and column: bytes
+    that are not UTF-8, an address that does not parse (nor names one of
+    ``symbols``), more than ``room`` addresses, a file over
+    WATCH_FILE_BYTES. OSError as the OS reports it."""
+    with open(path, "rb") as f:
+        raw = f.read(WATCH_FILE_BYTES + 1)
+    if len(raw) > WATCH_FILE_BYTES:
+        raise LocatedError(f"larger than {WATCH_FILE_BYTES // 1024} KiB: a watch file lists at most {WATCH_MAX} "
+                           "addresses, one a line", str(path))
+    text = decode_text(raw, str(path))
     out = []
-    with open(path, encoding="utf-8") as f:
-        for line in f:
-            text = line.split("#", 1)[0].strip()
-            if text:
-                out.append(text)
+    for number, line in enumerate(text.split("\n"), 1):
+        content = line.split("#", 1)[0].rstrip("\r")
+        item = content.strip()
+        if not item:
+            continue
+        column = len(content) - len(content.lstrip()) + 1
+        if len(out) >= room:
+            raise LocatedError(f"one address too many: the watch list holds at most {WATCH_MAX} "
+                               "(--watch and --watch-file together)", str(path), number, column)
+        if not (symbols and item in symbols):
+            try:
+                parse_address(item)
+            except AddressError as e:
+                raise LocatedError(str(e), str(path), number, column + e.position) from None
+            except DataTableError as e:
+                raise LocatedError(str(e), str(path), number, column) from None
+        out.append(item)
     return out
