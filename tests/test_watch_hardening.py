@@ -390,3 +390,105 @@ def test_too_many_watch_addresses_and_long_arguments_give_short_errors(tmp_path)
     force = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
                     "--force", "B3/0=" + "1" * 50_000, "--snapshot", str(tmp_path / "v.txt"))
     assert force.returncode == 1 and len(force.stderr) < 400, force.stderr[:400]
+
+
+def test_setting_thousands_of_forces_costs_the_same_for_each(tmp_path):
+    # each force used to resolve every force again: 10,000 of them took minutes
+    from softplc_lite.app import load_app
+    from softplc_lite.runner import RunOptions
+    from softplc_lite.watch.forces import parse_force
+    from softplc_lite.watch.session import WatchOptions, WatchSession
+
+    session = WatchSession(load_app(ROOT / "programs" / "blinker", tmp_path), WatchOptions(run=RunOptions(fresh=True)))
+    try:
+        forces = session.forces
+        start = time.perf_counter()
+        for k in range(10_000):
+            forces.set(parse_force(f"B20/{k}={k % 2}"))
+        assert time.perf_counter() - start < 5
+        session.scan()
+        assert session.engine.table.read("B20/9999") == 1 and session.engine.table.read("B20/9998") == 0
+        assert forces.remove("B20/9999") and not forces.remove("B20/9999")
+        session.engine.table.write("B20/9999", 0)
+        session.scan()
+        assert session.engine.table.read("B20/9999") == 0 and session.engine.table.read("B20/9997") == 1
+    finally:
+        session.quit()
+
+
+def test_history_keeps_fewer_scans_of_a_big_table(tmp_path):
+    from softplc_lite.watch.history import MIN_DEPTH, History
+
+    table = DataTable()
+    for n in range(10, 30):  # 20 files of 10,000 words: 400 KB a scan
+        table.reference(f"N{n}:9999")
+    history = History(table, max_bytes=4 << 20)
+    for scan in range(1, 201):
+        table.write("N10:0", scan)  # every scan differs
+        history.record(scan, scan * 10)
+    size = len(history.frames[-1].raw)
+    assert size >= 400_000
+    assert history.kept_bytes == size * len(history.frames) <= 4 << 20
+    assert MIN_DEPTH <= len(history.frames) == (4 << 20) // size
+    while history.back() is not None:
+        pass
+    assert table.read("N10:0") == 201 - len(history.frames)  # the oldest kept
+    history.latest()
+    assert table.read("N10:0") == 200
+    # scans that change nothing share one copy: the 1,000 scans fit
+    still = History(table, max_bytes=4 << 20)
+    for scan in range(1, 1201):
+        still.record(scan, scan * 10)
+    assert len(still.frames) == 1000 and still.kept_bytes == size
+
+
+def test_a_prompt_takes_at_most_200_characters(tmp_path):
+    from softplc_lite.app import load_app
+    from softplc_lite.runner import RunOptions
+    from softplc_lite.watch.session import WatchOptions, WatchSession
+    from softplc_lite.watch.terminal import PROMPT_MAX, Controller
+
+    session = WatchSession(load_app(ROOT / "programs" / "blinker", tmp_path), WatchOptions(run=RunOptions(fresh=True)))
+    try:
+        keys = Controller(session)
+        for k in ["g", *("9" * 5000), "\r"]:
+            keys.key(k)
+        assert session.selected == len(session.rungs) - 1  # 999...9 (200 nines): the last rung
+        keys.key("F")
+        for k in "x" * 1000:
+            keys.key(k)
+        assert len(keys.buffer) == PROMPT_MAX == 200
+    finally:
+        session.quit()
+
+
+def test_a_huge_rung_comment_is_wrapped_only_as_far_as_it_is_drawn():
+    comment = "\n".join(" ".join(f"word{k}" for k in range(12)) for _ in range(20_000))  # 1.4 MB, one paragraph
+    rung = Rung([ins("XIC", "B3/0"), ins("OTE", "B3/1")], comment)
+    table = table_for(rung)
+    full = draw(rung, 100, table)
+    top = draw(rung, 100, table, max_lines=30)
+    assert top == full[:30] and top[1].startswith("    word0 word1")
+    assert best_time(lambda: draw(rung, 100, table, max_lines=30), repeat=3, number=1) < 0.05
+
+
+def test_thousands_of_forces_are_counted_not_listed(tmp_path):
+    from softplc_lite.app import load_app
+    from softplc_lite.runner import RunOptions
+    from softplc_lite.watch.cli import render
+    from softplc_lite.watch.screen import FORCES_SHOWN
+    from softplc_lite.watch.session import WatchOptions, WatchSession
+
+    forces = tuple(f"B20/{k}=1" for k in range(5000))
+    session = WatchSession(load_app(ROOT / "programs" / "blinker", tmp_path),
+                           WatchOptions(run=RunOptions(fresh=True), forces=forces))
+    try:
+        start = time.perf_counter()
+        screen = render(session, 80, 24).export_text()
+        assert time.perf_counter() - start < 2
+        assert "Rung 0" in screen and "q quit" in screen  # the forces do not push the rungs off the screen
+        wide = " ".join(render(session, 1000, 60).export_text().split())
+        assert f"forces: B20/0=ON B20/1=ON B20/10=ON" in wide and f"and {5000 - FORCES_SHOWN} more" in wide
+        assert wide.count("=ON") == FORCES_SHOWN
+    finally:
+        session.quit()

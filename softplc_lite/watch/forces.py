@@ -54,35 +54,35 @@ class Forces:
         self.engine = engine
         self.table: DataTable = engine.table
         self.forces: dict[str, Force] = {}
-        self._resolved: list[tuple[object, int, int, bool]] = []
+        # address -> (word array, index, mask, on): one entry per force, so
+        # setting or removing one costs the same however many there are
+        self._resolved: dict[str, tuple[object, int, int, bool]] = {}
         self._hooked = False
 
     def set(self, force: Force) -> None:
-        self.forces[str(force.address)] = force
-        self._resolve()
-        self.apply()
+        key = str(force.address)
+        self.table.reference(force.address)  # forcing B3/40 creates the word, as a write would
+        f, index, bit = self.table.resolve(force.address)
+        self.forces[key] = force
+        data, mask = f.data, bit_mask(bit)
+        self._resolved[key] = (data, index, mask, force.on)
+        self._hook(True)
+        data[index] = (data[index] | mask) if force.on else (data[index] & ~mask)  # at once, in the table shown
 
     def remove(self, address: str | Address) -> bool:
         key = str(address if isinstance(address, Address) else _bit_address(parse_address(address), address))
         found = self.forces.pop(key, None) is not None
-        self._resolve()
+        self._resolved.pop(key, None)
+        self._hook(bool(self._resolved))
         return found
 
     def clear(self) -> None:
         self.forces.clear()
-        self._resolve()
+        self._resolved.clear()
+        self._hook(False)
 
     def listed(self) -> list[Force]:
         return [self.forces[k] for k in sorted(self.forces)]
-
-    def _resolve(self) -> None:
-        out = []
-        for force in self.forces.values():
-            self.table.reference(force.address)  # forcing B3/40 creates the word, as a write would
-            f, index, bit = self.table.resolve(force.address)
-            out.append((f.data, index, bit_mask(bit), force.on))
-        self._resolved = out
-        self._hook(bool(out))
 
     def _hook(self, on: bool) -> None:
         """The engine calls the forces only while there are some (a scan
@@ -97,7 +97,7 @@ class Forces:
         self._hooked = on
 
     def apply(self) -> None:
-        for data, index, mask, on in self._resolved:
+        for data, index, mask, on in self._resolved.values():
             w = data[index]
             data[index] = (w | mask) if on else (w & ~mask)
 

@@ -7,7 +7,10 @@ move through the recorded scans by writing them into the live table (in
 place: compiled rungs keep references to the file arrays); running again
 starts from the newest scan, which ``latest()`` restores.
 
-At least ``DEPTH`` (1,000) scans are kept; older ones are dropped.
+The last ``DEPTH`` (1,000) scans are kept, older ones dropped; and at most
+``MAX_BYTES`` (256 MiB) of them: a table too big for 1,000 copies in that
+(over 256 KiB, say 30 files of 10,000 words changing every scan) keeps
+fewer, never less than the last ``MIN_DEPTH`` (10).
 """
 
 from __future__ import annotations
@@ -18,7 +21,8 @@ from typing import NamedTuple
 from ..datatable import DataTable
 
 DEPTH = 1000
-
+MAX_BYTES = 256 << 20  # the most memory the kept tables take (when they differ scan to scan)
+MIN_DEPTH = 10  # scans kept however big the table
 
 
 class Frame(NamedTuple):
@@ -42,9 +46,12 @@ class Frame(NamedTuple):
 
 
 class History:
-    def __init__(self, table: DataTable, depth: int = DEPTH) -> None:
+    def __init__(self, table: DataTable, depth: int = DEPTH, max_bytes: int = MAX_BYTES) -> None:
         self.table = table
-        self.frames: deque[Frame] = deque(maxlen=max(depth, 1))
+        self.depth = max(depth, 1)
+        self.max_bytes = max_bytes
+        self.frames: deque[Frame] = deque()
+        self.kept_bytes = 0  # of the distinct tables the frames hold
         self.position: int | None = None  # index into frames while stepping back; None: live
         self._count = -1  # files in the table when the layout below was taken
         self._layout: tuple[tuple[str, int], ...] = ()
@@ -69,7 +76,14 @@ class History:
         frames = self.frames
         if frames and frames[-1].raw == raw and frames[-1].layout is self._layout:
             raw = frames[-1].raw
+        else:
+            self.kept_bytes += len(raw)
         frames.append(Frame(scan, now_ms, self._layout, raw))
+        floor = min(MIN_DEPTH, self.depth)
+        while len(frames) > self.depth or (self.kept_bytes > self.max_bytes and len(frames) > floor):
+            oldest = frames.popleft()
+            if oldest.raw is not frames[0].raw:  # not shared with the next frame
+                self.kept_bytes -= len(oldest.raw)
 
     def _take_layout(self) -> None:
         files = self.table.files()

@@ -797,6 +797,16 @@ def _paragraphs(comment: str) -> list[str]:
     return paragraphs
 
 
+def _clipped(text: str, limit: int) -> str:
+    """The start of ``text`` (about ``limit`` characters, cut between words):
+    wrapped, it gives the same first lines as the whole text as long as
+    ``limit`` is two lines more than they hold."""
+    if len(text) <= limit:
+        return text
+    cut = text.rfind(" ", 0, limit)
+    return text[:cut if cut > 0 else limit]
+
+
 def _wrapped(console: Console, text: str, width: int, indent: int, style: Style) -> Iterable[list[Segment]]:
     """``text`` wrapped to ``width``, indented: one list of segments a line."""
     for line in Text(text, style=style).wrap(console, max(10, width - indent)):
@@ -851,6 +861,10 @@ class RungView:
                Segment(f" Rung {self.number}", SELECTED if self.selected else HEADER)]
         used = 1
         for paragraph in _paragraphs(self.rung.comment or ""):
+            if self.max_lines is not None:  # wrap no more of a long comment than is drawn
+                if used >= self.max_lines:
+                    return
+                paragraph = _clipped(paragraph, (self.max_lines - used + 2) * width)
             for line in _wrapped(console, paragraph, width, COMMENT_INDENT, COMMENT):
                 yield line
                 used += 1

@@ -17,6 +17,7 @@ from .portsview import PortsView
 from .session import WatchSession
 
 WIDE = 120  # from this width the side panels go beside the rungs
+FORCES_SHOWN = 64  # forces listed by name; the rest are counted
 SIDE_WIDTH = 46
 KEYS = ("space/n step  r run  p pause  +/- speed  ↑↓/jk rung  f file  g go to rung  b breakpoint  "
         "⌫ back  F force  U unforce  M mode  q quit")
@@ -82,8 +83,10 @@ class ForcesView:
         text = Text("forces: ", style="bold")
         if not forced:
             text.append("none", style="dim")
-        for k, f in enumerate(forced):
+        for k, f in enumerate(forced[:FORCES_SHOWN]):
             text.append(("  " if k else "") + f"{f.address}={'ON' if f.on else 'OFF'}", style="bold red")
+        if len(forced) > FORCES_SHOWN:
+            text.append(f"  and {len(forced) - FORCES_SHOWN} more", style="bold")
         yield text
 
 

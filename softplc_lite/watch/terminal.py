@@ -25,6 +25,7 @@ from .session import WatchSession
 REDRAW_HZ = 10  # at most
 DRAW_SHARE = 0.04  # of the wall time spent drawing while running, at most
 SLICE_S = 0.02  # scanning time between two looks at the keyboard
+PROMPT_MAX = 200  # characters a prompt (g, F, U, M) takes
 
 _ESCAPES = {"\x1b[A": "up", "\x1b[B": "down", "\x1bOA": "up", "\x1bOB": "down",
             "\x1b[5~": "pgup", "\x1b[6~": "pgdown"}
@@ -137,7 +138,7 @@ class Controller:
             return
         if k in ("\x7f", "\x08"):
             self.buffer = self.buffer[:-1]
-        elif len(k) == 1 and k.isprintable():
+        elif len(k) == 1 and k.isprintable() and len(self.buffer) < PROMPT_MAX:
             self.buffer += k
         self.prompt = label[self.prompt_kind] + self.buffer
 
