@@ -492,3 +492,16 @@ def test_thousands_of_forces_are_counted_not_listed(tmp_path):
         assert wide.count("=ON") == FORCES_SHOWN
     finally:
         session.quit()
+
+
+@pytest.mark.parametrize("condition, message", [
+    ("Reading < 1", "ST9:0 holds a string, not a number or a bit"),
+    ("T4:0 > 1", "T4:0 is a whole timer; compare one of its words or bits (T4:0.ACC, ...)"),
+])
+def test_a_break_condition_on_a_string_or_a_whole_timer_is_refused_at_start(tmp_path, condition, message):
+    # a TypeError at the first scan before (an internal error, exit 4)
+    strings = app(tmp_path, "SYMBOL Reading ST9:0\nDATA ST9 1 = \"WT: 12\"\nXIC B3/0 TON T4:0 0.01 5 0\n")
+    proc = softplc("watch", str(strings), "--fresh", "--state", str(tmp_path / "state"), "--scans", "2",
+                   "--break-when", condition, "--snapshot", str(tmp_path / "view.txt"))
+    assert proc.returncode == 1
+    assert proc.stderr.strip() == f"error: --break-when {condition!r}: {message}"

@@ -21,8 +21,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Callable
 
-from ..datatable import DataTable, DataTableError
-from ..ladder.ast import AddressRef, Pos, SymbolRef
+from ..datatable import DataTable, DataTableError, ValueKind
+from ..ladder.ast import AddressRef, Pos, SymbolRef, address_refs
 from ..ladder.errors import LadderError
 from ..ladder.expr import evaluate
 from ..ladder.parser import parse_expression
@@ -69,6 +69,9 @@ class _PureMath:
             return 0
 
 
+_NUMBERS = (ValueKind.BIT, ValueKind.WORD, ValueKind.FLOAT)
+
+
 class Condition:
     """A --break-when expression."""
 
@@ -78,13 +81,20 @@ class Condition:
             self.node = _resolve(parse_expression(text, Pos("--break-when", 1, 1)), symbols or {})
         except LadderError as e:
             raise DataTableError(f"--break-when {quoted(text)}: {e.message if hasattr(e, 'message') else e}") from None
+        for ref in address_refs(self.node):
+            a = ref.address
+            if a.kind is ValueKind.STRING:  # ST9:0 < 1 cannot be computed: say so now, not at a scan
+                raise DataTableError(f"--break-when {quoted(text)}: {a} holds a string, not a number or a bit")
+            if a.kind not in _NUMBERS:
+                raise DataTableError(f"--break-when {quoted(text)}: {a} is a whole {a.kind.value}; compare one of "
+                                     f"its words or bits ({a}.{a.ftype.word_members[-1].name}, ...)")
         self.was = False
 
     def value(self, table: DataTable) -> bool:
         try:
             return bool(evaluate(self.node, lambda ref: table.read(ref.address), _PureMath))
-        except DataTableError:
-            return False  # an address past its file is "not true", not a crash
+        except (DataTableError, ArithmeticError, TypeError, ValueError):
+            return False  # an address past its file (or a value it cannot use) is "not true", not a crash
 
     def became_true(self, table: DataTable) -> bool:
         now = self.value(table)
