@@ -34,6 +34,7 @@ from .datatable import DataTable, snapshot
 from .ladder import status as S
 
 DURABLE_EVERY_S = 5.0  # one periodic save in this many seconds is fsynced (and becomes NAME.prev)
+LAG_SHARE = 0.25  # at most this share of save_ms is taken off the period to make up for slow writes
 WRITER_JOIN_S = 30.0  # at stop, how long to wait for a save still being written
 HANDOVER_S = 0.0002  # the interpreter's thread switch interval while a save is being written
 
@@ -131,9 +132,10 @@ class _Job:
 class WriteResult:
     seq: int
     taken_at: float
-    done_at: float
+    renamed_at: float  # when NAME held it (before the fsync of a durable save)
     durable: bool
     error: str | None  # None: written
+    durable_error: str | None = None  # a durable save's fsync or NAME.prev link that failed
 
 
 class SnapshotWriter:
@@ -146,9 +148,8 @@ class SnapshotWriter:
     (which never blocks). The outcome of each write is in :attr:`result`.
     """
 
-    def __init__(self, path: Path, write: Callable[[bytes, Path, bool], None] = snapshot.write) -> None:
+    def __init__(self, path: Path) -> None:
         self.path = path
-        self._write = write
         self._latest: _Job | None = None
         self._wake: queue.SimpleQueue = queue.SimpleQueue()
         self._woken = False
@@ -187,12 +188,18 @@ class SnapshotWriter:
                     return
                 continue
             written = self.taken = job.seq
+            error = durable_error = None
             try:
-                self._write(job.data, self.path, job.durable)
-                error = None
+                snapshot.write(job.data, self.path, False)
             except Exception as e:  # noqa: BLE001 - reported as a minor fault; the thread must live on
                 error = describe_os_error(e)
-            self.result = WriteResult(job.seq, job.taken_at, time.monotonic(), job.durable, error)
+            renamed_at = time.monotonic()
+            if job.durable and error is None:
+                try:
+                    snapshot.make_durable(self.path)
+                except Exception as e:  # noqa: BLE001
+                    durable_error = describe_os_error(e)
+            self.result = WriteResult(job.seq, job.taken_at, renamed_at, job.durable, error, durable_error)
             if not self._woken and self._latest is job:  # nothing new: the interval goes back
                 _handover.end(self)
 
@@ -207,13 +214,11 @@ class Retentive:
     """
 
     def __init__(self, path: Path, save_ms: int, faults: StorageFaults,
-                 write: Callable[[bytes, Path, bool], None] = snapshot.write,
                  durable_every_s: float = DURABLE_EVERY_S) -> None:
         self.path = Path(path)
         self.save_s = save_ms / 1000
         self.durable_every_s = durable_every_s
         self.faults = faults
-        self._write = write
         self.removed_stale = snapshot.remove_stale(self.path)
         self._writer: SnapshotWriter | None = None
         self._seq = 0
@@ -228,9 +233,11 @@ class Retentive:
     @property
     def lag_s(self) -> float:
         """How long a write took recently (from encoding to the rename), at
-        most: the next snapshot is taken that much before save_ms is up, so
-        that it is on disk by then."""
-        return max(self._latencies, default=0.0)
+        most, but no more than LAG_SHARE of save_ms: the next snapshot is
+        taken that much before save_ms is up, so that it is on disk by then.
+        (Capped so that on a machine too busy to write in time, saving more
+        often, which would make it busier, never goes past a third more.)"""
+        return min(max(self._latencies, default=0.0), self.save_s * LAG_SHARE)
 
     def tick(self, table: DataTable, now: float) -> None:
         """Between scans, when due: take the outcome of the last write (the
@@ -239,7 +246,7 @@ class Retentive:
         data = snapshot.encode(table)
         self._seq += 1
         if self._writer is None:
-            self._writer = SnapshotWriter(self.path, self._write)
+            self._writer = SnapshotWriter(self.path)
         writer = self._writer
         # A durable job replaced before the writer took it hands its durability on.
         durable = now - self._last_durable >= self.durable_every_s or writer.taken < self._durable_seq
@@ -248,7 +255,7 @@ class Retentive:
             self._durable_seq = self._seq
         writer.submit(_Job(self._seq, data, now, durable))
         # Early enough that this write's bytes are on disk within save_s of the last one's.
-        self.due = now + max(self.save_s - self.lag_s, self.save_s / 2)
+        self.due = now + self.save_s - self.lag_s
 
     def _collect(self) -> None:
         writer = self._writer
@@ -256,13 +263,21 @@ class Retentive:
         if result is None or result.seq == self._seen:
             return
         self._seen = result.seq
-        self._latencies.append(result.done_at - result.taken_at)
+        self._latencies.append(result.renamed_at - result.taken_at)
         if result.error is None:
             self.saves += 1
             self.faults.ok("save", f"the retentive snapshot {self.path} is saved again")
         else:
             self._failed(result.error, f"; the PLC keeps running and tries again every "
                                        f"{round(self.save_s * 1000)} ms")
+        if result.durable_error is not None:
+            # Its own source: the saves themselves work, so this is told once, not every 5 s.
+            self.faults.failed("durable", S.MINOR_CODE_SAVE, f"cannot put the retentive snapshot {self.path} on "
+                               f"disk (fsync, {self.path.name}.prev): {result.durable_error}",
+                               f"; it is saved, but may not survive a power loss; tried again every "
+                               f"{self.durable_every_s:.0f} s")
+        elif result.durable and result.error is None:
+            self.faults.ok("durable", f"the retentive snapshot {self.path} is put on disk again")
 
     def _failed(self, reason: str, advice: str = "", log: bool = True) -> None:
         self.faults.failed("save", S.MINOR_CODE_SAVE, f"cannot save the retentive snapshot {self.path}: {reason}",
@@ -273,11 +288,10 @@ class Retentive:
         the writer (its write in progress completes), then write the table
         as it is now. None when saved, else the error message (not logged
         here: the caller reports it), with the minor fault set in the table."""
-        writer, self._writer = self._writer, None
         self.due = float("inf")
+        writer = self._writer
         if writer is not None:
             finished = writer.stop()
-            self._writer = writer
             self._collect()
             self._writer = None
             if not finished:
@@ -285,10 +299,11 @@ class Retentive:
                 self._failed(reason, log=False)
                 return f"cannot save the retentive snapshot {self.path}: {reason}"
         try:
-            self._write(snapshot.encode(table), self.path, True)
+            snapshot.write(snapshot.encode(table), self.path, True)
         except Exception as e:  # noqa: BLE001 - reported, the run's output still printed
             reason = describe_os_error(e)
             self._failed(reason, log=False)
             return f"cannot save the retentive snapshot {self.path} at the end of the run: {reason}"
         self.faults.ok("save", f"the retentive snapshot {self.path} is saved again")
+        self.faults.ok("durable", f"the retentive snapshot {self.path} is put on disk again")
         return None

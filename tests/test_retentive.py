@@ -192,6 +192,36 @@ def test_a_durable_save_every_few_seconds_becomes_prev(tmp_path):
     assert os.path.samefile(path, tmp_path / "datatable.snap.prev")
 
 
+def test_a_durable_step_that_fails_is_told_once_while_the_saves_go_on(tmp_path):
+    """NAME.prev.tmp is a directory, so NAME.prev cannot be linked: every
+    durable save's last step fails, every save itself works."""
+    path = tmp_path / "datatable.snap"
+    t = DataTable()
+    s = t.file("S2").data
+    logged: list[str] = []
+    ret = Retentive(path, 100, StorageFaults(s, logged.append), durable_every_s=0.1)
+    (tmp_path / "datatable.snap.prev.tmp").mkdir()
+    try:
+        for value in range(1, 7):
+            t.write("N7:0", value)
+            ret.tick(t, time.monotonic())
+            time.sleep(0.12)  # every save durable
+        ret._collect()
+        assert snapshot.load(path).read("N7:0") == 6 and not (tmp_path / "datatable.snap.prev").exists()
+        assert s[S.MINOR_FAULT_BITS] == STORAGE and s[S.MINOR_FAULT_CODE] == S.MINOR_CODE_SAVE
+        assert len(logged) == 1 and logged[0].startswith(f"warning: cannot put the retentive snapshot {path} on disk "
+                                                         f"(fsync, datatable.snap.prev): Is a directory")
+        (tmp_path / "datatable.snap.prev.tmp").rmdir()
+        t.write("N7:0", 7)
+        ret.tick(t, time.monotonic())
+        time.sleep(0.12)
+        ret._collect()
+        assert logged[1:] == [f"the retentive snapshot {path} is put on disk again"] and s[S.MINOR_FAULT_BITS] == 0
+        assert snapshot.load(tmp_path / "datatable.snap.prev").read("N7:0") == 7
+    finally:
+        assert ret.finish(t) is None
+
+
 # -- storage trouble: a fault, not a stop ----------------------------------------------------------------------
 
 

@@ -18,9 +18,9 @@ leaves a loadable snapshot.
 A running PLC saves with :func:`write` instead (softplc_lite/retentive.py):
 the bytes :func:`encode` made between two scans, to ``NAME`` through the same
 temp file and rename, without fsync for the frequent saves (a killed process
-does not lose the page cache) and with fsync for the durable ones, which
-also become ``NAME.prev``: the newest snapshot known to be on disk, for
-after a power loss. :func:`remove_stale` deletes the temp files a killed
+does not lose the page cache); the durable ones are then fsynced and become
+``NAME.prev`` (:func:`make_durable`): the newest snapshot known to be on
+disk, for after a power loss. :func:`remove_stale` deletes the temp files a killed
 process left.
 """
 
@@ -125,26 +125,38 @@ def save(table: DataTable, path: str | os.PathLike[str]) -> None:
 def write(data: bytes, path: str | os.PathLike[str], durable: bool) -> None:
     """Put encoded snapshot bytes at ``path`` atomically: ``NAME.tmp``, then
     a rename over ``NAME``, so ``NAME`` is always a complete snapshot.
-
-    ``durable``: fsync the temp file before the rename, then make ``NAME.prev``
-    a hard link to the new ``NAME`` and fsync the directory, so that both
-    names hold this snapshot on disk, whatever a power loss does to later
-    non-durable writes. Not durable: no fsync, ``NAME.prev`` left alone (it
-    stays the last durable snapshot). Creates the directory when missing.
-    Raises OSError; a failed write leaves ``NAME`` and ``NAME.prev`` as they
-    were (and perhaps a partial ``NAME.tmp``, truncated by the next write).
-    """
+    Creates the directory when missing. Not durable: no fsync, and
+    ``NAME.prev`` is left alone (it stays the last durable snapshot).
+    Durable: then :func:`make_durable`. Raises OSError; a failed write leaves
+    ``NAME`` and ``NAME.prev`` as they were (and perhaps a partial
+    ``NAME.tmp``, truncated by the next write)."""
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     try:
-        _write_tmp(data, tmp, durable)
+        _write_tmp(data, tmp, False)
     except FileNotFoundError:
         path.parent.mkdir(parents=True, exist_ok=True)
-        _write_tmp(data, tmp, durable)
+        _write_tmp(data, tmp, False)
     os.replace(tmp, path)
     if durable:
-        _link_as(path, path.with_name(path.name + ".prev"))
-        _fsync_dir(path.parent)
+        make_durable(path)
+
+
+def make_durable(path: str | os.PathLike[str]) -> None:
+    """Put the snapshot now at ``path`` on disk: fsync it, make ``NAME.prev``
+    a hard link to it, fsync the directory. Only then does ``NAME.prev`` name
+    it, so after a power loss ``NAME.prev`` holds a whole snapshot whatever
+    happened to later writes of ``NAME`` that were not made durable. (The
+    rename comes before the fsync, so a save's rename, all a killed process
+    needs, never waits for the disk.)"""
+    path = Path(path)
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+    _link_as(path, path.with_name(path.name + ".prev"))
+    _fsync_dir(path.parent)
 
 
 def remove_stale(path: str | os.PathLike[str]) -> list[Path]:
