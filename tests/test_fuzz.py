@@ -1,0 +1,194 @@
+"""Fuzzing softplc in the default suite: a few dozen inputs of every kind.
+
+The generators are tests/fuzz_inputs.py, the oracle tests/fuzz_oracle.py;
+tools/fuzz.py runs the same for minutes in several processes
+(docs/fuzzing.md). Here every input kind gets a bounded, derandomized run
+(the same inputs on every machine, no example database), with the profile
+``MUST_PASS``: the input classes issue 15 lists as still being fixed are
+left out, so a failure here is a new regression, not a known bug. The
+campaign (``tools/fuzz.py``, profile ``all``) is where the open classes
+show.
+
+Every command goes through ``softplc_lite.cli.main`` in-process; a few cases
+also run as the real ``softplc`` command.
+"""
+
+from __future__ import annotations
+
+import re
+import tempfile
+import time
+from pathlib import Path
+
+import fuzz_inputs as fi
+import fuzz_oracle as fo
+import pytest
+from fuzz_inputs import KINDS, MUST_PASS, Case, cases
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+# Examples per kind: together about 30-60 s on a CI machine.
+EXAMPLES = {
+    "ladder": 45, "toml": 30, "datatable_json": 30, "load_json": 30, "modules_lst": 25, "comgenius_lst": 35,
+    "modbmast_xml": 20, "cli_args": 40, "trace": 20, "snapshot_file": 40, "snapshot_app": 25, "address": 40,
+    "watch": 25,
+}
+
+# Findings the product still has for inputs the MUST_PASS profile draws,
+# each reported (issue 15); tolerated here by signature until fixed.
+TOLERATED = {
+    r"^unlocated:\w+:toml:line-in-words$":
+        "a softplc.toml syntax error reads 'softplc.toml: ... (at line N, column M)', not softplc.toml:N:M",
+    r"^unlocated:\w+:toml:no-line:: \[display\]":
+        "a [display] problem in softplc.toml names the file but no line",
+    r"^check-run:run:.*cannot open sim://":
+        "check does not read the sim:// URLs of COMGENIUS.LST [PORTS] and MODBMAST.XML device=; run refuses a bad one",
+}
+
+COMMAND_TIMEOUT = 20.0
+
+
+def open_findings(findings: list[fo.Finding]) -> list[fo.Finding]:
+    return [f for f in findings if not any(re.search(p, f.signature) for p in TOLERATED)]
+
+
+def run_case(case: Case, runner=fo.run_main) -> list[fo.Finding]:
+    with tempfile.TemporaryDirectory(prefix="softplc-fuzz-") as d:
+        findings, _ = fo.check_case(case, Path(d), COMMAND_TIMEOUT, runner)
+        return open_findings(findings)
+
+
+def _report(case: Case, findings: list[fo.Finding]) -> str:
+    return f"{case.kind} ({case.note}):\n" + "\n".join(str(f) for f in findings)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_fuzz(kind):
+    @settings(max_examples=EXAMPLES[kind], deadline=None, derandomize=True, database=None,
+              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much])
+    @given(cases([kind], MUST_PASS))
+    def fuzz(case):
+        findings = run_case(case)
+        assert not findings, _report(case, findings)
+
+    fuzz()
+
+
+# -- the real command, for a few cases ---------------------------------------------------------
+
+
+@pytest.mark.parametrize("kind", ["ladder", "comgenius_lst", "datatable_json", "address"])
+def test_fuzz_as_the_softplc_command(kind):
+    @settings(max_examples=1, deadline=None, derandomize=True, database=None,
+              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    @given(cases([kind], MUST_PASS))
+    def fuzz(case):
+        findings = run_case(case, fo.run_command)
+        assert not findings, _report(case, findings)
+
+    fuzz()
+
+
+# -- the oracle itself -----------------------------------------------------------------------------
+
+
+def _case(**kw) -> Case:
+    return Case("ladder", target="app/main.lad", **kw)
+
+
+def _classes(result: fo.Result, case: Case | None = None) -> set[str]:
+    return {f.cls for f in fo.judge(result, case or _case(), "/tmp/x")}
+
+
+def test_oracle_sees_an_escaped_exception_a_traceback_and_odd_exit_codes():
+    assert _classes(fo.Result(["run"], None, exception="KeyError: 'x'", traceback="...")) == {"exception"}
+    assert _classes(fo.Result(["run"], 1, err="Traceback (most recent call last):\n  ...")) == {"exception"}
+    assert _classes(fo.Result(["run"], 4, err="softplc: internal error: KeyError: 'x' (a bug)")) == {"internal-error"}
+    assert _classes(fo.Result(["run"], 5)) == {"exit-code"}
+    assert _classes(fo.Result(["run"], 130)) == {"exit-code"}
+    assert _classes(fo.Result(["run"], 3, err="softplc: a: major fault 255: internal error: KeyError: 2")) == {"fault-255"}
+    assert _classes(fo.Result(["run"], 0, out="\udcff")) == {"unencodable-output"}
+    for code in (0, 2, 3):
+        assert _classes(fo.Result(["run"], code, err="softplc: a: major fault 20: x")) == set()
+
+
+def test_oracle_wants_path_and_line_in_errors_about_the_fuzzed_file():
+    located = fo.Result(["check"], 1, err="/tmp/x/app/main.lad:3:7: unknown instruction 'XIX'")
+    unlocated = fo.Result(["check"], 1, err="/tmp/x/app/main.lad: something is wrong")
+    in_passing = fo.Result(["check"], 1, err="main.lad:1:1: add COMGENIUS to the app's main.lad")
+    assert _classes(located) == set() and _classes(in_passing) == set()
+    assert _classes(unlocated) == {"unlocated"}
+
+
+def test_watchdog_ends_a_command_that_hangs(monkeypatch):
+    import softplc_lite.cli
+
+    def sleepy(argv):
+        time.sleep(30)
+        return 0
+
+    monkeypatch.setattr(softplc_lite.cli, "main", sleepy)
+    start = time.monotonic()
+    r = fo.run_main(["run", "x"], timeout=0.5)
+    assert r.hung and time.monotonic() - start < 5
+    assert _classes(r) == {"hang"}
+
+
+def test_run_main_catches_what_escapes_and_usage_exits(monkeypatch):
+    import softplc_lite.cli
+
+    def broken(argv):
+        raise RecursionError("deep")
+
+    monkeypatch.setattr(softplc_lite.cli, "main", broken)
+    r = fo.run_main(["check", "x"])
+    assert r.exception == "RecursionError: deep" and "broken" in r.traceback
+    monkeypatch.undo()
+    assert fo.run_main(["run"]).code == 2  # argparse: APP is missing
+    assert fo.run_main(["check", "programs/blinker"]).code == 0
+
+
+def test_fmt_property_sees_text_that_does_not_parse_back(tmp_path):
+    """fmt_roundtrip on a stand-in for fmt whose output never parses."""
+    lad = tmp_path / "app" / "main.lad"
+    lad.parent.mkdir()
+    lad.write_text("XIC B3/0 OTE O:0/0\n")
+    findings: list[fo.Finding] = []
+
+    def do(argv, located=True):
+        if argv[1] == str(lad):
+            return fo.Result(argv, 0, out="XIC B3/0 BND\n")
+        return fo.run_main(argv)
+
+    fo.fmt_roundtrip(lad, "mnemonic", do, findings, _case())
+    assert [f.cls for f in findings] == ["fmt-reparse"]
+
+
+@given(cases(profile=fi.EVERYTHING))
+@settings(max_examples=60, deadline=None, derandomize=True, database=None,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+def test_every_case_survives_json_and_names_real_commands(case):
+    """What the campaign saves (case.json) gives the same case back."""
+    again = Case.from_json(case.to_json())
+    assert again == case
+    assert case.kind in KINDS
+    for argv in case.commands:
+        assert argv[0] in {"run", "check", "fmt", "watch", "address", "datatable"}
+
+
+def test_profiles_keep_the_known_classes_out_of_the_default_suite():
+    assert fi.KNOWN_OPEN <= set(fi.FEATURES)
+    assert not any(MUST_PASS.allows(f) for f in fi.KNOWN_OPEN)
+    assert all(fi.EVERYTHING.allows(f) for f in fi.FEATURES)
+
+
+@given(st.integers(0, 2 ** 32 - 1))
+@settings(max_examples=30, deadline=None, derandomize=True, database=None)
+def test_must_pass_numbers_stay_under_the_digit_limit(n):
+    import random
+
+    rnd = random.Random(n)
+    for _ in range(20):
+        text = fi.interesting_number(rnd, MUST_PASS)
+        assert len(text) <= 4302, text[:40]
+        assert "e999" not in text
