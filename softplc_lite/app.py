@@ -93,9 +93,11 @@ def parse_files(files: list[Path], base: Path, instructions: InstructionSet = BU
         except OSError as e:
             errors.append(LadderError(Pos(_display(f, base), 1, 1), f"cannot read: {e.strerror or e}"))
             continue
+        problems: list[LadderError] = []
         try:
-            parse_program(text, _display(f, base), instructions, program=program)
-        except LadderError as e:
+            parse_program(text, _display(f, base), instructions, program=program, problems=problems)
+            errors.extend(problems[:50])
+        except LadderError as e:  # a syntax error: list every problem, resuming after each
             errors.extend(syntax_problems(text, _display(f, base), instructions=instructions) or [e])
     return program, errors
 

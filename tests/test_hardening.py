@@ -331,3 +331,23 @@ def test_a_break_when_condition_has_the_expression_limit_too(tmp_path, capsys):
     with pytest.raises(LadderError, match=f"nested 501 levels deep; the limit is {MAX_EXPRESSION_DEPTH}"):
         parse_expression("NOT " * 500 + "N7:0 > 1", Pos("--break-when", 1, 1))
     assert parse_expression("(" * 5000 + "N7:0" + ")" * 5000 + " > 1", Pos("--break-when", 1, 1)).op == ">"
+
+
+def test_every_problem_short_of_a_syntax_error_is_found_in_one_parse(tmp_path, monkeypatch):
+    """A file of rungs each past a limit (or with a bad address or number)
+    was parsed again after each problem: a 1 MB file of 1,000-deep branches
+    took over a minute to check. Now one parse lists them all."""
+    from softplc_lite import app as app_module
+    from softplc_lite.ladder import parser
+
+    rung = "XIC B3/0 " + "BST XIC B3/3 NXB " * 40 + "OTE B3/2 " + "BND " * 40
+    text = (f"{rung}\nMOV 1 N7:x\nMOV 1e999 F8:0\nCPT N7:0 \"FOO(N7:1)\"\nSYMBOL S1 Q:9\n") * 10
+    (tmp_path / "main.lad").write_text(text)
+    calls = []
+    real = parser._parse_tree
+    monkeypatch.setattr(parser, "_parse_tree", lambda *a, **k: calls.append(a[2]) or real(*a, **k))
+    _, errors = app_module.parse_files([tmp_path / "main.lad"], tmp_path)
+    assert calls.count("start") == 1
+    assert len(errors) == 50  # 5 a block, 10 blocks
+    assert [e.pos.line for e in errors[:5]] == [1, 2, 3, 4, 5]
+    assert "branches nested" in errors[0].message and "unknown function FOO()" in errors[3].message

@@ -179,6 +179,22 @@ class _ToAst(Transformer):
     def __init__(self) -> None:
         super().__init__()
         self.context = ("<program>", 0, 0)
+        # Where problems found while building nodes go when the caller lists
+        # every problem (syntax_problems): a placeholder node stands in for
+        # the bad one and the parse goes on. None: the first one is raised.
+        self.problems: list[LadderError] | None = None
+
+    def _fail(self, error: LadderError, placeholder):
+        if self.problems is None:
+            raise error
+        self.problems.append(error)
+        return placeholder
+
+    def _num(self, tok: Token) -> int | float:
+        try:
+            return _number(tok)
+        except _NumberRangeError as e:
+            return self._fail(_range_error(e, self), 0)
 
     def _pos(self, item) -> Pos:
         """The position of a token, or of an AST node already built."""
@@ -194,7 +210,8 @@ class _ToAst(Transformer):
         refused here, before Python is asked to convert thousands of digits."""
         text = str(tok)
         if len(text) > 9:
-            raise LadderError(self._pos(tok), f"{what} {text[:12]}... ({len(text)} digits) is out of range")
+            return self._fail(LadderError(self._pos(tok), f"{what} {text[:12]}... ({len(text)} digits) is out of range"),
+                              None)
         return int(text)
 
     # operands ------------------------------------------------------------------
@@ -203,7 +220,7 @@ class _ToAst(Transformer):
             return AddressRef(parse_address(str(tok)), self._pos(tok))
         except AddressError as e:
             p = self._pos(tok)
-            raise LadderError(Pos(p.source, p.line, p.column + e.position), e.reason) from None
+            return self._fail(LadderError(Pos(p.source, p.line, p.column + e.position), e.reason), Const(0, p))
 
     @v_args(inline=True)
     def address(self, tok):
@@ -215,11 +232,11 @@ class _ToAst(Transformer):
 
     @v_args(inline=True)
     def signed_number(self, tok):
-        return Const(_number(tok), self._pos(tok))
+        return Const(self._num(tok), self._pos(tok))
 
     @v_args(inline=True)
     def negative_number(self, sign, tok):
-        value = _number(tok)
+        value = self._num(tok)
         return Const(-value if str(sign) == "-" else value, self._pos(sign))
 
     @v_args(inline=True)
@@ -227,8 +244,8 @@ class _ToAst(Transformer):
         arg = self._atomize(arg)
         func = str(name).upper()
         if func not in _CALLS:
-            raise LadderError(self._pos(name), f"unknown function {name}() in an expression; "
-                              f"functions are {' '.join(_CALLS)}")
+            return self._fail(LadderError(self._pos(name), f"unknown function {name}() in an expression; "
+                                          f"functions are {' '.join(_CALLS)}"), Const(0, self._pos(name)))
         return Call(func, arg, self._pos(name))
 
     @v_args(inline=True)
@@ -255,7 +272,7 @@ class _ToAst(Transformer):
 
     def _atomize(self, item):
         if isinstance(item, Token) and item.type in ("INT", "FLOAT", "HEX"):
-            return Const(_number(item), self._pos(item))
+            return Const(self._num(item), self._pos(item))
         return item
 
     # neutral text -----------------------------------------------------------------
@@ -316,7 +333,8 @@ class _ToAst(Transformer):
     def file_header(self, items):
         number = _tokens(items, "INT")[0]
         name = _tokens(items, "NAME")
-        return _Header(self._small_int(number, "program file number"), str(name[0]) if name else None, self._pos(items[0]))
+        number = self._small_int(number, "program file number")
+        return None if number is None else _Header(number, str(name[0]) if name else None, self._pos(items[0]))
 
     def data_decl(self, items):
         name, size = _tokens(items, "NAME", "INT")[:2]
@@ -327,11 +345,13 @@ class _ToAst(Transformer):
                     values.append(_unquote(str(v)))
             else:
                 values.append(v.value)
-        return DataDecl(str(name).upper(), self._small_int(size, f"DATA {name}: size"), values, self._pos(items[0]))
+        size = self._small_int(size, f"DATA {name}: size")
+        return None if size is None else DataDecl(str(name).upper(), size, values, self._pos(items[0]))
 
     @v_args(inline=True)
     def symbol_decl(self, name, addr, *_comment_nl):
-        return SymbolDecl(str(name), self._address(addr).address, self._pos(name))
+        ref = self._address(addr)
+        return SymbolDecl(str(name), ref.address, self._pos(name)) if isinstance(ref, AddressRef) else None
 
     def start(self, items):
         return list(items)
@@ -387,11 +407,13 @@ def _syntax_error(e: UnexpectedInput, text: str, source: str, line_offset: int, 
     return LadderError(pos, message, context)
 
 
-def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column_offset: int = 0):
+def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column_offset: int = 0,
+                problems: list[LadderError] | None = None):
     parser = _ast_parser()
     builder = parser.options.transformer
-    saved = builder.context  # an expression parse happens inside a program parse
+    saved = builder.context, builder.problems  # an expression parse happens inside a program parse
     builder.context = (source, line_offset, column_offset)
+    builder.problems = problems
     try:
         result = parser.parse(text, start=start)
     except UnexpectedInput as e:
@@ -405,7 +427,7 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
     except _NumberRangeError as e:
         raise _range_error(e, builder) from None
     finally:
-        builder.context = saved
+        builder.context, builder.problems = saved
     if isinstance(result, Token):  # a bare number as a whole expression
         return builder._atomize(result)
     return result
@@ -437,18 +459,25 @@ def parse_program(
     instructions=None,
     program: Program | None = None,
     line_offset: int = 0,
+    problems: list[LadderError] | None = None,
 ) -> Program:
     """Parse one .lad text into ``program`` (a new one by default).
 
     ``instructions`` (an InstructionSet) tells instruction names from symbol
     names in mnemonic rungs: by default the built-in instructions; an app
     passes the set that includes its modules' (TLM) instructions.
+
+    The first problem is raised as a LadderError, unless ``problems`` is a
+    list: then every problem short of a syntax error (a bad address or
+    number, an unknown instruction, a rung past the limits...) is added to
+    it and the parse goes on, so one parse finds them all; a syntax error is
+    still raised (syntax_problems resumes after it).
     """
     if instructions is None:
         from .instructions import BUILTIN as instructions
     if text and not text.endswith("\n"):
         text += "\n"
-    items = _parse_tree(text, source, "start", line_offset)
+    items = _parse_tree(text, source, "start", line_offset, problems=problems)
     program = program if program is not None else Program()
     current: ProgramFile | None = None
     comments: list[_Comment] = []
@@ -459,10 +488,8 @@ def parse_program(
             current = _add_file(program, MAIN_FILE, None, Pos(source, pos.line, 1))
         return current
 
-    for item in items:
-        if isinstance(item, _Comment):
-            comments.append(item)
-            continue
+    def add(item) -> None:
+        nonlocal current
         if isinstance(item, _Header):
             current = _add_file(program, item.number, item.name, item.pos)
         elif isinstance(item, DataDecl):
@@ -481,7 +508,21 @@ def parse_program(
             if problem is not None:
                 raise LadderError(problem[0].pos, problem[1])
             file_for_rungs(item.pos).rungs.append(Rung(elements, rung_comment, item.pos))
+
+    for item in items:
+        if isinstance(item, _Comment):
+            comments.append(item)
+            continue
+        if problems is None:
+            add(item)
+        else:
+            try:
+                add(item)
+            except LadderError as e:
+                problems.append(e)
         comments = []
+    if problems:
+        problems.sort(key=lambda e: (e.pos.line, e.pos.column))
     return program
 
 
@@ -500,10 +541,13 @@ def syntax_problems(text: str, source: str, limit: int = 50, instructions=None) 
         # lines[start:end]; ``cut``: the range ends where a later problem is,
         # so a rung may be cut short there (not a problem of its own).
         while start < end and len(found) < limit:
+            problems: list[LadderError] = []
             try:
-                parse_program("".join(lines[start:end]), source, instructions, program=Program(), line_offset=start)
+                parse_program("".join(lines[start:end]), source, instructions, program=Program(), line_offset=start,
+                              problems=problems)
+                found.extend(problems)
                 return
-            except LadderError as e:
+            except LadderError as e:  # a syntax error: what came before it is parsed on its own
                 line = e.pos.line
                 if cut and e.message.startswith("unexpected end of file"):
                     end -= 1  # a rung cut short at the range's end: check the range without it
