@@ -351,3 +351,25 @@ def test_every_problem_short_of_a_syntax_error_is_found_in_one_parse(tmp_path, m
     assert len(errors) == 50  # 5 a block, 10 blocks
     assert [e.pos.line for e in errors[:5]] == [1, 2, 3, 4, 5]
     assert "branches nested" in errors[0].message and "unknown function FOO()" in errors[3].message
+
+
+def test_validate_refuses_trees_past_the_limits_built_through_the_library():
+    """A program built as an AST (not parsed) is checked against the same
+    limits before validation walks it."""
+    from softplc_lite.ladder import check, parse_program
+    from softplc_lite.ladder.ast import Branch, UnaryOp
+
+    program = parse_program('XIC B3/0 OTE B3/1\nCPT N7:0 "N7:1 + 1"\n')
+    first, second = program.files[2].rungs
+    elements = first.elements
+    for _ in range(3000):
+        elements = [Branch([elements, [first.elements[0]]], first.pos)]
+    first.elements[:] = elements
+    cpt = second.elements[0]
+    for _ in range(3000):
+        cpt.operands[1] = UnaryOp("NEG", cpt.operands[1], second.pos)
+    _, problems = check(program)
+    assert [str(p) for p in problems] == [
+        f"<program>:1:1: branches nested more than {MAX_BRANCH_DEPTH} levels deep (the limit is {MAX_BRANCH_DEPTH})",
+        f"<program>:2:1: expression nested 3001 levels deep; the limit is {MAX_EXPRESSION_DEPTH} "
+        "(split it over several CPT instructions)"]

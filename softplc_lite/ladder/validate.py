@@ -33,6 +33,7 @@ from .ast import (
 )
 from .errors import LadderError, ProgramErrors
 from .instructions import BUILTIN, InstructionSet, K
+from .limits import limit_problem
 from .parser import parse_expression
 
 _NUMERIC = (ValueKind.WORD, ValueKind.FLOAT)
@@ -255,6 +256,11 @@ class _Checker:
             for rung in pfile.rungs:
                 if not rung.elements:
                     self.error(rung.pos, "empty rung")
+                over = limit_problem(rung.elements)  # a tree built through the library, not the parser
+                if over is not None:
+                    self.error(over[0].pos, over[1])
+                    rungs.append(rung)
+                    continue
                 rungs.append(Rung(self.series(rung.elements, number, set(labels), True), rung.comment, rung.pos))
             resolved.files[number] = replace(pfile, rungs=rungs)
         return resolved
