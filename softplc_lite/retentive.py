@@ -1,8 +1,9 @@
 """Retentive memory for a running PLC, like battery-backed RAM.
 
 While ``softplc run`` scans, the data table is saved every
-``[retentive] save_ms`` of wall-clock time (100 ms by default), so a process
-killed with SIGKILL loses at most that much. The snapshot is encoded by the
+``[retentive] save_ms`` of wall-clock time (100 ms by default) at the
+latest, so a process killed with SIGKILL loses at most that much (a
+snapshot every 0.8 x save_ms less the writes' lag; the rest is margin). The snapshot is encoded by the
 scan thread *between two scans* (``Retentive.tick``), so the table on disk
 is always the table at the end of one completed scan; a background thread
 (:class:`SnapshotWriter`) takes the encoded bytes and does the file work,
@@ -34,7 +35,13 @@ from .datatable import DataTable, snapshot
 from .ladder import status as S
 
 DURABLE_EVERY_S = 5.0  # one periodic save in this many seconds is fsynced (and becomes NAME.prev)
-LAG_SHARE = 0.25  # at most this share of save_ms is taken off the period to make up for slow writes
+# save_ms is the most a killed process may lose. A snapshot is taken every
+# PERIOD_SHARE of it, less how long writes have lately taken to land (at
+# most LAG_SHARE of it): the rest covers the scan in progress at the kill and
+# a write slower than the last ones (measured worst 110 ms with the whole
+# period, tests/test_retentive.py).
+PERIOD_SHARE = 0.8
+LAG_SHARE = 0.2
 WRITER_JOIN_S = 30.0  # at stop, how long to wait for a save still being written
 HANDOVER_S = 0.0002  # the interpreter's thread switch interval while a save is being written
 
@@ -228,7 +235,7 @@ class Retentive:
         self.saves = 0  # periodic snapshots written
         now = time.monotonic()
         self._last_durable = now
-        self.due = now + self.save_s if save_ms > 0 else float("inf")
+        self.due = now + self.save_s * PERIOD_SHARE if save_ms > 0 else float("inf")
 
     @property
     def lag_s(self) -> float:
@@ -255,7 +262,7 @@ class Retentive:
             self._durable_seq = self._seq
         writer.submit(_Job(self._seq, data, now, durable))
         # Early enough that this write's bytes are on disk within save_s of the last one's.
-        self.due = now + self.save_s - self.lag_s
+        self.due = now + self.save_s * PERIOD_SHARE - self.lag_s
 
     def _collect(self) -> None:
         writer = self._writer
