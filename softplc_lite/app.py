@@ -28,6 +28,7 @@ from .ladder.semantics import MAX_JSR_DEPTH, Settings
 from .ladder.validate import check
 from .ladder.engine import layout_problems
 from .ports import claim_conflicts
+from .ports.urlhandler.protocol_sim import url_problem as sim_url_problem
 from .tlm.api import TLM, find_file
 from .tlm.errors import ModuleError
 from .tlm.registry import configure_modules, installed, instruction_set, load_module, load_modules
@@ -123,13 +124,41 @@ def read_settings_file(path: Path) -> dict:
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise AppError(f"{path}: {e}") from None
+        # tomllib says "... (at line 3, column 7)" or "(at end of document)": put it first, as everywhere
+        m = re.search(r"\s*\(at line (\d+), column (\d+)\)$", str(e))
+        message = str(e)[:m.start()] if m else re.sub(r"\s*\(at end of document\)$", "", str(e))
+        line, column = (int(m.group(1)), int(m.group(2))) if m else (text.count("\n") + 1, 0)
+        raise AppError([LocatedError(message, str(path), line, column)]) from None
     except ValueError:  # an integer past Python's 4,300-digit conversion limit
         m = re.search(r"[0-9_]{4000,}", text)
         line = text.count("\n", 0, m.start()) + 1 if m else 0
         raise AppError([LocatedError("a number too long to be any setting", str(path), line)]) from None
+    except RecursionError:  # arrays or inline tables nested hundreds deep
+        raise AppError([LocatedError("values nested too deeply for a setting", str(path),
+                                     _nesting_line(text))]) from None
     doc["__text__"] = text  # for locating a bad value (load_settings); not a section
     return doc
+
+
+def _nesting_line(text: str, limit: int = 100) -> int:
+    """The line where brackets and braces (outside strings) first nest
+    deeper than ``limit``; 0 if they never do."""
+    depth, quote = 0, None
+    line = 1
+    for ch in text:
+        if ch == "\n":
+            line += 1
+        elif quote:
+            quote = None if ch == quote else quote
+        elif ch in "\"'":
+            quote = ch
+        elif ch in "[{":
+            depth += 1
+            if depth > limit:
+                return line
+        elif ch in "]}":
+            depth -= 1
+    return 0
 
 
 # softplc.toml settings: section -> key -> allowed values (a tuple of choices,
@@ -146,7 +175,7 @@ SETTING_RULES: dict[str, dict[str, tuple | range]] = {
 def _setting_line(text: str, section: str, key: str | None = None) -> int:
     """The line of ``[section]`` (or of ``key`` inside it) in a TOML text, 0
     when not found: tomllib gives no positions for valid documents."""
-    current = None
+    current = ""  # keys before any [section] header
     for number, line in enumerate(text.splitlines(), 1):
         stripped = line.strip()
         if stripped.startswith("[") and "]" in stripped:
@@ -176,7 +205,13 @@ def load_settings(path: Path, doc: dict | None = None) -> Settings:
     for section, values in doc.items():
         if section in ("display", "__text__"):  # [display] is read by load_display, once the symbols are known
             continue
-        if section not in SETTING_RULES or not isinstance(values, dict):
+        if not isinstance(values, dict):  # a key before any [section]
+            home = next((f" (under [{name}]?)" for name, keys in SETTING_RULES.items() if section in keys), "")
+            problems.append(LocatedError(f"{section} = ... is outside any section{home}; settings go under "
+                                         f"{', '.join(f'[{s}]' for s in SETTING_RULES)}", str(path),
+                                         _setting_line(text, "", section)))
+            continue
+        if section not in SETTING_RULES:
             problem(f"unknown section [{section}] (expected "
                     f"{', '.join(f'[{s}]' for s in [*SETTING_RULES, 'display'])})", section)
             continue
@@ -214,7 +249,23 @@ def load_display(path: Path, symbols=None, doc: dict | None = None) -> Display:
     try:
         return parse_display(doc["display"], str(path), symbols)
     except DataTableError as e:
-        raise AppError(str(e)) from None
+        message = str(e).removeprefix(f"{path}: ")
+        raise AppError([LocatedError(message, str(path), _display_line(doc.get("__text__", ""), message))]) from None
+
+
+def _display_line(text: str, message: str) -> int:
+    """The line of [display] that a parse_display message is about: the
+    first line of the section naming its label, else the section's header."""
+    m = re.match(r"\[display\] (?:has )?(.+?) = ", message)
+    label = m.group(1) if m else None
+    header = _setting_line(text, "display")
+    if label and header:
+        for number, line in enumerate(text.splitlines()[header:], header + 1):
+            if line.lstrip().startswith("["):
+                break
+            if label in line:
+                return number
+    return header
 
 
 def display_problems(display: Display, table, path: Path, doc: dict) -> list[LocatedError]:
@@ -252,8 +303,10 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
     # Every problem at once: the modules' config files, then the program's.
     warnings, config_problems = configure_modules(modules, module_dir)
     if not config_problems:
-        conflicts = claim_conflicts([c for m in modules for c in m.port_claims()])
-        config_problems = [ModuleError(c) for c in conflicts]
+        claims = [c for m in modules for c in m.port_claims()]
+        config_problems = [ModuleError(c) for c in claim_conflicts(claims)]
+        config_problems += [ModuleError(f"{c.where}: {c.module} port {c.number}: {problem}") for c in claims
+                            if c.url.lower().startswith("sim://") and (problem := sim_url_problem(c.url))]
     warnings += _unused_configs(module_dir, modules)
     parsed, errors = parse_files(files, path, instructions)
     resolved, problems = check(parsed, instructions)

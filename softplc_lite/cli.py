@@ -25,7 +25,7 @@ from .datatable.display import format_value
 from .display import StatusLine
 from .ladder.engine import Mode
 from .ladder.errors import LadderError
-from .ladder.fmt import STYLES, format_program
+from .ladder.fmt import STYLES, format_program, unprintable
 from .runner import RunOptions, Runner
 from .errors import LocatedError
 
@@ -187,6 +187,7 @@ def _cmd_fmt(args: argparse.Namespace) -> int:
     instructions = app_instructions(path)
     for k, f in enumerate(files):
         program, errors = parse_files([f], path, instructions)
+        errors = errors or unprintable(program, args.style, instructions)
         if errors:
             raise AppError(errors)
         if len(files) > 1:

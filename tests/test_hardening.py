@@ -373,3 +373,57 @@ def test_validate_refuses_trees_past_the_limits_built_through_the_library():
         f"<program>:1:1: branches nested more than {MAX_BRANCH_DEPTH} levels deep (the limit is {MAX_BRANCH_DEPTH})",
         f"<program>:2:1: expression nested 3001 levels deep; the limit is {MAX_EXPRESSION_DEPTH} "
         "(split it over several CPT instructions)"]
+
+
+# -- found by the fuzz harness (tools/fuzz.py) --------------------------------------------
+
+@pytest.mark.parametrize("toml, says", [
+    ("[scan]\nscan_ms = " + "[" * 1000 + "]" * 1000 + "\n", "softplc.toml:2: values nested too deeply"),
+    ("[scan]\nscan_ms = { a = " * 1 + "{ b = " * 1000 + "1" + " }" * 1001 + "\n", "softplc.toml:2: values nested"),
+    ("[scan\nx = 1\n", "softplc.toml:1:6: Expected ']' at the end of a table declaration"),
+    ("[scan]\nscan_ms =", "softplc.toml:2: Invalid value"),  # "at end of document": its last line
+    ("save_ms = 5\n[scan]\nscan_ms = 5\n", "softplc.toml:1: save_ms = ... is outside any section (under [retentive]?)"),
+    ('[display]\nstatus = { x = "N7:" }\n', "softplc.toml:2: [display] x = 'N7:': bad address"),
+], ids=short)
+def test_every_softplc_toml_problem_is_located(tmp_path, capsys, toml, says):
+    app = make_app(tmp_path, "MOV 1 N7:0\n", softplc_toml=toml)
+    code, _, err = run_cli(capsys, "check", str(app))
+    assert code == cli.EXIT_ERROR and says in err, err
+
+
+@pytest.mark.parametrize("lad, style", [
+    ("XIC(B3/0)OTE(O:0/0);\n;\n", "mnemonic"),  # an empty rung: once a blank line, then nothing
+    ("XIC(B3/0)OTE(O:0/0);\n;\n", "neutral"),
+    ("XIC B3/0 BST NXB XIC B3/1 BND OTE O:0/0\n", "neutral"),
+])
+def test_fmt_is_a_fixed_point_even_for_rungs_check_refuses(tmp_path, capsys, lad, style):
+    (tmp_path / "a.lad").write_text(lad)
+    code, once, _ = run_cli(capsys, "fmt", "--style", style, str(tmp_path / "a.lad"))
+    (tmp_path / "b.lad").write_text(once)
+    code2, twice, _ = run_cli(capsys, "fmt", "--style", style, str(tmp_path / "b.lad"))
+    assert code == code2 == 0 and twice == once
+    assert run_cli(capsys, "check", str(tmp_path / "a.lad"))[2] == run_cli(capsys, "check", str(tmp_path / "b.lad"))[2] \
+        .replace("b.lad", "a.lad")
+
+
+@pytest.mark.parametrize("lad, style, says", [
+    ("FOO(N7:0);\n", "mnemonic", "a.lad:1:1: unknown instruction 'FOO'"),
+    ('XIC "B3/0" OTE O:0/0\n', "neutral", "a.lad:1:5: XIC has a quoted string operand, which neutral text cannot write"),
+])
+def test_fmt_refuses_what_it_could_not_print_back(tmp_path, capsys, lad, style, says):
+    (tmp_path / "a.lad").write_text(lad)
+    code, out, err = run_cli(capsys, "fmt", "--style", style, str(tmp_path / "a.lad"))
+    assert code == cli.EXIT_ERROR and out == "" and says in err
+
+
+@pytest.mark.parametrize("url, says", [
+    ("sim://x?device=nosuch", "COMGENIUS.LST:3: COMGENIUS port 0: unknown device kind 'nosuch'"),
+    ("sim://x?device=modbus&turnaround_ms=abc", "turnaround_ms must be a number >= 0, not 'abc'"),
+    ("sim://bad name", "bad link name"),
+])
+def test_check_refuses_the_sim_urls_run_would_refuse(tmp_path, capsys, url, says):
+    app = make_app(tmp_path, "MOV 1 N7:0\n", MODULES_LST="COMGENIUS\n",
+                   COMGENIUS_LST=f"[DRIVER]\n[PORTS]\n0, {url}, ISO-8859-1, 9600, 8, N, 1, 100\n")
+    for command in ("check", "run"):
+        code, _, err = run_cli(capsys, command, str(app))
+        assert code == cli.EXIT_ERROR and says in err, (command, err)

@@ -20,7 +20,9 @@ from .ast import (
     SymbolRef,
     Text,
     UnaryOp,
+    walk,
 )
+from .errors import LadderError
 
 STYLES = ("mnemonic", "neutral")
 
@@ -115,6 +117,8 @@ def format_series(elements: list[Element], style: str) -> str:
 def format_rung(rung: Rung, style: str = "mnemonic") -> str:
     lines = [f"// {line}".rstrip() for line in (rung.comment or "").split("\n")] if rung.comment else []
     body = format_series(rung.elements, style)
+    if not body and style == "mnemonic":
+        body = "SOR EOR"  # an empty rung (check refuses it) stays a rung, not a blank line
     lines.append(body + ";" if style == "neutral" else body)
     return "\n".join(lines)
 
@@ -123,6 +127,24 @@ def _data_value(v) -> str:
     if isinstance(v, str):
         return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
     return _number(v)
+
+
+def unprintable(program: Program, style: str, instructions) -> list[LadderError]:
+    """What ``style`` cannot print so that it parses back: in mnemonic
+    style an instruction the set does not know (neutral text accepts any
+    name, mnemonic text must tell instructions from symbols); in neutral
+    style a quoted string operand (neutral text has no string operands)."""
+    found = []
+    for pfile in program.files.values():
+        for rung in pfile.rungs:
+            for ins in walk(rung.elements):
+                if style == "mnemonic" and instructions.lookup(ins.mnemonic) is None:
+                    found.append(LadderError(ins.pos, f"unknown instruction {ins.mnemonic!r}"
+                                                      f"{instructions.hint(ins.mnemonic)}"))
+                if style == "neutral":
+                    found += [LadderError(op.pos, f"{ins.mnemonic} has a quoted string operand, which neutral "
+                                                  "text cannot write") for op in ins.operands if isinstance(op, Text)]
+    return found
 
 
 def format_program(program: Program, style: str = "mnemonic") -> str:

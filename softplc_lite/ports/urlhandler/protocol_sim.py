@@ -53,6 +53,19 @@ def parse_url(url: str) -> tuple[str, str | None, dict[str, str], bool]:
     return name, kind, options, rate == "unlimited"
 
 
+def url_problem(url: str) -> str | None:
+    """Why opening ``url`` (a sim:// URL) would fail, without opening it: a
+    bad form, an unknown device kind or a bad device option; None when it
+    would open. ``softplc check`` asks, so that it refuses what run would."""
+    try:
+        _, kind, options, _ = parse_url(url)
+        if kind is not None:
+            simdevices.create_device(kind, options)
+    except (ValueError, SerialException) as e:
+        return f'{e} (expected "{FORM}")'
+    return None
+
+
 class Serial(wire.ClockedSerial):
     """A port on a simulated link (see the module docstring)."""
 
