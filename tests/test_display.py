@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import subprocess
 import sys
 from pathlib import Path
@@ -59,4 +61,4 @@ def test_status_line_renders_scan_time_and_values():
 def test_bad_display_settings_name_the_file(tmp_path, display, message):
     with pytest.raises(AppError) as info:
         load_app(app_dir(tmp_path, display))
-    assert "softplc.toml: " in str(info.value) and message in str(info.value)
+    assert re.search(r"softplc.toml:\d+: ", str(info.value)) and message in str(info.value)
