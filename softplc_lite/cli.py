@@ -34,6 +34,11 @@ EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT, EXIT_INTERNAL = 0, 1, 2, 3, 4
 # --scan-ms: simulated ms per scan, or the --realtime period (0: free-running).
 # S:8 and S:9 hold a scan time in a 16-bit word, hence the top.
 SCAN_MS_RANGE = range(0, 32768)
+SCANS_RANGE = range(0, 2 ** 63)
+# watch --snapshot sizes: a real terminal's at the low end; the top keeps a
+# snapshot's memory and time bounded (1000x1000 takes about 1.3 s).
+SNAPSHOT_WIDTH = range(40, 1001)
+SNAPSHOT_HEIGHT = range(12, 1001)
 
 
 def int_in(valid: range, what: str):
@@ -206,7 +211,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("run", help="run an app (directory or .lad file) in RUN mode")
     r.add_argument("app", metavar="APP", help="app directory or .lad file")
-    r.add_argument("--scans", type=int_in(range(0, 2 ** 63), "--scans"), metavar="N", help="stop after N scans (default: run until Ctrl-C)")
+    r.add_argument("--scans", type=int_in(SCANS_RANGE, "--scans"), metavar="N", help="stop after N scans (default: run until Ctrl-C)")
     r.add_argument("--scan-ms", type=int_in(SCAN_MS_RANGE, "--scan-ms"), metavar="MS",
                    help="simulated ms per scan (default 10), or with --realtime the scan period "
                    "(0 = free-running); 0..32767")
@@ -240,13 +245,13 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE", help="set a value at start")
     w.add_argument("--port", action="append", default=[], metavar="N=DEVICE", help="as for run")
     w.add_argument("--replay", metavar="TRACE", help="play every port back from a recorded TRACE file")
-    w.add_argument("--scans", type=int_in(range(0, 2 ** 63), "--scans"), default=0, metavar="N",
+    w.add_argument("--scans", type=int_in(SCANS_RANGE, "--scans"), default=0, metavar="N",
                    help="with --snapshot: scans to run first (0 or more; default 0)")
     w.add_argument("--snapshot", metavar="FILE", help="render the view after --scans N scans to FILE "
                    "(.svg: an SVG picture; otherwise text) and exit; needs no terminal")
-    w.add_argument("--width", type=int_in(range(40, 1001), "--width"), default=100, metavar="COLS",
+    w.add_argument("--width", type=int_in(SNAPSHOT_WIDTH, "--width"), default=100, metavar="COLS",
                    help="--snapshot width, 40..1000 (default 100)")
-    w.add_argument("--height", type=int_in(range(12, 1001), "--height"), default=40, metavar="ROWS",
+    w.add_argument("--height", type=int_in(SNAPSHOT_HEIGHT, "--height"), default=40, metavar="ROWS",
                    help="--snapshot height, 12..1000 (default 40)")
     w.set_defaults(func=_cmd_watch)
 

@@ -9,15 +9,12 @@ import sys
 from rich.console import Console
 
 from ..app import load_app
+from ..cli import EXIT_USAGE, SNAPSHOT_HEIGHT, SNAPSHOT_WIDTH  # the ranges the argument parser checks too
 from ..runner import RunOptions
 from .screen import WatchScreen, rung_view
 from .session import WatchOptions, WatchSession
 from .watchlist import WATCH_MAX, read_watch_file
 
-EXIT_USAGE = 2
-# The snapshot's size (--width, --height; the command line checks them too).
-SNAPSHOT_WIDTH = range(40, 1001)
-SNAPSHOT_HEIGHT = range(12, 1001)
 
 
 def watch_command(args) -> int:
