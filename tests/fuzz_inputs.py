@@ -307,7 +307,10 @@ def _one_mutation(rnd: random.Random, data: bytes, profile: Profile, dictionary:
         return b"\n".join(lines)
     if op == "long_line":
         i = rnd.randrange(len(lines))
-        lines[i] = lines[i] + (b" " + (lines[i].strip() or b"x")) * rnd.choice([100, 2000])
+        # The line repeated, up to about 4 MB: mutations applied one after another
+        # once multiplied an already long line by 2000 twice (a MemoryError in the harness).
+        piece = b" " + ((lines[i].strip() or b"x")[:2000])
+        lines[i] = lines[i] + piece * rnd.choice([100, 2000])
         return b"\n".join(lines)
     toks = _tokens(data)
     if not toks:

@@ -286,8 +286,11 @@ def judge(r: Result, case: Case, root: str, check_location: bool = True) -> list
         # A line naming the file as a path (".../name" or "name" first), not in passing ("the app's MODULES.LST").
         as_path = re.compile(r"(?:^|[/\\]|error: )" + re.escape(name) + r"(?!:\d)", re.IGNORECASE)
         located = re.compile(re.escape(name) + r":\d+", re.IGNORECASE)
+        # A line located elsewhere (main.lad:39:41: ... port 0 is not in [PORTS] of .../COMGENIUS.LST) is located.
+        elsewhere = re.compile(r"^(?:warning: |error: )?\S+:\d+(?::\d+)?: ")
         bad = [ln for ln in r.err.splitlines()
-               if as_path.search(ln) and not located.search(ln) and not WHOLE_FILE.search(ln)]
+               if as_path.search(ln) and not located.search(ln) and not WHOLE_FILE.search(ln)
+               and not elsewhere.match(ln)]
         if bad:
             words = re.search(r"\bline \d+|at end of document", bad[0])
             what = "" if words else ":" + normalise(bad[0].split(name, 1)[1], root)[:12]

@@ -395,6 +395,8 @@ def test_every_softplc_toml_problem_is_located(tmp_path, capsys, toml, says):
     ("XIC(B3/0)OTE(O:0/0);\n;\n", "mnemonic"),  # an empty rung: once a blank line, then nothing
     ("XIC(B3/0)OTE(O:0/0);\n;\n", "neutral"),
     ("XIC B3/0 BST NXB XIC B3/1 BND OTE O:0/0\n", "neutral"),
+    ("SYMBOL Temp N7:[N9:2]\nDATA N9 5 = 1 2 3 70 7\n\nFILE 2", "mnemonic"),  # an empty main file
+    ("SYMBOL Temp N7:[N9:2]\nDATA N9 5 = 1 2 3 70 7\n\nFILE 2", "neutral"),
 ])
 def test_fmt_is_a_fixed_point_even_for_rungs_check_refuses(tmp_path, capsys, lad, style):
     (tmp_path / "a.lad").write_text(lad)

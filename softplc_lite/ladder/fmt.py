@@ -160,7 +160,7 @@ def format_program(program: Program, style: str = "mnemonic") -> str:
         pfile = program.files[number]
         if out:
             out.append("")
-        if number != MAIN_FILE or pfile.name:
+        if number != MAIN_FILE or pfile.name or not pfile.rungs:  # an empty main file needs its header to stay
             out.append(f"FILE {number}" + (f" {pfile.name}" if pfile.name else ""))
         for rung in pfile.rungs:
             out.append(format_rung(rung, style))
