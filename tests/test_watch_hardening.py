@@ -22,7 +22,8 @@ from rich.console import Console
 from softplc_lite.datatable import DataTable, parse_address
 from softplc_lite.ladder import validate
 from softplc_lite.ladder.ast import AddressRef, Branch, Instruction, Rung, address_refs, walk
-from softplc_lite.watch import rungs
+from softplc_lite.ladder.instructions import BUILTIN
+from softplc_lite.watch import cells, layout as layout_module
 from softplc_lite.watch.power import rung_power
 from softplc_lite.watch.rungs import RungView
 
@@ -66,10 +67,10 @@ def draw(rung: Rung, width: int, table: DataTable | None = None, **view) -> list
     return console.export_text().splitlines()
 
 
-def layout(rung: Rung, width: int, table: DataTable) -> rungs._Block:
+def layout(rung: Rung, width: int, table: DataTable) -> cells._Block:
     """The rung's body block itself: its width is not cut to a console's."""
-    ctx = rungs._Context(table, rung_power(rung, table), rungs._SymbolNames(None), frozenset(), rungs.BUILTIN, True)
-    return rungs._Layout(ctx, rung.elements).rung(width)
+    ctx = cells._Context(table, rung_power(rung, table), cells._SymbolNames(None), frozenset(), BUILTIN, True)
+    return layout_module._Layout(ctx, rung.elements).rung(width)
 
 
 def best_time(fn, repeat: int = 5, number: int = 3) -> float:
@@ -154,7 +155,7 @@ def test_200_levels_built_by_the_library_render_quickly(width, second_leg):
     assert time.perf_counter() - start < 5.0
     assert "B3/0" in lines[1] and any("B3/2" in line for line in lines) and lines[-1].endswith("|")
     block = layout(rung, width, table)
-    assert {rungs._width(line) for line in block.lines} == {width}
+    assert {cells._width(line) for line in block.lines} == {width}
 
 
 def test_power_flow_of_a_very_deep_rung_needs_no_recursion():
@@ -204,7 +205,7 @@ def test_every_rung_line_is_exactly_the_width(program, width):
     table = table_for(*rungs_)
     for rung in rungs_:
         block = layout(rung, width, table)
-        assert {rungs._width(line) for line in block.lines} == {width}
+        assert {cells._width(line) for line in block.lines} == {width}
 
 
 # -- the command line: sizes ---------------------------------------------------------------------
