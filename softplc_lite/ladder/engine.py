@@ -168,17 +168,25 @@ def layout_problems(program: Program, modules=()) -> tuple[DataTable, list[Ladde
         for address in module.config_references():
             with _located(where, problems):
                 table.reference(address)
-    owner = {spec.mnemonic: m for m in modules for spec in m.instructions()}
-    if owner:
-        for pfile in program.files.values():
-            for rung in pfile.rungs:
-                for ins in walk(rung.elements):
-                    module = owner.get(ins.mnemonic)
-                    if module is not None:
-                        with _located(ins.pos, problems):
-                            for address in module.references(ins):
-                                table.reference(address)
+    reference_module_blocks(program, table, {spec.mnemonic: m for m in modules for spec in m.instructions()},
+                            problems)
     return table, problems
+
+
+def reference_module_blocks(program: Program, table: DataTable, owner: dict, problems: list | None = None) -> None:
+    """Grow the table to what module instructions reach beyond their
+    operands (``owner``: mnemonic -> module); ``problems`` as for
+    reference_program."""
+    if not owner:
+        return
+    for pfile in program.files.values():
+        for rung in pfile.rungs:
+            for ins in walk(rung.elements):
+                module = owner.get(ins.mnemonic)
+                if module is not None:
+                    with _located(ins.pos, problems):
+                        for address in module.references(ins):
+                            table.reference(address)
 
 
 class _located:
@@ -237,7 +245,7 @@ class Engine:
         self._owner = {spec.mnemonic: m for m in self.modules for spec in m.instructions()}
         self.module_warnings: list[str] = []
         self.recorder = None  # the --record trace, shared by the modules' ports
-        self._reference_module_blocks()
+        reference_module_blocks(program, self.table, self._owner)
         self._attach_modules(module_options or {})
         self._attach_hooks()
         self.files = {}
@@ -263,17 +271,6 @@ class Engine:
             for m in attached:  # a module refused to start: release what the others opened
                 m.close()
             raise
-
-    def _reference_module_blocks(self) -> None:
-        if not self._owner:
-            return
-        for pfile in self.program.files.values():
-            for rung in pfile.rungs:
-                for ins in walk(rung.elements):
-                    module = self._owner.get(ins.mnemonic)
-                    if module is not None:
-                        for address in module.references(ins):
-                            self.table.reference(address)
 
     def _attach_hooks(self) -> None:
         from ..tlm.api import overrides
