@@ -165,9 +165,10 @@ def _nesting_line(text: str, limit: int = 100) -> int:
 # or an inclusive integer range). The ranges are what the engine can honour:
 # S:8 and S:28 are 16-bit words, and the JSR nesting the engine runs without
 # reaching Python's own recursion limit (docs/engine.md).
+SCAN_MS_RANGE = range(0, 32768)  # also softplc run/watch --scan-ms
 SETTING_RULES: dict[str, dict[str, tuple | range]] = {
     "math": {"overflow": ("clamp", "wrap"), "divide_by_zero": ("overflow", "fault")},
-    "scan": {"scan_ms": range(0, 32768), "watchdog_ms": range(1, 32768), "jsr_depth": range(1, MAX_JSR_DEPTH + 1)},
+    "scan": {"scan_ms": SCAN_MS_RANGE, "watchdog_ms": range(1, 32768), "jsr_depth": range(1, MAX_JSR_DEPTH + 1)},
     "retentive": {"save_ms": range(0, 3_600_001)},
 }
 

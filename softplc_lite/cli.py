@@ -18,7 +18,7 @@ from rich.console import Console
 from rich.live import Live
 
 from . import __version__
-from .app import AppError, app_instructions, lad_files, load_app, parse_files
+from .app import SCAN_MS_RANGE, AppError, app_instructions, lad_files, load_app, parse_files
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
 from .datatable.display import format_value
@@ -31,9 +31,8 @@ from .errors import LocatedError
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT, EXIT_INTERNAL = 0, 1, 2, 3, 4
 
-# --scan-ms: simulated ms per scan, or the --realtime period (0: free-running).
-# S:8 and S:9 hold a scan time in a 16-bit word, hence the top.
-SCAN_MS_RANGE = range(0, 32768)
+# --scan-ms (SCAN_MS_RANGE, the range of softplc.toml's scan_ms): simulated ms
+# per scan, or the --realtime period (0: free-running).
 SCANS_RANGE = range(0, 2 ** 63)
 # watch --snapshot sizes: a real terminal's at the low end; the top keeps a
 # snapshot's memory and time bounded (1000x1000 takes about 1.3 s).
