@@ -68,6 +68,7 @@ HUGE = "9" * 5000
     (f"DATA N7 2 = 1 {HUGE}\nMOV 1 N7:0\n", "main.lad:1:15", "out of range"),
     ('CPT N7:0 "N7:1 + ' + HUGE + '"\n', "main.lad:1:18", "out of range"),
     ("MOV 1e999 F8:0\n", "main.lad:1:5", "number 1e999 is out of range"),
+    ('MOV 1 N7:0\nCPT N7:0 "1e999"\n', "main.lad:2:11", "number 1e999 is out of range"),  # a bare-number expression
     ("MOV(-1e39,F8:0);\n", "main.lad:1:6", "out of range"),
 ], ids=short)
 def test_huge_and_overflowing_literals_are_located_check_errors(tmp_path, capsys, lad, where, says):

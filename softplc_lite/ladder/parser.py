@@ -143,20 +143,19 @@ class _RungDraft:
 
 
 def _number(tok: Token) -> int | float:
-    """A numeric token's value; NumberRangeError for one no element can hold
+    """A numeric token's value; _NumberRangeError for one no element can hold
     (checked on the text first: Python converts at most 4,300 digits)."""
     text = str(tok)
     if tok.type in ("HEX", "INT") and len(text) > MAX_NUMBER_DIGITS:
-        raise _NumberRangeError(tok, f"{text[:12]}... ({len(text)} {'characters' if tok.type == 'HEX' else 'digits'})")
+        raise _NumberRangeError(f"{text[:12]}... ({len(text)} {'characters' if tok.type == 'HEX' else 'digits'})")
     value: int | float = int(text, 16) if tok.type == "HEX" else int(text) if tok.type == "INT" else float(text)
     if not abs(value) <= MAX_CONSTANT:  # also catches inf from 1e999
-        raise _NumberRangeError(tok, text if len(text) <= 30 else f"{text[:12]}... ({len(text)} characters)")
+        raise _NumberRangeError(text if len(text) <= 30 else f"{text[:12]}... ({len(text)} characters)")
     return value
 
 
 class _NumberRangeError(Exception):
-    def __init__(self, tok: Token, shown: str) -> None:
-        self.tok = tok
+    def __init__(self, shown: str) -> None:
         self.shown = shown
 
 
@@ -194,7 +193,8 @@ class _ToAst(Transformer):
         try:
             return _number(tok)
         except _NumberRangeError as e:
-            return self._fail(_range_error(e, self), 0)
+            return self._fail(LadderError(self._pos(tok), f"number {e.shown} is out of range: no data table "
+                                          f"element holds a value beyond +-{MAX_CONSTANT:.8g}"), 0)
 
     def _pos(self, item) -> Pos:
         """The position of a token, or of an AST node already built."""
@@ -416,26 +416,17 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
     builder.problems = problems
     try:
         result = parser.parse(text, start=start)
+        if isinstance(result, Token):  # a bare number as a whole expression: in this parse's context
+            result = builder._atomize(result)
     except UnexpectedInput as e:
         raise _syntax_error(e, text, source, line_offset, column_offset) from None
     except VisitError as e:
         if isinstance(e.orig_exc, LadderError):
             raise e.orig_exc from None
-        if isinstance(e.orig_exc, _NumberRangeError):
-            raise _range_error(e.orig_exc, builder) from None
         raise
-    except _NumberRangeError as e:
-        raise _range_error(e, builder) from None
     finally:
         builder.context, builder.problems = saved
-    if isinstance(result, Token):  # a bare number as a whole expression
-        return builder._atomize(result)
     return result
-
-
-def _range_error(e: _NumberRangeError, builder: "_ToAst") -> LadderError:
-    return LadderError(builder._pos(e.tok), f"number {e.shown} is out of range: no data table element holds "
-                       f"a value beyond +-{MAX_CONSTANT:.8g}")
 
 
 def parse_expression(text: str, pos: Pos) -> Operand:
