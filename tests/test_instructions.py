@@ -74,7 +74,9 @@ def scans(e, n: int, probe) -> list:
 
 
 def test_every_builtin_instruction_has_a_test():
-    words = {w for name in re.findall(r"^def test_(\w+)", Path(__file__).read_text(), re.M) for w in name.split("_")}
+    # Groups of bound instructions (ladder/instr/) have test files of their own.
+    texts = [p.read_text() for p in sorted(Path(__file__).parent.glob("test_*.py"))]
+    words = {w for text in texts for name in re.findall(r"^def test_(\w+)", text, re.M) for w in name.split("_")}
     assert [m for m in BUILTIN if m.lower() not in words] == []
 
 

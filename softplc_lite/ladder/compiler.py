@@ -25,8 +25,10 @@ from ..datatable.errors import AddressRangeError, DataTableError
 from ..datatable.filetypes import Storage
 from . import status as S
 from .ast import AddressRef, BinOp, Branch, Const, Element, Instruction, Program, Rung, UnaryOp, walk
+from .bound import BoundAccess
 from .expr import namespace as expr_namespace
 from .expr import to_python
+from .instr import BOUND
 from .semantics import BASE_MS, Machine, MajorFault, lim, source_units
 
 RET = -1
@@ -196,6 +198,12 @@ class _FileCompiler:
         if m in _COMPARE:
             a, b = self.value(ind, ops[0]), self.value(ind, ops[1])
             self.emit(ind, f"c = c and {a} {_COMPARE[m]} {b}")
+            return
+        bound = BOUND.get(m)
+        if bound is not None:
+            # A bound instruction (ladder/instr/): one object per instruction.
+            run = bound.bind(ins, BoundAccess(self.table, self.machine))
+            self.emit(ind, f"c = {self.bind(f'_bi{len(self.env)}', run)}(c)")
             return
         instance = self.module_instance(ins) if self.module_instance is not None else None
         if instance is not None:

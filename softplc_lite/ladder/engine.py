@@ -24,6 +24,7 @@ from . import status as S
 from .ast import MAIN_FILE, AddressRef, Pos, Program, address_refs, walk
 from .compiler import RET, EndScan, compile_file, describe
 from .errors import LadderError
+from .instr import BOUND
 from .interpreter import interpret_file
 from .semantics import Machine, MajorFault, Settings, source_units
 
@@ -124,6 +125,10 @@ def _reference_instruction(ins, table: DataTable) -> None:
     for op in ins.operands:
         for ref in address_refs(op):
             table.reference(ref.address)
+    bound = BOUND.get(ins.mnemonic)
+    if bound is not None and bound.references is not None:
+        for address in bound.references(ins):
+            table.reference(address)
     if ins.mnemonic in ("COP", "FLL") and ins.operands[1].address.is_direct:
         n = ins.operands[2].value
         dest = ins.operands[1].address

@@ -9,68 +9,10 @@ this order. Plug-in modules (TLMs) add their instructions through an
 from __future__ import annotations
 
 import difflib
-from dataclasses import dataclass
-from enum import Enum
 
 
-class K(Enum):
-    """Operand kinds."""
-
-    BIT = "bit address"
-    SOURCE = "number or word/float address"  # read-only numeric operand
-    DEST = "word or float address"  # numeric destination
-    INT_SOURCE = "integer or word address"
-    WORD = "word address"
-    TIMER = "timer element (T)"
-    COUNTER = "counter element (C)"
-    CONTROL = "control element (R)"
-    RESETTABLE = "timer, counter or control element"
-    TIMEBASE = "time base 1.0, 0.01 or 0.001"
-    PRESET = "integer constant"
-    LABEL = "label number 0..999"
-    PROGRAM_FILE = "program file number 3..999"
-    EXPRESSION = "expression"
-    FILE = "file address (#N7:0)"
-    WORD_FILE = "word file address (#B3:0)"  # a block of 16-bit words (module instructions)
-    FILE_SOURCE = "number, or file address (#N7:0)"
-    LENGTH = "length 1..1000"
-    STRING = "string element (ST)"
-    BIT_NUMBER = "bit number 0..15"
-    ANY = "operand"  # TLM parameters: validated by the TLM
-    # TLM parameter kinds (COMGENIUS and third-party modules)
-    PORT = "port number 0..35 or word address"
-    FORMAT = "format index (integer or word address)"
-    PARAM = "number, or word, float or STRING element"  # read by a conversion
-    PARAM_OUT = "word, float or STRING element"  # written by a conversion
-
-
-@dataclass(frozen=True)
-class OperandSpec:
-    name: str
-    kind: K
-
-
-@dataclass(frozen=True)
-class InstructionSpec:
-    mnemonic: str
-    title: str
-    operands: tuple[OperandSpec, ...]
-    output: bool  # output instructions are last in a series (informational)
-    optional: int = 0  # how many trailing operands may be left out
-    module: str | None = None  # the TLM that provides it; None = built in
-
-    @property
-    def min_operands(self) -> int:
-        return len(self.operands) - self.optional
-
-    def signature(self) -> str:
-        names = [o.name if i < self.min_operands else f"[{o.name}]" for i, o in enumerate(self.operands)]
-        return f"{self.mnemonic} {' '.join(names)}".strip()
-
-
-def _spec(mnemonic: str, title: str, output: bool, *operands: tuple[str, K], optional: int = 0) -> InstructionSpec:
-    return InstructionSpec(mnemonic, title, tuple(OperandSpec(n, k) for n, k in operands), output, optional)
-
+from .instr import BOUND as _BOUND
+from .specs import K, OperandSpec, InstructionSpec, _spec  # noqa: F401 - re-exported
 
 _BUILTIN = [
     # bit
@@ -180,6 +122,7 @@ class InstructionSet:
 
 
 _BUILTIN_TABLE: dict[str, InstructionSpec] = {s.mnemonic: s for s in _BUILTIN}
+_BUILTIN_TABLE.update((m, bi.spec) for m, bi in _BOUND.items())
 BUILTIN = InstructionSet()
 
 

@@ -15,7 +15,9 @@ from ..datatable import DataTable, bit_mask
 from ..datatable.errors import AddressRangeError
 from .ast import AddressRef, Branch, Const, Instruction, Program, Rung, address_refs, walk
 from .compiler import RET, TND, EndScan, address_fault, describe, labels_of
+from .bound import ReferenceAccess
 from .expr import evaluate
+from .instr import BOUND
 from .semantics import BASE_MS, Machine, MajorFault, lim, source_units
 from . import status as S
 
@@ -57,6 +59,7 @@ class ReferenceFile:
 class Interpreter:
     def __init__(self, table: DataTable, machine: Machine, jsr, zone: list) -> None:
         self.modules: dict[int, object] = {}  # id(Instruction) -> module (TLM) instance
+        self.bound: dict[int, object] = {}  # id(Instruction) -> bound instruction (ladder/instr/)
         self.table = table
         self.m = machine
         self.jsr = jsr
@@ -271,6 +274,8 @@ class Interpreter:
         elif m == "ASR":
             (ad, ai, _), (bd, bi, _) = self.loc(ops[0]), self.loc(ops[1])
             return mc.asr(ad, ai, bd, bi)
+        elif id(ins) in self.bound:
+            return self.bound[id(ins)](c)
         elif id(ins) in self.modules:
             return self.modules[id(ins)](c)
         else:
@@ -289,9 +294,13 @@ def interpret_file(program: Program, number: int, table: DataTable, machine: Mac
                    module_instance=None) -> ReferenceFile:
     interp = Interpreter(table, machine, jsr, zone)
     rungs = program.files[number].rungs
-    if module_instance is not None:
-        for rung in rungs:
-            for ins in walk(rung.elements):
+    access = ReferenceAccess(table, machine)
+    for rung in rungs:
+        for ins in walk(rung.elements):
+            bound = BOUND.get(ins.mnemonic)
+            if bound is not None:
+                interp.bound[id(ins)] = bound.bind(ins, access)
+            elif module_instance is not None:
                 instance = module_instance(ins)
                 if instance is not None:
                     interp.modules[id(ins)] = instance

@@ -1,0 +1,158 @@
+"""Bound instructions: built-in instructions written once, as Python
+objects bound to their operands, and run the same way by both executors.
+
+Most instructions have a compiler template (compiler.py) and a second,
+plain rule in the reference interpreter. Instructions with more state than
+a line of code (shift registers, FIFOs, sequencers, file arithmetic, PID)
+are written here instead, one module per group in ``ladder/instr/``: each
+declares a :class:`BoundInstruction`, whose ``bind(instr, access)`` returns
+a callable taking the rung-in condition and returning the rung-out one
+(as a plug-in module's instance does). The compiler emits ``c = _bN(c)``;
+the interpreter calls the same object. What differs is ``access``: the
+compiled path resolves a direct address once (:class:`BoundAccess`), the
+reference path every time it is used (:class:`ReferenceAccess`), so the
+differential test still compares two ways of finding operands.
+
+An operand is read through a getter made once at bind time:
+
+- ``access.location(op)`` -> ``get() -> (array, index, bit or None)``
+- ``access.value(op)`` -> ``get() -> int | float`` (a constant, a word,
+  a float, or 0/1 for a bit)
+- ``access.expression(node)`` -> ``get() -> int | float`` (CPT-style
+  expression; its ``#`` addresses follow S:24 at each call, which is how
+  FAL and FSC step through files)
+
+Faults: a bad indirect address raises the same MajorFault as built-in
+instructions; a block past the end of its file raises FAULT_BLOCK_RANGE
+(``block()`` below). The engine names the instruction in either case.
+"""
+
+from __future__ import annotations
+
+from array import array
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Callable
+
+from ..datatable import Address, DataTable
+from ..datatable.errors import AddressRangeError
+from .ast import AddressRef, Const, Instruction, address_refs
+from .expr import evaluate
+from .semantics import Machine, MajorFault
+from . import status as S
+
+if TYPE_CHECKING:  # pragma: no cover - type only
+    from .specs import InstructionSpec
+
+Location = tuple[array, int, "int | None"]
+Run = Callable[[bool], bool]
+
+
+@dataclass(frozen=True)
+class BoundInstruction:
+    """One built-in instruction implemented as a bound object.
+
+    ``references(instr)``: addresses the instruction reaches beyond its
+    operands (the last element of a file operand whose length is a
+    constant), so the data table grows those files at load as it does for
+    COP; the run still checks every block against its file."""
+
+    spec: "InstructionSpec"
+    bind: Callable[[Instruction, "Access"], Run]
+    references: Callable[[Instruction], list[Address]] | None = None
+
+
+def _fault(address: Address, error: AddressRangeError) -> MajorFault:
+    from .compiler import address_fault
+
+    return address_fault(address, error)
+
+
+class Access:
+    """How a bound instruction reaches its operands (see the module doc)."""
+
+    cache_direct = False
+
+    def __init__(self, table: DataTable, machine: Machine) -> None:
+        self.table = table
+        self.machine = machine
+
+    def _resolve(self, address: Address) -> Location:
+        try:
+            f, index, bit = self.table.resolve(address)
+        except AddressRangeError as e:
+            raise _fault(address, e) from None
+        return f.data, index, bit
+
+    def location(self, operand) -> Callable[[], Location]:
+        if not isinstance(operand, AddressRef):
+            raise TypeError(f"{operand!r} is not an address")
+        address = operand.address
+        if self.cache_direct and address.is_direct:
+            fixed = self._resolve(address)
+            return lambda: fixed
+        resolve = self._resolve
+        return lambda: resolve(address)
+
+    def value(self, operand) -> Callable[[], int | float]:
+        if isinstance(operand, Const):
+            v = operand.value
+            return lambda: v
+        get = self.location(operand)
+
+        def read():
+            d, i, bit = get()
+            return d[i] if bit is None else (d[i] >> bit) & 1
+        return read
+
+    def expression(self, node) -> Callable[[], int | float]:
+        if isinstance(node, (Const, AddressRef)):
+            return self.value(node)
+        machine = self.machine
+        getters = {id(leaf): self.location(leaf) for leaf in address_refs(node)}
+
+        def compute():
+            # Resolve every address first, in tree order (as compiled CPT
+            # does), so an address fault comes before a minor fault.
+            locs = {k: g() for k, g in getters.items()}
+
+            def read(ref):
+                d, i, bit = locs[id(ref)]
+                return d[i] if bit is None else (d[i] >> bit) & 1
+            return evaluate(node, read, machine)
+        return compute
+
+
+class BoundAccess(Access):
+    """The compiled path: a direct address is resolved once, at load."""
+
+    cache_direct = True
+
+
+class ReferenceAccess(Access):
+    """The reference interpreter: every address resolved each time."""
+
+
+def block(d: array, i: int, words: int, what: str) -> None:
+    """A file operand of ``words`` words from index ``i``: a major fault
+    when it runs past the end of its file (as COP and FLL)."""
+    if i < 0 or i + words > len(d):
+        raise MajorFault(S.FAULT_BLOCK_RANGE, f"{words} words from {what} run past the end of the file "
+                         f"({len(d)} words)")
+
+
+def file_references(instr: Instruction, operand: int, length: int | None) -> list[Address]:
+    """The last element of file operand ``operand`` when ``length`` (a
+    constant element count) is known and the address is direct."""
+    if length is None or length < 1 or operand >= len(instr.operands):
+        return []
+    op = instr.operands[operand]
+    if not isinstance(op, AddressRef) or not op.address.is_direct or op.address.element is None:
+        return []
+    return [op.address.with_element(op.address.element + length - 1)]
+
+
+def constant(instr: Instruction, operand: int) -> int | float | None:
+    """Operand ``operand`` when it is a constant, else None."""
+    if operand < len(instr.operands) and isinstance(instr.operands[operand], Const):
+        return instr.operands[operand].value
+    return None
