@@ -54,11 +54,17 @@ class BoundInstruction:
     ``references(instr)``: addresses the instruction reaches beyond its
     operands (the last element of a file operand whose length is a
     constant), so the data table grows those files at load as it does for
-    COP; the run still checks every block against its file."""
+    COP; the run still checks every block against its file.
+
+    ``initial(instr)``: what a download writes for the instruction, as
+    (address, value) pairs (the length and position operands of a shift
+    register or sequencer go into its control's LEN and POS, as a timer's
+    preset goes into PRE); only for a fresh table, like DATA values."""
 
     spec: "InstructionSpec"
     bind: Callable[[Instruction, "Access"], Run]
     references: Callable[[Instruction], list[Address]] | None = None
+    initial: Callable[[Instruction], list[tuple[Address, int]]] | None = None
 
 
 def _fault(address: Address, error: AddressRangeError) -> MajorFault:

@@ -158,6 +158,11 @@ def initial_values(program: Program, table: DataTable, problems: list | None = N
                     pre, acc = ins.operands[-2], ins.operands[-1]
                     with _located(ins.pos, problems):
                         table.write(ins.operands[0].address, {"PRE": pre.value, "ACC": acc.value})
+                bound = BOUND.get(ins.mnemonic)
+                if bound is not None and bound.initial is not None:
+                    with _located(ins.pos, problems):
+                        for address, value in bound.initial(ins):
+                            table.write(address, value)
 
 
 def layout_problems(program: Program, modules=()) -> tuple[DataTable, list[LadderError]]:
