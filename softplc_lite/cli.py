@@ -26,6 +26,7 @@ from .display import StatusLine
 from .ladder.engine import Mode
 from .ladder.errors import LadderError
 from .ladder.fmt import STYLES, format_program, unprintable
+from .ladder.symbols import SymbolIndex, is_symbol_text, resolve_name
 from .runner import RunOptions, Runner
 from .errors import LocatedError
 
@@ -88,14 +89,10 @@ def _cmd_datatable(args: argparse.Namespace) -> int:
 
 
 def _print_values(table: DataTable, addresses: list[str], symbols=None) -> None:
+    names = SymbolIndex(symbols)
     for text in addresses:
-        name = text
-        if symbols and text in symbols:
-            a = symbols[text].address
-            name = f"{text} ({a})"
-        else:
-            a = parse_address(text)
-            name = str(a)
+        a = resolve_name(text, names)
+        name = f"{text} ({a})" if is_symbol_text(text.strip()) else str(a)
         print(f"{name} = {format_value(table.read(a))}")
 
 

@@ -25,9 +25,10 @@ from typing import Iterable
 from rich.console import Console, ConsoleOptions, RenderResult
 from rich.text import Text
 
-from .datatable import DataTable, DataTableError, parse_address
+from .datatable import DataTable, DataTableError
 from .datatable.address import Address
 from .datatable.display import format_value
+from .ladder.symbols import resolve_name
 
 _BLOCK = re.compile(r"#\s*(\S+)\s+([0-9]{1,6})$")
 
@@ -63,13 +64,10 @@ def parse_item(label: str, value: object, where: str, symbols=None) -> Item:
     text = value.strip()
     m = _BLOCK.match(text)
     name = m.group(1) if m else text
-    if symbols and name in symbols:
-        address = symbols[name].address
-    else:
-        try:
-            address = parse_address(name)
-        except DataTableError as e:
-            raise DataTableError(f"{where}: [display] {label} = {value!r}: {e}") from None
+    try:
+        address = resolve_name(name, symbols)
+    except DataTableError as e:
+        raise DataTableError(f"{where}: [display] {label} = {value!r}: {e}") from None
     if m:
         count = int(m.group(2))
         if not 1 <= count <= 1000 or not str(address).rpartition(":")[2].isdigit():

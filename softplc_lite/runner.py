@@ -18,10 +18,11 @@ from pathlib import Path
 from typing import Callable
 
 from .app import App
-from .datatable import DataTable, DataTableError, parse_address
+from .datatable import DataTable, DataTableError
 from .datatable import jsonio, snapshot
 from .ladder import status as S
 from .ladder.engine import Engine, Mode, RealClock, SimulatedClock
+from .ladder.symbols import resolve_name
 from .ports import parse_port_overrides
 from .ports.recorder import MAX_PENDING
 from .retentive import Retentive, StorageFaults
@@ -34,7 +35,7 @@ def parse_assignment(text: str, symbols=None) -> tuple[object, object]:
         raise DataTableError(f"--set {text!r}: expected ADDR=VALUE, e.g. N7:0=5")
     name, _, raw = text.partition("=")
     name = name.strip()
-    addr = symbols[name].address if symbols and name in symbols else parse_address(name)
+    addr = resolve_name(name, symbols)
     problem = jsonio.json_limit_problem(raw)
     if problem is not None:
         raise DataTableError(f"--set {name}: the value at {problem}")

@@ -304,6 +304,10 @@ class _ToAst(Transformer):
         return self._address(tok)
 
     @v_args(inline=True)
+    def mn_symbol(self, tok):  # PollTimer/DN: never a mnemonic, so an operand at once
+        return SymbolRef(str(tok), self._pos(tok))
+
+    @v_args(inline=True)
     def mn_string(self, tok):
         return Text(_unquote(str(tok)), self._pos(tok))
 
@@ -367,7 +371,7 @@ def _unquote(text: str) -> str:
 _FRIENDLY = {
     "_NL": "end of line", "$END": "end of file", "SEMICOLON": "';'", "COMMA": "','",
     "LPAR": "'('", "RPAR": "')'", "LSQB": "'['", "RSQB": "']'", "NAME": "an instruction or name",
-    "ADDRESS": "an address", "INT": "a number", "FLOAT": "a number", "HEX": "a number",
+    "ADDRESS": "an address", "SYMBOL_MEMBER": "a symbol", "INT": "a number", "FLOAT": "a number", "HEX": "a number",
     "STRING": "a quoted string", "COMMENT": "a comment", "BND": "BND", "NXB": "NXB",
     "BST": "BST", "EOR": "EOR", "SOR": "SOR", "MINUS": "'-'", "EQUAL": "'='",
     "COMPARE_OP": "a comparison", "ADD_OP": "'+' or '-'", "MUL_OP": "'*', '|' or MOD",
@@ -472,6 +476,7 @@ def parse_program(
     program = program if program is not None else Program()
     current: ProgramFile | None = None
     comments: list[_Comment] = []
+    declared = {d.name.upper(): d for d in program.symbols.values()}  # other files' symbols too
 
     def file_for_rungs(pos: Pos) -> ProgramFile:
         nonlocal current
@@ -486,10 +491,14 @@ def parse_program(
         elif isinstance(item, DataDecl):
             program.data.append(item)
         elif isinstance(item, SymbolDecl):
-            if item.name in program.symbols:
+            # Symbols compare without regard to case (docs/language.md), so
+            # Start and START are one name declared twice.
+            first = declared.get(item.name.upper())
+            if first is not None:
+                spelt = "" if first.name == item.name else f" as {first.name}"
                 raise LadderError(item.pos, f"symbol {item.name} is declared twice "
-                                  f"(first at {program.symbols[item.name].pos})")
-            program.symbols[item.name] = item
+                                  f"(first at {first.pos}{spelt}; symbols compare without regard to case)")
+            program.symbols[item.name] = declared[item.name.upper()] = item
         elif isinstance(item, _RungDraft):
             rung_comment = _comment_above(comments, item.pos.line)
             if item.comment:

@@ -24,6 +24,7 @@ from .ast import (
     Element,
     Instruction,
     Operand,
+    Pos,
     Program,
     Rung,
     SymbolRef,
@@ -35,6 +36,7 @@ from .errors import LadderError, ProgramErrors
 from .instructions import BUILTIN, InstructionSet, K
 from .limits import limit_problem
 from .parser import parse_expression
+from .symbols import SymbolIndex, resolve_name, symbol_base
 
 _NUMERIC = (ValueKind.WORD, ValueKind.FLOAT)
 COMPARISONS = ("=", "<>", "<", "<=", ">", ">=")
@@ -43,7 +45,8 @@ COMPARISONS = ("=", "<>", "<", "<=", ">", ">=")
 
 # Operand kinds that must be constants, and the value kinds each address
 # operand kind accepts (built once: validate() asks for every operand).
-_CONSTANT_KINDS = frozenset({K.TIMEBASE, K.PRESET, K.LABEL, K.PROGRAM_FILE, K.LENGTH, K.BIT_NUMBER})
+_CONSTANT_KINDS = frozenset({K.TIMEBASE, K.PRESET, K.LABEL, K.PROGRAM_FILE, K.LENGTH, K.BIT_NUMBER,
+                             K.BIT_LENGTH, K.POSITION})
 _WANT = {
     K.BIT: (ValueKind.BIT,), K.SOURCE: _NUMERIC, K.DEST: _NUMERIC, K.FILE: _NUMERIC,
     K.FILE_SOURCE: _NUMERIC, K.INT_SOURCE: (ValueKind.WORD,), K.WORD: (ValueKind.WORD,),
@@ -62,6 +65,7 @@ class _Checker:
         self.program = program
         self.instructions = instructions
         self.errors: list[LadderError] = []
+        self.symbols = SymbolIndex(program.symbols)
 
     def error(self, pos, message: str) -> None:
         self.errors.append(LadderError(pos, message))
@@ -70,13 +74,7 @@ class _Checker:
     def resolve(self, operand: Operand) -> Operand | None:
         """Symbols -> addresses, recursively through expressions."""
         if isinstance(operand, SymbolRef):
-            decl = self.program.symbols.get(operand.name)
-            if decl is None:
-                hint = self.instructions.suggest(operand.name)
-                extra = f" (is {operand.name} a misspelt instruction? did you mean {hint}?)" if hint else ""
-                self.error(operand.pos, f"unknown symbol {operand.name!r}{extra}")
-                return None
-            return AddressRef(decl.address, operand.pos)
+            return self.symbol(operand)
         if isinstance(operand, BinOp):
             left, right = self.resolve(operand.left), self.resolve(operand.right)
             return None if left is None or right is None else replace(operand, left=left, right=right)
@@ -87,6 +85,28 @@ class _Checker:
             inner = self.resolve(operand.arg)
             return None if inner is None else replace(operand, arg=inner)
         return operand
+
+    def symbol(self, ref: SymbolRef) -> AddressRef | None:
+        """A symbol, with its offset, member or bit (PollTimer/DN), as an
+        address (symbols.py); an unknown name suggests the nearest declared
+        symbol first, then a mnemonic it may be a misspelling of."""
+        name = symbol_base(ref.name) or ref.name
+        if self.symbols.get(name) is None:
+            near = self.symbols.nearest(name)
+            mnemonic = None if near else self.instructions.suggest(name)
+            extra = (f" (did you mean {near}?)" if near else
+                     f" (is {name} a misspelt instruction? did you mean {mnemonic}?)" if mnemonic else "")
+            self.error(ref.pos, f"unknown symbol {name!r}{extra}")
+            return None
+        try:
+            return AddressRef(resolve_name(ref.name, self.symbols), ref.pos)
+        except AddressError as e:
+            reason = e.reason
+            bit = ref.name.rpartition("/")[2]
+            if "/" in ref.name and self.symbols.get(bit) is not None:
+                reason += f" ({ref.name} reads as a bit of {name}; to divide, write {name} / {bit} or {name} | {bit})"
+            self.error(Pos(ref.pos.source, ref.pos.line, ref.pos.column + e.position), reason)
+            return None
 
     def expression(self, operand: Operand, mnemonic: str) -> Operand | None:
         if isinstance(operand, Text):
@@ -141,7 +161,8 @@ class _Checker:
                 bad(f"an integer ({kind.value})")
                 return None
             lo, hi = {K.PRESET: (-32768, 32767), K.LABEL: (0, 999), K.PROGRAM_FILE: (3, 999),
-                      K.LENGTH: (1, 1000), K.BIT_NUMBER: (0, 15)}[kind]
+                      K.LENGTH: (1, 1000), K.BIT_NUMBER: (0, 15),
+                      K.BIT_LENGTH: (1, 16000), K.POSITION: (0, 1000)}[kind]
             if kind is K.BIT_NUMBER and instr.mnemonic == "BTD" and index == 4:
                 lo, hi = 1, 16
             if not lo <= v <= hi:
@@ -192,7 +213,8 @@ class _Checker:
         n = len(instr.operands)
         if not spec.min_operands <= n <= len(spec.operands):
             extras = instr.operands[len(spec.operands):]
-            stray = next((o for o in extras if isinstance(o, SymbolRef) and o.name not in self.program.symbols), None)
+            stray = next((o for o in extras if isinstance(o, SymbolRef)
+                      and self.symbols.get(symbol_base(o.name) or o.name) is None), None)
             if stray is not None:
                 self.error(stray.pos, f"unknown instruction {stray.name!r}{self.instructions.hint(stray.name)}")
                 return instr
@@ -233,9 +255,14 @@ class _Checker:
 
     def run(self) -> Program:
         prog = self.program
+        spelt: dict[str, str] = {}
         for name, decl in prog.symbols.items():
             if self.instructions.lookup(name) is not None:
                 self.error(decl.pos, f"symbol {name} has the name of an instruction")
+            first = spelt.setdefault(name.upper(), name)
+            if first != name:  # a program built as a tree (the parser refuses this itself)
+                self.error(decl.pos, f"symbol {name} is declared twice (first as {first}; symbols compare "
+                           "without regard to case)")
         for decl in prog.data:
             self.data(decl)
         if prog.files and MAIN_FILE not in prog.files:

@@ -26,6 +26,7 @@ from ..ladder.ast import AddressRef, Pos, SymbolRef, address_refs
 from ..ladder.errors import LadderError
 from ..ladder.expr import evaluate
 from ..ladder.parser import parse_expression
+from ..ladder.symbols import resolve_name
 
 
 def quoted(text: str, limit: int = 60) -> str:
@@ -106,9 +107,10 @@ class Condition:
 def _resolve(node, symbols):
     """Symbols in a --break-when expression become their addresses."""
     if isinstance(node, SymbolRef):
-        if node.name not in symbols:
-            raise DataTableError(f"--break-when: {node.name!r} is neither an address nor a program symbol")
-        return AddressRef(symbols[node.name].address, node.pos)
+        try:
+            return AddressRef(resolve_name(node.name, symbols), node.pos)
+        except DataTableError as e:
+            raise DataTableError(f"--break-when: {e}") from None
     for name in ("left", "right", "operand", "arg"):
         child = getattr(node, name, None)
         if child is not None:

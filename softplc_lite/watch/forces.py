@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from ..datatable import DataTable, DataTableError, bit_mask, parse_address
 from ..datatable.address import Address
+from ..ladder.symbols import resolve_name
 from .breakpoints import quoted
 
 
@@ -37,7 +38,7 @@ def parse_force(text: str, symbols=None) -> Force:
     name, value = name.strip(), value.strip()
     if not eq or value not in ("0", "1"):
         raise ForceError(f"--force {quoted(text)}: expected ADDR=1 or ADDR=0, e.g. --force I:0/0=1")
-    address = symbols[name].address if symbols and name in symbols else parse_address(name)
+    address = resolve_name(name, symbols)
     return Force(_bit_address(address, text), value == "1")
 
 

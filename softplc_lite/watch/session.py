@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 from ..app import App
 from ..ladder.engine import Mode, ModeError
+from ..ladder.symbols import is_symbol_text, resolve_name
 from ..runner import RunOptions, Runner
 from .breakpoints import Breakpoints, Hit
 from .forces import Forces, parse_force
@@ -224,7 +225,7 @@ class WatchSession:
 
     def unforce(self, text: str) -> None:
         symbols = self.app.program.symbols
-        found = self.forces.remove(symbols[text].address if text in symbols else text)
+        found = self.forces.remove(resolve_name(text, symbols) if is_symbol_text(text.strip()) else text)
         self.message = f"force removed: {text}" if found else f"{text} is not forced"
 
     # -- the end ---------------------------------------------------------------------------------

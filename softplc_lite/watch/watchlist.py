@@ -10,10 +10,11 @@ from rich.console import Console, ConsoleOptions, RenderResult
 from rich.table import Table
 from rich.text import Text
 
-from ..datatable import DataTable, DataTableError, ValueKind, parse_address
+from ..datatable import DataTable, DataTableError, ValueKind
 from ..datatable.display import format_value
 from ..datatable.errors import AddressError
 from ..errors import LocatedError
+from ..ladder.symbols import resolve_name
 from ..textfile import decode_text
 
 BARS = "▁▂▃▄▅▆▇█"
@@ -35,7 +36,7 @@ def sparkline(values: list[float]) -> str:
 class WatchItem:
     def __init__(self, text: str, symbols=None) -> None:
         self.text = text
-        self.address = symbols[text].address if symbols and text in symbols else parse_address(text)
+        self.address = resolve_name(text, symbols)  # an address, or a symbol with its suffix (PollTimer/DN)
         self.trend: deque[float] = deque(maxlen=TREND)
         self.value: object = None
         self.changed = False
@@ -126,12 +127,11 @@ def read_watch_file(path: str | Path, symbols=None, room: int = WATCH_MAX) -> li
         if len(out) >= room:
             raise LocatedError(f"one address too many: the watch list holds at most {WATCH_MAX} "
                                "(--watch and --watch-file together)", str(path), number, column)
-        if not (symbols and item in symbols):
-            try:
-                parse_address(item)
-            except AddressError as e:
-                raise LocatedError(str(e), str(path), number, column + e.position) from None
-            except DataTableError as e:
-                raise LocatedError(str(e), str(path), number, column) from None
+        try:
+            resolve_name(item, symbols)
+        except AddressError as e:
+            raise LocatedError(str(e), str(path), number, column + e.position) from None
+        except DataTableError as e:
+            raise LocatedError(str(e), str(path), number, column) from None
         out.append(item)
     return out
