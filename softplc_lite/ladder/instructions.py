@@ -11,6 +11,7 @@ from __future__ import annotations
 import difflib
 
 
+from .ab_mnemonics import ab_instruction
 from .instr import BOUND as _BOUND
 from .specs import K, OperandSpec, InstructionSpec, _spec  # noqa: F401 - re-exported
 
@@ -117,6 +118,9 @@ class InstructionSet:
         module = self.unavailable.get(name.upper())
         if module is not None:
             return f" ({name.upper()} is an instruction of the {module} module: add {module} to the app's MODULES.LST)"
+        real = ab_instruction(name) if self.lookup(name) is None else None  # the live table decides
+        if real is not None:
+            return f" ({real} softplc_lite does not implement; docs/instructions.md lists those it does)"
         close = self.suggest(name)
         return f" (did you mean {close}?)" if close else ""
 
