@@ -21,7 +21,7 @@ from . import __version__
 from .app import SCAN_MS_RANGE, AppError, app_instructions, lad_files, load_app, parse_files
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
-from .datatable.display import format_value
+from .datatable.display import format_read
 from .display import StatusLine
 from .ladder.engine import Mode
 from .ladder.errors import LadderError
@@ -93,7 +93,7 @@ def _print_values(table: DataTable, addresses: list[str], symbols=None) -> None:
     for text in addresses:
         a = resolve_name(text, names)
         name = f"{text} ({a})" if is_symbol_text(text.strip()) else str(a)
-        print(f"{name} = {format_value(table.read(a))}")
+        print(f"{name} = {format_read(table, a)}")
 
 
 def _cmd_run(args: argparse.Namespace) -> int:

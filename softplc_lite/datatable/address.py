@@ -2,7 +2,8 @@
 
 Forms accepted (see docs/datatable.md for the full table)::
 
-    N7:0   N7:0/3   B3/17   B3:1/1   O:0/0   I:012/17   S:1/15
+    N7:0   N7:0/3   B3/17   B3:1/1   O:0/0   I:012/17   S:1/15   L9:0   D10:0   A11:0
+    I:1.0/3  O:2.1 (SLC slot.word/bit: word 32*slot + word of the I/O file)
     T4:0.ACC  T4:0/DN  T4:0.DN  C5:0/OV  R6:0.LEN  ST9:0  ST9:0.LEN  F8:2
     #N7:0 (indexed by S:24)   N7:[N7:1]   N[N7:2]:0   N7:0/[N7:3] (indirect)
 
@@ -11,12 +12,13 @@ the canonical form, and ``parse_address(str(a)) == a`` for every address.
 Canonical choices: type letters and member names upper case; ``O:``/``I:``/
 ``S:`` for the fixed files; I/O word and bit numbers in octal without leading
 zeros; status bits of T/C/R by name (``T4:0/DN``); direct B-file bits in the
-bit-number-across-file form (``B3/17``), as RSLogix 5 shows them.
+bit-number-across-file form (``B3/17``), as RSLogix 5 shows them; an I/O
+address written in SLC form (``I:1.0/3``) prints back in SLC form.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 from functools import cached_property, lru_cache
 from typing import Union
@@ -37,11 +39,17 @@ class ValueKind(Enum):
     BIT = "bit"
     WORD = "word"  # a 16-bit signed integer word
     FLOAT = "float"
+    LONG = "long"  # a 32-bit signed integer (L element)
     STRING = "string"  # a whole ST element
     TIMER = "timer"  # a whole T element
     COUNTER = "counter"
     CONTROL = "control"
 
+
+#: SLC I/O addresses I:e.s/b: slot e (0..30) word s (0..31) is word
+#: SLC_SLOT_WORDS * e + s of the I/O file (softplc choice, docs/datatable.md).
+SLC_SLOT_WORDS = 32
+SLC_MAX_SLOT = 30
 
 _STRUCT_KINDS = {"T": ValueKind.TIMER, "C": ValueKind.COUNTER, "R": ValueKind.CONTROL}
 
@@ -65,6 +73,9 @@ class Address:
     member: str | None = None  # word member: PRE ACC LEN POS
     bit: Part | None = None
     indexed: bool = False
+    # Written as an SLC slot.word address (I:1.0/3): only how it prints. The
+    # same word in PLC-5 form is the same address (equal, same hash).
+    slc: bool = field(default=False, compare=False)
 
     # -- what it is -------------------------------------------------------
     @property
@@ -91,6 +102,8 @@ class Address:
             return _STRUCT_KINDS[ftype.letter]
         if ftype.letter == "F":
             return ValueKind.FLOAT
+        if ftype.letter == "L":
+            return ValueKind.LONG
         return ValueKind.WORD
 
     def file_name(self) -> str:
@@ -101,7 +114,7 @@ class Address:
 
     def with_element(self, element: int) -> "Address":
         """The same address at another element (used for blocks and files)."""
-        return Address(self.type_letter, self.file, element, self.member, self.bit, self.indexed)
+        return Address(self.type_letter, self.file, element, self.member, self.bit, self.indexed, self.slc)
 
     # -- canonical text -----------------------------------------------------
     def __str__(self) -> str:
@@ -119,6 +132,12 @@ class Address:
             and isinstance(self.bit, int)
         ):
             out.append(f"/{self.element * WORD_BITS + self.bit}")
+            return "".join(out)
+        if self.slc and isinstance(self.element, int):
+            slot, word = divmod(self.element, SLC_SLOT_WORDS)
+            out.append(f":{slot}.{word}")
+            if isinstance(self.bit, int):
+                out.append(f"/{self.bit}")
             return "".join(out)
         if self.element is not None:
             out.append(":" + _number_text(self.element, ftype.octal))
@@ -225,7 +244,16 @@ def _parse(sc: _Scanner, nested: bool) -> Address:
     member: str | None = None
     bit: Part | None = None
 
+    slc = False
     if sc.take(":"):
+        slot_word = _slc_slot_word(sc, ftype)
+        if slot_word is not None:
+            slc = True
+            element = slot_word
+            if sc.take("/"):
+                bit = _number(sc, "bit number", False, WORD_BITS - 1)
+            addr = Address(ftype.letter, file_part, element, None, bit, indexed, slc=True)
+            return _checked_nested(sc, addr, nested, type_pos)
         element = _element_number(sc, ftype)
         if sc.take("."):
             member, bit = _member(sc, ftype)
@@ -243,7 +271,11 @@ def _parse(sc: _Scanner, nested: bool) -> Address:
         example = "B3/17 or B3:1/1" if ftype.bits_across_file else f"{_example(ftype)}"
         raise sc.error(f"expected ':' and an element number after the file, as in {example}")
 
-    addr = Address(ftype.letter, file_part, element, member, bit, indexed)
+    addr = Address(ftype.letter, file_part, element, member, bit, indexed, slc)
+    return _checked_nested(sc, addr, nested, type_pos)
+
+
+def _checked_nested(sc: _Scanner, addr: Address, nested: bool, type_pos: int) -> Address:
     if nested and addr.kind is not ValueKind.WORD:
         raise AddressError(
             sc.text, type_pos,
@@ -253,6 +285,26 @@ def _parse(sc: _Scanner, nested: bool) -> Address:
     if nested and not addr.is_direct:
         raise AddressError(sc.text, type_pos, "an indirect reference cannot itself be indirect")
     return addr
+
+
+def _slc_slot_word(sc: _Scanner, ftype: FileType) -> int | None:
+    """``1.0`` after ``I:``: an SLC slot and word (both decimal), as the I/O
+    file's word SLC_SLOT_WORDS * slot + word; None (nothing taken) when the
+    element is not written that way (PLC-5's octal ``I:012``)."""
+    if not ftype.octal:
+        return None
+    start = sc.pos
+    digits = sc.digits()
+    if not digits or sc.peek() != ".":
+        sc.pos = start
+        return None
+    slot = _to_int(digits)
+    if slot > SLC_MAX_SLOT:
+        raise sc.error(f"slot {_shown(digits)} out of range 0..{SLC_MAX_SLOT} (SLC I/O address "
+                       f"{ftype.letter}:slot.word/bit)", start)
+    sc.take(".")
+    word = _number(sc, "word number", False, SLC_SLOT_WORDS - 1)
+    return slot * SLC_SLOT_WORDS + word
 
 
 def _example(ftype: FileType) -> str:

@@ -1,8 +1,8 @@
 """Storage of one data file: a single machine-word array.
 
-Word-based files (O I S B N T C R ST) keep every word in one ``array('h')``:
+Word-based files (O I S B N T C R ST D A) keep every word in one ``array('h')``:
 element ``e`` starts at word ``e * words_per_element``. F files keep float32
-values in one ``array('f')``. Growing extends the same array object in place,
+values in one ``array('f')``, L files 32-bit integers in one 4-byte array. Growing extends the same array object in place,
 so compiled rungs may hold a reference to ``DataFile.data`` for the life of the
 table.
 """
@@ -15,7 +15,10 @@ from array import array
 from .errors import DataTableError
 from .filetypes import MAX_ELEMENTS, FileType, Storage, file_name
 
-_TYPECODE = {Storage.WORD: "h", Storage.FLOAT: "f"}
+# An L element is 4 bytes on every platform: "i" where C int is 32-bit, else "l".
+_LONG_CODE = "i" if array("i").itemsize == 4 else "l"
+assert array(_LONG_CODE).itemsize == 4, "no 4-byte array typecode for L files"
+_TYPECODE = {Storage.WORD: "h", Storage.FLOAT: "f", Storage.LONG: _LONG_CODE}
 
 
 class DataFile:

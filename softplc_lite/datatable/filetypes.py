@@ -18,6 +18,8 @@ MAX_FILE_NUMBER = 9999
 STRING_CHARS = 82
 #: Bits in a data table word.
 WORD_BITS = 16
+#: An L element's range (1747-RM001 / 1763-RM001: -2,147,483,648..2,147,483,647).
+LONG_MIN, LONG_MAX = -(2 ** 31), 2 ** 31 - 1
 
 
 class Storage(Enum):
@@ -25,6 +27,7 @@ class Storage(Enum):
 
     WORD = "word"  # 16-bit words in array('h')
     FLOAT = "float"  # IEEE float32 in array('f')
+    LONG = "long"  # 32-bit signed integers in a 4-byte array (SLC/MicroLogix L files)
 
 
 @dataclass(frozen=True)
@@ -51,7 +54,7 @@ class FileType:
     letter: str
     title: str
     storage: Storage
-    words_per_element: int  # for FLOAT storage: floats per element (1)
+    words_per_element: int  # for FLOAT (LONG) storage: floats (longs) per element, 1
     word_members: tuple[WordMember, ...] = ()
     bit_members: tuple[BitMember, ...] = ()
     has_bits: bool = True  # /n bit addressing on the element word
@@ -60,6 +63,9 @@ class FileType:
     default_number: int | None = None
     default_size: int = 1
     bits_across_file: bool = False  # B3/17 form
+    # How text forms (DATA values, --print, the watch view) show a word:
+    # "decimal", "bcd" (D: four BCD digits) or "ascii" (A: two characters).
+    radix: str = "decimal"
     members_by_name: dict[str, WordMember | BitMember] = field(
         init=False, repr=False, compare=False
     )
@@ -128,9 +134,18 @@ STRING = FileType(
     has_bits=False,
 )
 
+# PLC-5 BCD and ASCII files (1785-6.1 data table: D and A file types): 16-bit
+# words like N; what they hold only changes how text shows them (docs/datatable.md).
+BCD = FileType("D", "BCD", Storage.WORD, 1, radix="bcd")
+ASCII = FileType("A", "ASCII", Storage.WORD, 1, radix="ascii")
+# SLC 5/03+ and MicroLogix long integer file (1747-RM001, 1763-RM001): one
+# 32-bit signed integer an element. No /bit addressing (softplc choice).
+LONG = FileType("L", "long integer", Storage.LONG, 1, has_bits=False)
+
 FILE_TYPES: dict[str, FileType] = {
     t.letter: t
-    for t in (OUTPUT, INPUT, STATUS, BINARY, TIMER, COUNTER, CONTROL, INTEGER, FLOAT, STRING)
+    for t in (OUTPUT, INPUT, STATUS, BINARY, TIMER, COUNTER, CONTROL, INTEGER, FLOAT, STRING,
+              BCD, ASCII, LONG)
 }
 
 #: The files every data table starts with, in PLC-5 order.

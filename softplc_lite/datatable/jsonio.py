@@ -4,7 +4,10 @@ Keys are file names (``"N7"``, ``"ST9"``, ``"R6"``, ``"O0"``; on import
 ``"O"``, ``"I"``, ``"S"`` are accepted for the fixed files); values are lists
 by element:
 
-* O I S B N: signed 16-bit integers;
+* O I S B N D A: signed 16-bit integers (D and A words as numbers, what
+  they hold; on import a D word may be given as its BCD digits "1234" and
+  an A word as its two characters "AB");
+* L: signed 32-bit integers;
 * F: numbers (float32 values print exactly, e.g. 3.140000104904175);
 * ST: strings, or ``{"LEN": n, "CHARS": "..."}`` where the element holds more
   than its string (characters past LEN, or a LEN above 82 from raw writes);
@@ -29,7 +32,7 @@ from ..errors import LocatedError
 from ..textfile import read_text
 from .errors import DataTableError
 from .files import DataFile
-from .filetypes import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, FileType
+from .filetypes import FILE_TYPES, LONG_MAX, LONG_MIN, MAX_ELEMENTS, STRING_CHARS, FileType, Storage
 from .table import (
     RAW_MAX,
     DataTable,
@@ -39,6 +42,7 @@ from .table import (
     member_order,
     read_string,
     to_signed,
+    word_from_text,
 )
 
 
@@ -267,6 +271,10 @@ def _load_element(f: DataFile, element: int, value: Any) -> None:
         _load_string(data, start, value, name)
     elif ftype.is_structure:
         _load_struct(data, start, ftype, value, name)
+    elif ftype.storage is Storage.LONG:
+        data[start] = _check_int(value, LONG_MIN, LONG_MAX, name, "a 32-bit signed integer")
+    elif isinstance(value, str) and ftype.radix != "decimal":
+        data[start] = word_from_text(value, ftype, name)
     else:
         data[start] = _check_int(value, -32768, 32767, name, "a 16-bit signed integer")
 

@@ -7,6 +7,10 @@ PLC rules, not Python ones:
   -32768..32767 is refused, a raw word write takes the bit pattern 0..65535
   and reads back signed;
 * F elements are float32 (3.14 reads back as 3.140000104904175);
+* L elements are 32-bit signed (-2147483648..2147483647);
+* D (BCD) and A (ASCII) words are 16-bit words like N; a write also takes
+  their text forms: "1234" (four BCD digits, 0x1234) for D, "AB" (two
+  characters, high byte first) for A;
 * an address past the end of a file is an error, not a silent grow: files
   grow only through :meth:`DataTable.reference` (what a program names or
   declares) and through loading.
@@ -29,7 +33,10 @@ from .filetypes import (
     MAX_FILE_NUMBER,
     STRING_CHARS,
     WORD_BITS,
+    LONG_MAX,
+    LONG_MIN,
     FileType,
+    Storage,
 )
 
 AddressLike = Union[str, Address]
@@ -112,7 +119,9 @@ class WordBlock:
 
     def __setitem__(self, k: int, value: int | float) -> None:
         i = self._index(k)
-        if self.file.is_words:
+        if self.file.ftype.storage is Storage.LONG:
+            self.file.data[i] = _check_int(value, LONG_MIN, LONG_MAX, f"long {k} of {self}", "a 32-bit integer")
+        elif self.file.is_words:
             raw = _check_int(value, 0, RAW_MAX, f"word {k} of {self}", "a raw word")
             self.file.data[i] = to_signed(raw)
         else:
@@ -132,7 +141,7 @@ class WordBlock:
         return iter(self.values())
 
     def __str__(self) -> str:
-        unit = "word" if self.file.is_words else "float"
+        unit = {Storage.WORD: "word", Storage.FLOAT: "float", Storage.LONG: "long"}[self.file.ftype.storage]
         return f"{self.count} {unit}{'s' if self.count != 1 else ''} from {self.origin}"
 
 
@@ -288,7 +297,7 @@ class DataTable:
         data = f.data
         if kind is ValueKind.BIT:
             return (data[i] >> bit) & 1
-        if kind is ValueKind.WORD or kind is ValueKind.FLOAT:
+        if kind is ValueKind.WORD or kind is ValueKind.FLOAT or kind is ValueKind.LONG:
             return data[i]
         if kind is ValueKind.STRING:
             return read_string(data, i)
@@ -314,10 +323,14 @@ class DataTable:
         elif kind is ValueKind.WORD:
             if f.ftype.is_string:  # ST LEN
                 data[i] = _check_int(value, 0, STRING_CHARS, str(a), "a string length")
+            elif isinstance(value, str) and f.ftype.radix != "decimal" and a.member is None:
+                data[i] = word_from_text(value, f.ftype, str(a))
             else:
                 data[i] = _check_int(value, WORD_MIN, WORD_MAX, str(a), "a 16-bit signed integer")
         elif kind is ValueKind.FLOAT:
             data[i] = check_float32(value, str(a))
+        elif kind is ValueKind.LONG:
+            data[i] = _check_int(value, LONG_MIN, LONG_MAX, str(a), "a 32-bit signed integer")
         elif kind is ValueKind.STRING:
             write_string(data, i, value, str(a))
         else:
@@ -354,6 +367,8 @@ class DataTable:
     # -- raw words ----------------------------------------------------------------
     def _word_location(self, a: Address) -> Location:
         loc = self.resolve(a)
+        if loc.file.ftype.storage is Storage.LONG:
+            raise DataTableError(f"{a} is a 32-bit long; L files have no raw 16-bit words")
         if not loc.file.is_words:
             raise DataTableError(f"{a} is a float; F files have no raw 16-bit words")
         if loc.bit is not None:
@@ -397,7 +412,7 @@ class DataTable:
             raise DataTableError(f"{a} is indirect or indexed; resolve it each scan")
         if a.kind is ValueKind.BIT:
             raise DataTableError(f"{a} is a bit; use bit_ref")
-        if a.kind not in (ValueKind.WORD, ValueKind.FLOAT):
+        if a.kind not in (ValueKind.WORD, ValueKind.FLOAT, ValueKind.LONG):
             raise DataTableError(f"{a} is a whole {a.kind.value} element, not a word or float")
         f, i, _ = self.resolve(a)
         return f.data, i
@@ -453,6 +468,33 @@ class DataTable:
 
     def __repr__(self) -> str:
         return f"<DataTable {' '.join(f'{f.name}[{f.size}]' for f in self.files())}>"
+
+
+def word_from_text(text: str, ftype: FileType, where: str) -> int:
+    """A D word from its four BCD digits ("1234" -> 0x1234), an A word from
+    its two characters ("AB" -> 0x4142, high byte first); signed, as stored."""
+    if ftype.radix == "bcd":
+        if not (1 <= len(text) <= 4 and text.isascii() and text.isdigit()):
+            raise ValueRangeError(f"{text!r} does not fit {where}, which holds four BCD digits (\"0\"..\"9999\")")
+        return to_signed(int(text, 16))
+    codes = [ord(c) for c in text]
+    if len(codes) > 2 or any(c > 0xFF for c in codes):
+        raise ValueRangeError(f"{text!r} does not fit {where}, which holds two 8-bit characters (high byte first)")
+    codes = (codes + [0, 0])[:2]
+    return to_signed(codes[0] << 8 | codes[1])
+
+
+def word_text(word: int, ftype: FileType) -> str | None:
+    """The text form of a D or A word ("1234", "AB"), or None when the word
+    has none (a D word that is not BCD) or the file shows decimals."""
+    raw = word & RAW_MAX
+    if ftype.radix == "bcd":
+        digits = format(raw, "04X")
+        return digits if digits.isdigit() else None
+    if ftype.radix == "ascii":
+        text = chr(raw >> 8) + chr(raw & 0xFF)
+        return text[:1] if text[1] == "\0" else text  # "A" for 0x4100; 0x0041 stays "\0A"
+    return None
 
 
 def member_order(ftype: FileType) -> list[str]:

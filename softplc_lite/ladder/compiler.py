@@ -330,7 +330,9 @@ class _FileCompiler:
 
     def i_NEG(self, ind, ops):
         self.emit(ind, "if c:")
-        self._store(ind, ops[1], f"-{self.value(ind + 1, ops[0])}")
+        v = self.value(ind + 1, ops[0])
+        d, i, _ = self.location(ind + 1, ops[1])
+        self.emit(ind + 1, f"{self.bind('_neg', self.machine.neg)}({v}, {d}, {i})")
 
     def i_ABS(self, ind, ops):
         self.emit(ind, "if c:")
@@ -418,13 +420,24 @@ class _FileCompiler:
         pass
 
     def i_SBR(self, ind, ops):
-        pass
+        pass  # its parameters are written by the engine when a JSR enters the file (Engine.run_file)
+
+    def _call(self) -> str:
+        """``_calls[k]``: the instruction being compiled, for the engine to
+        move its parameters (JSR inputs and returns, RET values)."""
+        calls = self.env.setdefault("_calls", [])
+        calls.append(self.current)
+        return f"_calls[{len(calls) - 1}]"
 
     def i_JSR(self, ind, ops):
-        self.emit(ind, f"if c: _jsr({ops[0].value!r})")
+        if len(ops) > 1:
+            self.emit(ind, f"if c: _jsr({ops[0].value!r}, {self._call()})")
+        else:
+            self.emit(ind, f"if c: _jsr({ops[0].value!r})")
 
     def i_RET(self, ind, ops):
-        self.emit(ind, f"if c: return {RET!r}")
+        # A RET with values returns itself: run_file reads them, the JSR stores them.
+        self.emit(ind, f"if c: return {self._call() if ops else repr(RET)}")
 
     def i_TND(self, ind, ops):
         self.emit(ind, f"if c: return {TND!r}")
@@ -463,6 +476,7 @@ class _FileCompiler:
         self._strings(ind, "aex", ops, values=(1, 2))
 
     def i_ASC(self, ind, ops):
+        # operands in AB order, as the kernel takes them: source (sought), index, string search, result
         self._strings(ind, "asc", ops, values=(1,))
 
     def i_ASR(self, ind, ops):
@@ -515,11 +529,12 @@ class _FileCompiler:
 
 def _is_word(operand) -> bool:
     """A 16-bit word at run time, known at load: an integer constant in word
-    range, or an address in a word file (its type letter never changes, even
+    range, or an address in a word file (not F, not L) (its type letter never changes, even
     when its file or element number is indirect)."""
     if isinstance(operand, Const):
         return isinstance(operand.value, int) and -32768 <= operand.value <= 32767
-    return isinstance(operand, AddressRef) and operand.address.ftype.storage is not Storage.FLOAT
+    # Storage.WORD only: an L element (Storage.LONG) is an integer but not 16-bit.
+    return isinstance(operand, AddressRef) and operand.address.ftype.storage is Storage.WORD
 
 
 def _word_valued(node) -> bool:

@@ -19,10 +19,11 @@ from dataclasses import dataclass
 from typing import Callable
 
 from ..datatable import DataTable, DataTableError
+from ..datatable.errors import AddressRangeError
 from ..datatable.table import to_signed
 from . import status as S
-from .ast import MAIN_FILE, AddressRef, Pos, Program, address_refs, walk
-from .compiler import RET, EndScan, compile_file, describe
+from .ast import MAIN_FILE, AddressRef, Const, Instruction, Pos, Program, address_refs, walk
+from .compiler import RET, EndScan, address_fault, compile_file, describe
 from .errors import LadderError
 from .instr import BOUND
 from .interpreter import interpret_file
@@ -147,7 +148,7 @@ def initial_values(program: Program, table: DataTable, problems: list | None = N
         for k, v in enumerate(decl.values):
             addr = f"{decl.file}:{k}"
             with _located(decl.pos, problems, f"DATA {decl.file} value {k + 1}: "):
-                if isinstance(v, int) and letter != "F" and v > 32767:
+                if isinstance(v, int) and letter not in ("F", "L") and v > 32767:
                     table.write_word(addr, v)
                 else:
                     table.write(addr, v)
@@ -249,6 +250,7 @@ class Engine:
         self.mode_hooks: list[Callable[["Engine", Mode, Mode], None]] = []
         self.last_scan_ms = 0.0
         self.max_scan_ms = 0.0
+        self._clock_s4_ms = self.clock.now_ms  # the clock time S:4 has counted up to
         self._first_pass = False
         self._depth = 0
         self._deadline = 0.0
@@ -332,6 +334,9 @@ class Engine:
         self.s[S.MODE_WORD] = mode.value
         if mode in (Mode.RUN, Mode.TEST) and old is Mode.PROGRAM:
             self._first_pass = True
+            # SLC 500's free-running clock S:4 is cleared on entering an executing mode (1763-RM001).
+            self.s[S.FREE_RUNNING_CLOCK] = 0
+            self._clock_s4_ms = self.clock.now_ms
         for hook in self.mode_hooks:
             hook(self, old, mode)
 
@@ -342,6 +347,8 @@ class Engine:
     def scan(self) -> None:
         m = self.machine
         m.dt = self.clock.advance()
+        m.now_ms = self.clock.now_ms
+        self._free_running_clock()
         for hook in self.input_hooks:
             try:
                 hook(self)
@@ -355,6 +362,14 @@ class Engine:
                 hook(self, enabled)
             except Exception as exc:
                 self._hook_failed(hook, exc)
+
+    def _free_running_clock(self) -> None:
+        """S:4 counts 10 ms steps of the engine's clock (simulated or real),
+        16 bits, wrapping; a value the program writes counts on from there."""
+        steps, _ = divmod(self.clock.now_ms - self._clock_s4_ms, S.FREE_RUNNING_CLOCK_MS)
+        if steps:
+            self._clock_s4_ms += steps * S.FREE_RUNNING_CLOCK_MS
+            self.s[S.FREE_RUNNING_CLOCK] = to_signed((self.s[S.FREE_RUNNING_CLOCK] + steps) & 0xFFFF)
 
     def _hook_failed(self, hook, exc: Exception) -> None:
         owner = getattr(getattr(hook, "__self__", None), "name", None) or getattr(hook, "__qualname__", "a hook")
@@ -398,7 +413,10 @@ class Engine:
             self._major(MajorFault(S.FAULT_WATCHDOG, f"scan took {elapsed_ms:.1f} ms, "
                                    f"more than the watchdog setpoint S:28 = {watchdog_ms} ms"))
 
-    def run_file(self, number: int) -> None:
+    def run_file(self, number: int, inputs: list | None = None) -> list | None:
+        """Scan program file ``number``; a JSR's ``inputs`` (values) go into
+        the addresses of the file's SBR first. Returns the values of the RET
+        that ended it, or None (a RET without values, the end of the file)."""
         compiled, zone = self.files[number]
         rungs = compiled.rungs
         m = self.machine
@@ -409,13 +427,20 @@ class Engine:
         zone[0] = True
         i = 0
         count = len(rungs)
+        returned = None
         try:
+            if inputs:
+                m.file, m.rung = number, 0
+                self._receive(number, inputs)
             while i < count:
                 m.file = number
                 m.rung = i
                 r = rungs[i](zone[0])
                 if r is None:
                     i += 1
+                elif r.__class__ is not int:  # a RET with values: the instruction itself
+                    returned = [self._parameter_value(op, r) for op in r.operands]
+                    break
                 elif r >= 0:
                     if r <= i and time.perf_counter() > self._deadline:
                         raise MajorFault(S.FAULT_WATCHDOG, "watchdog: the scan is stuck in a backward JMP loop "
@@ -441,8 +466,14 @@ class Engine:
         finally:
             zone[0] = saved_zone
             m.file, m.rung = saved_at
+        return returned
 
-    def _jsr(self, number: int) -> None:
+    def _jsr(self, number: int, call: Instruction | None = None) -> None:
+        """Run subroutine file ``number`` for a JSR; ``call`` is the JSR when
+        it has parameters (1785-6.1 JSR/SBR/RET, docs/instructions.md): its
+        inputs are read here, in the caller, all before any is written; the
+        values of the RET that ends the subroutine go to its return
+        parameters, pairwise, converted as MOV converts."""
         self._depth += 1
         try:
             if self._depth > self.settings.jsr_depth:
@@ -450,9 +481,48 @@ class Engine:
                                  f"{self.settings.jsr_depth} deep")
             if time.perf_counter() > self._deadline:
                 raise MajorFault(S.FAULT_WATCHDOG, "watchdog: scan time exceeded S:28 in subroutine calls")
-            self.run_file(number)
+            if call is None:
+                self.run_file(number)
+                return
+            ops = call.operands
+            first_return = 2 + ops[1].value
+            inputs = [self._parameter_value(op, call) for op in ops[2:first_return]]
+            values = self.run_file(number, inputs)
+            if values:
+                self._store_parameters(ops[first_return:], values, call)
         finally:
             self._depth -= 1
+
+    def _receive(self, number: int, inputs: list) -> None:
+        """A JSR's input values into the addresses of file ``number``'s SBR
+        (the first instruction of its first rung, as the validator requires)."""
+        rungs = self.program.files[number].rungs
+        sbr = rungs[0].elements[0] if rungs and rungs[0].elements else None
+        if isinstance(sbr, Instruction) and sbr.mnemonic == "SBR":
+            self._store_parameters(sbr.operands, inputs, sbr)
+
+    def _store_parameters(self, refs, values: list, ins: Instruction) -> None:
+        """Pairwise, as many as both lists have: each value stored as MOV
+        stores it (float to integer rounds, overflow clamps or wraps, S:0)."""
+        store = self.machine.store
+        for ref, value in zip(refs, values):
+            d, i = self._parameter_location(ref, ins)
+            store(value, d, i)
+
+    def _parameter_location(self, ref: AddressRef, ins: Instruction):
+        try:
+            f, index, _ = self.table.resolve(ref.address)
+        except AddressRangeError as e:
+            fault = address_fault(ref.address, e)
+            fault.instruction = describe(ins)
+            raise fault from None
+        return f.data, index
+
+    def _parameter_value(self, op, ins: Instruction):
+        if isinstance(op, Const):
+            return op.value
+        d, i = self._parameter_location(op, ins)
+        return d[i]
 
     @staticmethod
     def _which_instruction(compiled, exc: BaseException) -> str | None:

@@ -15,6 +15,9 @@ from .ab_mnemonics import ab_instruction
 from .instr import BOUND as _BOUND
 from .specs import K, OperandSpec, InstructionSpec, _spec  # noqa: F401 - re-exported
 
+# Input parameters a JSR may pass, and return parameters it may receive (each).
+MAX_PARAMETERS = 40
+
 _BUILTIN = [
     # bit
     _spec("XIC", "examine if closed", False, ("bit", K.BIT)),
@@ -46,9 +49,9 @@ _BUILTIN = [
         ("NEG", "negate"), ("ABS", "absolute value"), ("SQR", "square root"))],
     _spec("CPT", "compute", True, ("dest", K.DEST), ("expression", K.EXPRESSION)),
     _spec("CLR", "clear", True, ("dest", K.DEST)),
-    *[_spec(m, t, True, ("a", K.INT_SOURCE), ("b", K.INT_SOURCE), ("dest", K.WORD)) for m, t in (
+    *[_spec(m, t, True, ("a", K.INTEGER_SOURCE), ("b", K.INTEGER_SOURCE), ("dest", K.INTEGER_DEST)) for m, t in (
         ("AND", "bitwise and"), ("OR", "bitwise or"), ("XOR", "bitwise exclusive or"))],
-    _spec("NOT", "bitwise not", True, ("source", K.INT_SOURCE), ("dest", K.WORD)),
+    _spec("NOT", "bitwise not", True, ("source", K.INTEGER_SOURCE), ("dest", K.INTEGER_DEST)),
     # move and file
     _spec("MOV", "move", True, ("source", K.SOURCE), ("dest", K.DEST)),
     _spec("MVM", "masked move", True, ("source", K.INT_SOURCE), ("mask", K.INT_SOURCE), ("dest", K.WORD)),
@@ -59,9 +62,12 @@ _BUILTIN = [
     # program control
     _spec("JMP", "jump to label", True, ("label", K.LABEL)),
     _spec("LBL", "label", False, ("label", K.LABEL)),
-    _spec("JSR", "jump to subroutine", True, ("file", K.PROGRAM_FILE)),
-    _spec("SBR", "subroutine", False),
-    _spec("RET", "return", True),
+    # JSR file [inputs] [parameter...]: the first `inputs` parameters are passed to the SBR, the
+    # rest receive RET's values (Logix's JSR(routine,count,in...,ret...) order, with a file number)
+    _spec("JSR", "jump to subroutine", True, ("file", K.PROGRAM_FILE), ("inputs", K.PARAM_COUNT),
+          ("parameter", K.SOURCE), optional=2, repeat=2 * MAX_PARAMETERS),
+    _spec("SBR", "subroutine", False, ("parameter", K.DEST), optional=1, repeat=MAX_PARAMETERS),
+    _spec("RET", "return", True, ("value", K.SOURCE), optional=1, repeat=MAX_PARAMETERS),
     _spec("MCR", "master control reset", True),
     _spec("AFI", "always false", False),
     _spec("TND", "temporary end", True),
@@ -71,8 +77,9 @@ _BUILTIN = [
     _spec("ACN", "string concatenate", True, ("a", K.STRING), ("b", K.STRING), ("dest", K.STRING)),
     _spec("AEX", "string extract", True, ("source", K.STRING), ("index", K.INT_SOURCE),
           ("count", K.INT_SOURCE), ("dest", K.STRING)),
+    # AB order (1747-RM001 ASC): the string searched for, the start index, the string examined, the result
     _spec("ASC", "string search", True, ("source", K.STRING), ("index", K.INT_SOURCE),
-          ("search", K.STRING), ("result", K.WORD)),
+          ("string_search", K.STRING), ("result", K.WORD)),
     _spec("ASR", "string compare", False, ("a", K.STRING), ("b", K.STRING)),
 ]
 

@@ -16,7 +16,7 @@ from array import array
 from dataclasses import dataclass
 
 from ..datatable import DataTable
-from ..datatable.filetypes import Storage
+from ..datatable.filetypes import LONG_MAX, LONG_MIN, Storage
 from ..datatable.table import STRING_CHARS, read_string
 from . import status as S
 
@@ -24,9 +24,18 @@ from . import status as S
 EN, TT, DN = -32768, 1 << 14, 1 << 13  # timer
 CU, CD, OV, UN = -32768, 1 << 14, 1 << 12, 1 << 11  # counter (DN shared)
 R_EN, R_EU, R_DN, R_EM, R_ER, R_UL, R_IN, R_FD = -32768, 1 << 14, 1 << 13, 1 << 12, 1 << 11, 1 << 10, 1 << 9, 1 << 8
-# Timers keep the milliseconds not yet counted (less than one time-base tick)
-# in bits 0..9 of word 0, as PLC-5 timers keep internal state in that word.
-FRACTION = 0x3FF
+# A timer keeps the clock time of its last update, in ms modulo 8192, in
+# bits 0..12 of word 0 (EN/TT/DN are 15/14/13), as SLC 500 timers keep a copy
+# of a hardware clock in that word (1747-UM010, timer instructions). The
+# stamp trails the clock by the milliseconds short of a tick, so it carries
+# them to the next update.
+STAMP = 0x1FFF
+STAMP_MODULO = STAMP + 1
+
+
+def signed32(v: int) -> int:
+    v &= 0xFFFFFFFF
+    return v - 0x100000000 if v & 0x80000000 else v
 
 
 def signed16(v: int) -> int:
@@ -83,6 +92,7 @@ class Machine:
         table.reference("S:127")
         self.s = table.file("S2").data
         self.dt = 0  # milliseconds since the previous scan
+        self.now_ms = 0  # the engine's clock at this scan (timers measure from it)
         self.file = 0  # program file and rung being scanned (for faults)
         self.rung = 0
         self.clamp = self.settings.overflow == "clamp"
@@ -92,12 +102,16 @@ class Machine:
         s = self.s
         s[0] = (s[0] & ~0xF) | carry | (overflow << 1) | (zero << 2) | (sign << 3)
 
-    def minor(self, bit: int, code: int) -> None:
+    def minor(self, bit: int, code: int, word: int = S.MINOR_FAULT_BITS) -> None:
         s = self.s
-        s[S.MINOR_FAULT_BITS] |= 1 << bit
+        s[word] |= 1 << bit if bit < 15 else -32768
         s[S.MINOR_FAULT_CODE] = code
         s[S.MINOR_FAULT_FILE] = self.file
         s[S.MINOR_FAULT_RUNG] = self.rung
+
+    def overflow_fault(self) -> None:
+        """Math overflow: PLC-5's minor fault bit S:10/14 and code 1 in S:102."""
+        self.minor(S.MINOR_OVERFLOW_BIT, S.MINOR_CODE_OVERFLOW, S.PLC5_MINOR_FAULT_BITS)
 
     # -- storing numbers ------------------------------------------------------------
     def store(self, value: int | float, d: array, i: int, carry: bool = False) -> None:
@@ -115,24 +129,26 @@ class Machine:
             stored = d[i]
             # A result that is not a finite float32 (too large, division by zero, NaN) is an overflow.
             if over or not math.isfinite(stored):
-                self.minor(S.MINOR_OVERFLOW_BIT, S.MINOR_CODE_OVERFLOW)
+                self.overflow_fault()
                 over = True
             self.flags(False, over, stored == 0, stored < 0)
             return
         over = False
+        # A 16-bit word, or a 32-bit L element (1747-RM001/1763-RM001 L file range).
+        lo, hi, wrap = (-32768, 32767, signed16) if d.itemsize == 2 else (LONG_MIN, LONG_MAX, signed32)
         if isinstance(value, float):
             if math.isnan(value):
                 value, over = 0, True
             elif math.isinf(value):
-                # No low 16 bits to keep: the extreme of its sign whatever the overflow setting.
-                value, over = (32767 if value > 0 else -32768), True
+                # No low bits to keep: the extreme of its sign whatever the overflow setting.
+                value, over = (hi if value > 0 else lo), True
             else:
                 value = int(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
-        if not -32768 <= value <= 32767:
+        if not lo <= value <= hi:
             over = True
-            value = (32767 if value > 0 else -32768) if self.clamp else signed16(value)
+            value = (hi if value > 0 else lo) if self.clamp else wrap(value)
         if over:
-            self.minor(S.MINOR_OVERFLOW_BIT, S.MINOR_CODE_OVERFLOW)
+            self.overflow_fault()
         d[i] = value
         self.flags(carry, over, value == 0, value < 0)
 
@@ -217,15 +233,26 @@ class Machine:
         except ValueError:  # fmod(inf, b): no remainder
             return math.nan
 
+    def neg(self, v, d: array, i: int) -> None:
+        """NEG: dest = -source. Carry is set unless the source is 0 or the
+        result overflows (-(-32768)), as SLC 500 / MicroLogix NEG say."""
+        carry = isinstance(v, int) and v != 0 and v != -32768
+        self.store(-v, d, i, carry)
+
     def sqr(self, v, d: array, i: int) -> None:
         self.store(math.sqrt(abs(v)), d, i)
 
     def logic(self, value: int, d: array, i: int) -> None:
-        """Bitwise results: always 16 bits, never overflow. (signed16 and
-        flags written out: a ladder CRC loop runs this for every byte.)"""
-        value &= 0xFFFF
-        if value > 0x7FFF:
-            value -= 0x10000
+        """Bitwise results: as wide as the destination (16 bits, 32 in an L
+        file), never overflow: bits above the destination are dropped.
+        (signed16 and flags written out: a ladder CRC loop runs this for
+        every byte.)"""
+        if d.itemsize == 2:
+            value &= 0xFFFF
+            if value > 0x7FFF:
+                value -= 0x10000
+        else:
+            value = signed32(value)
         d[i] = value
         s = self.s
         s[0] = (s[0] & -16) | ((value == 0) << 2) | ((value < 0) << 3)
@@ -251,16 +278,23 @@ class Machine:
             raise MajorFault(S.FAULT_NEGATIVE_TIMER,
                              f"negative timer preset or accumulator (PRE={d[i + 1]}, ACC={d[i + 2]})")
 
+    def _stamp(self, w: int) -> int:
+        """Word 0 with the stamp set to now: nothing counted yet from here."""
+        return (w & ~STAMP) | (self.now_ms & STAMP)
+
     def _accumulate(self, d: array, i: int, w: int, base_ms: int) -> int:
-        """Add this scan's time to ACC; returns word 0 with the new fraction."""
-        total = (w & FRACTION) + self.dt
-        ticks, rest = divmod(total, base_ms)
+        """Add the time since this timer's own last update to ACC (not the
+        scan's: a timer evaluated twice in a scan adds nothing the second
+        time, one skipped for a scan adds both); returns word 0 with the new
+        stamp. Time more than 8192 ms old is lost (STAMP_MODULO)."""
+        elapsed = (self.now_ms - (w & STAMP)) % STAMP_MODULO
+        ticks, rest = divmod(elapsed, base_ms)
         acc = d[i + 2] + ticks
         pre = d[i + 1]
         if acc >= pre:
             acc, rest = pre if d[i + 2] <= pre else d[i + 2], 0
         d[i + 2] = acc
-        return (w & ~FRACTION) | rest
+        return (w & ~STAMP) | ((self.now_ms - rest) & STAMP)
 
     def ton(self, d: array, i: int, c: bool, base_ms: int) -> None:
         self._check_timer(d, i)
@@ -270,14 +304,16 @@ class Machine:
             # raised times on again (it does not test its own DN bit).
             if w & EN and d[i + 2] < d[i + 1]:
                 w = self._accumulate(d, i, w, base_ms)
-            # The scan the rung goes true starts the timer; time counts from the next one.
+            else:
+                # The evaluation that enables the timer starts it: time counts from here.
+                w = self._stamp(w)
             w |= EN
             if d[i + 2] >= d[i + 1]:
-                w = (w | DN) & ~TT & ~FRACTION
+                w = self._stamp(w | DN) & ~TT
             else:
                 w = (w | TT) & ~DN
         else:
-            w &= ~(EN | TT | DN | FRACTION)
+            w &= ~(EN | TT | DN | STAMP)
             d[i + 2] = 0
         d[i] = w
 
@@ -285,15 +321,15 @@ class Machine:
         self._check_timer(d, i)
         w = d[i]
         if c:
-            w = (w | EN | DN) & ~TT & ~FRACTION
+            w = self._stamp(w | EN | DN) & ~TT
             d[i + 2] = 0
         else:
             if w & DN:
-                if w & TT:
-                    w = self._accumulate(d, i, w, base_ms)
+                # The first false evaluation starts the delay; time counts from it.
+                w = self._accumulate(d, i, w, base_ms) if w & TT else self._stamp(w)
                 w = (w | TT) & ~EN
                 if d[i + 2] >= d[i + 1]:
-                    w &= ~(DN | TT | FRACTION)
+                    w &= ~(DN | TT | STAMP)
             else:
                 w &= ~(EN | TT)
         d[i] = w
@@ -304,12 +340,22 @@ class Machine:
         if c:
             if w & EN and d[i + 2] < d[i + 1]:
                 w = self._accumulate(d, i, w, base_ms)
+            elif not w & EN:
+                # Timing resumes: the bits hold the part of a tick counted before the pause.
+                w = (w & ~STAMP) | ((self.now_ms - (w & STAMP)) & STAMP)
+            else:
+                w = self._stamp(w)
             w |= EN
             if d[i + 2] >= d[i + 1]:
-                w = (w | DN) & ~TT & ~FRACTION
+                w = self._stamp(w | DN) & ~TT
             else:
                 w = (w | TT) & ~DN
         else:
+            if w & EN:
+                # Paused: keep the milliseconds short of a tick, counted up to the
+                # previous scan (this one's time is not timed), for when it resumes.
+                rest = (self.now_ms - self.dt - (w & STAMP)) % STAMP_MODULO
+                w = (w & ~STAMP) | (rest if rest < base_ms else 0)
             w &= ~(EN | TT)  # ACC and DN are retained until RES
         d[i] = w
 
@@ -347,9 +393,9 @@ class Machine:
         if sd.typecode == dd.typecode:
             dd[di:di + n] = sd[si:si + n]
             return
-        # F <-> word file: PLC-5 COP copies memory without conversion. n counts
+        # F or L <-> word file: COP copies memory without conversion. n counts
         # destination units; the source gives the same number of bytes (a float
-        # is two words, low word first).
+        # or a long is two words, low word first). An F <-> L copy is 1:1.
         nbytes = n * dd.itemsize
         m = -(-nbytes // sd.itemsize)
         if si + m > len(sd):
@@ -360,6 +406,16 @@ class Machine:
     def fll(self, value, dd: array, di: int, n: int) -> None:
         if dd.typecode == "f":
             dd[di:di + n] = array("f", [float(value)]) * n
+        elif dd.itemsize == 4:  # an L file: the 32-bit range, the same rules as words
+            if isinstance(value, float):
+                if math.isnan(value):
+                    value = 0
+                elif math.isinf(value):
+                    value = LONG_MAX if value > 0 else LONG_MIN
+                else:
+                    value = int(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
+            value = max(LONG_MIN, min(LONG_MAX, value)) if self.clamp else signed32(value)
+            dd[di:di + n] = array(dd.typecode, [value]) * n
         else:
             if isinstance(value, float):
                 if math.isnan(value):
@@ -390,19 +446,28 @@ class Machine:
         d[i + 1:i + 1 + STRING_CHARS] = array("h", [signed16(u) for u in units])
 
     def aci(self, sd: array, si: int, d: array, di: int) -> None:
-        """String to integer: leading spaces, optional sign, digits."""
-        text = read_string(sd, si).lstrip(" ")
-        digits = ""
-        for k, ch in enumerate(text):
-            if ch.isdigit() and ch.isascii() or (k == 0 and ch in "+-"):
-                digits += ch
-            else:
-                break
-        if digits in ("", "+", "-"):
+        """String to integer, as SLC 500 ACI: skip to the first digit; a + or -
+        right before it gives the sign; digits and commas (ignored) follow up
+        to the first other character. No digit: nothing is stored (the string
+        error). Out of range of a word: overflow, 32767 (-32768 below) and
+        the string error, whatever the overflow setting."""
+        text = read_string(sd, si)
+        first = next((k for k, ch in enumerate(text) if "0" <= ch <= "9"), None)
+        if first is None:
             self._string_error()
-            value = 0
-        else:
-            value = int(digits)
+            return
+        end = first
+        while end < len(text) and ("0" <= text[end] <= "9" or text[end] == ","):
+            end += 1
+        value = int(text[first:end].replace(",", ""))
+        if first > 0 and text[first - 1] == "-":
+            value = -value
+        if d.typecode != "f" and not -32768 <= value <= 32767:
+            self._string_error()
+            self.overflow_fault()
+            d[di] = value = 32767 if value > 0 else -32768
+            self.flags(False, True, False, value < 0)
+            return
         self.store(value, d, di)
 
     def aic(self, value: int, d: array, i: int) -> None:
@@ -419,20 +484,17 @@ class Machine:
             return
         self._put_string(text[index - 1:index - 1 + count], d, di)
 
-    def asc(self, sd: array, si: int, index: int, qd: array, qi: int, d: array, di: int) -> None:
-        """Search for a string from 1-based ``index``; result is the 1-based
-        position, or 0 (with the string minor fault) when not found."""
-        text = read_string(sd, si)
-        if index < 1 or index > max(len(text), 1):
+    def asc(self, qd: array, qi: int, index: int, sd: array, si: int, d: array, di: int) -> None:
+        """String search, AB operand order: look for the source string ``q``
+        in the String Search string ``s`` from 1-based ``index``; result is the
+        1-based position, or 0 when it is not there. An empty source, or an
+        index below 1 or past the end of ``s``: the string error, result
+        unchanged."""
+        wanted, text = read_string(qd, qi), read_string(sd, si)
+        if not wanted or index < 1 or index > len(text):
             self._string_error()
-            d[di] = 0
             return
-        found = text.find(read_string(qd, qi), index - 1)
-        if found < 0:
-            self._string_error()
-            d[di] = 0
-        else:
-            d[di] = found + 1
+        d[di] = text.find(wanted, index - 1) + 1
 
     def asr(self, ad: array, ai: int, bd: array, bi: int) -> bool:
         return read_string(ad, ai) == read_string(bd, bi)
@@ -441,7 +503,7 @@ class Machine:
 def source_units(count: int, src_ftype, dest_ftype) -> int:
     """COP between a float file and a word file copies memory: the number
     of source array units holding as many bytes as ``count`` destination units."""
-    sb, db = (4 if f.storage is Storage.FLOAT else 2 for f in (src_ftype, dest_ftype))
+    sb, db = (2 if f.storage is Storage.WORD else 4 for f in (src_ftype, dest_ftype))
     return count if sb == db else -(-count * db // sb)
 
 

@@ -38,6 +38,15 @@ class K(Enum):
     FORMAT = "format index (integer or word address)"
     PARAM = "number, or word, float or STRING element"  # read by a conversion
     PARAM_OUT = "word, float or STRING element"  # written by a conversion
+    PARAM_COUNT = "input parameter count 0..40"  # JSR: how many of the parameters after it are inputs
+    # shift registers and sequencers (ladder/instr/shift.py, sequencer.py)
+    BIT_LENGTH = "length 1..16000 bits"  # a bit array: at most a 1000-word file
+    POSITION = "position 0..1000"
+    # FAL / FSC (ladder/instr/filemath.py): ALL and INC are words of the instruction, never symbols
+    FILE_MODE = "mode ALL, INC or a number of elements per scan"
+    # bitwise instructions on SLC/MicroLogix L files (32-bit, 1763-RM001)
+    INTEGER_SOURCE = "integer, or word or long address"
+    INTEGER_DEST = "word or long address"
 
 
 @dataclass(frozen=True)
@@ -54,15 +63,29 @@ class InstructionSpec:
     output: bool  # output instructions are last in a series (informational)
     optional: int = 0  # how many trailing operands may be left out
     module: str | None = None  # the TLM that provides it; None = built in
+    repeat: int = 0  # > 0: the last operand may be given up to this many times (JSR, SBR, RET parameters)
 
     @property
     def min_operands(self) -> int:
         return len(self.operands) - self.optional
 
+    @property
+    def max_operands(self) -> int:
+        return len(self.operands) - 1 + self.repeat if self.repeat else len(self.operands)
+
+    def operand_at(self, index: int) -> OperandSpec:
+        """The spec of operand ``index``: a repeated last operand covers every
+        position from its own on."""
+        return self.operands[min(index, len(self.operands) - 1)]
+
     def signature(self) -> str:
         names = [o.name if i < self.min_operands else f"[{o.name}]" for i, o in enumerate(self.operands)]
+        if self.repeat and names:
+            names[-1] = names[-1][:-1] + "...]" if names[-1].startswith("[") else names[-1] + "..."
         return f"{self.mnemonic} {' '.join(names)}".strip()
 
 
-def _spec(mnemonic: str, title: str, output: bool, *operands: tuple[str, K], optional: int = 0) -> InstructionSpec:
-    return InstructionSpec(mnemonic, title, tuple(OperandSpec(n, k) for n, k in operands), output, optional)
+def _spec(mnemonic: str, title: str, output: bool, *operands: tuple[str, K], optional: int = 0,
+          repeat: int = 0) -> InstructionSpec:
+    return InstructionSpec(mnemonic, title, tuple(OperandSpec(n, k) for n, k in operands), output, optional,
+                           repeat=repeat)

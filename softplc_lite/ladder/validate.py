@@ -13,6 +13,9 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..gcpause import gc_paused
+from ..datatable.errors import DataTableError
+from ..datatable.filetypes import LONG_MAX, LONG_MIN
+from ..datatable.table import word_from_text
 from ..datatable import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, Address, AddressError, ValueKind, parse_address
 from .ast import (
     MAIN_FILE,
@@ -31,14 +34,15 @@ from .ast import (
     Text,
     UnaryOp,
     leaves,
+    walk,
 )
 from .errors import LadderError, ProgramErrors
-from .instructions import BUILTIN, InstructionSet, K
+from .instructions import BUILTIN, MAX_PARAMETERS, InstructionSet, K
 from .limits import limit_problem
 from .parser import parse_expression
 from .symbols import SymbolIndex, resolve_name, symbol_base
 
-_NUMERIC = (ValueKind.WORD, ValueKind.FLOAT)
+_NUMERIC = (ValueKind.WORD, ValueKind.FLOAT, ValueKind.LONG)  # LONG: SLC/MicroLogix L elements
 COMPARISONS = ("=", "<>", "<", "<=", ">", ">=")
 
 
@@ -46,7 +50,7 @@ COMPARISONS = ("=", "<>", "<", "<=", ">", ">=")
 # Operand kinds that must be constants, and the value kinds each address
 # operand kind accepts (built once: validate() asks for every operand).
 _CONSTANT_KINDS = frozenset({K.TIMEBASE, K.PRESET, K.LABEL, K.PROGRAM_FILE, K.LENGTH, K.BIT_NUMBER,
-                             K.BIT_LENGTH, K.POSITION})
+                             K.BIT_LENGTH, K.POSITION, K.PARAM_COUNT})
 _WANT = {
     K.BIT: (ValueKind.BIT,), K.SOURCE: _NUMERIC, K.DEST: _NUMERIC, K.FILE: _NUMERIC,
     K.FILE_SOURCE: _NUMERIC, K.INT_SOURCE: (ValueKind.WORD,), K.WORD: (ValueKind.WORD,),
@@ -54,6 +58,7 @@ _WANT = {
     K.RESETTABLE: (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL),
     K.STRING: (ValueKind.STRING,),
     K.PORT: (ValueKind.WORD,), K.FORMAT: (ValueKind.WORD,), K.WORD_FILE: (ValueKind.WORD,),
+    K.INTEGER_SOURCE: (ValueKind.WORD, ValueKind.LONG), K.INTEGER_DEST: (ValueKind.WORD, ValueKind.LONG),
     K.PARAM: (ValueKind.WORD, ValueKind.FLOAT, ValueKind.STRING),
     K.PARAM_OUT: (ValueKind.WORD, ValueKind.FLOAT, ValueKind.STRING),
 }
@@ -142,7 +147,7 @@ class _Checker:
         if resolved is None:
             return None
         def where() -> str:
-            return f"{instr.mnemonic} operand {index + 1} ({self.instructions.lookup(instr.mnemonic).operands[index].name})"
+            return f"{instr.mnemonic} operand {index + 1} ({self.instructions.lookup(instr.mnemonic).operand_at(index).name})"
 
         def bad(expected: str) -> None:
             self.error(_pos(resolved), f"{where()} must be {expected}, not {_describe(resolved)}")
@@ -162,7 +167,7 @@ class _Checker:
                 return None
             lo, hi = {K.PRESET: (-32768, 32767), K.LABEL: (0, 999), K.PROGRAM_FILE: (3, 999),
                       K.LENGTH: (1, 1000), K.BIT_NUMBER: (0, 15),
-                      K.BIT_LENGTH: (1, 16000), K.POSITION: (0, 1000)}[kind]
+                      K.BIT_LENGTH: (1, 16000), K.POSITION: (0, 1000), K.PARAM_COUNT: (0, MAX_PARAMETERS)}[kind]
             if kind is K.BIT_NUMBER and instr.mnemonic == "BTD" and index == 4:
                 lo, hi = 1, 16
             if not lo <= v <= hi:
@@ -180,7 +185,7 @@ class _Checker:
                 return self._int_constant(resolved, where()) if isinstance(resolved.value, int) else resolved
             if kind in (K.SOURCE, K.FILE_SOURCE):
                 return _word_constant(resolved) if isinstance(resolved.value, int) else resolved
-            if kind is K.INT_SOURCE and isinstance(resolved.value, int):
+            if kind in (K.INT_SOURCE, K.INTEGER_SOURCE) and isinstance(resolved.value, int):
                 return self._int_constant(resolved, where())
             bad(kind.value)
             return None
@@ -198,10 +203,12 @@ class _Checker:
         return resolved
 
     def _int_constant(self, const: Const, where: str) -> Const | None:
+        """Where only a 16-bit word can go: a decimal constant in
+        -32768..32767, or a hex bit pattern up to 0xFFFF."""
         v = const.value
-        if -32768 <= v <= 0xFFFF:
+        if -32768 <= v <= 32767 or const.hex and 0 <= v <= 0xFFFF:
             return _word_constant(const)
-        self.error(const.pos, f"{where}: {v} does not fit a 16-bit word")
+        self.error(const.pos, f"{where}: {_word_range_problem(v)}")
         return None
 
     # -- instructions and rungs ---------------------------------------------------------
@@ -211,20 +218,20 @@ class _Checker:
             self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}{self.instructions.hint(instr.mnemonic)}")
             return instr
         n = len(instr.operands)
-        if not spec.min_operands <= n <= len(spec.operands):
-            extras = instr.operands[len(spec.operands):]
+        if not spec.min_operands <= n <= spec.max_operands:
+            extras = instr.operands[spec.max_operands:]
             stray = next((o for o in extras if isinstance(o, SymbolRef)
                       and self.symbols.get(symbol_base(o.name) or o.name) is None), None)
             if stray is not None:
                 self.error(stray.pos, f"unknown instruction {stray.name!r}{self.instructions.hint(stray.name)}")
                 return instr
-            want = (f"{spec.min_operands}..{len(spec.operands)}" if spec.optional else str(len(spec.operands)))
+            want = (f"{spec.min_operands}..{spec.max_operands}" if spec.optional else str(spec.max_operands))
             plural = "" if want == "1" else "s"
             self.error(instr.pos, f"{spec.mnemonic} takes {want} operand{plural} ({spec.signature()}), got {n}")
             return instr
         operands = []
         for i, op in enumerate(instr.operands):
-            checked = self.operand(instr, i, spec.operands[i].kind, op)
+            checked = self.operand(instr, i, spec.operand_at(i).kind, op)
             operands.append(checked if checked is not None else op)
         if spec.mnemonic == "LBL" and not first:
             self.error(instr.pos, "LBL must be the first instruction of its rung")
@@ -233,10 +240,61 @@ class _Checker:
             if target not in self.program.files:
                 self.error(_pos(operands[0]), f"JSR to program file {target}, which does not exist"
                            f" (files: {', '.join(map(str, sorted(self.program.files)))})")
+            else:
+                self.jsr_parameters(instr, operands, target)
+        if spec.mnemonic == "SBR" and operands:
+            rungs = self.program.files[file_number].rungs
+            if file_number == MAIN_FILE or not (rungs and rungs[0].elements and rungs[0].elements[0] is instr):
+                self.error(instr.pos, "an SBR with parameters must be the first instruction of the first rung "
+                           "of a subroutine file (3..999): a JSR passes its inputs there")
         if spec.mnemonic == "JMP" and operands and isinstance(operands[0], Const):
             if operands[0].value not in labels:
                 self.error(_pos(operands[0]), f"JMP to label {operands[0].value}, which is not in program file {file_number}")
         return Instruction(instr.mnemonic, operands, instr.pos)
+
+    def jsr_parameters(self, instr: Instruction, operands: list, target: int) -> None:
+        """A JSR's parameters against its subroutine: as many inputs as the
+        target's SBR receives, return parameters that are addresses, and as
+        many of them as each RET with values in the target returns."""
+        count = operands[1] if len(operands) > 1 else None
+        if not (isinstance(count, Const) and isinstance(count.value, int) and 0 <= count.value <= MAX_PARAMETERS):
+            return  # no parameters, or a count already reported
+        inputs, params = operands[1].value, operands[2:]
+        if inputs > len(params):
+            self.error(_pos(operands[1]), f"JSR passes {inputs} input parameter{_s(inputs)} but lists "
+                       f"{len(params)} parameter{_s(len(params))}")
+            return
+        returns = params[inputs:]
+        if len(returns) > MAX_PARAMETERS:
+            self.error(_pos(returns[MAX_PARAMETERS]), f"JSR takes at most {MAX_PARAMETERS} return parameters, "
+                       f"got {len(returns)}")
+        for k, ret in enumerate(returns):
+            if isinstance(ret, Const):
+                self.error(_pos(ret), f"JSR operand {inputs + 3 + k} (return parameter) must be a word or float "
+                           f"address, not {_describe(ret)}")
+        sbr, rets = self.subroutine_shape(target)
+        received = len(sbr.operands) if sbr is not None else 0
+        if received != inputs:
+            where = f"its SBR at {sbr.pos} receives {received}" if sbr is not None else "it has no SBR with parameters"
+            self.error(_pos(operands[1]), f"JSR passes {inputs} input parameter{_s(inputs)} to program file "
+                       f"{target}, but {where}")
+        if returns:
+            if not rets:
+                self.error(instr.pos, f"JSR expects {len(returns)} return parameter{_s(len(returns))} from program "
+                           f"file {target}, which has no RET with values")
+            for ret in rets:
+                if len(ret.operands) != len(returns):
+                    self.error(instr.pos, f"JSR expects {len(returns)} return parameter{_s(len(returns))} from "
+                               f"program file {target}, but the RET at {ret.pos} returns {len(ret.operands)}")
+
+    def subroutine_shape(self, number: int) -> tuple[Instruction | None, list[Instruction]]:
+        """Program file ``number``'s SBR with parameters (the first instruction
+        of its first rung) and its RETs with values, from the parsed text."""
+        rungs = self.program.files[number].rungs
+        first = rungs[0].elements[0] if rungs and rungs[0].elements else None
+        sbr = first if isinstance(first, Instruction) and first.mnemonic == "SBR" and first.operands else None
+        rets = [ins for rung in rungs for ins in walk(rung.elements) if ins.mnemonic == "RET" and ins.operands]
+        return sbr, rets
 
     def series(self, elements: list[Element], file_number: int, labels: set[int], first: bool) -> list[Element]:
         out: list[Element] = []
@@ -318,21 +376,58 @@ class _Checker:
                 if isinstance(v, str):
                     self.error(decl.pos, f"DATA {text}: float files take numbers")
                     return
-            elif ftype.letter in ("N", "B", "O", "I", "S"):
-                if not isinstance(v, int) or not -32768 <= v <= 0xFFFF:
-                    self.error(decl.pos, f"DATA {text}: {v!r} does not fit a 16-bit word")
+            elif ftype.letter == "L":
+                if not isinstance(v, int) or not LONG_MIN <= v <= LONG_MAX:
+                    self.error(decl.pos, f"DATA {text}: {v!r} does not fit a 32-bit long ({LONG_MIN}..{LONG_MAX})")
+                    return
+            elif ftype.radix != "decimal" and isinstance(v, str):  # D "1234" (BCD digits), A "AB"
+                try:
+                    word_from_text(v, ftype, f"{text}")
+                except DataTableError as e:
+                    self.error(decl.pos, f"DATA {text}: {e}")
+                    return
+            elif ftype.letter in ("N", "B", "O", "I", "S", "D", "A"):
+                # The parser has made hex bit patterns (0xFFFF) negative already.
+                if not isinstance(v, int) or not -32768 <= v <= 32767:
+                    problem = _word_range_problem(v) if isinstance(v, int) else f"{v!r} does not fit a 16-bit word"
+                    self.error(decl.pos, f"DATA {text}: {problem}")
                     return
             else:
-                self.error(decl.pos, f"DATA {text}: initial values are for N, B, F and ST files")
+                self.error(decl.pos, f"DATA {text}: initial values are for N, B, F, ST, L, D and A files")
                 return
 
 
 def _word_constant(const: Const) -> Const:
-    """Hex constants above 0x7FFF are bit patterns: 0xFFFF is -1."""
+    """Hex constants 0x8000..0xFFFF are bit patterns: 0xFFFF is -1. A
+    decimal constant is its value (MOV 40000 N7:0 overflows, as 70000)."""
     v = const.value
-    if isinstance(v, int) and 0x8000 <= v <= 0xFFFF:
-        return Const(v - 0x10000, const.pos)
+    if const.hex and isinstance(v, int) and 0x8000 <= v <= 0xFFFF:
+        return Const(v - 0x10000, const.pos, hex=True)
     return const
+
+
+def _word_range_problem(v: int) -> str:
+    """Why a decimal integer cannot be a 16-bit word, with the hex spelling
+    of its bit pattern when it has one."""
+    hint = f"; for the 16-bit pattern write 0x{v:X}" if 0x8000 <= v <= 0xFFFF else ""
+    return f"{v} does not fit a 16-bit word (decimal -32768..32767){hint}"
+
+
+def constant_fits(const: Const, dest: Address, overflow: str = "clamp") -> str | None:
+    """For softplc check's warnings: None when ``const`` stored in ``dest``
+    (MOV 40000 N7:0) keeps its value, else what the store will do. A hex
+    0x8000..0xFFFF constant is a bit pattern and fits; ``overflow`` is the
+    app setting (semantics.Settings.overflow)."""
+    v = const.value
+    if not isinstance(v, int) or dest.kind is not ValueKind.WORD or -32768 <= v <= 32767:
+        return None
+    if const.hex and 0 <= v <= 0xFFFF:
+        return None
+    if overflow == "clamp":
+        stored = 32767 if v > 0 else -32768
+    else:
+        stored = (v & 0xFFFF) - 0x10000 if v & 0x8000 else v & 0xFFFF
+    return f"{v} cannot fit {dest}, it will be stored as {stored} with overflow"
 
 
 def _has_compare(expr) -> bool:
@@ -343,6 +438,10 @@ def _has_compare(expr) -> bool:
     if isinstance(expr, Call):
         return _has_compare(expr.arg)
     return False
+
+
+def _s(n: int) -> str:
+    return "" if n == 1 else "s"
 
 
 def _pos(operand):

@@ -13,6 +13,7 @@ from rich.cells import cell_len
 from rich.style import Style
 
 from ..datatable import Address, DataTable, ValueKind
+from ..datatable.display import word_shown
 from ..ladder.ast import (
     AddressRef,
     Branch,
@@ -198,7 +199,10 @@ class _Context:
 
     def value(self, address: Address) -> Run:
         try:
-            return (_value_text(self.table.read(address)), None)
+            value = self.table.read(address)
+            # D and A words show as BCD digits / two characters (their radix).
+            shown = word_shown(value, address.ftype) if address.kind is ValueKind.WORD else None
+            return (shown or _value_text(value), None)
         except READ_FAILURES:
             return ("?", FAULT)
 
