@@ -34,20 +34,25 @@ def _safe(fn: Callable[[float], float]) -> Callable[[float], float]:
     return wrapped
 
 
-def _frd(v) -> int:
-    """BCD to integer (4 digits)."""
+def _frd(v) -> int | float:
+    """BCD to integer (4 digits). A nibble above 9 is no BCD value: NaN,
+    which the store turns into overflow (S:0/1 and the minor fault), as the
+    FRD instruction does (ladder/instr/convert.py, docs/instructions.md)."""
     v = _int(v) & 0xFFFF
     digits = [(v >> s) & 0xF for s in (12, 8, 4, 0)]
     if any(d > 9 for d in digits):
-        return 0
+        return math.nan
     return int("".join(map(str, digits)))
 
 
-def _tod(v) -> int:
-    """Integer 0..9999 to BCD."""
+def _tod(v) -> int | float:
+    """Integer 0..9999 to BCD, as the signed 16-bit word that holds the
+    pattern (9760 gives 0x9760, -26784). Outside 0..9999 there is no 4-digit
+    BCD value: NaN, stored as overflow (PLC-5 TOD sets V for a negative
+    source or one above 9999)."""
     v = _int(v)
     if not 0 <= v <= 9999:
-        return v
+        return math.nan
     out = 0
     for ch in f"{v:04d}":
         out = (out << 4) | int(ch)
