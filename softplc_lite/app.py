@@ -19,13 +19,14 @@ from pathlib import Path
 
 from .datatable import DataTableError, jsonio
 from .errors import LocatedError
-from .display import Display, parse_display
+from .display import Display, display_names, parse_display
 from .ladder.ast import Pos, Program, walk
 from .ladder.errors import LadderError
 from .ladder.instructions import BUILTIN, InstructionSet
 from .ladder.parser import parse_program, syntax_problems
 from .ladder.semantics import MAX_JSR_DEPTH, Settings
 from .ladder.validate import check
+from .ladder.verify import verify
 from .ladder.engine import layout_problems
 from .ports import claim_conflicts
 from .ports.urlhandler.protocol_sim import url_problem as sim_url_problem
@@ -319,6 +320,7 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
         errors += layout
     settings_problems: list = []
     settings, display = Settings(), Display()
+    settings_doc = None
     if is_dir:
         try:
             settings_doc = read_settings_file(path / SETTINGS_FILE)
@@ -338,6 +340,9 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
         raise AppError(config_problems + settings_problems
                        + sorted(errors, key=lambda e: (e.pos.source, e.pos.line, e.pos.column)))
     warnings += [w.report() for w in _module_checks(resolved, modules)]
+    # RSLogix-style verify (duplicate OTE, shared timers, rungs without output, unused symbols): warnings
+    shown = display_names(settings_doc.get("display")) if is_dir and isinstance(settings_doc, dict) else set()
+    warnings += [w.report() for w in verify(resolved, instructions, parsed, settings.overflow, shown)]
     if state_dir is not None:
         state = Path(state_dir)
     else:

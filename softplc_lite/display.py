@@ -89,6 +89,18 @@ class Display:
         return [f"{item.label} ({item.text}) = {item.read(table)}" for item in self.status + self.summary]
 
 
+def display_names(section: object) -> set[str]:
+    """The names a ``[display]`` table shows (``FaultMap``, ``#Levels 5``):
+    a symbol shown there is used, for softplc check's unused-symbol warning."""
+    names: set[str] = set()
+    for value in (section or {}).values() if isinstance(section, dict) else ():
+        for text in value.values() if isinstance(value, dict) else ():
+            if isinstance(text, str):
+                m = _BLOCK.match(text.strip())
+                names.add(m.group(1) if m else text.strip())
+    return names
+
+
 def parse_display(section: object, where: str, symbols=None) -> Display:
     """The ``[display]`` table of softplc.toml."""
     if not isinstance(section, dict):
