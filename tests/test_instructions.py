@@ -44,9 +44,11 @@ def flags(e) -> str:
 
 
 def minor_bits(e) -> set[str]:
-    s17 = e.table.read("S:17")
-    names = {S.MINOR_OVERFLOW_BIT: "overflow", S.MINOR_DIV_ZERO_BIT: "div0", S.MINOR_STRING_BIT: "string"}
-    return {name for bit, name in names.items() if s17 >> bit & 1}
+    """The minor faults raised: overflow is PLC-5's S:10/14, the others softplc's S:17 bits."""
+    s10, s17 = e.table.read("S:10"), e.table.read("S:17")
+    names = {S.MINOR_DIV_ZERO_BIT: "div0", S.MINOR_STRING_BIT: "string"}
+    found = {name for bit, name in names.items() if s17 >> bit & 1}
+    return found | ({"overflow"} if s10 >> S.MINOR_OVERFLOW_BIT & 1 else set())
 
 
 def timer(e, addr: str = "T4:0") -> tuple[int, int, int, int]:
@@ -462,6 +464,15 @@ def test_neg(run, overflow, result, flag):
     assert (e.table.read("N7:0"), flags(e), minor_bits(e)) == (result, flag, {"overflow"})
 
 
+# SLC 500 / MicroLogix NEG (1747-RM001, 1761-6.3): carry is cleared if the source is 0 or the
+# result overflows, otherwise set.
+@pytest.mark.parametrize("source,result,flag", [(5, -5, "CS"), (-7, 7, "C"), (0, 0, "Z"), (32767, -32767, "CS"),
+                                                (-32768, 32767, "V")])
+def test_neg_sets_carry_unless_the_source_is_0_or_it_overflows(run, source, result, flag):
+    e = run("NEG N7:1 N7:0", values={"N7:1": source, "S:0": 1})
+    assert (e.table.read("N7:0"), flags(e)) == (result, flag)
+
+
 def test_abs(run):
     e = run("ABS -5 N7:0\nABS F8:0 F8:1\nABS 7 N7:1", values={"F8:0": -2.5})
     assert (e.table.read("N7:0"), e.table.read("F8:1"), e.table.read("N7:1")) == (5, 2.5, 7)
@@ -742,14 +753,26 @@ def test_indexed_address_uses_the_index_register_s24(run, index, code):
 # -- strings -------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("text,value,errors", [("42", 42, set()), ("  -123abc", -123, set()), ("+7", 7, set()),
-                                               ("abc", 0, {"string"}), ("", 0, {"string"}), ("-", 0, {"string"}),
-                                               ("99999", 32767, {"overflow"})])
-def test_aci(run, text, value, errors):
-    e = run("ACI ST9:0 N7:0", values={"ST9:0": text, "N7:0": 5})
-    assert e.table.read("N7:0") == value and minor_bits(e) == errors
-    if "string" in errors:
-        assert e.table.read("S:102") == S.MINOR_CODE_STRING
+# SLC 500 ACI (1747-RM001, ASCII instructions): skip to the first digit, commas allowed, a sign
+# right before the first digit counts; no digit: nothing stored; out of range: overflow and 32767.
+@pytest.mark.parametrize("text,value,errors,flag", [
+    ("42", 42, set(), ""), ("  -123abc", -123, set(), "S"), ("+7", 7, set(), ""),
+    ("T=123", 123, set(), ""), ("1,234", 1234, set(), ""), ("-1,234,5", -12345, set(), "S"),
+    ("T=-45 degrees", -45, set(), "S"), ("- 5", 5, set(), ""), ("x9y8", 9, set(), ""), ("007", 7, set(), ""),
+    ("abc", 5, {"string"}, "C"), ("", 5, {"string"}, "C"), ("-", 5, {"string"}, "C"), (",,", 5, {"string"}, "C"),
+    ("99999", 32767, {"overflow", "string"}, "V"), ("-40000", -32768, {"overflow", "string"}, "VS"),
+    ("32,767", 32767, set(), ""), ("-32768", -32768, set(), "S"), ("0", 0, set(), "Z")])
+def test_aci(run, text, value, errors, flag):
+    # S:0/0 carry is set beforehand: an ACI that finds no digit leaves S:0 (and the destination) alone.
+    e = run("ACI ST9:0 N7:0", values={"ST9:0": text, "N7:0": 5, "S:0": 1})
+    assert (e.table.read("N7:0"), minor_bits(e), flags(e)) == (value, errors, flag)
+    if errors:
+        assert e.table.read("S:102") == (S.MINOR_CODE_OVERFLOW if "overflow" in errors else S.MINOR_CODE_STRING)
+
+
+def test_aci_out_of_range_is_32767_in_both_overflow_modes(run):
+    e = run("ACI ST9:0 N7:0", values={"ST9:0": "70000"}, settings=Settings(overflow="wrap"))
+    assert e.table.read("N7:0") == 32767 and flags(e) == "V"
 
 
 def test_aci_into_a_float(run):
@@ -782,12 +805,22 @@ def test_aex(run, index, count, result, errors):
     assert e.table.read("ST9:1") == result and minor_bits(e) == errors
 
 
+# AB order (1747-RM001 ASC): Source = the string searched for, Index, String Search = the string
+# examined, Result. Not found: 0. Index outside the examined string or an empty source: the string
+# error and the result unchanged.
 @pytest.mark.parametrize("index,search,result,errors", [(1, "o", 5, set()), (6, "o", 8, set()), (1, "world", 7, set()),
-                                                        (1, "z", 0, {"string"}), (9, "o", 0, {"string"}),
-                                                        (0, "o", 0, {"string"}), (12, "o", 0, {"string"})])
+                                                        (11, "d", 11, set()), (1, "z", 0, set()), (9, "o", 0, set()),
+                                                        (1, "Hello world!", 0, set()),
+                                                        (0, "o", 99, {"string"}), (12, "o", 99, {"string"}),
+                                                        (1, "", 99, {"string"})])
 def test_asc(run, index, search, result, errors):
-    e = run(f"ASC ST9:0 {index} ST9:1 N7:0", values={"ST9:0": "Hello world", "ST9:1": search, "N7:0": 99})
+    e = run(f"ASC ST9:1 {index} ST9:0 N7:0", values={"ST9:0": "Hello world", "ST9:1": search, "N7:0": 99})
     assert e.table.read("N7:0") == result and minor_bits(e) == errors
+
+
+def test_asc_neutral_text_takes_the_same_ab_operand_order(run):
+    e = run('ASC(ST9:1,1,ST9:0,N7:0);', values={"ST9:0": "T=123", "ST9:1": "="})
+    assert e.table.read("N7:0") == 2
 
 
 @pytest.mark.parametrize("a,b,out", [("abc", "abc", 1), ("abc", "abd", 0), ("abc", "abcd", 0), ("", "", 1),
@@ -810,5 +843,5 @@ def test_neutral_text_runs_like_mnemonic(run):
 def test_a_minor_fault_after_a_jsr_in_the_same_rung_names_the_callers_rung(run):
     # The JSR's subroutine ran rungs of file 3; the overflow after it is in file 2, rung 1.
     e = run("MOV 1 N7:1\nJSR 3 ADD 32767 N7:1 N7:0\nFILE 3\nSBR\nMOV 2 N7:2\nMOV 3 N7:3\n")
-    assert e.table.read("S:17/0") == 1
+    assert e.table.read("S:10/14") == 1
     assert (e.table.read("S:103"), e.table.read("S:104")) == (2, 1)

@@ -36,10 +36,13 @@ def _pos() -> Pos:
 
 @dataclass(frozen=True)
 class Const:
-    """A number: an int (decimal or 0x hex) or a float."""
+    """A number: an int (decimal or 0x hex) or a float. ``hex`` says it was
+    written 0x...: a hex constant is a 16-bit pattern (0xFFFF is -1), a
+    decimal one its value (docs/language.md); fmt prints it back in hex."""
 
     value: int | float
     pos: Pos = _pos()
+    hex: bool = field(default=False, compare=False, repr=False)
 
 
 @dataclass(frozen=True)

@@ -36,19 +36,26 @@ def _number(v: int | float) -> str:
     return repr(v) if isinstance(v, float) else str(v)
 
 
+def _constant(c: Const) -> str:
+    """A constant as written: hex ones in hex (a validated 0xFFFF holds -1)."""
+    if c.hex and isinstance(c.value, int) and -0x8000 <= c.value <= 0xFFFF:
+        return f"0x{c.value & 0xFFFF if c.value < 0 else c.value:X}"
+    return _number(c.value)
+
+
 def _prec(node) -> int:
     if isinstance(node, BinOp):
         return _PREC[node.op]
     if isinstance(node, UnaryOp):
         return _UNARY
-    if isinstance(node, Const) and node.value < 0:
+    if isinstance(node, Const) and node.value < 0 and not node.hex:
         return _UNARY  # printed with a leading '-'
     return _ATOM
 
 
 def format_expression(node) -> str:
     if isinstance(node, Const):
-        return _number(node.value)
+        return _constant(node)
     if isinstance(node, AddressRef):
         return str(node.address)
     if isinstance(node, SymbolRef):
@@ -82,7 +89,7 @@ def format_operand(op, style: str, file_operand: bool = False) -> str:
         text = format_expression(op)
         return f'"{text}"' if style == "mnemonic" else text
     if isinstance(op, Const):
-        return _number(op.value)
+        return _constant(op)
     if isinstance(op, AddressRef):
         return str(op.address)
     if isinstance(op, SymbolRef):

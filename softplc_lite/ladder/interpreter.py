@@ -191,10 +191,14 @@ class Interpreter:
             a, b = self.read(ops[0]), self.read(ops[1])
             d, i, _ = self.loc(ops[2])
             mc.store(a * b, d, i)
-        elif m in ("NEG", "ABS", "MOV"):
+        elif m == "NEG":
             v = self.read(ops[0])
             d, i, _ = self.loc(ops[1])
-            mc.store(-v if m == "NEG" else abs(v) if m == "ABS" else v, d, i)
+            mc.neg(v, d, i)
+        elif m in ("ABS", "MOV"):
+            v = self.read(ops[0])
+            d, i, _ = self.loc(ops[1])
+            mc.store(abs(v) if m == "ABS" else v, d, i)
         elif m == "SQR":
             v = self.read(ops[0])
             d, i, _ = self.loc(ops[1])
@@ -266,11 +270,11 @@ class Interpreter:
             index, count = self.read(ops[1]), self.read(ops[2])
             d, i, _ = self.loc(ops[3])
             mc.aex(sd, si, index, count, d, i)
-        elif m == "ASC":
-            sd, si, _ = self.loc(ops[0])
+        elif m == "ASC":  # AB order: source (searched for), index, string search (examined), result
+            qd, qi, _ = self.loc(ops[0])
             index = self.read(ops[1])
-            (qd, qi, _), (d, i, _) = self.loc(ops[2]), self.loc(ops[3])
-            mc.asc(sd, si, index, qd, qi, d, i)
+            (sd, si, _), (d, i, _) = self.loc(ops[2]), self.loc(ops[3])
+            mc.asc(qd, qi, index, sd, si, d, i)
         elif m == "ASR":
             (ad, ai, _), (bd, bi, _) = self.loc(ops[0]), self.loc(ops[1])
             return mc.asr(ad, ai, bd, bi)

@@ -232,12 +232,16 @@ class _ToAst(Transformer):
 
     @v_args(inline=True)
     def signed_number(self, tok):
-        return Const(self._num(tok), self._pos(tok))
+        return self._const(tok)
 
     @v_args(inline=True)
     def negative_number(self, sign, tok):
-        value = self._num(tok)
-        return Const(-value if str(sign) == "-" else value, self._pos(sign))
+        const = self._const(tok)
+        # -0x10 is the number -16: only an unsigned hex constant is a bit pattern
+        return Const(-const.value, self._pos(sign)) if str(sign) == "-" else Const(const.value, self._pos(sign), hex=const.hex)
+
+    def _const(self, tok: Token) -> Const:
+        return Const(self._num(tok), self._pos(tok), hex=tok.type == "HEX")
 
     @v_args(inline=True)
     def call(self, name, arg):
@@ -272,7 +276,7 @@ class _ToAst(Transformer):
 
     def _atomize(self, item):
         if isinstance(item, Token) and item.type in ("INT", "FLOAT", "HEX"):
-            return Const(self._num(item), self._pos(item))
+            return self._const(item)
         return item
 
     # neutral text -----------------------------------------------------------------
@@ -347,6 +351,8 @@ class _ToAst(Transformer):
             if isinstance(v, Token):
                 if v.type == "STRING":
                     values.append(_unquote(str(v)))
+            elif v.hex and 0x8000 <= v.value <= 0xFFFF and str(name)[:1].upper() in ("N", "B", "O", "I", "S"):
+                values.append(v.value - 0x10000)  # a hex bit pattern for a 16-bit word file: 0xFFFF is -1
             else:
                 values.append(v.value)
         size = self._small_int(size, f"DATA {name}: size")
