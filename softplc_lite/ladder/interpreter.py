@@ -241,10 +241,13 @@ class Interpreter:
                 raise _Jump(pfile.labels[ops[0].value])
         elif m == "JSR":
             if c:
-                self.jsr(ops[0].value)
+                if len(ops) > 1:
+                    self.jsr(ops[0].value, ins)  # the engine moves the parameters
+                else:
+                    self.jsr(ops[0].value)
         elif m == "RET":
             if c:
-                raise _Jump(RET)
+                raise _Jump(ins if ops else RET)  # with values: the engine reads them (Engine.run_file)
         elif m == "TND":
             if c:
                 raise _Jump(TND)

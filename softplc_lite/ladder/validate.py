@@ -256,12 +256,12 @@ class _Checker:
         """A JSR's parameters against its subroutine: as many inputs as the
         target's SBR receives, return parameters that are addresses, and as
         many of them as each RET with values in the target returns."""
-        count = operands[1] if len(operands) > 1 else None
+        count = operands[1] if len(operands) > 1 else Const(0, instr.pos)  # JSR file: no parameters
         if not (isinstance(count, Const) and isinstance(count.value, int) and 0 <= count.value <= MAX_PARAMETERS):
-            return  # no parameters, or a count already reported
-        inputs, params = operands[1].value, operands[2:]
+            return  # a count already reported
+        inputs, params = count.value, operands[2:]
         if inputs > len(params):
-            self.error(_pos(operands[1]), f"JSR passes {inputs} input parameter{_s(inputs)} but lists "
+            self.error(_pos(count), f"JSR passes {inputs} input parameter{_s(inputs)} but lists "
                        f"{len(params)} parameter{_s(len(params))}")
             return
         returns = params[inputs:]
@@ -276,7 +276,7 @@ class _Checker:
         received = len(sbr.operands) if sbr is not None else 0
         if received != inputs:
             where = f"its SBR at {sbr.pos} receives {received}" if sbr is not None else "it has no SBR with parameters"
-            self.error(_pos(operands[1]), f"JSR passes {inputs} input parameter{_s(inputs)} to program file "
+            self.error(_pos(count), f"JSR passes {inputs} input parameter{_s(inputs)} to program file "
                        f"{target}, but {where}")
         if returns:
             if not rets:
