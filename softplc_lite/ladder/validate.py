@@ -130,15 +130,17 @@ class _Checker:
                            "take words, floats and numbers")
                 ok = False
         top_is_compare = isinstance(operand, BinOp) and operand.op in COMPARISONS
-        if mnemonic == "CMP" and not top_is_compare:
-            self.error(_pos(operand), "CMP needs a comparison (=, <>, <, <=, >, >=) at the top of its expression")
+        if mnemonic in ("CMP", "FSC") and not top_is_compare:
+            self.error(_pos(operand), f"{mnemonic} needs a comparison (=, <>, <, <=, >, >=) at the top of its expression")
             ok = False
-        if mnemonic != "CMP" and _has_compare(operand):
+        if mnemonic not in ("CMP", "FSC") and _has_compare(operand):
             self.error(_pos(operand), f"{mnemonic} computes a value; comparisons belong in CMP")
             ok = False
         return operand if ok else None
 
     def operand(self, instr: Instruction, index: int, kind: K, operand: Operand) -> Operand | None:
+        if kind is K.FILE_MODE:
+            return self.file_mode(instr, index, operand)
         if kind is K.EXPRESSION:
             return self.expression(operand, instr.mnemonic)
         if kind is K.ANY:
@@ -201,6 +203,21 @@ class _Checker:
             # '#' marks a file operand here (PLC-5 file instructions), not indexing.
             return AddressRef(Address(a.type_letter, a.file, a.element, a.member, a.bit, False), resolved.pos)
         return resolved
+
+    def file_mode(self, instr: Instruction, index: int, operand: Operand) -> Operand | None:
+        """FAL/FSC mode: ALL or INC (words of the instruction, never looked up
+        as symbols) or a number of elements per scan, 1..the length."""
+        if isinstance(operand, SymbolRef) and operand.name.upper() in ("ALL", "INC"):
+            return operand
+        spec = self.instructions.lookup(instr.mnemonic)
+        length = next((o.value for o, s in zip(instr.operands, spec.operands)
+                       if s.kind is K.LENGTH and isinstance(o, Const) and isinstance(o.value, int)), 1000)
+        if isinstance(operand, Const) and isinstance(operand.value, int) and 1 <= operand.value <= length:
+            return operand
+        what = operand.name if isinstance(operand, SymbolRef) else _describe(operand)
+        self.error(_pos(operand), f"{instr.mnemonic} operand {index + 1} (mode) must be ALL, INC or a number "
+                   f"of elements per scan 1..{length}, not {what}")
+        return None
 
     def _int_constant(self, const: Const, where: str) -> Const | None:
         """Where only a 16-bit word can go: a decimal constant in
