@@ -230,3 +230,16 @@ def test_longs_where_they_do_not_belong_are_located_errors(text, message):
     with pytest.raises((ProgramErrors, LadderError)) as e:
         load_text(text)
     assert message in str(e.value) and "<program>:1:" in str(e.value)
+
+
+def test_watch_break_condition_and_watch_list_take_longs():
+    from softplc_lite.watch.breakpoints import Condition
+    from softplc_lite.watch.watchlist import WatchItem
+
+    t = DataTable()
+    t.reference("L9:0")
+    t.write("L9:0", 40001)
+    assert Condition("L9:0 > 40000").value(t) is True
+    item = WatchItem("L9:0")
+    item.sample(t)
+    assert item.value == 40001

@@ -70,7 +70,7 @@ class _PureMath:
             return 0
 
 
-_NUMBERS = (ValueKind.BIT, ValueKind.WORD, ValueKind.FLOAT)
+_NUMBERS = (ValueKind.BIT, ValueKind.WORD, ValueKind.FLOAT, ValueKind.LONG)
 
 
 class Condition:

@@ -52,7 +52,7 @@ class WatchItem:
         try:
             if a.is_direct and a.kind is ValueKind.BIT:
                 self._ref = table.bit_ref(a)
-            elif a.is_direct and a.kind in (ValueKind.WORD, ValueKind.FLOAT):
+            elif a.is_direct and a.kind in (ValueKind.WORD, ValueKind.FLOAT, ValueKind.LONG):
                 self._ref = (*table.word_ref(a), None)
         except DataTableError:
             pass  # past the end of its file (for now): read() says why
