@@ -145,6 +145,12 @@ def test_xpy_result_too_large_overflows(run):
     assert "V" in flags(e)
 
 
+def test_xpy_scp_frd_into_a_long_file_use_its_32_bit_range(run):
+    e = run("XPY 2 20 L9:0\nSCP 5 0 10 0 100000 L9:1\nFRD 0x1234 L9:2")
+    assert [e.table.read(f"L9:{k}") for k in range(3)] == [1048576, 50000, 1234]
+    assert e.table.read("S:102") == 0
+
+
 def test_xpy_agrees_with_cpt_power(run):
     e = run('XPY F8:0 F8:1 F8:2\nCPT F8:3 "F8:0 ** F8:1"', values={"F8:0": 1.7, "F8:1": 2.3})
     assert e.table.read("F8:2") == e.table.read("F8:3")
