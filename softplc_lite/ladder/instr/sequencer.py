@@ -1,0 +1,200 @@
+"""Sequencers: SQO (output), SQI (input), SQL (load).
+
+A sequencer file holds one word per step, from position 0 (the startup
+step) to position LEN; the control (R) element keeps LEN and POS. On a
+false-to-true transition SQO and SQL step POS on (LEN wraps to 1) and
+act on the word at POS; while the rung stays true they act on it again
+each scan without stepping (PLC-5 1785 user manual, "Sequencer
+Instructions"). SQI compares without stepping: it usually shares its
+control with an SQO.
+
+A mask, source or destination written as a file (``#N7:30``) steps
+through its own file with POS, as the sequencer file does; written as a
+word address or a constant it is used as is (1747-RM001 "Application
+Specific Instructions", sequencer TIP). ``#`` here marks a file, as it
+does for the sequencer file; it is not S:24 indexing.
+
+Length and Position are what a download writes into LEN and POS (see
+shift.py); ER is set for LEN <= 0, POS < 0 or POS > LEN, and then the
+instruction does nothing else.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Callable
+
+from ...datatable import Address
+from ..ast import AddressRef, Instruction
+from ..bound import BoundInstruction, block, constant
+from ..semantics import R_DN, R_EN, R_ER, signed16
+from ..specs import K, _spec
+from .shift import LEN, POS, control_words
+
+
+def _bad(n: int, pos: int) -> bool:
+    return n <= 0 or pos < 0 or pos > n
+
+
+def _stepping(access, operand) -> Callable[[int, int], tuple]:
+    """A getter ``(pos, n) -> (array, index)`` for an operand that steps
+    with POS when written as a file (``#``), or stays on its word."""
+    if isinstance(operand, AddressRef) and operand.address.indexed:
+        get = access.location(AddressRef(replace(operand.address, indexed=False), operand.pos))
+        what = str(operand.address)
+
+        def at_step(pos: int, n: int):
+            d, i, _ = get()
+            block(d, i, n + 1, what)  # position 0 to LEN: LEN + 1 words
+            return d, i + pos
+        return at_step
+    get = access.location(operand)
+
+    def fixed(pos: int, n: int):
+        d, i, _ = get()
+        return d, i
+    return fixed
+
+
+def _stepping_value(access, operand) -> Callable[[int, int], int]:
+    """As _stepping, for a read-only operand that may also be a constant."""
+    if isinstance(operand, AddressRef):
+        at = _stepping(access, operand)
+
+        def read(pos: int, n: int) -> int:
+            d, i = at(pos, n)
+            return d[i]
+        return read
+    get = access.value(operand)
+    return lambda pos, n: get()
+
+
+def _step(d, i: int, w: int) -> tuple[int, int]:
+    """A false-to-true transition: DN off, POS on by one (after LEN, back
+    to 1), DN on at the last step. Returns (status word, position)."""
+    n, pos = d[i + LEN], d[i + POS]
+    pos = 1 if pos >= n else pos + 1
+    d[i + POS] = pos
+    w &= ~R_DN
+    if pos == n:
+        w |= R_DN
+    return w, pos
+
+
+def _bind_output(instr: Instruction, access):
+    """SQO file mask dest control length position."""
+    file = _stepping(access, _as_file(instr.operands[0]))
+    mask = _stepping_value(access, instr.operands[1])
+    dest = _stepping(access, instr.operands[2])
+    get_control = access.location(instr.operands[3])
+
+    def run(c: bool) -> bool:
+        d, i, _ = get_control()
+        w = d[i]
+        if not c:
+            d[i] = w & ~R_EN
+            return c
+        n, pos = d[i + LEN], d[i + POS]
+        if _bad(n, pos):
+            d[i] = w | R_EN | R_ER
+            return c
+        w &= ~R_ER
+        if not w & R_EN:
+            w, pos = _step(d, i, w)
+        fd, fi = file(pos, n)
+        m = mask(pos, n)
+        dd, di = dest(pos, n)
+        dd[di] = signed16((dd[di] & ~m) | (fd[fi] & m))
+        d[i] = w | R_EN
+        return c
+    return run
+
+
+def _bind_input(instr: Instruction, access):
+    """SQI file mask source control length position: true when the masked
+    source equals the masked step word at POS."""
+    file = _stepping(access, _as_file(instr.operands[0]))
+    mask = _stepping_value(access, instr.operands[1])
+    source = _stepping_value(access, instr.operands[2])
+    get_control = access.location(instr.operands[3])
+
+    def run(c: bool) -> bool:
+        if not c:
+            return False
+        d, i, _ = get_control()
+        n, pos = d[i + LEN], d[i + POS]
+        if _bad(n, pos):
+            d[i] |= R_ER
+            return False
+        d[i] &= ~R_ER
+        fd, fi = file(pos, n)
+        m = mask(pos, n)
+        return (source(pos, n) & m) == (fd[fi] & m)
+    return run
+
+
+def _bind_load(instr: Instruction, access):
+    """SQL file source control length position."""
+    file = _stepping(access, _as_file(instr.operands[0]))
+    source = _stepping_value(access, instr.operands[1])
+    get_control = access.location(instr.operands[2])
+
+    def run(c: bool) -> bool:
+        d, i, _ = get_control()
+        w = d[i]
+        if not c:
+            d[i] = w & ~R_EN
+            return c
+        n, pos = d[i + LEN], d[i + POS]
+        if _bad(n, pos):
+            d[i] = w | R_EN | R_ER
+            return c
+        w &= ~R_ER
+        if not w & R_EN:
+            w, pos = _step(d, i, w)
+        fd, fi = file(pos, n)
+        fd[fi] = signed16(source(pos, n))
+        d[i] = w | R_EN
+        return c
+    return run
+
+
+def _as_file(operand):
+    """The sequencer file operand: the validator took its ``#`` off (a
+    K.WORD_FILE operand); mark it again so it steps with POS."""
+    if isinstance(operand, AddressRef) and not operand.address.indexed:
+        return AddressRef(replace(operand.address, indexed=True), operand.pos)
+    return operand
+
+
+def _references(files: tuple[int, ...], length: int):
+    """The last step word (LEN + 1 words from position 0) of the sequencer
+    file and of every other operand written as a file."""
+    def references(instr: Instruction) -> list[Address]:
+        n = constant(instr, length)
+        if n is None:
+            return []
+        out = []
+        for k in files:
+            op = instr.operands[k]
+            if not isinstance(op, AddressRef) or (k != 0 and not op.address.indexed):
+                continue
+            a = replace(op.address, indexed=False)
+            if a.is_direct and a.element is not None:
+                out.append(a.with_element(a.element + n))
+        return out
+    return references
+
+
+SQO = _spec("SQO", "sequencer output", True, ("file", K.WORD_FILE), ("mask", K.INT_SOURCE), ("dest", K.WORD),
+            ("control", K.CONTROL), ("length", K.LENGTH), ("position", K.POSITION))
+SQI = _spec("SQI", "sequencer input", False, ("file", K.WORD_FILE), ("mask", K.INT_SOURCE),
+            ("source", K.INT_SOURCE), ("control", K.CONTROL), ("length", K.LENGTH), ("position", K.POSITION))
+SQL = _spec("SQL", "sequencer load", True, ("file", K.WORD_FILE), ("source", K.INT_SOURCE), ("control", K.CONTROL),
+            ("length", K.LENGTH), ("position", K.POSITION))
+
+INSTRUCTIONS = [
+    BoundInstruction(SQO, _bind_output, _references((0, 1, 2), 4), lambda instr: control_words(instr, 3, 4, 5)),
+    BoundInstruction(SQI, _bind_input, _references((0, 1, 2), 4), lambda instr: control_words(instr, 3, 4, 5)),
+    BoundInstruction(SQL, _bind_load, _references((0, 1), 3), lambda instr: control_words(instr, 2, 3, 4)),
+]
