@@ -164,10 +164,23 @@ def test_fal_a_position_written_outside_the_file_sets_er():
     assert words(e, "N7", 10, 5) == [1, 0, 0, 0, 0]
 
 
-def test_fal_length_operand_is_written_to_the_control_each_scan():
-    e, _ = drive("FAL R6:0 3 0 ALL #N7:10 #N7:0", ({"R6:0.LEN": 99}, 1), values=FIVE)
-    assert e.table.read("R6:0.LEN") == 3 and words(e, "N7", 10, 3) == [1, 2, 3]
-    assert e.table.file("N7").size == 13  # the file was grown for 3 elements, and 3 were written
+def test_fal_length_and_position_operands_are_what_a_download_writes():
+    # the first pass starts at the downloaded POS; the false rung after it resets POS to 0
+    text = "XIC B3/0 FAL R6:0 5 2 ALL #N7:10 #N7:0"
+    e, _ = drive(text, ({}, 1), values=FIVE)
+    assert control(e) == {"LEN": 5, "POS": 2}
+    e, _ = drive(text, (ON, 1), values=FIVE)
+    assert words(e, "N7", 10, 5) == [0, 0, 3, 4, 5] and control(e)["DN"] == 1
+    e, _ = drive(text, (ON, 1), (OFF, 1), (ON, 1), values=FIVE)
+    assert words(e, "N7", 10, 5) == [1, 2, 3, 4, 5]
+    # the instruction works from the control's LEN, which the program may change
+    e, _ = drive("XIC B3/0 FAL R6:0 5 0 ALL #N7:10 #N7:0", ({"R6:0.LEN": 2, "B3/0": 1}, 1), values=FIVE)
+    assert words(e, "N7", 10, 5) == [1, 2, 0, 0, 0] and control(e) == {"EN": 1, "DN": 1, "LEN": 2, "POS": 2}
+    e, _ = drive("XIC B3/0 FAL R6:0 5 0 ALL #N7:10 #N7:0", ({"R6:0.LEN": -1, "B3/0": 1}, 1), values=FIVE)
+    assert control(e)["ER"] == 1 and words(e, "N7", 10, 5) == [0] * 5
+    # a LEN past the end of the files the load grew: major fault 20 at the first element outside
+    e, r = drive("XIC B3/0 FAL R6:0 5 0 ALL #N7:10 #N7:0", ({"R6:0.LEN": 8, "B3/0": 1}, 1), values=FIVE)
+    assert e.fault.code == r.fault.code == S.FAULT_INDIRECT_RANGE and e.table.read("R6:0.POS") == 5
 
 
 def test_fal_and_fsc_rung_syntaxes_give_the_same_program_and_results():
@@ -292,6 +305,17 @@ def test_ave_result_too_big_for_its_word_sets_er_and_overflow():
 def test_ave_file_past_its_end_is_a_major_fault():
     e, _ = drive("DATA N9 3\nAVE #N[N7:0]:0 N7:5 R6:0 5 0", ({}, 1), values={"N7:0": 9})
     assert e.fault.code == S.FAULT_BLOCK_RANGE
+    e, _ = drive("XIC B3/0 AVE #N7:0 N7:5 R6:0 5 0", ({"R6:0.LEN": 7, "B3/0": 1}, 1))
+    assert e.fault.code == S.FAULT_BLOCK_RANGE
+
+
+def test_ave_std_srt_work_from_the_control_len():
+    values = {"N7:0": 4, "N7:1": 2, "N7:2": 9}
+    e, _ = drive("XIC B3/0 AVE #N7:0 N7:5 R6:0 3 0\nXIC B3/0 SRT #N7:0 R6:1 3 0",
+                 ({"R6:0.LEN": 2, "R6:1.LEN": 2, "B3/0": 1}, 1), values=values)
+    assert e.table.read("N7:5") == 3 and words(e, "N7", 0, 3) == [2, 4, 9]
+    e, _ = drive("XIC B3/0 AVE #N7:0 N7:5 R6:0 3 0", ({"R6:0.LEN": 0, "B3/0": 1}, 1), values=values)
+    assert control(e) == {"EN": 1, "ER": 1}
 
 
 def test_std_is_the_sample_standard_deviation():

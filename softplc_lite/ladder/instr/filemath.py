@@ -16,17 +16,24 @@ position 3. How many elements a scan does is the mode:
 - a number N: N elements a scan from the transition on, on every scan
   until the file is done, whatever the rung does meanwhile.
 
+The Length and Position operands are what a download writes into the
+control's LEN and POS (``initial``, as for shift registers); at run time the
+instructions work from the control's words, so a program may change them.
+
 Control bits: EN follows the rung; EU is set while an operation is under
 way (started, not done); DN when the last element is done; ER when a
 FAL store overflows (the operation stops at that element). FSC sets FD
 and IN on a true comparison and stops there; the program clears IN to go
 on. A false rung resets a finished or stopped operation (DN, ER, FD, IN
-cleared, POS 0); one under way (EU) is left to go on.
+cleared, POS 0); one under way (EU) is left to go on. A new operation
+starts at POS: 0 after that reset, or what the download or the program
+wrote.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from ...datatable import Address
 from ..ast import Instruction, SymbolRef, address_refs
@@ -60,13 +67,12 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
     and IN); ``clears_stop`` says whether a stop ends the operation (FAL's
     ER does; FSC's find only pauses it until the program clears IN)."""
     control = access.location(instr.operands[0])
-    length = instr.operands[1].value
     mode = file_mode(instr.operands[3])
     per_scan = None if mode == ALL else 1 if mode == INC else mode
     s = access.machine.s
 
     def work(d, i: int, w: int) -> int:
-        p = d[i + 2]
+        p, length = d[i + 2], d[i + 1]
         if w & R_FD:  # FSC resuming after a find: the found element is behind it
             w = _clear(w, R_FD)
             p += 1
@@ -85,7 +91,7 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
             if budget is not None:
                 budget -= 1
         if p < 0 or p > length:
-            # A position the program wrote outside the file (softplc choice: ER, nothing done).
+            # A length or position the program wrote outside the file (softplc choice: ER, nothing done).
             return _clear(w | R_ER, R_EU)
         d[i + 2] = p
         if p == length:
@@ -94,15 +100,13 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
 
     def run(c: bool) -> bool:
         d, i, _ = control()
-        d[i + 1] = length
         w = d[i]
         if c:
             first = not w & R_EN
             w |= R_EN
             if first and not w & R_EU:
-                # A new operation: from element 0, last run's bits cleared.
+                # A new operation, from POS, with the last one's bits cleared.
                 w = _clear(w, _FINISHED) | R_EU
-                d[i + 2] = 0
             busy = w & R_EU and not w & (R_IN | R_ER)
             if busy and (mode != INC or first):
                 w = work(d, i, w)
@@ -111,7 +115,7 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
             if w & R_EU:
                 if isinstance(mode, int) and not w & (R_IN | R_ER):
                     w = work(d, i, w)  # numeric mode goes on whatever the rung does
-            elif w & _FINISHED or d[i + 2]:
+            elif w & _FINISHED:
                 w = _clear(w, _FINISHED)
                 d[i + 2] = 0
         d[i] = w
@@ -169,24 +173,24 @@ def _statistic(compute):
     def bind(instr: Instruction, access):
         source = access.location(instr.operands[0])
         control = access.location(instr.operands[-3])
-        length = instr.operands[-2].value
         dest = access.location(instr.operands[1]) if len(instr.operands) == 5 else None
         machine = access.machine
 
         def run(c: bool) -> bool:
             d, i, _ = control()
-            d[i + 1] = length
-            w = d[i]
+            w, length = d[i], d[i + 1]
             if not c:
                 d[i] = _clear(w, R_EN | R_DN | R_ER)
                 d[i + 2] = 0
                 return False
             if w & R_EN:
                 return True  # done on the transition; nothing more while the rung stays true
-            fd, fi, _ = source()
-            block(fd, fi, length, str(instr.operands[0].address))
-            error = compute(machine, fd, fi, length, dest)
-            d[i + 2] = length
+            error = length < 1  # nothing to average or sort (softplc choice: ER)
+            if not error:
+                fd, fi, _ = source()
+                block(fd, fi, length, str(instr.operands[0].address))
+                error = compute(machine, fd, fi, length, dest)
+                d[i + 2] = length
             d[i] = w | R_EN | (R_ER if error else R_DN)
             return True
 
@@ -224,6 +228,20 @@ def _sort(machine, fd, fi, n, dest) -> bool:
     return False
 
 
+def _download(control: int, length: int, position: int):
+    """What a download writes: the length and position operands into the
+    control's LEN and POS (nothing for a control reached indirectly)."""
+
+    def initial(instr: Instruction) -> list[tuple[Address, int]]:
+        address = instr.operands[control].address
+        if not address.is_direct:
+            return []
+        return [(replace(address, member="LEN"), constant(instr, length)),
+                (replace(address, member="POS"), constant(instr, position))]
+
+    return initial
+
+
 def _file_references(instr: Instruction) -> list[Address]:
     length = constant(instr, len(instr.operands) - 2)
     return file_references(instr, 0, length if isinstance(length, int) else None)
@@ -241,18 +259,18 @@ INSTRUCTIONS = [
     BoundInstruction(
         _spec("FAL", "file arithmetic and logic", _CONTROL, _LENGTH, _POSITION, ("mode", K.FILE_MODE),
               ("dest", K.DEST), ("expression", K.EXPRESSION)),
-        _bind_fal, lambda instr: _indexed_references(instr, (4, 5))),
+        _bind_fal, lambda instr: _indexed_references(instr, (4, 5)), _download(0, 1, 2)),
     BoundInstruction(
         _spec("FSC", "file search and compare", _CONTROL, _LENGTH, _POSITION, ("mode", K.FILE_MODE),
               ("expression", K.EXPRESSION)),
-        _bind_fsc, lambda instr: _indexed_references(instr, (4,))),
+        _bind_fsc, lambda instr: _indexed_references(instr, (4,)), _download(0, 1, 2)),
     BoundInstruction(
         _spec("AVE", "file average", ("file", K.FILE), ("dest", K.DEST), _CONTROL, _LENGTH, _POSITION),
-        _statistic(_average), _file_references),
+        _statistic(_average), _file_references, _download(2, 3, 4)),
     BoundInstruction(
         _spec("STD", "file standard deviation", ("file", K.FILE), ("dest", K.DEST), _CONTROL, _LENGTH, _POSITION),
-        _statistic(_deviation), _file_references),
+        _statistic(_deviation), _file_references, _download(2, 3, 4)),
     BoundInstruction(
         _spec("SRT", "file sort (ascending)", ("file", K.FILE), _CONTROL, _LENGTH, _POSITION),
-        _statistic(_sort), _file_references),
+        _statistic(_sort), _file_references, _download(1, 2, 3)),
 ]
