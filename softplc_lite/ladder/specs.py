@@ -38,9 +38,6 @@ class K(Enum):
     FORMAT = "format index (integer or word address)"
     PARAM = "number, or word, float or STRING element"  # read by a conversion
     PARAM_OUT = "word, float or STRING element"  # written by a conversion
-    # shift registers and sequencers (ladder/instr/shift.py, sequencer.py)
-    BIT_LENGTH = "length 1..16000 bits"  # a bit array: at most a 1000-word file
-    POSITION = "position 0..1000"
     PARAM_COUNT = "input parameter count 0..40"  # JSR: how many of the parameters after it are inputs
     # shift registers and sequencers (ladder/instr/shift.py, sequencer.py)
     BIT_LENGTH = "length 1..16000 bits"  # a bit array: at most a 1000-word file
