@@ -380,6 +380,78 @@ def test_add_overflow_clamps_or_wraps_and_sets_the_minor_fault(run, overflow, re
     assert (e.table.read("S:102"), e.table.read("S:103"), e.table.read("S:104")) == (S.MINOR_CODE_OVERFLOW, 2, 1)
 
 
+def test_overflow_sets_plc5_minor_fault_s10_14_not_s17(run):
+    # PLC-5 status file (1785-6.5.14 appendix B): S:10 bit 14 is "arithmetic overflow".
+    e = run("ADD 32767 1 N7:0")
+    assert (e.table.read("S:10"), e.table.read("S:17")) == (1 << 14, 0)
+    e = run("MUL 300 300 N7:0\nDIV 1 0 N7:1")
+    assert e.table.read("S:10/14") == 1 and e.table.read("S:17") == 1 << S.MINOR_DIV_ZERO_BIT
+
+
+# -- one rule for integer constants: decimal is a value, hex 0x8000..0xFFFF a bit pattern ---------
+
+
+@pytest.mark.parametrize("overflow,decimal", [("clamp", 32767), ("wrap", -25536)])
+def test_mov_decimal_40000_overflows_like_70000(run, overflow, decimal):
+    e = run("MOV 40000 N7:0\nMOV 0x9C40 N7:1", settings=Settings(overflow=overflow))
+    assert (e.table.read("N7:0"), e.table.read("N7:1")) == (decimal, -25536)
+    e = run("MOV 40000 N7:0", settings=Settings(overflow=overflow))
+    assert "V" in flags(e) and minor_bits(e) == {"overflow"}
+    e = run("MOV 70000 N7:0", settings=Settings(overflow=overflow))
+    assert e.table.read("N7:0") == (32767 if overflow == "clamp" else 70000 - 65536) and "V" in flags(e)
+    e = run("MOV 0xFFFF N7:0\nMOV 65535 F8:0")
+    assert (e.table.read("N7:0"), e.table.read("F8:0"), flags(e)) == (-1, 65535.0, "")
+
+
+@pytest.mark.parametrize("text,column,message", [
+    ("AND N7:0 40000 N7:1", 10, "AND operand 2 (b): 40000 does not fit a 16-bit word (decimal -32768..32767); "
+                                "for the 16-bit pattern write 0x9C40"),
+    ("MEQ N7:0 65535 N7:1 OTE B3/0", 10, "MEQ operand 2 (mask): 65535 does not fit a 16-bit word (decimal "
+                                         "-32768..32767); for the 16-bit pattern write 0xFFFF"),
+    ("AND N7:0 70000 N7:1", 10, "AND operand 2 (b): 70000 does not fit a 16-bit word (decimal -32768..32767)"),
+    ("DATA N7 3 = 1 40000 3\nNOP", 1, "DATA N7: 40000 does not fit a 16-bit word (decimal -32768..32767); "
+                                      "for the 16-bit pattern write 0x9C40"),
+])
+def test_a_decimal_constant_a_word_cannot_hold_is_a_located_error(text, column, message):
+    from softplc_lite.ladder import ProgramErrors, load_text
+
+    with pytest.raises(ProgramErrors) as info:
+        load_text(text, source="demo.lad")
+    assert str(info.value.errors[0]) == f"demo.lad:1:{column}: {message}"
+
+
+def test_hex_bit_patterns_go_where_a_word_goes(run):
+    e = run("DATA N7 3 = 1 0x9C40 0xFFFF\nAND N7:1 0xFF00 N7:2\nMEQ N7:1 0x8000 0x8000 OTE B3/0")
+    assert [e.table.read(f"N7:{k}") for k in range(3)] == [1, -25536, -25600] and e.table.read("B3/0") == 1
+
+
+def test_constant_fits_says_what_a_store_will_do():
+    from softplc_lite.datatable import parse_address
+    from softplc_lite.ladder.ast import Const
+    from softplc_lite.ladder.validate import constant_fits
+
+    n7, f8 = parse_address("N7:0"), parse_address("F8:0")
+    assert constant_fits(Const(40000), n7) == "40000 cannot fit N7:0, it will be stored as 32767 with overflow"
+    assert constant_fits(Const(-40000), n7) == "-40000 cannot fit N7:0, it will be stored as -32768 with overflow"
+    assert constant_fits(Const(40000), n7, "wrap") == "40000 cannot fit N7:0, it will be stored as -25536 with overflow"
+    assert constant_fits(Const(40000, hex=True), n7) is None
+    assert constant_fits(Const(32767), n7) is None and constant_fits(Const(40000), f8) is None
+    assert constant_fits(Const(1.5), n7) is None
+
+
+def test_fmt_prints_hex_constants_in_hex():
+    from softplc_lite.ladder import load_text
+    from softplc_lite.ladder.fmt import format_program
+    from softplc_lite.ladder.parser import parse_program
+
+    text = "MOV 0xFFFF N7:0\nAND N7:0 0x00ff N7:1\nMOV 40000 N7:2\nMOV -0x10 N7:3\n"
+    printed = format_program(parse_program(text))
+    assert "MOV 0xFFFF N7:0" in printed and "AND N7:0 0xFF N7:1" in printed
+    assert "MOV 40000 N7:2" in printed and "MOV -16 N7:3" in printed
+    assert "MOV 0xFFFF N7:0" in format_program(load_text(text))  # validated: holds -1, still printed as written
+    assert parse_program(printed) == parse_program(text)
+
+
 def test_add_false_rung_leaves_dest_and_flags(run):
     e = run("XIC B3/0 ADD 32767 1 N7:0", values={"N7:0": 9})
     assert (e.table.read("N7:0"), flags(e), minor_bits(e)) == (9, "", set())
@@ -464,8 +536,8 @@ def test_neg(run, overflow, result, flag):
     assert (e.table.read("N7:0"), flags(e), minor_bits(e)) == (result, flag, {"overflow"})
 
 
-# SLC 500 / MicroLogix NEG (1747-RM001, 1761-6.3): carry is cleared if the source is 0 or the
-# result overflows, otherwise set.
+# SLC 500 / MicroLogix NEG (SLC 500 HHT manual 1747-PT1 ch. 20, MicroLogix 1000 user manual):
+# carry is cleared if the source is 0 or the result overflows, otherwise set.
 @pytest.mark.parametrize("source,result,flag", [(5, -5, "CS"), (-7, 7, "C"), (0, 0, "Z"), (32767, -32767, "CS"),
                                                 (-32768, 32767, "V")])
 def test_neg_sets_carry_unless_the_source_is_0_or_it_overflows(run, source, result, flag):
