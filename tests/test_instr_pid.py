@@ -298,21 +298,24 @@ def test_pid_closed_loop_is_identical_on_both_executors():
 # -- both executors on random loops -----------------------------------------------------------------
 
 words = st.integers(-32768, 32767)
+# Direct operands (the compiled path resolves them once) and indexed ones (resolved every scan);
+# N7:0 and N7:1 are 0, so both read the same words.
+RANDOM_PROGRAMS = ("PID N10:0 N11:0 N11:2 N11:1", "MOV 0 N10:22\nPID N10:[N7:0] N11:[N7:1] N11:2 N11:1")
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(w0=words, sp=st.integers(-100, 4200), p=st.integers(0, 1000), i=st.integers(0, 500),
        d=st.integers(0, 200), bias=st.integers(-500, 4095), lims=st.tuples(st.integers(0, 100), st.integers(0, 100)),
        db=st.integers(0, 300), update=st.integers(1, 30), scale=st.tuples(words, words),
        pvs=st.lists(st.integers(-200, 4300), min_size=1, max_size=12), tieback=st.integers(-10, 4200),
-       setout=st.integers(0, 100))
+       setout=st.integers(0, 100), program=st.sampled_from(RANDOM_PROGRAMS))
 def test_pid_executors_agree_on_random_gains_and_pv_sequences(w0, sp, p, i, d, bias, lims, db, update, scale,
-                                                            pvs, tieback, setout):
+                                                            pvs, tieback, setout, program):
     values = {**block(w0=w0, sp=sp, p=p, i=i, d=d, bias=bias, smax=scale[0], smin=scale[1], db=db,
                       setout=setout, lmax=max(lims), lmin=min(lims), update=update), "N11:2": tieback}
     tables = []
     for executor in EXECUTORS:
-        e = Engine(load_text("PID N10:0 N11:0 N11:2 N11:1"), executor=executor)
+        e = Engine(load_text(program), executor=executor)
         for k, v in values.items():
             e.table.write(k, v)
         e.set_mode(Mode.RUN)
