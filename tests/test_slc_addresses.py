@@ -104,3 +104,14 @@ def test_softplc_address_prints_the_slc_form(capsys):
     out = capsys.readouterr().out.splitlines()
     assert out[0].split("\t")[:3] == ["I:1.0/3", "I:1.0/3", "bit"]
     assert out[1].split("\t")[:3] == ["O:2.1", "O:2.1", "word"]
+
+
+def test_a_decimal_bit_in_the_plc5_form_suggests_the_slc_form():
+    with pytest.raises(AddressError, match=r"octal.*SLC address names the slot and word, decimal: I:1\.0/8"):
+        parse_address("I:1/8")
+
+
+def test_a_file_operand_keeps_its_slc_form_through_validation():
+    program = load_text("COP #I:1.0 #N7:0 2\n")
+    source = program.main.rungs[0].elements[0].operands[0].address
+    assert str(source) == "I:1.0" and not source.indexed

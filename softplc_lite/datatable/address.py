@@ -389,7 +389,8 @@ def _number(sc: _Scanner, what: str, octal: bool, limit: int) -> int:
     if octal:
         bad = next((d for d in digits if d in "89"), None)
         if bad:
-            raise sc.error(f"I/O {what}s are octal; '{bad}' is not an octal digit in '{digits}'", pos)
+            hint = " (an SLC address names the slot and word, decimal: I:1.0/8)" if what == "bit number" else ""
+            raise sc.error(f"I/O {what}s are octal; '{bad}' is not an octal digit in '{digits}'{hint}", pos)
         value = _to_int(digits, 8)
     else:
         value = _to_int(digits)

@@ -201,7 +201,7 @@ class _Checker:
             return None
         if kind in (K.FILE, K.FILE_SOURCE, K.WORD_FILE) and a.indexed:
             # '#' marks a file operand here (PLC-5 file instructions), not indexing.
-            return AddressRef(Address(a.type_letter, a.file, a.element, a.member, a.bit, False), resolved.pos)
+            return AddressRef(replace(a, indexed=False), resolved.pos)  # keeps an SLC address's form
         return resolved
 
     def file_mode(self, instr: Instruction, index: int, operand: Operand) -> Operand | None:
