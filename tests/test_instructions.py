@@ -433,7 +433,8 @@ def test_constant_fits_says_what_a_store_will_do():
     n7, f8 = parse_address("N7:0"), parse_address("F8:0")
     assert constant_fits(Const(40000), n7) == "40000 cannot fit N7:0, it will be stored as 32767 with overflow"
     assert constant_fits(Const(-40000), n7) == "-40000 cannot fit N7:0, it will be stored as -32768 with overflow"
-    assert constant_fits(Const(40000), n7, "wrap") == "40000 cannot fit N7:0, it will be stored as -25536 with overflow"
+    wrapped = constant_fits(Const(40000), n7, "wrap")
+    assert wrapped == "40000 cannot fit N7:0, it will be stored as -25536 with overflow"
     assert constant_fits(Const(40000, hex=True), n7) is None
     assert constant_fits(Const(32767), n7) is None and constant_fits(Const(40000), f8) is None
     assert constant_fits(Const(1.5), n7) is None

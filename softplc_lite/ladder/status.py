@@ -7,7 +7,8 @@ ARITH_FLAGS = 0  # S:0  bit 0 carry, 1 overflow, 2 zero, 3 sign
 CARRY, OVERFLOW, ZERO, SIGN = 0, 1, 2, 3
 PROCESSOR_STATUS = 1  # S:1
 FIRST_PASS_BIT = 15  # S:1/15
-FREE_RUNNING_CLOCK = 4  # S:4 SLC 500 free-running clock, 10 ms per count (PLC-5's S:3..S:6 hold a DH+ table softplc has not)
+# S:4: SLC 500's free-running clock, 10 ms per count (PLC-5's S:3..S:6 hold a DH+ table softplc has not)
+FREE_RUNNING_CLOCK = 4
 FREE_RUNNING_CLOCK_MS = 10
 LAST_SCAN_MS = 8  # S:8
 MAX_SCAN_MS = 9  # S:9

@@ -67,7 +67,8 @@ class StatusBar:
             minor = e.s[S.MINOR_FAULT_BITS]
             overflow = e.s[S.PLC5_MINOR_FAULT_BITS] >> S.MINOR_OVERFLOW_BIT & 1  # PLC-5's overflow bit S:10/14
             if minor or overflow:
-                shown = (["S:10/14 overflow"] if overflow else []) + ([f"S:17={minor & 0xFFFF:#06x}"] if minor else [])
+                shown = ["S:10/14 overflow"] if overflow else []
+                shown += [f"S:17={minor & 0xFFFF:#06x}"] if minor else []
                 second.append(f" minor faults {' '.join(shown)} code {e.s[S.MINOR_FAULT_CODE]}", style="yellow")
         if s.message:
             second.append(f" {s.message}", style="cyan")
