@@ -83,6 +83,43 @@ def test_pid_isa_gains_use_controller_gain_reset_and_rate_minutes(executor):
 
 
 @pytest.mark.parametrize("executor", EXECUTORS)
+def test_pid_feed_forward_bias_is_added_to_the_output(executor):
+    # Kp = 1, E = 100, bias (word 6) 500 -> 600; a negative bias can pull the output to 0
+    e = start(executor, sp=2000, p=100, bias=500, pv=1900)
+    assert cv(e) == 600
+    e = start(executor, sp=2000, p=100, bias=-500, pv=1900)
+    assert (cv(e), bit(e, 10)) == (0, 1)
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_pid_isa_reset_time_zero_means_no_integral(executor):
+    # ISA, Kc = 1, Ti = 0: three updates (0, 0.1, 0.2 s) with E = 100 all give P = 100
+    e = start(executor, w0=PE, sp=2000, p=100, i=0, pv=1900)
+    update(e, scans=20)
+    assert cv(e) == 100
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_pid_pv_outside_0_to_4095_is_used_as_the_nearest_end(executor):
+    e = start(executor, sp=100, p=100, pv=-300)  # used as 0: E = 100
+    assert (cv(e), e.table.read("N10:14")) == (100, 0)
+    e = start(executor, w0=CA, sp=4000, p=100, pv=5000)  # used as 4095: E = PV - SP = 95
+    assert (cv(e), e.table.read("N10:14")) == (95, 4095)
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_pid_scaled_dead_band_and_reversed_scale(executor):
+    # Smin 0, Smax 100 units: DB 2 units = 81.9 counts. SP 50 units = 2047.5 counts.
+    e = start(executor, w0=SC, sp=50, p=100, db=2, smax=100, smin=0, pv=2100)
+    assert (cv(e), bit(e, 8), e.table.read("N10:15")) == (0, 0, -1)  # E = -52.5 counts, -1.28 units
+    update(e, pv=2000)  # E = +47.5: crossed zero, inside 81.9 counts
+    assert (cv(e), bit(e, 8)) == (0, 1)
+    # Smin 100, Smax 0 (reversed): SP 25 units = (25 - 100) / (-100 / 4095) = 3071.25 counts
+    e = start(executor, w0=SC, sp=25, p=100, smax=0, smin=100, pv=3000)
+    assert (cv(e), e.table.read("N10:14")) == (71, 27)
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
 def test_pid_control_action_bit_chooses_pv_minus_sp(executor):
     # Kp = 1: CA clear, E = SP - PV = -1000 -> output 0 (OLL); CA set, E = PV - SP = 1000 -> 1000
     e = start(executor, sp=2000, p=100, pv=3000)
