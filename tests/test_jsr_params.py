@@ -378,3 +378,19 @@ def test_jsr_programs_with_parameterless_subroutines_still_load(app):
     loaded = load_app(Path(__file__).resolve().parent.parent / "programs" / app)
     assert any(ins.mnemonic == "JSR" for f in loaded.program.files.values() for r in f.rungs
                for ins in walk(r.elements))
+
+
+def test_jsr_symbols_and_structure_members_as_parameters(run):
+    text = ("SYMBOL Level N7:0\nSYMBOL Result F8:3\nJSR 3 2 Level T4:0.ACC Result\nFILE 3\n"
+            "SBR N10:0 C5:0.PRE\nCPT F8:0 \"N10:0 / C5:0.PRE\"\nRET F8:0")
+    e = run(text, values={"N7:0": 9, "T4:0.ACC": 4})
+    assert read(e, "N10:0", "C5:0.PRE", "F8:3") == (9, 4, 2.0)  # 9 / 4 on words: a word result, rounded
+
+
+def test_jsr_a_ninth_nested_call_faults_with_slc_depth_eight(run):
+    # SLC 5/02 and later nest eight levels (1747-RM001, Nesting Subroutine Files)
+    text = "JSR 3 1 0\nFILE 3\nSBR N7:0\nADD N7:0 1 N7:0\nLES N7:0 N7:1 JSR 3 1 N7:0"
+    ok = run(text, values={"N7:1": 8}, settings=Settings(jsr_depth=8))
+    assert ok.mode is Mode.RUN and ok.table.read("N7:0") == 8
+    over = run(text, values={"N7:1": 9}, settings=Settings(jsr_depth=8))
+    assert over.mode is Mode.FAULTED and over.fault.code == S.FAULT_JSR_NESTING and over.table.read("N7:0") == 8
