@@ -1,5 +1,5 @@
-"""Sequencers (ladder/instr/sequencer.py): SQO, SQI, SQL on both
-executors. docs/instructions.md cites the AB section of each rule."""
+"""Sequencers (ladder/instr/sequencer.py): SQO, SQI, SQL and SLC's SQC
+on both executors. docs/instructions.md cites the AB section of each rule."""
 
 from __future__ import annotations
 
@@ -183,6 +183,31 @@ def test_sql_with_a_source_file_and_dn_at_the_last_step(engine):
     assert (e.table.read("N7:1"), e.table.read("N7:2"), state(e)) == (5, 6, (2, "DN"))
 
 
+# -- SQC (SLC 500) ----------------------------------------------------------------------------
+
+
+def test_sqc_steps_like_sqo_and_sets_fd_when_the_masked_source_matches(engine):
+    e = engine("XIC B3/0 SQC #N7:0 0x00FF I:0.0 R6:0 2 0", {"N7:1": 0x0012, "N7:2": 0x0034, "I:0.0": 0x7712})
+    e.table.write("B3/0", 1)
+    e.scan()
+    assert e.table.read("R6:0/FD") == 1 and state(e) == (1, "EN")
+    e.table.write("I:0.0", 0x0013)  # assessed at every true evaluation, without stepping
+    e.scan()
+    assert e.table.read("R6:0/FD") == 0 and state(e) == (1, "EN")
+    e.table.write("B3/0", 0)
+    e.scan()
+    e.table.write("I:0.0", 0x0034)
+    pulse(e)
+    assert e.table.read("R6:0/FD") == 1 and state(e) == (2, "DN")
+
+
+def test_sqc_bad_position_sets_er_and_leaves_fd(engine):
+    e = engine("XIC B3/0 SQC #N7:0 0x00FF I:0.0 R6:0 2 0")
+    e.table.write("R6:0", {"POS": 3, "FD": 1})
+    pulse(e)
+    assert state(e) == (3, "ER") and e.table.read("R6:0/FD") == 1
+
+
 # -- syntax and validation ------------------------------------------------------------------
 
 
@@ -217,13 +242,14 @@ PROGRAM = """XIC B3/0 SQO #N7:0 #N7:10 N7:30 R6:0 5 0
 XIC B3/1 SQI #N7:0 0x00FF N7:31 R6:0 5 0 OTE B3/8
 XIC B3/2 SQL #N7:20 N7:30 R6:1 3 1
 XIO B3/3 SQO #N7:20 0xFFFF #N7:40 R6:2 3 0
+XIC B3/3 SQC #N7:0 0x0F0F N7:31 R6:3 4 0
 ADD N7:31 3 N7:31
 """
 
 
 @settings(max_examples=40, deadline=None)
 @given(st.lists(st.integers(0, 15), min_size=1, max_size=40))
-def test_sqo_sqi_sql_executors_agree_on_random_rung_states(states):
+def test_sqo_sqi_sql_sqc_executors_agree_on_random_rung_states(states):
     tables = []
     for executor in EXECUTORS:
         e = Engine(load_text(PROGRAM), executor=executor)

@@ -1,4 +1,5 @@
-"""Sequencers: SQO (output), SQI (input), SQL (load).
+"""Sequencers: SQO (output), SQI (input), SQL (load), and SLC 500's SQC
+(compare).
 
 A sequencer file holds one word per step, from position 0 (the startup
 step) to position LEN; the control (R) element keeps LEN and POS. On a
@@ -6,7 +7,9 @@ false-to-true transition SQO and SQL step POS on (LEN wraps to 1) and
 act on the word at POS; while the rung stays true they act on it again
 each scan without stepping (PLC-5 1785 user manual, "Sequencer
 Instructions"). SQI compares without stepping: it usually shares its
-control with an SQO.
+control with an SQO. SQC (SLC 500) steps like SQO and sets FD when the
+masked source matches the step word (1747-RM001 "Application Specific
+Instructions").
 
 A mask, source or destination written as a file (``#N7:30``) steps
 through its own file with POS, as the sequencer file does; written as a
@@ -27,7 +30,7 @@ from typing import Callable
 from ...datatable import Address
 from ..ast import AddressRef, Instruction
 from ..bound import BoundInstruction, block, constant
-from ..semantics import R_DN, R_EN, R_ER, signed16
+from ..semantics import R_DN, R_EN, R_ER, R_FD, signed16
 from ..specs import K, _spec
 from .shift import LEN, POS, control_words
 
@@ -133,6 +136,36 @@ def _bind_input(instr: Instruction, access):
     return run
 
 
+def _bind_compare(instr: Instruction, access):
+    """SQC file mask source control length position (SLC 500): steps like
+    SQO; FD says whether the masked source equals the masked step word,
+    assessed at each evaluation on a true rung."""
+    file = _stepping(access, _as_file(instr.operands[0]))
+    mask = _stepping_value(access, instr.operands[1])
+    source = _stepping_value(access, instr.operands[2])
+    get_control = access.location(instr.operands[3])
+
+    def run(c: bool) -> bool:
+        d, i, _ = get_control()
+        w = d[i]
+        if not c:
+            d[i] = w & ~R_EN
+            return c
+        n, pos = d[i + LEN], d[i + POS]
+        if _bad(n, pos):
+            d[i] = w | R_EN | R_ER
+            return c
+        w &= ~R_ER
+        if not w & R_EN:
+            w, pos = _step(d, i, w)
+        fd, fi = file(pos, n)
+        m = mask(pos, n)
+        found = (source(pos, n) & m) == (fd[fi] & m)
+        d[i] = (w | R_EN | R_FD) if found else (w | R_EN) & ~R_FD
+        return c
+    return run
+
+
 def _bind_load(instr: Instruction, access):
     """SQL file source control length position."""
     file = _stepping(access, _as_file(instr.operands[0]))
@@ -190,11 +223,14 @@ SQO = _spec("SQO", "sequencer output", True, ("file", K.WORD_FILE), ("mask", K.I
             ("control", K.CONTROL), ("length", K.LENGTH), ("position", K.POSITION))
 SQI = _spec("SQI", "sequencer input", False, ("file", K.WORD_FILE), ("mask", K.INT_SOURCE),
             ("source", K.INT_SOURCE), ("control", K.CONTROL), ("length", K.LENGTH), ("position", K.POSITION))
+SQC = _spec("SQC", "sequencer compare", True, ("file", K.WORD_FILE), ("mask", K.INT_SOURCE),
+            ("source", K.INT_SOURCE), ("control", K.CONTROL), ("length", K.LENGTH), ("position", K.POSITION))
 SQL = _spec("SQL", "sequencer load", True, ("file", K.WORD_FILE), ("source", K.INT_SOURCE), ("control", K.CONTROL),
             ("length", K.LENGTH), ("position", K.POSITION))
 
 INSTRUCTIONS = [
     BoundInstruction(SQO, _bind_output, _references((0, 1, 2), 4), lambda instr: control_words(instr, 3, 4, 5)),
     BoundInstruction(SQI, _bind_input, _references((0, 1, 2), 4), lambda instr: control_words(instr, 3, 4, 5)),
+    BoundInstruction(SQC, _bind_compare, _references((0, 1, 2), 4), lambda instr: control_words(instr, 3, 4, 5)),
     BoundInstruction(SQL, _bind_load, _references((0, 1), 3), lambda instr: control_words(instr, 2, 3, 4)),
 ]
