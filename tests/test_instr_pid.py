@@ -175,6 +175,11 @@ def test_pid_deadband_is_entered_at_the_zero_crossing(executor):
     assert (cv(e), bit(e, 8)) == (20, 1)  # still inside: held
     update(e, pv=1900)
     assert (cv(e), bit(e, 8)) == (100, 0)  # out of the band: computed again
+    # An output alarm stays as it was while the output is held: Lmin 10 % (409.5 counts).
+    e = start(executor, sp=2000, p=100, db=50, lmin=10, pv=1980)
+    assert (cv(e), bit(e, 10)) == (20, 1)
+    update(e, pv=2010)
+    assert (cv(e), bit(e, 8), bit(e, 10)) == (20, 1, 1)
 
 
 @pytest.mark.parametrize("executor", EXECUTORS)

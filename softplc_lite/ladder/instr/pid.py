@@ -112,6 +112,7 @@ def compute(d: array, i: int, w0: int, last_sign: int, dt: float, pv: int | floa
             cd: array, ci: int) -> tuple[int, int]:
     """One loop update: writes words 14..20 and the control output
     ``cd[ci]``; returns word 0 (status bits set) and the error's sign code."""
+    alarms_before = w0 & (OLH | OLL)
     w0 &= ~_STATUS
     pv = _clamp(pv, 0, FULL_SCALE)
     sp = d[i + SP]
@@ -155,8 +156,9 @@ def compute(d: array, i: int, w0: int, last_sign: int, dt: float, pv: int | floa
         out = _clamp(raw, lo, hi)
         integral = out - proportional - bias
     elif in_deadband(err, band, w0, last_sign):
-        w0 |= EWD
-        hold = True  # the output does not change while in the dead band
+        # The output does not change while in the dead band, nor do its alarms.
+        w0 |= EWD | alarms_before
+        hold = True
         raw = out = 0.0
     else:
         step = ki * err * dt
