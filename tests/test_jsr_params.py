@@ -394,3 +394,17 @@ def test_jsr_a_ninth_nested_call_faults_with_slc_depth_eight(run):
     assert ok.mode is Mode.RUN and ok.table.read("N7:0") == 8
     over = run(text, values={"N7:1": 9}, settings=Settings(jsr_depth=8))
     assert over.mode is Mode.FAULTED and over.fault.code == S.FAULT_JSR_NESTING and over.table.read("N7:0") == 8
+
+
+def test_jsr_and_ret_compiled_code_names_only_allowed_names():
+    # the compiled path hands the JSR and the RET to the engine through one bound list, _calls
+    from test_compiler import ALLOWED, _names
+
+    from softplc_lite.ladder import Engine
+
+    engine = Engine(load_text(ADD_TWO + "XIC B3/0 RET 5\n"))
+    for number in (2, 3):
+        source = engine.files[number][0].source
+        assert not [n for n in _names(source) if not ALLOWED.match(n)]
+    assert "_jsr(3, _calls[0])" in engine.files[2][0].source
+    assert "return _calls[0]" in engine.files[3][0].source and "return _calls[1]" in engine.files[3][0].source
