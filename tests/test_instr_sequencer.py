@@ -96,11 +96,22 @@ def test_sqo_bad_length_or_position_sets_er_and_does_nothing(engine):
     e.table.write("R6:0", {"LEN": 0, "POS": 0})
     pulse(e)
     assert state(e) == (0, "ER")
-    e.table.write("R6:0", {"LEN": 4, "POS": 5})
+    e.table.write("R6:0", {"LEN": 4, "POS": 3})
     pulse(e)
-    assert state(e) == (5, "ER")
-    e.table.write("R6:0.POS", 4)
-    pulse(e)
+    assert state(e) == (4, "DN") and e.table.read("N7:20") == 8
+
+
+def test_sqo_position_past_the_length_is_wrapped_by_the_next_step(engine):
+    e = engine(SQO, STEPS)
+    e.table.write("B3/0", 1)
+    e.scan()
+    e.table.write("R6:0.POS", 9)  # written while the rung stays true: nothing until the next step
+    e.table.write("N7:20", 0)
+    e.scan()
+    assert state(e) == (9, "EN") and e.table.read("N7:20") == 0
+    e.table.write("B3/0", 0)
+    e.scan()
+    pulse(e)  # the next false-to-true transition wraps it to 1
     assert state(e) == (1, "") and e.table.read("N7:20") == 1
 
 
@@ -203,9 +214,9 @@ def test_sqc_steps_like_sqo_and_sets_fd_when_the_masked_source_matches(engine):
 
 def test_sqc_bad_position_sets_er_and_leaves_fd(engine):
     e = engine("XIC B3/0 SQC #N7:0 0x00FF I:0.0 R6:0 2 0")
-    e.table.write("R6:0", {"POS": 3, "FD": 1})
+    e.table.write("R6:0", {"POS": -1, "FD": 1})
     pulse(e)
-    assert state(e) == (3, "ER") and e.table.read("R6:0/FD") == 1
+    assert state(e) == (-1, "ER") and e.table.read("R6:0/FD") == 1
 
 
 # -- syntax and validation ------------------------------------------------------------------

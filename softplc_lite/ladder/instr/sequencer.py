@@ -18,8 +18,8 @@ Specific Instructions", sequencer TIP). ``#`` here marks a file, as it
 does for the sequencer file; it is not S:24 indexing.
 
 Length and Position are what a download writes into LEN and POS (see
-shift.py); ER is set for LEN <= 0, POS < 0 or POS > LEN, and then the
-instruction does nothing else.
+shift.py); ER is set for LEN <= 0 or POS < 0 (for SQI also POS > LEN),
+and then the instruction does nothing else.
 """
 
 from __future__ import annotations
@@ -36,7 +36,9 @@ from .shift import LEN, POS, control_words
 
 
 def _bad(n: int, pos: int) -> bool:
-    return n <= 0 or pos < 0 or pos > n
+    """ER for SQO, SQL, SQC (1747-RM001; the 1756-RM003 flow charts): a
+    position past LEN is not an error for them, the next step wraps it."""
+    return n <= 0 or pos < 0
 
 
 def _stepping(access, operand) -> Callable[[int, int], tuple]:
@@ -84,13 +86,10 @@ def _step(d, i: int, w: int) -> tuple[int, int]:
     return w, pos
 
 
-def _bind_output(instr: Instruction, access):
-    """SQO file mask dest control length position."""
-    file = _stepping(access, _as_file(instr.operands[0]))
-    mask = _stepping_value(access, instr.operands[1])
-    dest = _stepping(access, instr.operands[2])
-    get_control = access.location(instr.operands[3])
-
+def _stepper(get_control, act: Callable[[int, int, int], int]):
+    """The run of SQO, SQL and SQC: EN remembers the rung; a false-to-true
+    transition steps POS; on every true evaluation ``act(pos, n, status)``
+    does the instruction's work and returns the status word."""
     def run(c: bool) -> bool:
         d, i, _ = get_control()
         w = d[i]
@@ -104,36 +103,27 @@ def _bind_output(instr: Instruction, access):
         w &= ~R_ER
         if not w & R_EN:
             w, pos = _step(d, i, w)
-        fd, fi = file(pos, n)
-        m = mask(pos, n)
-        dd, di = dest(pos, n)
-        dd[di] = signed16((dd[di] & ~m) | (fd[fi] & m))
+        if pos <= n:  # a POS past LEN written while the rung stays true waits for the next step
+            w = act(pos, n, w)
         d[i] = w | R_EN
         return c
     return run
 
 
-def _bind_input(instr: Instruction, access):
-    """SQI file mask source control length position: true when the masked
-    source equals the masked step word at POS."""
+def _bind_output(instr: Instruction, access):
+    """SQO file mask dest control length position: dest = (dest AND NOT
+    mask) OR (step word AND mask)."""
     file = _stepping(access, _as_file(instr.operands[0]))
     mask = _stepping_value(access, instr.operands[1])
-    source = _stepping_value(access, instr.operands[2])
-    get_control = access.location(instr.operands[3])
+    dest = _stepping(access, instr.operands[2])
 
-    def run(c: bool) -> bool:
-        if not c:
-            return False
-        d, i, _ = get_control()
-        n, pos = d[i + LEN], d[i + POS]
-        if _bad(n, pos):
-            d[i] |= R_ER
-            return False
-        d[i] &= ~R_ER
+    def act(pos: int, n: int, w: int) -> int:
         fd, fi = file(pos, n)
         m = mask(pos, n)
-        return (source(pos, n) & m) == (fd[fi] & m)
-    return run
+        dd, di = dest(pos, n)
+        dd[di] = signed16((dd[di] & ~m) | (fd[fi] & m))
+        return w
+    return _stepper(access.location(instr.operands[3]), act)
 
 
 def _bind_compare(instr: Instruction, access):
@@ -143,52 +133,48 @@ def _bind_compare(instr: Instruction, access):
     file = _stepping(access, _as_file(instr.operands[0]))
     mask = _stepping_value(access, instr.operands[1])
     source = _stepping_value(access, instr.operands[2])
-    get_control = access.location(instr.operands[3])
 
-    def run(c: bool) -> bool:
-        d, i, _ = get_control()
-        w = d[i]
-        if not c:
-            d[i] = w & ~R_EN
-            return c
-        n, pos = d[i + LEN], d[i + POS]
-        if _bad(n, pos):
-            d[i] = w | R_EN | R_ER
-            return c
-        w &= ~R_ER
-        if not w & R_EN:
-            w, pos = _step(d, i, w)
+    def act(pos: int, n: int, w: int) -> int:
         fd, fi = file(pos, n)
         m = mask(pos, n)
-        found = (source(pos, n) & m) == (fd[fi] & m)
-        d[i] = (w | R_EN | R_FD) if found else (w | R_EN) & ~R_FD
-        return c
-    return run
+        return w | R_FD if (source(pos, n) & m) == (fd[fi] & m) else w & ~R_FD
+    return _stepper(access.location(instr.operands[3]), act)
 
 
 def _bind_load(instr: Instruction, access):
-    """SQL file source control length position."""
+    """SQL file source control length position: the source into the step
+    word."""
     file = _stepping(access, _as_file(instr.operands[0]))
     source = _stepping_value(access, instr.operands[1])
-    get_control = access.location(instr.operands[2])
 
-    def run(c: bool) -> bool:
-        d, i, _ = get_control()
-        w = d[i]
-        if not c:
-            d[i] = w & ~R_EN
-            return c
-        n, pos = d[i + LEN], d[i + POS]
-        if _bad(n, pos):
-            d[i] = w | R_EN | R_ER
-            return c
-        w &= ~R_ER
-        if not w & R_EN:
-            w, pos = _step(d, i, w)
+    def act(pos: int, n: int, w: int) -> int:
         fd, fi = file(pos, n)
         fd[fi] = signed16(source(pos, n))
-        d[i] = w | R_EN
-        return c
+        return w
+    return _stepper(access.location(instr.operands[2]), act)
+
+
+def _bind_input(instr: Instruction, access):
+    """SQI file mask source control length position: true when the masked
+    source equals the masked step word at POS. ER (and false) when LEN <= 0,
+    POS < 0 or POS > LEN (1756-RM003 SQI)."""
+    file = _stepping(access, _as_file(instr.operands[0]))
+    mask = _stepping_value(access, instr.operands[1])
+    source = _stepping_value(access, instr.operands[2])
+    get_control = access.location(instr.operands[3])
+
+    def run(c: bool) -> bool:
+        if not c:
+            return False
+        d, i, _ = get_control()
+        n, pos = d[i + LEN], d[i + POS]
+        if _bad(n, pos) or pos > n:
+            d[i] |= R_ER
+            return False
+        d[i] &= ~R_ER
+        fd, fi = file(pos, n)
+        m = mask(pos, n)
+        return (source(pos, n) & m) == (fd[fi] & m)
     return run
 
 
