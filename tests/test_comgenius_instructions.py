@@ -136,7 +136,7 @@ def test_check_warns_about_what_it_can_see_before_running(tmp_path, capsys):
     (tmp_path / "MODULES.LST").write_text("COMGENIUS\n")
     (tmp_path / "COMGENIUS.LST").write_text(STRINGS)
     (tmp_path / "main.lad").write_text("DATA ST9 1\nSTRPRINT ST9:0 1 F8:0 N7:0\nSTRSCAN R6:0 ST9:0 6 N7:0\n"
-                                       "STRSCAN R6:0 ST9:0 2 N7:0\nSTRPRINT ST9:0 7\nSTRPRINT ST9:0 N7:1 N7:0\n")
+                                       "STRSCAN R6:1 ST9:0 2 N7:0\nSTRPRINT ST9:0 7\nSTRPRINT ST9:0 N7:1 N7:0\n")
     assert main(["check", str(tmp_path)]) == 0
     err = capsys.readouterr().err.splitlines()
     where = str(tmp_path / "main.lad")
