@@ -178,3 +178,25 @@ def test_s4_follows_the_real_clock(executor):
     e.scan()
     steps = (e.table.read("S:4") - first) & 0xFFFF
     assert steps >= 5 and abs(steps - (e.clock.now_ms - first_ms) / 10) < 1
+
+
+def test_time_in_program_mode_is_not_timed(executor):
+    e = run_text("TON T4:0 0.01 100 0", scans=3, executor=executor)
+    assert e.table.read("T4:0.ACC") == 2
+    e.set_mode(Mode.PROGRAM)
+    e.run(50)  # 500 ms in PROGRAM: the ladder does not run
+    e.set_mode(Mode.RUN)
+    e.scan()
+    assert e.table.read("T4:0.ACC") == 3
+
+
+def test_a_restored_timing_timer_times_from_the_new_run(executor):
+    # A table saved while T4:0 was timing (a retentive snapshot): its stamp is a time of the old run.
+    old = run_text("TON T4:0 0.01 1000 0", scans=400, executor=executor, settings=Settings(scan_ms=13))
+    assert old.table.read("T4:0.ACC") == 518
+    table = DataTable()
+    table.assign(old.table)
+    e = Engine(load_text("TON T4:0 0.01 1000 0"), table=table, executor=executor, fresh=False)
+    e.set_mode(Mode.RUN)
+    e.scan()
+    assert e.table.read("T4:0.ACC") == 519  # one 10 ms scan, not the old stamp's distance to now

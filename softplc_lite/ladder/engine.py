@@ -27,7 +27,7 @@ from .compiler import RET, EndScan, address_fault, compile_file, describe
 from .errors import LadderError
 from .instr import BOUND
 from .interpreter import interpret_file
-from .semantics import Machine, MajorFault, Settings, source_units
+from .semantics import EN, STAMP, TT, Machine, MajorFault, Settings, source_units
 
 
 class Mode(enum.Enum):
@@ -337,6 +337,7 @@ class Engine:
             # SLC 500's free-running clock S:4 is cleared on entering an executing mode (1763-RM001).
             self.s[S.FREE_RUNNING_CLOCK] = 0
             self._clock_s4_ms = self.clock.now_ms
+            self._restamp_timers()
         for hook in self.mode_hooks:
             hook(self, old, mode)
 
@@ -362,6 +363,18 @@ class Engine:
                 hook(self, enabled)
             except Exception as exc:
                 self._hook_failed(hook, exc)
+
+    def _restamp_timers(self) -> None:
+        """Timers left timing (EN or TT on) when the ladder starts again, from
+        PROGRAM or from a restored table, time from now: the time in PROGRAM is
+        not timed, and a stamp from another run of the clock means nothing."""
+        now = self.clock.now_ms & STAMP
+        for f in self.table.files():
+            if f.ftype.letter == "T":
+                d = f.data
+                for i in range(0, len(d), f.ftype.words_per_element):
+                    if d[i] & (EN | TT):
+                        d[i] = (d[i] & ~STAMP) | now
 
     def _free_running_clock(self) -> None:
         """S:4 counts 10 ms steps of the engine's clock (simulated or real),
