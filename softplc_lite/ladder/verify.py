@@ -34,7 +34,8 @@ from .symbols import SymbolIndex, symbol_base
 _ELEMENT_KINDS = (K.TIMER, K.COUNTER, K.CONTROL)
 # Two instructions that share one element by design (AB: a counter counts up
 # and down; a FIFO or LIFO is loaded and unloaded through one control).
-_PAIRS = (frozenset({"CTU", "CTD"}), frozenset({"FFL", "FFU"}), frozenset({"LFL", "LFU"}))
+_PAIRS = (frozenset({"CTU", "CTD"}), frozenset({"FFL", "FFU"}), frozenset({"LFL", "LFU"}),
+          frozenset({"SQO", "SQI", "SQL"}))  # a sequencer checked by its SQI (1756-RM003)
 # Instructions that only mark a place in the program: a rung of these alone
 # has no output and needs none.
 _MARKERS = frozenset({"SBR", "LBL"})
