@@ -77,7 +77,7 @@ _BUILTIN = [
     _spec("ACN", "string concatenate", True, ("a", K.STRING), ("b", K.STRING), ("dest", K.STRING)),
     _spec("AEX", "string extract", True, ("source", K.STRING), ("index", K.INT_SOURCE),
           ("count", K.INT_SOURCE), ("dest", K.STRING)),
-    # AB order (1747-RM001 ASC): the string searched for, the start index, the string examined, the result
+    # AB order (1763-RM001 ASC): the string searched for, the start index, the string examined, the result
     _spec("ASC", "string search", True, ("source", K.STRING), ("index", K.INT_SOURCE),
           ("string_search", K.STRING), ("result", K.WORD)),
     _spec("ASR", "string compare", False, ("a", K.STRING), ("b", K.STRING)),
