@@ -274,3 +274,12 @@ def test_sqo_sqi_sql_sqc_executors_agree_on_random_rung_states(states):
         assert e.fault is None
         tables.append(dumps(e.table))
     assert tables[0] == tables[1]
+
+
+def test_sqi_on_the_control_of_its_sqo_is_no_check_warning():
+    from softplc_lite.ladder.verify import verify
+
+    shared = load_text("XIC B3/0 SQO #N7:0 0x0F N7:20 R6:0 3 0\nSQI #N7:10 0x0F I:0.0 R6:0 3 0 OTE B3/5")
+    assert verify(shared) == []
+    twice = load_text("XIC B3/0 SQO #N7:0 0x0F N7:20 R6:0 3 0\nXIC B3/1 SQO #N7:10 0x0F N7:21 R6:0 3 0")
+    assert ["also used by SQO" in str(w) for w in verify(twice)] == [True]
