@@ -12,10 +12,10 @@ time the instructions work from the control's words, so a program may
 change them, and a bad value sets ER instead of being refused at load.
 docs/instructions.md cites the AB section for each rule:
 
-- BSL/BSR: 1747-PT1 ch. 23 "Bit Shift, FIFO, and LIFO" (operation, UL,
-  wraparound), 1747-RM001 (control element), 1756-RM003 (a false rung
-  clears EN, DN and ER).
-- FFL/FFU/LFL/LFU: 1747-RM001 "FIFO and LIFO Instructions" and 1747-PT1
+- BSL/BSR: 1747-NP002 (the SLC 500 hand-held terminal manual) ch. 23
+  "Bit Shift, FIFO, and LIFO" (operation, UL, wraparound), 1747-RM001
+  (control element); a false rung clearing EN, DN and ER is our choice.
+- FFL/FFU/LFL/LFU: 1747-RM001 "FIFO and LIFO Instructions" and 1747-NP002
   ch. 23 (loading, unloading, DN full, EM empty, S:24).
 """
 
