@@ -243,3 +243,13 @@ def test_watch_break_condition_and_watch_list_take_longs():
     item = WatchItem("L9:0")
     item.sample(t)
     assert item.value == 40001
+
+
+def test_add_and_sub_into_a_long_carry_out_of_bit_31():
+    t = run_both("ADD L9:0 L9:1 L9:2\nADD L9:3 L9:1 L9:4\n", values={"L9:0": -1, "L9:1": 1, "L9:3": 0xFFFF})
+    assert t.read("L9:2") == 0 and t.read("L9:4") == 0x10000
+    assert t.read("S:0/0") == 0  # 0xFFFF + 1 carries out of 16 bits, not out of 32
+    t = run_both("ADD L9:0 L9:1 L9:2\n", values={"L9:0": -1, "L9:1": 1})
+    assert t.read("S:0/0") == 1 and t.read("S:0/2") == 1
+    t = run_both("SUB L9:0 L9:1 L9:2\n", values={"L9:0": 0x10000, "L9:1": 1})
+    assert t.read("L9:2") == 0xFFFF and t.read("S:0/0") == 0  # no borrow at 32 bits

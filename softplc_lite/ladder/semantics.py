@@ -196,13 +196,15 @@ class Machine:
     def add(self, a, b, d: array, i: int) -> None:
         carry = False
         if isinstance(a, int) and isinstance(b, int):
-            carry = (a & 0xFFFF) + (b & 0xFFFF) > 0xFFFF
+            mask = 0xFFFF if d.itemsize == 2 else 0xFFFFFFFF  # the carry out of an L element is bit 32's
+            carry = (a & mask) + (b & mask) > mask
         self.store(a + b, d, i, carry)
 
     def sub(self, a, b, d: array, i: int) -> None:
         carry = False
         if isinstance(a, int) and isinstance(b, int):
-            carry = (a & 0xFFFF) < (b & 0xFFFF)  # borrow
+            mask = 0xFFFF if d.itemsize == 2 else 0xFFFFFFFF
+            carry = (a & mask) < (b & mask)  # borrow
         self.store(a - b, d, i, carry)
 
     def div(self, a, b, d: array, i: int) -> None:
