@@ -218,6 +218,12 @@ def test_fal_and_fsc_mode_errors_are_located_and_name_the_choices():
         load_text('FSC R6:0 5 0 ALL "#N7:0 + 1"\nFAL R6:1 5 0 ALL #N7:10 "#N7:0 > 1"')
     assert "<program>:1:19: FSC needs a comparison" in str(info.value)
     assert "<program>:2:" in str(info.value)
+    # an unquoted expression in mnemonic text splits into operands: the error says to quote it
+    with pytest.raises(ProgramErrors) as info:
+        load_text("FAL R6:0 10 0 ALL #N7:10 #N7:0+5")
+    assert str(info.value) == ('<program>:1:1: FAL takes 6 operands (FAL control length position mode dest '
+                               'expression), got 7 (in mnemonic text an expression with operators is quoted: '
+                               '"N7:1 + 5")')
 
 
 # -- FSC -------------------------------------------------------------------------------------

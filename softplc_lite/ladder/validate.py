@@ -244,7 +244,10 @@ class _Checker:
                 return instr
             want = (f"{spec.min_operands}..{spec.max_operands}" if spec.optional else str(spec.max_operands))
             plural = "" if want == "1" else "s"
-            self.error(instr.pos, f"{spec.mnemonic} takes {want} operand{plural} ({spec.signature()}), got {n}")
+            # CPT N7:0 N7:1+5: the mnemonic form splits an unquoted expression into operands
+            quote = (' (in mnemonic text an expression with operators is quoted: "N7:1 + 5")'
+                     if n > spec.max_operands and any(o.kind is K.EXPRESSION for o in spec.operands) else "")
+            self.error(instr.pos, f"{spec.mnemonic} takes {want} operand{plural} ({spec.signature()}), got {n}{quote}")
             return instr
         operands = []
         for i, op in enumerate(instr.operands):
