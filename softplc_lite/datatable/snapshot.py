@@ -6,6 +6,11 @@ File format (little-endian throughout)::
     body    per file:  2s type letter(s)  u16 number  u32 elements  <data bytes>
     trailer u32 CRC-32 of header+body   "SPLCEND!"
 
+The data bytes are the file's array items, little-endian: 2 bytes a word
+(every word file, D and A included), 4 a float (F) or a long (L). The L, D
+and A files came later under the same version: an older softplc refuses a
+snapshot holding one as an unknown file type.
+
 A short file, a wrong length, a bad CRC or a missing trailer is reported as
 :class:`SnapshotError`; nothing half-read is ever returned.
 
