@@ -13,10 +13,10 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..gcpause import gc_paused
+from ..datatable import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, Address, AddressError, ValueKind, parse_address
 from ..datatable.errors import DataTableError
 from ..datatable.filetypes import LONG_MAX, LONG_MIN
 from ..datatable.table import word_from_text
-from ..datatable import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, Address, AddressError, ValueKind, parse_address
 from .ast import (
     MAIN_FILE,
     AddressRef,
