@@ -27,7 +27,7 @@ from rich.text import Text
 
 from .datatable import DataTable, DataTableError
 from .datatable.address import Address
-from .datatable.display import format_value
+from .datatable.display import format_read, format_value
 from .ladder.symbols import resolve_name
 
 _BLOCK = re.compile(r"#\s*(\S+)\s+([0-9]{1,6})$")
@@ -47,14 +47,15 @@ class Item:
 
     def read(self, table: DataTable) -> str:
         if self.count is None:
-            return format_value(table.read(self.address))
+            return format_read(table, self.address)
         return " ".join(format_value(v) for v in _block(table, self.address, self.count))
 
 
 def _block(table: DataTable, start: Address, count: int) -> Iterable[object]:
-    head, _, index = str(start).rpartition(":")  # parse_item made sure the element is a number
+    # parse_item made sure the element is a number; with_element keeps octal
+    # I/O numbers and SLC slot.word forms right (text arithmetic would not).
     for k in range(count):
-        yield table.read(f"{head}:{int(index) + k}")
+        yield table.read(start.with_element(start.element + k))
 
 
 def parse_item(label: str, value: object, where: str, symbols=None) -> Item:
@@ -70,7 +71,8 @@ def parse_item(label: str, value: object, where: str, symbols=None) -> Item:
         raise DataTableError(f"{where}: [display] {label} = {value!r}: {e}") from None
     if m:
         count = int(m.group(2))
-        if not 1 <= count <= 1000 or not str(address).rpartition(":")[2].isdigit():
+        whole_word = isinstance(address.element, int) and address.member is None and address.bit is None
+        if not 1 <= count <= 1000 or not whole_word or not address.is_direct:
             raise DataTableError(f"{where}: [display] {label} = {value!r}: a block is #FILE:ELEMENT LEN "
                                  "with LEN 1..1000, e.g. \"#N11:0 10\"")
         return Item(label, address, count)

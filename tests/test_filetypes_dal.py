@@ -253,3 +253,11 @@ def test_add_and_sub_into_a_long_carry_out_of_bit_31():
     assert t.read("S:0/0") == 1 and t.read("S:0/2") == 1
     t = run_both("SUB L9:0 L9:1 L9:2\n", values={"L9:0": 0x10000, "L9:1": 1})
     assert t.read("L9:2") == 0xFFFF and t.read("S:0/0") == 0  # no borrow at 32 bits
+
+
+def test_display_section_shows_d_and_a_text_forms():
+    from softplc_lite.display import parse_item
+
+    t = jsonio.table_from_json('{"D10": ["0042"], "A11": ["OK"]}')
+    assert parse_item("bcd", "D10:0", "softplc.toml").read(t) == "66 (BCD 0042)"
+    assert parse_item("text", "A11:0", "softplc.toml").read(t) == '20299 (ASCII "OK")'

@@ -115,3 +115,19 @@ def test_a_file_operand_keeps_its_slc_form_through_validation():
     program = load_text("COP #I:1.0 #N7:0 2\n")
     source = program.main.rungs[0].elements[0].operands[0].address
     assert str(source) == "I:1.0" and not source.indexed
+
+
+def test_display_blocks_of_slc_and_octal_io_words():
+    from softplc_lite.datatable import DataTable
+    from softplc_lite.display import parse_item
+
+    t = DataTable()
+    t.reference("I:2.1")
+    for k, v in enumerate((5, 6)):
+        t.write(f"I:2.{k}", v)
+    t.write("I:17", 7)
+    t.write("I:20", 8)
+    assert parse_item("slot 2", "#I:2.0 2", "softplc.toml").read(t) == "5 6"
+    assert parse_item("octal", "#I:17 2", "softplc.toml").read(t) == "7 8"  # I:17 then I:20 (octal)
+    with pytest.raises(Exception, match="a block is"):
+        parse_item("bad", "#T4:0.ACC 2", "softplc.toml")
