@@ -76,8 +76,12 @@ def test_a_member_the_element_lacks_is_a_clear_error_saying_where(text, message,
 def test_one_or_two_letters_before_a_slash_are_an_address_not_a_symbol():
     # The ladder lexer reads "In/3" as an address (file type IN), so every site does.
     symbols = {"In": SymbolDecl("In", parse_address("N7:0"))}
-    with pytest.raises(DataTableError, match="unknown file type 'IN'"):
+    with pytest.raises(DataTableError, match=r"unknown file type 'IN'.*\(In/3 reads as an address: one or two "
+                                             "letters and digits before '/' or ':' are one"):
         resolve_name("In/3", symbols)
+    with pytest.raises(DataTableError) as e:
+        resolve_name("In/3", {})  # no symbol In: the address error alone
+    assert "unknown file type 'IN'" in str(e.value) and "reads as an address" not in str(e.value)
     assert resolve_name("In", symbols) == parse_address("N7:0")
 
 

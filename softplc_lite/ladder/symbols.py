@@ -86,7 +86,15 @@ def resolve_name(text: str, symbols=None) -> Address:
     AddressError (SymbolError for a symbol problem) saying what is wrong."""
     text = text.strip()
     if not is_symbol_text(text):
-        return parse_address(text)
+        try:
+            return parse_address(text)
+        except AddressError as e:
+            base = symbol_base(text)
+            if base is None or index(symbols).get(base) is None:
+                raise
+            raise SymbolError(text, e.position, f"{e.reason} ({text} reads as an address: one or two letters "
+                              f"and digits before '/' or ':' are one, in a rung too; give symbol {base} a "
+                              "longer name to take its bits)") from None
     m = _SYMBOL_TEXT.fullmatch(text)
     name, offset, member, bit = m.groups()
     table = index(symbols)
