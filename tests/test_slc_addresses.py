@@ -131,3 +131,11 @@ def test_display_blocks_of_slc_and_octal_io_words():
     assert parse_item("octal", "#I:17 2", "softplc.toml").read(t) == "7 8"  # I:17 then I:20 (octal)
     with pytest.raises(Exception, match="a block is"):
         parse_item("bad", "#T4:0.ACC 2", "softplc.toml")
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_data_values_of_an_io_file_fill_consecutive_words(executor):
+    """DATA O0 10 = ...: value k goes to word k (O:0..O:11 octal), not to the text "O0:k"."""
+    t = run_text("DATA O0 10 = 1 2 3 4 5 6 7 8 9 10\n", 1, executor=executor).table
+    assert [t.read(f"O:{k:o}") for k in range(10)] == list(range(1, 11))
+    assert t.read("O:0.9") == 10  # SLC form of the same word

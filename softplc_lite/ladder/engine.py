@@ -18,7 +18,7 @@ import traceback
 from dataclasses import dataclass
 from typing import Callable
 
-from ..datatable import DataTable, DataTableError
+from ..datatable import DataTable, DataTableError, parse_address
 from ..datatable.errors import AddressRangeError
 from ..datatable.table import to_signed
 from . import status as S
@@ -146,7 +146,7 @@ def initial_values(program: Program, table: DataTable, problems: list | None = N
     for decl in program.data:
         letter = "ST" if decl.file.startswith("ST") else decl.file[:1]
         for k, v in enumerate(decl.values):
-            addr = f"{decl.file}:{k}"
+            addr = parse_address(f"{decl.file}:0").with_element(k)  # not text: O0 and I1 count in octal
             with _located(decl.pos, problems, f"DATA {decl.file} value {k + 1}: "):
                 if isinstance(v, int) and letter not in ("F", "L") and v > 32767:
                     table.write_word(addr, v)
