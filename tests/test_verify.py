@@ -117,3 +117,18 @@ def test_shipped_programs_have_no_warnings(name):
     p = subprocess.run([sys.executable, "-m", "softplc_lite", "check", str(ROOT / "programs" / name)], cwd=ROOT,
                        capture_output=True, text=True, timeout=120)
     assert p.returncode == 0 and "warning" not in p.stderr, p.stderr
+
+
+def test_ffl_with_ffu_on_one_control_is_the_fifo_pair_not_a_warning():
+    from softplc_lite.ladder.instructions import BUILTIN
+
+    if BUILTIN.lookup("FFL") is None or BUILTIN.lookup("FFU") is None:
+        pytest.skip("no FFL/FFU in the instruction table")
+    pair = "XIC B3/0 FFL N7:0 #N7:10 R6:0 5 0\nXIC B3/1 FFU #N7:10 N7:1 R6:0 5 0\n"
+    assert warnings(pair) == []
+    found = warnings(pair + "XIC B3/2 FFL N7:2 #N7:10 R6:0 5 0\n")
+    assert found == ["v.lad:3:10: FFL R6:0: R6:0 is also used by FFL at v.lad:1:10; two instructions driving one "
+                     "element overwrite each other's status bits and values"]
+    assert warnings("XIC B3/0 CTU C5:0 9 0\nXIC B3/1 CTD C5:0 9 0\nXIC B3/2 CTD C5:0 9 0\n") == [
+        "v.lad:3:10: CTD C5:0: C5:0 is also used by CTD at v.lad:2:10; two instructions driving one "
+        "element overwrite each other's status bits and values"]

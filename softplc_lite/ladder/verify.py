@@ -79,13 +79,16 @@ def verify(program: Program, instructions: InstructionSet = BUILTIN, parsed: Pro
             found.append(LadderError(ins.pos, f"OTE {address}: duplicate destructive bit, also written by "
                                      f"OTE at {writers[0].pos} (the last OTE in the scan decides)"))
     for address, users in elements.items():
-        mnemonics = [u.mnemonic for u in users]
-        if len(users) < 2 or (len(set(mnemonics)) == len(mnemonics) and any(set(mnemonics) <= p for p in _PAIRS)):
-            continue
-        for ins in users[1:]:
-            found.append(LadderError(ins.pos, f"{ins.mnemonic} {address}: {address} is also used by "
-                                     f"{users[0].mnemonic} at {users[0].pos}; two instructions driving "
-                                     "one element overwrite each other's status bits and values"))
+        seen: dict[str, Instruction] = {}
+        for ins in users:
+            # A second instruction of one mnemonic, or one that is not the first's pair, shares the element.
+            other = seen.get(ins.mnemonic) or next(
+                (u for m, u in seen.items() if not any({m, ins.mnemonic} <= p for p in _PAIRS)), None)
+            if other is not None:
+                found.append(LadderError(ins.pos, f"{ins.mnemonic} {address}: {address} is also used by "
+                                         f"{other.mnemonic} at {other.pos}; two instructions driving "
+                                         "one element overwrite each other's status bits and values"))
+            seen.setdefault(ins.mnemonic, ins)
     if parsed is not None:
         found += _unused_symbols(parsed, instructions, shown)
     return sorted(found, key=lambda e: (e.pos.source, e.pos.line, e.pos.column))
