@@ -261,3 +261,11 @@ def test_display_section_shows_d_and_a_text_forms():
     t = jsonio.table_from_json('{"D10": ["0042"], "A11": ["OK"]}')
     assert parse_item("bcd", "D10:0", "softplc.toml").read(t) == "66 (BCD 0042)"
     assert parse_item("text", "A11:0", "softplc.toml").read(t) == '20299 (ASCII "OK")'
+
+
+def test_logical_constants_stay_16_bit_and_sign_extend_against_a_long():
+    t = run_both("AND L9:0 0xFFFF L9:1\nAND L9:0 0x7FFF L9:2\n", values={"L9:0": 0x12345678})
+    assert t.read("L9:1") == 0x12345678  # 0xFFFF is the word -1: every bit set
+    assert t.read("L9:2") == 0x5678
+    with pytest.raises(ProgramErrors, match="16-bit"):
+        load_text("AND L9:0 0x12345678 L9:1\n")
