@@ -261,3 +261,10 @@ def test_every_bad_member_of_a_program_is_listed_at_once():
     with pytest.raises(ProgramErrors) as e:
         load_text(DECLS + "XIC PollTimer.XY OTE Reply.ZZ\n")
     assert [x.message.split(":")[0] for x in e.value.errors] == ["PollTimer is T4", "Reply is R6"]
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_symbol_members_in_cmp_in_both_syntaxes(executor):
+    program = DECLS + 'CMP "PollTimer.PRE > Levels[2]" OTE Flags/1\nCMP(PollTimer.PRE < Levels[2])OTE(Flags/2);\n'
+    engine = run_text(program, executor=executor, values={"T4:0.PRE": 9, "N7:12": 4})
+    assert engine.table.read("B3:2/1") == 1 and engine.table.read("B3:2/2") == 0
