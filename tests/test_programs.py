@@ -127,3 +127,21 @@ def test_modbus_scada_polls_two_slaves_and_reports_the_missing_one(executor):
         r.engine.scan()
     assert slave.unit(1).coils[:4] == [False] * 4
     r.engine.close()
+
+
+@pytest.mark.parametrize("executor", ["compiled", "reference"])
+def test_tank_pid_settles_at_its_setpoint(executor):
+    r = runner("tank", executor)
+    levels = []
+    r.run(1000, on_scan=lambda e: levels.append(e.table.read("N11:0")))
+    t = r.table
+    # Kp 2 and Ki = Kp / tau (tau = 2 s) cancel the tank's pole: a first-order
+    # closed loop with a 1 s time constant, sampled every 0.1 s. After 10 s the
+    # level is at the setpoint within 0.5 %; it never overshoots by 1 %.
+    assert abs(t.read("N11:0") - 2000) <= 10
+    assert max(levels) <= 2020 and levels[0] < 100
+    assert t.read("O:0/0") == 1 and 48.5 <= t.read("F8:1") <= 49.2
+    # 63 % of the step (1260 counts) about 1 s in, as the hand calculation says
+    first = next(k for k, v in enumerate(levels) if v >= 1260)
+    assert 90 <= first <= 140
+    assert r.engine.mode is Mode.RUN
