@@ -8,7 +8,8 @@ is never called unimplemented.
 
 Which families a mnemonic is in: the instruction lists of the PLC-5
 Instruction Set Reference (1785-6.1), the SLC 500 Instruction Set Reference
-(1747-RM001) and Logix5000 General Instructions (1756-RM003). A family is
+(1747-RM001), the MicroLogix references (1762-RM001, 1763-RM001) and
+Logix5000 General Instructions (1756-RM003). A family is
 marked only where we are sure of it; the message names the families marked.
 Motion, function-block-only and structured-text-only instructions are left
 out (they do not appear in ladder text exports of these processors).
@@ -16,7 +17,7 @@ out (they do not appear in ladder text exports of these processors).
 
 from __future__ import annotations
 
-P5, SLC, LGX = "PLC-5", "SLC 500", "Logix5000"
+P5, SLC, LGX, ML = "PLC-5", "SLC 500", "Logix5000", "MicroLogix"
 
 # mnemonic -> (title, families)
 AB_MNEMONICS: dict[str, tuple[str, tuple[str, ...]]] = {
@@ -30,8 +31,8 @@ AB_MNEMONICS: dict[str, tuple[str, tuple[str, ...]]] = {
     "OSF": ("one shot falling", (P5, LGX)),
     "CTUD": ("count up/down", (LGX,)),
     "HSC": ("high-speed counter", (SLC,)),
-    "RHC": ("read high-speed clock", (SLC,)),
-    "TDF": ("compute time difference", (SLC,)),
+    "RHC": ("read high-speed clock", (ML,)),
+    "TDF": ("compute time difference", (ML,)),
     # compare
     **{m: (t, (P5, SLC, LGX)) for m, t in (
         ("EQU", "equal"), ("NEQ", "not equal"), ("LES", "less than"), ("LEQ", "less than or equal"),
@@ -47,7 +48,7 @@ AB_MNEMONICS: dict[str, tuple[str, tuple[str, ...]]] = {
         ("COP", "file copy"), ("FLL", "file fill"), ("CPT", "compute"), ("XPY", "x to the power of y"),
         ("SIN", "sine"), ("COS", "cosine"), ("TAN", "tangent"), ("ASN", "arc sine"), ("ACS", "arc cosine"),
         ("ATN", "arc tangent"), ("LN", "natural log"), ("LOG", "log to the base 10"))},
-    "DDV": ("double divide", (P5, SLC)),
+    "DDV": ("double divide", (SLC,)),
     "ABS": ("absolute value", (SLC, LGX)),
     "MOD": ("modulo", (SLC, LGX)),
     "DEG": ("radians to degrees", (SLC, LGX)),
@@ -94,8 +95,9 @@ AB_MNEMONICS: dict[str, tuple[str, tuple[str, ...]]] = {
     "STE": ("selectable timed enable", (SLC,)),
     "INT": ("interrupt subroutine", (SLC,)),
     "JXR": ("jump to external routine", (LGX,)),
-    "FOR": ("for loop", (LGX,)),
-    "BRK": ("break", (LGX,)),
+    "FOR": ("for loop", (P5, LGX)),
+    "NXT": ("next, the end of a FOR loop", (P5,)),
+    "BRK": ("break", (P5, LGX)),
     "EVENT": ("trigger event task", (LGX,)),
     # I/O and communication
     "BTR": ("block transfer read", (P5,)),
