@@ -64,3 +64,21 @@ def opened():
     yield open_
     for port in ports:
         port.close()
+
+
+@pytest.fixture(params=("compiled", "reference"))
+def engine(request):
+    """engine(text, values=None) -> an Engine in RUN that has not scanned
+    yet, on each executor in turn (the bound instruction groups' tests)."""
+    from softplc_lite.ladder import Engine, Mode, load_text
+
+    def make(text: str, values: dict | None = None) -> Engine:
+        table = DataTable()
+        for address in values or {}:
+            table.reference(address)
+        e = Engine(load_text(text), table=table, executor=request.param)
+        for address, value in (values or {}).items():
+            e.table.write(address, value)
+        e.set_mode(Mode.RUN)
+        return e
+    return make

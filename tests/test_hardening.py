@@ -5,10 +5,8 @@ point (``softplc_lite.cli.main``) in-process, and a few run the real
 
 from __future__ import annotations
 
-import gc
 import subprocess
 import sys
-import threading
 from pathlib import Path
 
 import pytest
@@ -169,7 +167,7 @@ def test_every_stage_works_at_exactly_the_limits(tmp_path, capsys):
         code, out, err = run_cli(capsys, "run", str(app), "--fresh", "--scans", "2", "--executor", executor,
                                  "--set", "N7:1=-5", "--print", "N7:0", "--print", "N7:2", "--print", "S:12")
         # the subroutine recurses until the documented fault 30, never Python's recursion limit
-        assert code == cli.EXIT_FAULT and f"major fault 30" in err and f"more than {MAX_JSR_DEPTH} deep" in err
+        assert code == cli.EXIT_FAULT and "major fault 30" in err and f"more than {MAX_JSR_DEPTH} deep" in err
         assert out.splitlines() == ["N7:0 = 6", f"N7:2 = {-5 * (MAX_EXPRESSION_DEPTH + 1)}", "S:12 = 30"]
     for style in ("mnemonic", "neutral"):
         code, text, _ = run_cli(capsys, "fmt", "--style", style, str(app))

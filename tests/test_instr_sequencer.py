@@ -6,37 +6,11 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from softplc_lite.datatable import DataTable
+from instr_helpers import EXECUTORS, pulse
 from softplc_lite.datatable.jsonio import dumps
 from softplc_lite.ladder import Engine, Mode, ProgramErrors, load_text, run_text
 
-EXECUTORS = ("compiled", "reference")
 STEPS = {"N7:0": 0x0F0F, "N7:1": 0x0001, "N7:2": 0x0002, "N7:3": 0x0004, "N7:4": 0x0008}
-
-
-@pytest.fixture(params=EXECUTORS)
-def engine(request):
-    """engine(text, values=None) -> an Engine in RUN that has not scanned yet."""
-
-    def make(text: str, values: dict | None = None) -> Engine:
-        table = DataTable()
-        for address in values or {}:
-            table.reference(address)
-        e = Engine(load_text(text), table=table, executor=request.param)
-        for address, value in (values or {}).items():
-            e.table.write(address, value)
-        e.set_mode(Mode.RUN)
-        return e
-    return make
-
-
-def pulse(e: Engine, bit: str = "B3/0") -> Engine:
-    """One false-to-true transition: a scan true, then a scan false."""
-    e.table.write(bit, 1)
-    e.scan()
-    e.table.write(bit, 0)
-    e.scan()
-    return e
 
 
 def state(e: Engine, address: str = "R6:0") -> tuple[int, str]:

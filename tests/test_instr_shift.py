@@ -7,27 +7,10 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from softplc_lite.datatable import DataTable
+from instr_helpers import EXECUTORS
 from softplc_lite.datatable.jsonio import dumps
 from softplc_lite.ladder import Engine, Mode, ProgramErrors, load_text, run_text
 
-EXECUTORS = ("compiled", "reference")
-
-
-@pytest.fixture(params=EXECUTORS)
-def engine(request):
-    """engine(text, values=None) -> an Engine in RUN that has not scanned yet."""
-
-    def make(text: str, values: dict | None = None) -> Engine:
-        table = DataTable()
-        for address in values or {}:
-            table.reference(address)
-        e = Engine(load_text(text), table=table, executor=request.param)
-        for address, value in (values or {}).items():
-            e.table.write(address, value)
-        e.set_mode(Mode.RUN)
-        return e
-    return make
 
 
 def scan_with(e: Engine, **bits) -> Engine:

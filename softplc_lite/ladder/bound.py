@@ -138,6 +138,28 @@ class ReferenceAccess(Access):
     """The reference interpreter: every address resolved each time."""
 
 
+def unary_store(fn: Callable[[int | float], int | float], after: Callable[[Machine], None] | None = None):
+    """The bind of an instruction ``MNEM source dest`` that stores
+    ``fn(source)`` the way math instructions do (``Machine.store``: float
+    or word, overflow, S:0 flags) on a true rung; ``after(machine)`` may
+    adjust the flags an instruction sets differently (TOD resets S)."""
+
+    def bind(instr: Instruction, access: Access) -> Run:
+        source = access.value(instr.operands[0])
+        dest = access.location(instr.operands[1])
+        m = access.machine
+
+        def run(c: bool) -> bool:
+            if c:
+                d, i, _ = dest()
+                m.store(fn(source()), d, i)
+                if after is not None:
+                    after(m)
+            return c
+        return run
+    return bind
+
+
 def block(d: array, i: int, words: int, what: str) -> None:
     """A file operand of ``words`` words from index ``i``: a major fault
     when it runs past the end of its file (as COP and FLL)."""

@@ -18,7 +18,7 @@ docs/instructions.md has each rule with its source.
 
 from __future__ import annotations
 
-from ..bound import BoundInstruction, block, constant, file_references
+from ..bound import BoundInstruction, block, constant, file_references, unary_store
 from ..expr import FUNCTIONS
 from ..semantics import signed16
 from ..specs import K, _spec
@@ -27,31 +27,13 @@ from .. import status as S
 _TOD, _FRD = FUNCTIONS["TOD"], FUNCTIONS["FRD"]
 
 
-def _bind_tod(instr, access):
-    source = access.value(instr.operands[0])
-    dest = access.location(instr.operands[1])
-    m = access.machine
-
-    def run(c: bool) -> bool:
-        if c:
-            d, i, _ = dest()
-            m.store(_TOD(source()), d, i)
-            m.s[S.ARITH_FLAGS] &= ~(1 << S.SIGN)
-        return c
-    return run
+def _reset_sign(m) -> None:
+    m.s[S.ARITH_FLAGS] &= ~(1 << S.SIGN)
 
 
-def _bind_frd(instr, access):
-    source = access.value(instr.operands[0])
-    dest = access.location(instr.operands[1])
-    m = access.machine
-
-    def run(c: bool) -> bool:
-        if c:
-            d, i, _ = dest()
-            m.store(_FRD(source()), d, i)
-        return c
-    return run
+# TOD always resets S (the PLC-5 quick reference; docs/instructions.md).
+_bind_tod = unary_store(_TOD, after=_reset_sign)
+_bind_frd = unary_store(_FRD)
 
 
 def _bind_swp(instr, access):

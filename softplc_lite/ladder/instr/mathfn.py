@@ -19,9 +19,8 @@ docs/instructions.md has each rule with its source.
 
 from __future__ import annotations
 
-import math
 
-from ..bound import BoundInstruction
+from ..bound import BoundInstruction, unary_store
 from ..expr import FUNCTIONS
 from ..specs import K, _spec
 from .. import status as S
@@ -39,23 +38,6 @@ def set_overflow(m) -> None:
     the overflow itself (XPY's negative base, SCL's intermediate result)."""
     m.s[S.ARITH_FLAGS] |= 1 << S.OVERFLOW
     m.overflow_fault()
-
-
-def _function(name: str):
-    fn = FUNCTIONS[name]
-
-    def bind(instr, access):
-        source = access.value(instr.operands[0])
-        dest = access.location(instr.operands[1])
-        m = access.machine
-
-        def run(c: bool) -> bool:
-            if c:
-                d, i, _ = dest()
-                m.store(fn(source()), d, i)
-            return c
-        return run
-    return bind
 
 
 def _bind_xpy(instr, access):
@@ -163,7 +145,7 @@ def _bind_scp(instr, access):
 
 
 INSTRUCTIONS = [
-    *[BoundInstruction(_spec(name, title, True, ("source", K.SOURCE), ("dest", K.DEST)), _function(name))
+    *[BoundInstruction(_spec(name, title, True, ("source", K.SOURCE), ("dest", K.DEST)), unary_store(FUNCTIONS[name]))
       for name, title in _FUNCTIONS],
     BoundInstruction(_spec("XPY", "x to the power of y", True, ("a", K.SOURCE), ("b", K.SOURCE),
                            ("dest", K.DEST)), _bind_xpy),
