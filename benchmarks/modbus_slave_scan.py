@@ -28,7 +28,7 @@ and gives the share of ``DataTable.resolve`` (the general address resolver);
 and, without the profiler (``_common.sample_rounds``, GC paused), one lookup
 of the register loop's source ``N[N13:15]:[N13:11]`` (an indirect file
 number) against one of ``N12:[N13:13]`` (a fixed file), both as the compiled
-rungs resolve them (``compiler._resolver``: since the compiler's fast path
+rungs resolve them (``resolvers.resolver``: since the compiler's fast path
 takes an indirect file number too, both are fast-path lookups).
 """
 
@@ -344,9 +344,9 @@ def profile_serve(apps: Apps, transactions: int) -> dict:
 def bench_resolve(rounds: int) -> dict:
     """ns per call of the compiled code's address lookup for the register loop's source N[N13:15]:[N13:11]
     (the file number is indirect too) against its destination N12:[N13:13] (a fixed file), on the slave's own
-    table (``compiler._resolver``, what the rungs call; both now take the compiler's fast path)."""
+    table (``resolvers.resolver``, what the rungs call; both now take the compiler's fast path)."""
     from softplc_lite.datatable import parse_address
-    from softplc_lite.ladder.compiler import _resolver
+    from softplc_lite.ladder.resolvers import resolver as _resolver
 
     apps = Apps()
     s = wire_slave(apps, SCAN_BAUD, SCAN_QUIET_MS)

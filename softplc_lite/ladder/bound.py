@@ -68,7 +68,7 @@ class BoundInstruction:
 
 
 def _fault(address: Address, error: AddressRangeError) -> MajorFault:
-    from .compiler import address_fault
+    from .resolvers import address_fault
 
     return address_fault(address, error)
 

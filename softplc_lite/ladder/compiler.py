@@ -20,8 +20,7 @@ import re
 from dataclasses import dataclass, field
 
 from ..gcpause import gc_paused
-from ..datatable import Address, DataTable, ValueKind, bit_mask
-from ..datatable.errors import AddressRangeError, DataTableError
+from ..datatable import DataTable, ValueKind, bit_mask
 from ..datatable.filetypes import Storage
 from . import status as S
 from .ast import AddressRef, BinOp, Branch, Const, Element, Instruction, Program, Rung, UnaryOp, walk
@@ -29,6 +28,7 @@ from .bound import BoundAccess
 from .expr import namespace as expr_namespace
 from .expr import to_python
 from .instr import BOUND
+from .resolvers import resolver
 from .semantics import BASE_MS, Machine, MajorFault, lim, source_units
 
 RET = -1
@@ -53,11 +53,6 @@ def describe(instr: Instruction) -> str:
     from .fmt import format_instruction
 
     return f"{format_instruction(instr, 'mnemonic')} at {instr.pos}"
-
-
-def address_fault(addr: Address, error: AddressRangeError) -> MajorFault:
-    code = S.FAULT_INDIRECT_FILE if "no data file" in str(error) else S.FAULT_INDIRECT_RANGE
-    return MajorFault(code, str(error))
 
 
 class _FileCompiler:
@@ -100,8 +95,8 @@ class _FileCompiler:
             return self.array_name(f), repr(index), (repr(bit_mask(bit)) if bit is not None else None)
         k = self.temp
         self.temp += 1
-        resolver = self.bind(f"_loc{len(self.env)}", _resolver(self.table, a))
-        self.emit(ind, f"_d{k}, _i{k}, _m{k} = {resolver}()")
+        name = self.bind(f"_loc{len(self.env)}", resolver(self.table, a))
+        self.emit(ind, f"_d{k}, _i{k}, _m{k} = {name}()")
         return f"_d{k}", f"_i{k}", (f"_m{k}" if a.kind is ValueKind.BIT else None)
 
     def value(self, ind: int, operand) -> str:
@@ -552,82 +547,6 @@ _PASS_THROUGH = frozenset({"OTE", "OTL", "OTU"})
 # Rungs per compiled chunk (see _FileCompiler._compile_chunks).
 CHUNK_RUNGS = 200
 _IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
-
-
-_MASKS = tuple(bit_mask(b) for b in range(16))
-
-
-def _resolver(table: DataTable, addr: Address):
-    resolve = table.resolve
-
-    def locate():
-        try:
-            f, index, bit = resolve(addr)
-        except AddressRangeError as e:
-            raise address_fault(addr, e) from None
-        return f.data, index, (bit_mask(bit) if bit is not None else None)
-
-    return _fast_resolver(table, addr, locate) or locate
-
-
-def _fast_resolver(table: DataTable, addr: Address, slow):
-    """The common indirect shapes, ``N12:[N13:3]`` and ``O:[N13:13]/[N13:14]``
-    (a fixed file, element and bit numbers from direct words), without the
-    general resolver: the pointer words' arrays are bound once (arrays grow
-    in place), and only an out-of-range number takes ``slow``, which faults
-    with the full message. None when ``addr`` has another shape."""
-    if addr.indexed or not isinstance(addr.element, Address):
-        return None
-    try:
-        ed, ei = table.word_ref(addr.element)
-        bd, bi = table.word_ref(addr.bit) if isinstance(addr.bit, Address) else (None, 0)
-        if isinstance(addr.file, Address):
-            fd, fi = table.word_ref(addr.file)
-            return _file_indirect(table, addr, slow, fd, fi, ed, ei) if bd is None else None
-        f = table.file(addr.file)
-    except (DataTableError, AddressRangeError):
-        return None
-    if f.ftype is not addr.ftype:
-        return None
-    data = f.data
-    wpe = f.ftype.words_per_element
-    offset = f.ftype.members_by_name[addr.member].offset if addr.member is not None else 0
-    masks = _MASKS
-    if bd is None:
-        mask = bit_mask(addr.bit) if addr.bit is not None else None
-
-        def locate():
-            e = ed[ei]
-            if e < 0 or (e + 1) * wpe > len(data):
-                return slow()
-            return data, e * wpe + offset, mask
-    else:
-        def locate():
-            e = ed[ei]
-            b = bd[bi]
-            if e < 0 or (e + 1) * wpe > len(data) or not 0 <= b < 16:
-                return slow()
-            return data, e * wpe + offset, masks[b]
-    return locate
-
-
-def _file_indirect(table: DataTable, addr: Address, slow, fd, fi, ed, ei):
-    """``N[N13:15]:[N13:11]``: the file number from a word too; the file is
-    looked up each time (files are created, never replaced), the rest as
-    the fast path above; a bit number from a word takes the general path."""
-    files = table._files
-    ftype = addr.ftype
-    wpe = ftype.words_per_element
-    offset = ftype.members_by_name[addr.member].offset if addr.member is not None else 0
-    mask = bit_mask(addr.bit) if addr.bit is not None else None
-
-    def locate():
-        f = files.get(fd[fi])
-        e = ed[ei]
-        if f is None or f.ftype is not ftype or e < 0 or (e + 1) * wpe > len(f.data):
-            return slow()
-        return f.data, e * wpe + offset, mask
-    return locate
 
 
 def _block_check(d, i, n, text) -> None:

@@ -23,7 +23,8 @@ from ..datatable.errors import AddressRangeError
 from ..datatable.table import to_signed
 from . import status as S
 from .ast import MAIN_FILE, AddressRef, Const, Instruction, Pos, Program, address_refs, walk
-from .compiler import RET, EndScan, address_fault, compile_file, describe
+from .compiler import RET, EndScan, compile_file, describe
+from .resolvers import address_fault
 from .errors import LadderError
 from .instr import BOUND
 from .interpreter import interpret_file

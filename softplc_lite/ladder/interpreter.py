@@ -14,7 +14,8 @@ from __future__ import annotations
 from ..datatable import DataTable, bit_mask
 from ..datatable.errors import AddressRangeError
 from .ast import AddressRef, Branch, Const, Instruction, Program, Rung, address_refs, walk
-from .compiler import RET, TND, EndScan, address_fault, describe, labels_of
+from .compiler import RET, TND, EndScan, describe, labels_of
+from .resolvers import address_fault
 from .bound import ReferenceAccess
 from .expr import evaluate
 from .instr import BOUND

@@ -41,7 +41,7 @@ from typing import TYPE_CHECKING, Callable, Mapping
 
 from ..datatable.errors import AddressRangeError
 from ..ladder.ast import AddressRef, Const, Instruction
-from ..ladder.compiler import address_fault
+from ..ladder.resolvers import address_fault
 from ..ladder.errors import LadderError
 from ..ladder.instructions import InstructionSpec
 from ..ladder.semantics import R_DN, R_EM, R_EN, R_ER, Machine
