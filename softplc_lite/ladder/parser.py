@@ -12,10 +12,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Iterable, Iterator
+from typing import Iterator
 
 from lark import Lark, Token, Transformer, v_args
-from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
+from lark.exceptions import UnexpectedInput, VisitError
 
 from ..gcpause import gc_paused
 from ..datatable import AddressError, parse_address
@@ -40,6 +40,7 @@ from .ast import (
     UnaryOp,
 )
 from .errors import LadderError
+from .syntax_errors import syntax_error
 from .limits import MAX_CONSTANT, MAX_EXPRESSION_DEPTH, MAX_NUMBER_DIGITS, expression_depth, limit_problem
 
 # -- the post-lexer ---------------------------------------------------------------
@@ -374,49 +375,6 @@ def _unquote(text: str) -> str:
 
 # -- errors ---------------------------------------------------------------------------
 
-_FRIENDLY = {
-    "_NL": "end of line", "$END": "end of file", "SEMICOLON": "';'", "COMMA": "','",
-    "LPAR": "'('", "RPAR": "')'", "LSQB": "'['", "RSQB": "']'", "NAME": "an instruction or name",
-    "ADDRESS": "an address", "SYMBOL_MEMBER": "a symbol", "INT": "a number", "FLOAT": "a number", "HEX": "a number",
-    "STRING": "a quoted string", "COMMENT": "a comment", "BND": "BND", "NXB": "NXB",
-    "BST": "BST", "EOR": "EOR", "SOR": "SOR", "MINUS": "'-'", "EQUAL": "'='",
-    "COMPARE_OP": "a comparison", "ADD_OP": "'+' or '-'", "MUL_OP": "'*', '|' or MOD",
-}
-
-
-def _describe(names: Iterable[str]) -> str:
-    shown = sorted({_FRIENDLY.get(n, n) for n in names})
-    return ", ".join(shown) if shown else "nothing"
-
-
-def _syntax_error(e: UnexpectedInput, text: str, source: str, line_offset: int, column_offset: int) -> LadderError:
-    line = getattr(e, "line", None) or 1
-    column = getattr(e, "column", None) or 1
-    if line == 1:
-        column += column_offset
-    pos = Pos(source, line + line_offset, column)
-    try:
-        context = e.get_context(text)
-    except Exception:  # pragma: no cover - lark cannot always slice context at EOF
-        context = None
-    if isinstance(e, UnexpectedCharacters):
-        ch = text[e.pos_in_stream] if e.pos_in_stream < len(text) else "end of file"
-        message = f"unexpected character {ch!r}"
-    elif isinstance(e, UnexpectedEOF):
-        message = f"unexpected end of file; expected {_describe(e.expected)}"
-    else:
-        assert isinstance(e, UnexpectedToken)
-        tok = e.token
-        found = "end of file" if tok.type == "$END" else (
-            "end of line" if tok.type == "_NL" else repr(str(tok)))
-        message = f"unexpected {found}; expected {_describe(e.expected)}"
-        if tok.type == "$END" and "SEMICOLON" in e.expected:
-            message += " (a neutral-text rung must end with ';')"
-        elif tok.type == "$END" and "EOR" in e.expected:
-            message += " (SOR without EOR)"
-    return LadderError(pos, message, context)
-
-
 def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column_offset: int = 0,
                 problems: list[LadderError] | None = None):
     parser = _ast_parser()
@@ -429,7 +387,7 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
         if isinstance(result, Token):  # a bare number as a whole expression: in this parse's context
             result = builder._atomize(result)
     except UnexpectedInput as e:
-        raise _syntax_error(e, text, source, line_offset, column_offset) from None
+        raise syntax_error(e, text, source, line_offset, column_offset) from None
     except VisitError as e:
         if isinstance(e.orig_exc, LadderError):
             raise e.orig_exc from None
