@@ -135,7 +135,11 @@ class Machine:
             return
         over = False
         # A 16-bit word, or a 32-bit L element (1747-RM001/1763-RM001 L file range).
-        lo, hi, wrap = (-32768, 32767, signed16) if d.itemsize == 2 else (LONG_MIN, LONG_MAX, signed32)
+        # (Two plain assignments, not a tuple built per call: store() runs for most math.)
+        if d.itemsize == 2:
+            lo, hi, wrap = -32768, 32767, signed16
+        else:
+            lo, hi, wrap = LONG_MIN, LONG_MAX, signed32
         if isinstance(value, float):
             if math.isnan(value):
                 value, over = 0, True
