@@ -205,20 +205,31 @@ def _store_result(machine, value: float, dest) -> bool:
     return bool(machine.s[S.ARITH_FLAGS] & _OVERFLOW)
 
 
+def _sum(values) -> float:
+    """The sum in double precision; a float file holding both infinities
+    sums to NaN (math.fsum refuses them), which the store turns into
+    overflow: V, the overflow minor fault and ER, as for any result the
+    destination cannot hold."""
+    try:
+        return math.fsum(values)
+    except (ValueError, OverflowError):
+        return math.nan
+
+
 def _average(machine, fd, fi, n, dest) -> bool:
     values = [fd[fi + k] for k in range(n)]
     if all(isinstance(v, int) for v in values):
         total = sum(values)  # exact: a word file cannot overflow the sum
         return _store_result(machine, total / n, dest)
-    return _store_result(machine, math.fsum(values) / n, dest)
+    return _store_result(machine, _sum(values) / n, dest)
 
 
 def _deviation(machine, fd, fi, n, dest) -> bool:
     if n < 2:
         return True  # the sample deviation divides by n - 1 (softplc choice: ER, dest unchanged)
     values = [float(fd[fi + k]) for k in range(n)]
-    mean = math.fsum(values) / n
-    variance = math.fsum((v - mean) ** 2 for v in values) / (n - 1)
+    mean = _sum(values) / n
+    variance = _sum([(v - mean) ** 2 for v in values]) / (n - 1)
     return _store_result(machine, math.sqrt(variance), dest)
 
 

@@ -57,11 +57,23 @@ _NO_SAMPLE, _POSITIVE, _NEGATIVE, _ZERO = 0, 1, 2, 3
 _STAMP_MODULO = 1 << 30
 
 
+_FLOAT32_MAX = 3.4028234663852886e38
+
+
 def _get_float(d: array, i: int) -> float:
     return struct.unpack("<f", struct.pack("<hh", d[i], d[i + 1]))[0]
 
 
+def _get_state_float(d: array, i: int) -> float | None:
+    """An internal float (the integral, the last derivative input), or None
+    when the words do not hold a finite number: the program wrote them (Table
+    Q says "do not write"); the PID then starts that term again."""
+    v = _get_float(d, i)
+    return v if math.isfinite(v) else None
+
+
 def _put_float(d: array, i: int, v: float) -> None:
+    v = max(-_FLOAT32_MAX, min(_FLOAT32_MAX, v))  # float32 range (NaN cannot reach here)
     d[i], d[i + 1] = struct.unpack("<hh", struct.pack("<f", v))
 
 
@@ -141,9 +153,9 @@ def compute(d: array, i: int, w0: int, last_sign: int, dt: float, pv: int | floa
     # Derivative of the error, or of the PV with the error's sign (the
     # error's slope with the setpoint held), so a setpoint step gives no kick.
     d_input = err if w0 & DO else -sign * pv
-    last_input = _get_float(d, i + PREV_INPUT)
-    derivative = 0.0 if last_sign == _NO_SAMPLE else kd * (d_input - last_input) / dt
-    integral = _get_float(d, i + INTEGRAL)
+    last_input = _get_state_float(d, i + PREV_INPUT)
+    derivative = 0.0 if last_sign == _NO_SAMPLE or last_input is None else kd * (d_input - last_input) / dt
+    integral = _get_state_float(d, i + INTEGRAL) or 0.0
     proportional = kp * err
     bias = d[i + BIAS]
     alarm_hi, alarm_lo = d[i + LMAX] * FULL_SCALE / 100, d[i + LMIN] * FULL_SCALE / 100
