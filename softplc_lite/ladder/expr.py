@@ -25,6 +25,21 @@ def _int(v) -> int:
     return v
 
 
+# Integers from 2**1024 on have no float (float() raises OverflowError).
+_FLOAT_RANGE = 2 ** 1024
+
+
+def _mul(a, b):
+    """``*``: integer products are exact, but one past the float range (a
+    product of many L or word operands) is taken as +-inf, the overflow it
+    is on any PLC: mixed with a float, or stored, it would otherwise have no
+    float value at all (OverflowError)."""
+    r = a * b
+    if r.__class__ is int and not -_FLOAT_RANGE < r < _FLOAT_RANGE:
+        return math.inf if r > 0 else -math.inf
+    return r
+
+
 def _safe(fn: Callable[[float], float]) -> Callable[[float], float]:
     def wrapped(v):
         try:
@@ -38,6 +53,8 @@ def _frd(v) -> int | float:
     """BCD to integer (4 digits). A nibble above 9 is no BCD value: NaN,
     which the store turns into overflow (S:0/1 and the minor fault), as the
     FRD instruction does (ladder/instr/convert.py, docs/instructions.md)."""
+    if isinstance(v, float) and not math.isfinite(v):
+        return math.nan  # no word at all, so no BCD digits
     v = _int(v) & 0xFFFF
     digits = [(v >> s) & 0xF for s in (12, 8, 4, 0)]
     if any(d > 9 for d in digits):
@@ -49,7 +66,10 @@ def _tod(v) -> int | float:
     """Integer 0..9999 to BCD, as the signed 16-bit word that holds the
     pattern (9760 gives 0x9760, -26784). Outside 0..9999 there is no 4-digit
     BCD value: NaN, stored as overflow (PLC-5 TOD sets V for a negative
-    source or one above 9999)."""
+    source or one above 9999). An infinite or NaN float is outside too
+    (``_int`` would make it 0)."""
+    if isinstance(v, float) and not math.isfinite(v):
+        return math.nan
     v = _int(v)
     if not 0 <= v <= 9999:
         return math.nan
@@ -81,7 +101,7 @@ PY_COMPARE = {"=": "==", "<>": "!=", "<": "<", "<=": "<=", ">": ">", ">=": ">="}
 
 
 def to_python(node, operand_code: Callable[[AddressRef], str]) -> str:
-    """Python source for an expression. Names used: ``_x_div``, ``_x_mod``,
+    """Python source for an expression. Names used: ``_x_mul``, ``_x_div``, ``_x_mod``,
     ``_x_pow``, ``_int``, ``_fn_<NAME>``; ``operand_code`` gives the source of
     each address read. Only validated tokens reach the text: numbers are
     printed by repr(), operators come from fixed tables."""
@@ -98,8 +118,10 @@ def to_python(node, operand_code: Callable[[AddressRef], str]) -> str:
     assert isinstance(node, BinOp)
     a, b = to_python(node.left, operand_code), to_python(node.right, operand_code)
     op = node.op
-    if op in ("+", "-", "*"):
+    if op in ("+", "-"):
         return f"({a} {op} {b})"
+    if op == "*":
+        return f"_x_mul({a}, {b})"
     if op == "|":
         return f"_x_div({a}, {b})"
     if op == "MOD":
@@ -133,7 +155,7 @@ def evaluate(node, read: Callable[[AddressRef], int | float], machine):
     if op == "-":
         return a - b
     if op == "*":
-        return a * b
+        return _mul(a, b)
     if op == "|":
         return machine.divide(a, b)
     if op == "MOD":
@@ -151,7 +173,7 @@ def evaluate(node, read: Callable[[AddressRef], int | float], machine):
 
 def namespace(machine) -> dict[str, object]:
     """The helper names compiled expressions use."""
-    ns: dict[str, object] = {"_x_div": machine.divide, "_x_mod": machine.modulo, "_x_pow": machine.power, "_int": _int}
+    ns: dict[str, object] = {"_x_mul": _mul, "_x_div": machine.divide, "_x_mod": machine.modulo, "_x_pow": machine.power, "_int": _int}
     for name, fn in FUNCTIONS.items():
         ns[f"_fn_{name}"] = fn
     return ns
