@@ -189,6 +189,10 @@ def position(draw, n: int) -> str:
     return str(draw(st.one_of(st.integers(0, min(n, 6)), st.sampled_from([0, n, 1000]))))
 
 
+# A product of 40 L words: past the float range when they are large.
+_HUGE_PRODUCT = "(" + " * ".join("(" + " * ".join(f"L10:{k}" for k in range(8)) + ")" for _ in range(5)) + ")"
+
+
 def expression(draw, compare: bool = False) -> str:
     def term(depth: int) -> str:
         choice = draw(st.integers(0, 9 if depth < 2 else 4))
@@ -197,7 +201,8 @@ def expression(draw, compare: bool = False) -> str:
         if choice == 1:
             return f"#F8:{draw(st.integers(0, 10))}"
         if choice == 2:
-            return draw(st.sampled_from(["0", "1", "-1", "32767", "2.5", "0.0", "100000", "#L10:0", "L10:3"]))
+            return draw(st.sampled_from(["0", "1", "-1", "32767", "2.5", "0.0", "100000", "#L10:0", "L10:3",
+                                         _HUGE_PRODUCT, "(F8:1 ** 200.0)", "1e38"]))
         if choice == 3:
             return word_address(draw)
         if choice == 4:
@@ -466,8 +471,11 @@ def initial_values(draw) -> dict[str, object]:
     for k in range(draw(st.integers(0, 6))):
         # control words: LEN, POS and status bits the program did not set
         r = draw(st.integers(0, DATA["R6"] - 1))
-        member = draw(st.sampled_from(["LEN", "POS"]))
-        values[f"R6:{r}.{member}"] = draw(st.one_of(st.integers(-2, 20), st.sampled_from([-32768, 32767, 1000])))
+        member = draw(st.sampled_from(["LEN", "POS", "bits"]))
+        if member == "bits":  # status bits a program (or a snapshot) left set
+            values[f"R6:{r}"] = draw(st.integers(0, 0xFFFF)) & 0xFF00
+        else:
+            values[f"R6:{r}.{member}"] = draw(st.one_of(st.integers(-2, 20), st.sampled_from([-32768, 32767, 1000])))
     return values
 
 
@@ -628,3 +636,37 @@ def test_tod_of_an_infinite_or_nan_float_overflows(executor, value):
              {"F8:0": value, "N7:0": 5, "N7:1": 5, "N7:2": 5}, executor)
     assert [e.table.read(f"N7:{k}") for k in range(3)] == [0, 0, 0]
     assert e.table.read("S:0/1") == 1 and e.table.read("S:10/14") == 1
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_a_bit_of_a_symbol_of_an_slc_io_address_is_decimal_as_in_the_address(executor):
+    # SYMBOL Start I:1.0: Start/8 was refused as octal, Start/17 taken as bit 15 and printed I:40/17
+    text = "SYMBOL Start I:1.0\nSYMBOL Lamp O:2.1\nXIC Start/8 OTE Lamp/15\nXIC I:1.0/9 OTE Lamp/9"
+    e = _run(text, {"I:1.0/8": 1, "I:1.0/9": 1}, executor)
+    assert e.table.read("O:2.1/15") == 1 and e.table.read("O:2.1/9") == 1
+
+
+def test_a_bit_of_an_slc_symbol_past_15_is_refused_and_it_prints_in_slc_form():
+    from softplc_lite.ladder.parser import parse_program
+    from softplc_lite.ladder.symbols import SymbolIndex, resolve_name
+    from softplc_lite.datatable import AddressError
+
+    symbols = SymbolIndex(parse_program("SYMBOL Start I:1.0\nSYMBOL Old I:12").symbols)
+    assert str(resolve_name("Start/8", symbols)) == "I:1.0/8"
+    assert str(resolve_name("Old/17", symbols)) == "I:12/17"  # PLC-5 form: octal, as before
+    with pytest.raises(AddressError, match="bit 16 is past bit 15"):
+        resolve_name("Start/16", symbols)
+
+
+def test_an_offset_past_the_last_slc_slot_is_refused_located():
+    from softplc_lite.ladder.parser import parse_program
+
+    _, errors = check(parse_program("SYMBOL Last I:30.31\nXIC Last[1] OTE O:0/0\nXIC Last[0]/3 OTE O:0/1"))
+    assert [(e.pos.line, "past the last SLC slot 30" in e.message) for e in errors] == [(2, True)]
+
+
+def test_an_slc_address_stepped_past_slot_30_prints_in_plc5_form_that_parses_back():
+    from softplc_lite.datatable import parse_address
+
+    a = parse_address("I:30.31/3").with_element(30 * 32 + 32)
+    assert str(a) == "I:1740/3" and parse_address(str(a)) == a

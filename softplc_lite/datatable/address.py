@@ -133,7 +133,9 @@ class Address:
         ):
             out.append(f"/{self.element * WORD_BITS + self.bit}")
             return "".join(out)
-        if self.slc and isinstance(self.element, int):
+        # An SLC address stepped past the last slot (a block, a symbol's offset)
+        # prints in the PLC-5 form, the same word: I:31.0 would not parse back.
+        if self.slc and isinstance(self.element, int) and self.element < (SLC_MAX_SLOT + 1) * SLC_SLOT_WORDS:
             slot, word = divmod(self.element, SLC_SLOT_WORDS)
             out.append(f":{slot}.{word}")
             if isinstance(self.bit, int):

@@ -25,6 +25,7 @@ import re
 from typing import Mapping
 
 from ..datatable import MAX_ELEMENTS, Address, AddressError, parse_address
+from ..datatable.address import SLC_MAX_SLOT, SLC_SLOT_WORDS
 from ..datatable.errors import DataTableError
 from ..datatable.filetypes import WORD_BITS
 
@@ -121,6 +122,9 @@ def apply_suffix(text: str, name: str, address: Address, m: re.Match) -> Address
         if element >= MAX_ELEMENTS:
             raise SymbolError(text, m.start(2), f"{what}: {name}[{offset}] is element {element}, past the "
                               f"last element {MAX_ELEMENTS - 1}")
+        if a.slc and element >= (SLC_MAX_SLOT + 1) * SLC_SLOT_WORDS:
+            raise SymbolError(text, m.start(2), f"{what}: {name}[{offset}] is word {element} of the I/O file, "
+                              f"past the last SLC slot {SLC_MAX_SLOT} (I:{SLC_MAX_SLOT}.{SLC_SLOT_WORDS - 1})")
         a = a.with_element(element)
     if member is not None:
         if a.member is not None or a.bit is not None:
@@ -139,13 +143,14 @@ def apply_suffix(text: str, name: str, address: Address, m: re.Match) -> Address
         if not ftype.has_bits:
             raise SymbolError(text, at - 1, f"{what}: {ftype.title} elements have no bits")
         if bit.isdigit():
-            base = 8 if ftype.octal else 10
+            # octal for a PLC-5 I/O address (I:12/17); an SLC one (I:1.0/8) numbers its bits in decimal
+            base = 8 if ftype.octal and not a.slc else 10
             try:
                 number = int(bit, base)
             except ValueError:
                 number = WORD_BITS  # an 8 or 9 in an octal bit number
             if number >= WORD_BITS:
-                top = "17 (octal)" if ftype.octal else str(WORD_BITS - 1)
+                top = "17 (octal)" if base == 8 else str(WORD_BITS - 1)
                 raise SymbolError(text, at, f"{what}: bit {bit} is past bit {top}")
         else:
             found = ftype.members_by_name.get(bit.upper())
@@ -153,7 +158,7 @@ def apply_suffix(text: str, name: str, address: Address, m: re.Match) -> Address
                 raise SymbolError(text, at, f"{what}: {_members(ftype)}" if a.member is None
                                   else f"{what}: a member word's bits are numbered 0..15")
             number = found.bit
-        a = Address(a.type_letter, a.file, a.element, a.member, number, a.indexed)
+        a = Address(a.type_letter, a.file, a.element, a.member, number, a.indexed, a.slc)
     return a
 
 
