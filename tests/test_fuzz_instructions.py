@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 import os
 import random
+import re
 
 from hypothesis import HealthCheck, given, note, seed, settings
 from hypothesis import strategies as st
@@ -670,3 +671,23 @@ def test_an_slc_address_stepped_past_slot_30_prints_in_plc5_form_that_parses_bac
 
     a = parse_address("I:30.31/3").with_element(30 * 32 + 32)
     assert str(a) == "I:1740/3" and parse_address(str(a)) == a
+
+
+@pytest.mark.parametrize("text", [
+    "XIC Q7:0/3 OTE B3/0",
+    "BSL #N7:0 R6:0 Q7:0/3 5",
+    "SQO #N7:0 0 Q7:0 R6:0 4 0",
+    "FAL R6:0 4 0 ALL #Q7:0 1",
+    "CPT(N7:0, Q7:0 + 1);",
+    "JSR 3 0 Q7:0\nFILE 3\nRET 1",
+    "LBL Q7:0\nLBL Q8:0",
+])
+def test_a_bad_address_is_reported_once_not_again_as_the_constant_0(text):
+    # the parser's stand-in for the refused operand drew a second error: "... must be bit address,
+    # not the constant 0" (or a return parameter constant, a label 0 defined twice)
+    from softplc_lite.ladder.parser import parse_program
+
+    problems: list = []
+    program = parse_program(text, "<t>", problems=problems)
+    _, errors = check(program)
+    assert len(problems) == len(re.findall(r"Q\d", text)) and errors == []

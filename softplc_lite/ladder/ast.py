@@ -46,6 +46,13 @@ class Const:
 
 
 @dataclass(frozen=True)
+class Placeholder(Const):
+    """Stands in for an operand the parser refused (a bad address, an
+    unknown function) while it goes on to list every problem: that problem
+    is already reported, so the validator says nothing more about it."""
+
+
+@dataclass(frozen=True)
 class AddressRef:
     address: Address
     pos: Pos = _pos()

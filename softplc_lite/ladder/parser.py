@@ -22,6 +22,7 @@ from ..datatable import AddressError, parse_address
 from .ast import (
     MAIN_FILE,
     AddressRef,
+    Placeholder,
     BinOp,
     Branch,
     Call,
@@ -221,7 +222,7 @@ class _ToAst(Transformer):
             return AddressRef(parse_address(str(tok)), self._pos(tok))
         except AddressError as e:
             p = self._pos(tok)
-            return self._fail(LadderError(Pos(p.source, p.line, p.column + e.position), e.reason), Const(0, p))
+            return self._fail(LadderError(Pos(p.source, p.line, p.column + e.position), e.reason), Placeholder(0, p))
 
     @v_args(inline=True)
     def address(self, tok):
@@ -250,7 +251,7 @@ class _ToAst(Transformer):
         func = str(name).upper()
         if func not in _CALLS:
             return self._fail(LadderError(self._pos(name), f"unknown function {name}() in an expression; "
-                                          f"functions are {' '.join(_CALLS)}"), Const(0, self._pos(name)))
+                                          f"functions are {' '.join(_CALLS)}"), Placeholder(0, self._pos(name)))
         return Call(func, arg, self._pos(name))
 
     @v_args(inline=True)

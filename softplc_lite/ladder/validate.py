@@ -27,6 +27,7 @@ from .ast import (
     Element,
     Instruction,
     Operand,
+    Placeholder,
     Pos,
     Program,
     Rung,
@@ -139,6 +140,8 @@ class _Checker:
         return operand if ok else None
 
     def operand(self, instr: Instruction, index: int, kind: K, operand: Operand) -> Operand | None:
+        if any(isinstance(leaf, Placeholder) for leaf in leaves(operand)):
+            return None  # the parser has reported it
         if kind is K.FILE_MODE:
             return self.file_mode(instr, index, operand)
         if kind is K.EXPRESSION:
@@ -253,6 +256,8 @@ class _Checker:
         for i, op in enumerate(instr.operands):
             checked = self.operand(instr, i, spec.operand_at(i).kind, op)
             operands.append(checked if checked is not None else op)
+        if any(isinstance(leaf, Placeholder) for op in instr.operands for leaf in leaves(op)):
+            return Instruction(instr.mnemonic, operands, instr.pos)  # the parser has reported a bad operand
         if spec.mnemonic == "LBL" and not first:
             self.error(instr.pos, "LBL must be the first instruction of its rung")
         if spec.mnemonic == "JSR" and operands and isinstance(operands[0], Const):
@@ -352,7 +357,8 @@ class _Checker:
             for rung in pfile.rungs:
                 if rung.elements and isinstance(rung.elements[0], Instruction) and rung.elements[0].mnemonic == "LBL":
                     ops = rung.elements[0].operands
-                    if len(ops) == 1 and isinstance(ops[0], Const) and isinstance(ops[0].value, int):
+                    if len(ops) == 1 and isinstance(ops[0], Const) and not isinstance(ops[0], Placeholder) \
+                            and isinstance(ops[0].value, int):
                         if ops[0].value in labels:
                             self.error(rung.pos, f"label {ops[0].value} is defined twice in file {number} "
                                        f"(first at {labels[ops[0].value].pos})")
