@@ -40,7 +40,7 @@ from softplc_lite.ladder.fmt import format_program
 from softplc_lite.ladder.parser import parse_program
 from softplc_lite.ladder.semantics import signed16
 
-EXAMPLES = int(os.environ.get("FUZZ_INSTR_EXAMPLES", "150"))
+EXAMPLES = int(os.environ.get("FUZZ_INSTR_EXAMPLES", "300"))
 _SEED = os.environ.get("FUZZ_INSTR_SEED", "0")
 SCANS = 8
 INTERNAL = 255
@@ -50,7 +50,7 @@ INTERNAL = 255
 DATA = {"N7": 40, "N9": 4, "F8": 24, "L10": 16, "D11": 8, "A12": 8, "B3": 16, "T4": 6, "C5": 6, "R6": 8,
         "ST13": 2}
 SYMBOLS = ("SYMBOL Tmr T4:1\nSYMBOL Ctl R6:2\nSYMBOL Levels N7:10\nSYMBOL Flags B3:2\nSYMBOL Cnt C5:1\n"
-           "SYMBOL Temp F8:3\n")
+           "SYMBOL Temp F8:3\nSYMBOL Slot I:1.0\nSYMBOL Lamps O:2.1\nSYMBOL Old I:12\nSYMBOL Big L10:2\n")
 
 WORD_EDGES = (0, 1, -1, 2, 3, 7, 15, 16, 255, 4095, 9999, 10000, 32767, -32768, -32767, 0x7FFF)
 FLOAT_EDGES = (0.0, -0.0, 0.5, -0.5, 2.5, -2.5, 1e-30, 3.4e38, -3.4e38, 1e10, math.pi)
@@ -88,7 +88,7 @@ def word_address(draw, dest: bool = False) -> str:
     if choice == 11:
         return draw(st.sampled_from(["Levels", "Levels[3]", "Levels[12]"]))
     if choice == 12:
-        return draw(st.sampled_from(["I:1.0", "O:2.1", "I:0", "O:3.2", "O:0"]))
+        return draw(st.sampled_from(["I:1.0", "O:2.1", "I:0", "O:3.2", "O:0", "Slot", "Lamps[31]", "Old[1]"]))
     if choice == 13:
         return f"N[N9:{draw(st.integers(0, 3))}]:{draw(st.integers(0, 3))}" if not dest else "N7:1"
     if choice == 14 and not dest:
@@ -103,7 +103,8 @@ def dest_address(draw) -> str:
     if choice == 2:
         return f"L10:{_element(draw, DATA['L10'])}"
     if choice == 3:
-        return draw(st.sampled_from(["Temp", f"F8:[{_index_word(draw)}]", f"L10:[{_index_word(draw)}]", "#F8:2"]))
+        return draw(st.sampled_from(["Temp", f"F8:[{_index_word(draw)}]", f"L10:[{_index_word(draw)}]", "#F8:2",
+                                     "Big", "Big[3]", "#L10:1"]))
     return word_address(draw, dest=True)
 
 
@@ -117,7 +118,8 @@ def bit_address(draw) -> str:
         return draw(st.sampled_from(["I:1.0/3", "O:2.1/15", "I:0/0", "I:12/17", "O:0/5"]))
     if choice == 5:
         return draw(st.sampled_from(["Tmr/DN", "Tmr.EN", "Ctl/UL", "Ctl.DN", "Cnt/DN", "Flags/3", "Levels[2]/15",
-                                     "R6:0/UL", "R6:1/EN", "T4:0/DN"]))
+                                     "R6:0/UL", "R6:1/EN", "T4:0/DN", "Slot/8", "Slot[1]/15", "Lamps/9", "Old/17",
+                                     "Old[8]/7"]))
     if choice == 6:
         return f"B3/[{_index_word(draw)}]"
     if choice == 7:
