@@ -17,10 +17,10 @@ toggled by B3:0 bits written before each scan. Asserted:
 The default run is deterministic (``derandomize``) and takes well under 30 s.
 To search harder::
 
-    FUZZ_INSTR_EXAMPLES=5000 python -m pytest -q -p no:cacheprovider tests/test_fuzz_instructions.py
+    FUZZ_INSTR_EXAMPLES=5000 python -m pytest -q -p no:cacheprovider --timeout 0 tests/test_fuzz_instructions.py -k agree
 
 (``FUZZ_INSTR_SEED=n`` draws another deterministic set; ``FUZZ_INSTR_SEED=random``
-draws a fresh one each run.)
+draws a fresh one each run; ``--timeout 0`` lifts pytest-timeout's 120 s per test.)
 """
 
 from __future__ import annotations
