@@ -699,3 +699,16 @@ def test_a_bad_address_is_reported_once_not_again_as_the_constant_0(text):
     program = parse_program(text, "<t>", problems=problems)
     _, errors = check(program)
     assert len(problems) == len(re.findall(r"Q\d", text)) and errors == []
+
+
+def test_the_compiler_multiplies_inline_unless_a_product_could_pass_the_float_range():
+    # _x_mul costs a call per product: only where the operands' bits could add up to 2**1024
+    from softplc_lite.ladder.ast import Pos
+    from softplc_lite.ladder.expr import to_python
+    from softplc_lite.ladder.parser import parse_expression
+
+    def code(text):
+        return to_python(parse_expression(text, Pos("<t>", 1, 1)), lambda ref: "x")
+    assert "_x_mul" not in code("N7:1 * 3 + N7:2 * N7:3 * L10:0")
+    assert "_x_mul" in code(_HUGE)
+    assert "_x_mul" in code("(F8:0 OR 0) * 2")  # a float rounded to an integer may be 1024 bits

@@ -27,6 +27,7 @@ def _int(v) -> int:
 
 # Integers from 2**1024 on have no float (float() raises OverflowError).
 _FLOAT_RANGE = 2 ** 1024
+_FLOAT_BITS = 1025  # the bit length of the largest integer _int() makes of a finite float
 
 
 def _mul(a, b):
@@ -38,6 +39,33 @@ def _mul(a, b):
     if r.__class__ is int and not -_FLOAT_RANGE < r < _FLOAT_RANGE:
         return math.inf if r > 0 else -math.inf
     return r
+
+
+def int_bits(node) -> int:
+    """An upper bound on the bit length of the integer ``node`` can give
+    (0 for a float): the compiler multiplies inline, the fast way, unless a
+    product could reach the float range (see _mul)."""
+    if isinstance(node, Const):
+        return abs(node.value).bit_length() + 1 if isinstance(node.value, int) else 0
+    if isinstance(node, AddressRef):
+        kind = node.address.kind.name
+        return {"WORD": 16, "LONG": 32, "BIT": 1}.get(kind, 0)
+    if isinstance(node, UnaryOp):
+        inner = int_bits(node.operand)
+        return (inner or _FLOAT_BITS) + 1 if node.op != "NEG" else inner + 1
+    if isinstance(node, Call):
+        return int_bits(node.arg) + 1 if node.func in ("ABS", "NEG") else 17 if node.func in ("FRD", "TOD") else 0
+    op = node.op
+    if op == "*":
+        return int_bits(node.left) + int_bits(node.right)
+    if op == "**":
+        return 0  # Machine.power: always a float
+    if op in PY_COMPARE:
+        return 1
+    left, right = int_bits(node.left), int_bits(node.right)
+    if op in ("AND", "OR", "XOR"):  # a float operand is rounded to an integer (_int): up to 2**1024
+        left, right = left or _FLOAT_BITS, right or _FLOAT_BITS
+    return max(left, right) + 1  # + - | MOD AND OR XOR
 
 
 def _safe(fn: Callable[[float], float]) -> Callable[[float], float]:
@@ -121,7 +149,8 @@ def to_python(node, operand_code: Callable[[AddressRef], str]) -> str:
     if op in ("+", "-"):
         return f"({a} {op} {b})"
     if op == "*":
-        return f"_x_mul({a}, {b})"
+        # inline unless the product could pass the float range (a product of dozens of words)
+        return f"_x_mul({a}, {b})" if int_bits(node) >= 1000 else f"({a} * {b})"
     if op == "|":
         return f"_x_div({a}, {b})"
     if op == "MOD":
