@@ -82,3 +82,20 @@ def engine(request):
         e.set_mode(Mode.RUN)
         return e
     return make
+
+
+@pytest.fixture(params=("compiled", "reference"))
+def run(request):
+    """run(text, scans=1, values=None, **kw) -> Engine, on one executor
+    (the instruction tests). Every address in ``values`` is created first,
+    so tests may preset words the program itself does not name."""
+    from softplc_lite.ladder import run_text
+
+    def _run(text: str, scans: int = 1, values: dict | None = None, **kw):
+        table = kw.pop("table", None) or DataTable()
+        for addr in values or {}:
+            table.reference(addr)
+        return run_text(text, scans=scans, executor=request.param, table=table, values=values, **kw)
+
+    return _run
+

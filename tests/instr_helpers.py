@@ -1,5 +1,6 @@
 """Shared by the tests of the bound instruction groups (ladder/instr/): a
-one-scan rung pulse. (Their ``engine`` fixture is in conftest.py.)"""
+one-scan rung pulse and the S:0 flags as letters. (Their ``engine`` and
+``run`` fixtures are in conftest.py.)"""
 
 from __future__ import annotations
 
@@ -15,3 +16,10 @@ def pulse(e: Engine, bit: str = "B3/0") -> Engine:
     e.table.write(bit, 0)
     e.scan()
     return e
+
+
+def flags(e) -> str:
+    """S:0 arithmetic flags as letters: C carry, V overflow, Z zero, S sign."""
+    s0 = e.table.read("S:0")
+    return "".join(name for bit, name in enumerate("CVZS") if s0 >> bit & 1)
+

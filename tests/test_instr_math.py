@@ -15,6 +15,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from instr_helpers import flags
 from softplc_lite.datatable import DataTable
 from softplc_lite.ladder import Mode, Settings, run_text
 from softplc_lite.ladder import status as S
@@ -25,23 +26,7 @@ from softplc_lite.ladder.parser import parse_program
 EXECUTORS = ("compiled", "reference")
 
 
-@pytest.fixture(params=EXECUTORS)
-def run(request):
-    """run(text, scans=1, values=None, **kw) -> Engine, on one executor."""
 
-    def _run(text: str, scans: int = 1, values: dict | None = None, **kw):
-        table = kw.pop("table", None) or DataTable()
-        for addr in values or {}:
-            table.reference(addr)
-        return run_text(text, scans=scans, executor=request.param, table=table, values=values, **kw)
-
-    return _run
-
-
-def flags(e) -> str:
-    """S:0 as letters: C carry, V overflow, Z zero, S sign."""
-    s0 = e.table.read("S:0")
-    return "".join(name for bit, name in enumerate("CVZS") if s0 >> bit & 1)
 
 
 def overflow_fault(e) -> bool:

@@ -13,34 +13,15 @@ from pathlib import Path
 
 import pytest
 
-from softplc_lite.datatable import DataTable
-from softplc_lite.ladder import Mode, Settings, run_text
+from instr_helpers import flags
+from softplc_lite.ladder import Mode, Settings
 from softplc_lite.ladder import status as S
 from softplc_lite.ladder.instructions import all_specs
 
 BUILTIN = [s.mnemonic for s in all_specs() if s.module is None]
 
 
-@pytest.fixture(params=["compiled", "reference"])
-def run(request):
-    """run(text, scans=1, values=None, **kw) -> Engine, on one executor.
 
-    Every address in ``values`` is created first, so tests may preset words
-    the program itself does not name."""
-
-    def _run(text: str, scans: int = 1, values: dict | None = None, **kw):
-        table = kw.pop("table", None) or DataTable()
-        for addr in values or {}:
-            table.reference(addr)
-        return run_text(text, scans=scans, executor=request.param, table=table, values=values, **kw)
-
-    return _run
-
-
-def flags(e) -> str:
-    """S:0 arithmetic flags as letters: C carry, V overflow, Z zero, S sign."""
-    s0 = e.table.read("S:0")
-    return "".join(name for bit, name in enumerate("CVZS") if s0 >> bit & 1)
 
 
 def minor_bits(e) -> set[str]:
