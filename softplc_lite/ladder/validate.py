@@ -72,6 +72,7 @@ class _Checker:
         self.instructions = instructions
         self.errors: list[LadderError] = []
         self.symbols = SymbolIndex(program.symbols)
+        self._shapes: dict[int, tuple] = {}  # subroutine_shape, per program file
 
     def error(self, pos, message: str) -> None:
         self.errors.append(LadderError(pos, message))
@@ -140,8 +141,6 @@ class _Checker:
         return operand if ok else None
 
     def operand(self, instr: Instruction, index: int, kind: K, operand: Operand) -> Operand | None:
-        if any(isinstance(leaf, Placeholder) for leaf in leaves(operand)):
-            return None  # the parser has reported it
         if kind is K.FILE_MODE:
             return self.file_mode(instr, index, operand)
         if kind is K.EXPRESSION:
@@ -252,12 +251,14 @@ class _Checker:
                      if n > spec.max_operands and any(o.kind is K.EXPRESSION for o in spec.operands) else "")
             self.error(instr.pos, f"{spec.mnemonic} takes {want} operand{plural} ({spec.signature()}), got {n}{quote}")
             return instr
+        # An operand the parser refused (and reported) is a Placeholder: not checked again.
+        refused = [_refused(op) for op in instr.operands]
         operands = []
         for i, op in enumerate(instr.operands):
-            checked = self.operand(instr, i, spec.operand_at(i).kind, op)
+            checked = None if refused[i] else self.operand(instr, i, spec.operand_at(i).kind, op)
             operands.append(checked if checked is not None else op)
-        if any(isinstance(leaf, Placeholder) for op in instr.operands for leaf in leaves(op)):
-            return Instruction(instr.mnemonic, operands, instr.pos)  # the parser has reported a bad operand
+        if any(refused):
+            return Instruction(instr.mnemonic, operands, instr.pos)
         if spec.mnemonic == "LBL" and not first:
             self.error(instr.pos, "LBL must be the first instruction of its rung")
         if spec.mnemonic == "JSR" and operands and isinstance(operands[0], Const):
@@ -315,11 +316,14 @@ class _Checker:
     def subroutine_shape(self, number: int) -> tuple[Instruction | None, list[Instruction]]:
         """Program file ``number``'s SBR with parameters (the first instruction
         of its first rung) and its RETs with values, from the parsed text."""
-        rungs = self.program.files[number].rungs
-        first = rungs[0].elements[0] if rungs and rungs[0].elements else None
-        sbr = first if isinstance(first, Instruction) and first.mnemonic == "SBR" and first.operands else None
-        rets = [ins for rung in rungs for ins in walk(rung.elements) if ins.mnemonic == "RET" and ins.operands]
-        return sbr, rets
+        shape = self._shapes.get(number)  # every JSR to a file asks: walk it once
+        if shape is None:
+            rungs = self.program.files[number].rungs
+            first = rungs[0].elements[0] if rungs and rungs[0].elements else None
+            sbr = first if isinstance(first, Instruction) and first.mnemonic == "SBR" and first.operands else None
+            rets = [ins for rung in rungs for ins in walk(rung.elements) if ins.mnemonic == "RET" and ins.operands]
+            shape = self._shapes[number] = (sbr, rets)
+        return shape
 
     def series(self, elements: list[Element], file_number: int, labels: set[int], first: bool) -> list[Element]:
         out: list[Element] = []
@@ -421,6 +425,14 @@ class _Checker:
             else:
                 self.error(decl.pos, f"DATA {text}: initial values are for N, B, F, ST, L, D and A files")
                 return
+
+
+def _refused(operand: Operand) -> bool:
+    """Does the operand hold a Placeholder (a part the parser refused)?
+    Plain operands answer without walking a tree: validate asks for each."""
+    if isinstance(operand, (AddressRef, Const, SymbolRef, Text)):
+        return False
+    return any(isinstance(leaf, Placeholder) for leaf in leaves(operand))
 
 
 def _word_constant(const: Const) -> Const:
