@@ -431,7 +431,7 @@ def _refused(operand: Operand) -> bool:
     """Does the operand hold a Placeholder (a part the parser refused)?
     Plain operands answer without walking a tree: validate asks for each."""
     if isinstance(operand, (AddressRef, Const, SymbolRef, Text)):
-        return False
+        return isinstance(operand, Placeholder)  # a Const subclass
     return any(isinstance(leaf, Placeholder) for leaf in leaves(operand))
 
 
