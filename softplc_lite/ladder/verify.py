@@ -66,8 +66,7 @@ def verify(program: Program, instructions: InstructionSet = BUILTIN, parsed: Pro
                 if ins.mnemonic == "OTE" and _direct(ins.operands[0]) is not None:
                     outputs[str(ins.operands[0].address)].append(ins)
                 for i, op in enumerate(ins.operands):
-                    kind = spec.operands[min(i, len(spec.operands) - 1)].kind
-                    if kind in _ELEMENT_KINDS and _direct(op) is not None:
+                    if spec.operand_at(i).kind in _ELEMENT_KINDS and _direct(op) is not None:
                         elements[str(op.address)].append(ins)
                 if ins.mnemonic in _STORES:
                     found += _constant_warnings(ins, overflow)
