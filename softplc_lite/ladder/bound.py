@@ -30,7 +30,7 @@ instructions; a block past the end of its file raises FAULT_BLOCK_RANGE
 from __future__ import annotations
 
 from array import array
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Callable
 
 from ..datatable import Address, DataTable
@@ -177,6 +177,23 @@ def file_references(instr: Instruction, operand: int, length: int | None) -> lis
     if not isinstance(op, AddressRef) or not op.address.is_direct or op.address.element is None:
         return []
     return [op.address.with_element(op.address.element + length - 1)]
+
+
+LEN, POS = 1, 2  # words of a control (R) element after its status word
+
+
+def control_words(instr: Instruction, control: int, length: int, position: int | None = None
+                  ) -> list[tuple[Address, int]]:
+    """What a download writes for an instruction with a control: the length
+    (and position) operands into the control's LEN (and POS); nothing for a
+    control reached indirectly."""
+    address = instr.operands[control].address
+    if not address.is_direct:
+        return []
+    out = [(replace(address, member="LEN"), constant(instr, length))]
+    if position is not None:
+        out.append((replace(address, member="POS"), constant(instr, position)))
+    return out
 
 
 def constant(instr: Instruction, operand: int) -> int | float | None:

@@ -33,11 +33,10 @@ wrote.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 from ...datatable import Address
 from ..ast import Instruction, SymbolRef, address_refs
-from ..bound import BoundInstruction, block, constant, file_references
+from ..bound import LEN, POS, BoundInstruction, block, constant, control_words, file_references
 from ..semantics import R_DN, R_EN, R_ER, R_EU, R_FD, R_IN
 from ..specs import InstructionSpec, K, OperandSpec
 from .. import status as S
@@ -72,7 +71,7 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
     s = access.machine.s
 
     def work(d, i: int, w: int) -> int:
-        p, length = d[i + 2], d[i + 1]
+        p, length = d[i + POS], d[i + LEN]
         if w & R_FD:  # FSC resuming after a find: the found element is behind it
             w = _clear(w, R_FD)
             p += 1
@@ -80,7 +79,7 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
         while p < length and budget != 0:
             if p < 0:
                 break
-            d[i + 2] = p
+            d[i + POS] = p
             s[S.INDEX_REGISTER] = p
             if step(p):
                 w |= on_stop
@@ -93,7 +92,7 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
         if p < 0 or p > length:
             # A length or position the program wrote outside the file (softplc choice: ER, nothing done).
             return _clear(w | R_ER, R_EU)
-        d[i + 2] = p
+        d[i + POS] = p
         if p == length:
             w = _clear(w | R_DN, R_EU)
         return w
@@ -117,7 +116,7 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
                     w = work(d, i, w)  # numeric mode goes on whatever the rung does
             elif w & _FINISHED:
                 w = _clear(w, _FINISHED)
-                d[i + 2] = 0
+                d[i + POS] = 0
         d[i] = w
         return c
 
@@ -178,10 +177,10 @@ def _statistic(compute):
 
         def run(c: bool) -> bool:
             d, i, _ = control()
-            w, length = d[i], d[i + 1]
+            w, length = d[i], d[i + LEN]
             if not c:
                 d[i] = _clear(w, R_EN | R_DN | R_ER)
-                d[i + 2] = 0
+                d[i + POS] = 0
                 return False
             if w & R_EN:
                 return True  # done on the transition; nothing more while the rung stays true
@@ -190,7 +189,7 @@ def _statistic(compute):
                 fd, fi, _ = source()
                 block(fd, fi, length, str(instr.operands[0].address))
                 error = compute(machine, fd, fi, length, dest)
-                d[i + 2] = length
+                d[i + POS] = length
             d[i] = w | R_EN | (R_ER if error else R_DN)
             return True
 
@@ -239,20 +238,6 @@ def _sort(machine, fd, fi, n, dest) -> bool:
     return False
 
 
-def _download(control: int, length: int, position: int):
-    """What a download writes: the length and position operands into the
-    control's LEN and POS (nothing for a control reached indirectly)."""
-
-    def initial(instr: Instruction) -> list[tuple[Address, int]]:
-        address = instr.operands[control].address
-        if not address.is_direct:
-            return []
-        return [(replace(address, member="LEN"), constant(instr, length)),
-                (replace(address, member="POS"), constant(instr, position))]
-
-    return initial
-
-
 def _file_references(instr: Instruction) -> list[Address]:
     length = constant(instr, len(instr.operands) - 2)
     return file_references(instr, 0, length if isinstance(length, int) else None)
@@ -270,18 +255,18 @@ INSTRUCTIONS = [
     BoundInstruction(
         _spec("FAL", "file arithmetic and logic", _CONTROL, _LENGTH, _POSITION, ("mode", K.FILE_MODE),
               ("dest", K.DEST), ("expression", K.EXPRESSION)),
-        _bind_fal, lambda instr: _indexed_references(instr, (4, 5)), _download(0, 1, 2)),
+        _bind_fal, lambda instr: _indexed_references(instr, (4, 5)), lambda instr: control_words(instr, 0, 1, 2)),
     BoundInstruction(
         _spec("FSC", "file search and compare", _CONTROL, _LENGTH, _POSITION, ("mode", K.FILE_MODE),
               ("expression", K.EXPRESSION)),
-        _bind_fsc, lambda instr: _indexed_references(instr, (4,)), _download(0, 1, 2)),
+        _bind_fsc, lambda instr: _indexed_references(instr, (4,)), lambda instr: control_words(instr, 0, 1, 2)),
     BoundInstruction(
         _spec("AVE", "file average", ("file", K.FILE), ("dest", K.DEST), _CONTROL, _LENGTH, _POSITION),
-        _statistic(_average), _file_references, _download(2, 3, 4)),
+        _statistic(_average), _file_references, lambda instr: control_words(instr, 2, 3, 4)),
     BoundInstruction(
         _spec("STD", "file standard deviation", ("file", K.FILE), ("dest", K.DEST), _CONTROL, _LENGTH, _POSITION),
-        _statistic(_deviation), _file_references, _download(2, 3, 4)),
+        _statistic(_deviation), _file_references, lambda instr: control_words(instr, 2, 3, 4)),
     BoundInstruction(
         _spec("SRT", "file sort (ascending)", ("file", K.FILE), _CONTROL, _LENGTH, _POSITION),
-        _statistic(_sort), _file_references, _download(1, 2, 3)),
+        _statistic(_sort), _file_references, lambda instr: control_words(instr, 1, 2, 3)),
 ]

@@ -29,10 +29,9 @@ from typing import Callable
 
 from ...datatable import Address
 from ..ast import AddressRef, Instruction
-from ..bound import BoundInstruction, block, constant
+from ..bound import LEN, POS, BoundInstruction, block, constant, control_words
 from ..semantics import R_DN, R_EN, R_ER, R_FD, signed16
 from ..specs import K, _spec
-from .shift import LEN, POS, control_words
 
 
 def _bad(n: int, pos: int) -> bool:

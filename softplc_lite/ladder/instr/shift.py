@@ -7,9 +7,10 @@ LFL; EU for FFU and LFU, so that a load and an unload instruction can share
 one control, as AB pairs them).
 
 The Length and Position operands are what a download writes into LEN and
-POS (``initial`` below, as RSLogix writes a timer's preset into PRE); at run
-time the instructions work from the control's words, so a program may
-change them, and a bad value sets ER instead of being refused at load.
+POS (``initial``: bound.control_words, as RSLogix writes a timer's preset
+into PRE); at run time the instructions work from the control's words, so
+a program may change them, and a bad value sets ER instead of being
+refused at load.
 docs/instructions.md cites the AB section for each rule:
 
 - BSL/BSR: 1747-NP002 (the SLC 500 hand-held terminal manual) ch. 23
@@ -21,29 +22,12 @@ docs/instructions.md cites the AB section for each rule:
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 from ...datatable import Address
 from ..ast import Instruction
-from ..bound import BoundInstruction, block, constant, file_references
+from ..bound import LEN, POS, BoundInstruction, block, constant, control_words, file_references
 from ..semantics import R_DN, R_EM, R_EN, R_ER, R_EU, R_UL, signed16
 from ..specs import K, _spec
 from .. import status as S
-
-LEN, POS = 1, 2  # words of a control element after its status word
-
-
-def control_words(instr: Instruction, control: int, length: int, position: int | None = None
-                  ) -> list[tuple[Address, int]]:
-    """What a download writes: the length (and position) operands into the
-    control's LEN (and POS); nothing for a control reached indirectly."""
-    address = instr.operands[control].address
-    if not address.is_direct:
-        return []
-    out = [(replace(address, member="LEN"), constant(instr, length))]
-    if position is not None:
-        out.append((replace(address, member="POS"), constant(instr, position)))
-    return out
 
 
 # -- BSL, BSR --------------------------------------------------------------------------
