@@ -38,7 +38,7 @@ from ...datatable import Address
 from ..ast import Instruction, SymbolRef, address_refs
 from ..bound import LEN, POS, BoundInstruction, block, constant, control_words, file_references
 from ..semantics import R_DN, R_EN, R_ER, R_EU, R_FD, R_IN
-from ..specs import InstructionSpec, K, OperandSpec
+from ..specs import K, _spec
 from .. import status as S
 
 ALL, INC = "ALL", "INC"
@@ -243,30 +243,27 @@ def _file_references(instr: Instruction) -> list[Address]:
     return file_references(instr, 0, length if isinstance(length, int) else None)
 
 
-def _spec(mnemonic: str, title: str, *operands: tuple[str, K]) -> InstructionSpec:
-    return InstructionSpec(mnemonic, title, tuple(OperandSpec(n, k) for n, k in operands), True)
-
-
 _CONTROL = ("control", K.CONTROL)
 _LENGTH = ("length", K.LENGTH)
 _POSITION = ("position", K.POSITION)
 
 INSTRUCTIONS = [
     BoundInstruction(
-        _spec("FAL", "file arithmetic and logic", _CONTROL, _LENGTH, _POSITION, ("mode", K.FILE_MODE),
+        _spec("FAL", "file arithmetic and logic", True, _CONTROL, _LENGTH, _POSITION, ("mode", K.FILE_MODE),
               ("dest", K.DEST), ("expression", K.EXPRESSION)),
         _bind_fal, lambda instr: _indexed_references(instr, (4, 5)), lambda instr: control_words(instr, 0, 1, 2)),
     BoundInstruction(
-        _spec("FSC", "file search and compare", _CONTROL, _LENGTH, _POSITION, ("mode", K.FILE_MODE),
+        _spec("FSC", "file search and compare", True, _CONTROL, _LENGTH, _POSITION, ("mode", K.FILE_MODE),
               ("expression", K.EXPRESSION)),
         _bind_fsc, lambda instr: _indexed_references(instr, (4,)), lambda instr: control_words(instr, 0, 1, 2)),
     BoundInstruction(
-        _spec("AVE", "file average", ("file", K.FILE), ("dest", K.DEST), _CONTROL, _LENGTH, _POSITION),
+        _spec("AVE", "file average", True, ("file", K.FILE), ("dest", K.DEST), _CONTROL, _LENGTH, _POSITION),
         _statistic(_average), _file_references, lambda instr: control_words(instr, 2, 3, 4)),
     BoundInstruction(
-        _spec("STD", "file standard deviation", ("file", K.FILE), ("dest", K.DEST), _CONTROL, _LENGTH, _POSITION),
+        _spec("STD", "file standard deviation", True, ("file", K.FILE), ("dest", K.DEST), _CONTROL, _LENGTH,
+              _POSITION),
         _statistic(_deviation), _file_references, lambda instr: control_words(instr, 2, 3, 4)),
     BoundInstruction(
-        _spec("SRT", "file sort (ascending)", ("file", K.FILE), _CONTROL, _LENGTH, _POSITION),
+        _spec("SRT", "file sort (ascending)", True, ("file", K.FILE), _CONTROL, _LENGTH, _POSITION),
         _statistic(_sort), _file_references, lambda instr: control_words(instr, 1, 2, 3)),
 ]

@@ -23,7 +23,7 @@ import struct
 from array import array
 
 from ..bound import BoundInstruction, block, file_references
-from ..specs import InstructionSpec, K, OperandSpec
+from ..specs import K, _spec
 
 BLOCK_WORDS = 23
 FULL_SCALE = 4095  # counts: PV, tieback, bias, output (12-bit analog)
@@ -232,8 +232,7 @@ def _references(instr):
     return file_references(instr, 0, BLOCK_WORDS)
 
 
-SPEC = InstructionSpec("PID", "proportional integral derivative (integer control block)", (
-    OperandSpec("control_block", K.WORD), OperandSpec("process_variable", K.WORD),
-    OperandSpec("tieback", K.INT_SOURCE), OperandSpec("control_output", K.WORD)), True)
+SPEC = _spec("PID", "proportional integral derivative (integer control block)", True, ("control_block", K.WORD),
+             ("process_variable", K.WORD), ("tieback", K.INT_SOURCE), ("control_output", K.WORD))
 
 INSTRUCTIONS = [BoundInstruction(SPEC, _bind, _references)]
