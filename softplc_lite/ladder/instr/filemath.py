@@ -68,6 +68,7 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
     control = access.location(instr.operands[0])
     mode = file_mode(instr.operands[3])
     per_scan = None if mode == ALL else 1 if mode == INC else mode
+    incremental, numeric = mode == INC, isinstance(mode, int)
     s = access.machine.s
 
     def work(d, i: int, w: int) -> int:
@@ -107,12 +108,12 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
                 # A new operation, from POS, with the last one's bits cleared.
                 w = _clear(w, _FINISHED) | R_EU
             busy = w & R_EU and not w & (R_IN | R_ER)
-            if busy and (mode != INC or first):
+            if busy and (first or not incremental):
                 w = work(d, i, w)
         else:
             w = _clear(w, R_EN)
             if w & R_EU:
-                if isinstance(mode, int) and not w & (R_IN | R_ER):
+                if numeric and not w & (R_IN | R_ER):
                     w = work(d, i, w)  # numeric mode goes on whatever the rung does
             elif w & _FINISHED:
                 w = _clear(w, _FINISHED)
@@ -174,6 +175,7 @@ def _statistic(compute):
         control = access.location(instr.operands[-3])
         dest = access.location(instr.operands[1]) if len(instr.operands) == 5 else None
         machine = access.machine
+        what = str(instr.operands[0].address)
 
         def run(c: bool) -> bool:
             d, i, _ = control()
@@ -187,7 +189,7 @@ def _statistic(compute):
             error = length < 1  # nothing to average or sort (softplc choice: ER)
             if not error:
                 fd, fi, _ = source()
-                block(fd, fi, length, str(instr.operands[0].address))
+                block(fd, fi, length, what)
                 error = compute(machine, fd, fi, length, dest)
                 d[i + POS] = length
             d[i] = w | R_EN | (R_ER if error else R_DN)
