@@ -54,10 +54,6 @@ def file_mode(operand) -> str | int:
     return operand.value
 
 
-def _clear(w: int, mask: int) -> int:
-    return w & ~mask
-
-
 def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
     """The ALL / INC / numeric engine FAL and FSC share.
 
@@ -74,7 +70,7 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
     def work(d, i: int, w: int) -> int:
         p, length = d[i + POS], d[i + LEN]
         if w & R_FD:  # FSC resuming after a find: the found element is behind it
-            w = _clear(w, R_FD)
+            w &= ~R_FD
             p += 1
         budget = per_scan
         while p < length and budget != 0:
@@ -85,17 +81,17 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
             if step(p):
                 w |= on_stop
                 if clears_stop:
-                    w = _clear(w, R_EU)
+                    w &= ~R_EU
                 return w
             p += 1
             if budget is not None:
                 budget -= 1
         if p < 0 or p > length:
             # A length or position the program wrote outside the file (softplc choice: ER, nothing done).
-            return _clear(w | R_ER, R_EU)
+            return (w | R_ER) & ~R_EU
         d[i + POS] = p
         if p == length:
-            w = _clear(w | R_DN, R_EU)
+            w = (w | R_DN) & ~R_EU
         return w
 
     def run(c: bool) -> bool:
@@ -106,17 +102,17 @@ def _stepper(instr: Instruction, access, step, on_stop: int, clears_stop: bool):
             w |= R_EN
             if first and not w & R_EU:
                 # A new operation, from POS, with the last one's bits cleared.
-                w = _clear(w, _FINISHED) | R_EU
+                w = (w & ~_FINISHED) | R_EU
             busy = w & R_EU and not w & (R_IN | R_ER)
             if busy and (first or not incremental):
                 w = work(d, i, w)
         else:
-            w = _clear(w, R_EN)
+            w &= ~R_EN
             if w & R_EU:
                 if numeric and not w & (R_IN | R_ER):
                     w = work(d, i, w)  # numeric mode goes on whatever the rung does
             elif w & _FINISHED:
-                w = _clear(w, _FINISHED)
+                w &= ~_FINISHED
                 d[i + POS] = 0
         d[i] = w
         return c
@@ -181,7 +177,7 @@ def _statistic(compute):
             d, i, _ = control()
             w, length = d[i], d[i + LEN]
             if not c:
-                d[i] = _clear(w, R_EN | R_DN | R_ER)
+                d[i] = w & ~(R_EN | R_DN | R_ER)
                 d[i + POS] = 0
                 return False
             if w & R_EN:
