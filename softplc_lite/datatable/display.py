@@ -7,6 +7,7 @@ from typing import Any
 
 from .address import Address, ValueKind
 from .filetypes import FileType
+from .table import word_text
 
 
 def format_value(value: Any) -> str:
@@ -24,8 +25,6 @@ def word_shown(word: int, ftype: FileType) -> str | None:
     """A D word as its four BCD digits (``0012``), an A word as its two
     characters, quoted (``"AB"``): the watch view's cells. None for other
     files and for a D word that is not BCD (the plain number shows then)."""
-    from .table import word_text
-
     text = word_text(word, ftype)
     if text is None:
         return None
