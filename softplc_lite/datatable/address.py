@@ -50,6 +50,7 @@ class ValueKind(Enum):
 #: SLC_SLOT_WORDS * e + s of the I/O file (softplc choice, docs/datatable.md).
 SLC_SLOT_WORDS = 32
 SLC_MAX_SLOT = 30
+SLC_WORDS = (SLC_MAX_SLOT + 1) * SLC_SLOT_WORDS  # I/O words an SLC address can name: I:0.0 to I:30.31
 
 _STRUCT_KINDS = {"T": ValueKind.TIMER, "C": ValueKind.COUNTER, "R": ValueKind.CONTROL}
 
@@ -135,7 +136,7 @@ class Address:
             return "".join(out)
         # An SLC address stepped past the last slot (a block, a symbol's offset)
         # prints in the PLC-5 form, the same word: I:31.0 would not parse back.
-        if self.slc and isinstance(self.element, int) and self.element < (SLC_MAX_SLOT + 1) * SLC_SLOT_WORDS:
+        if self.slc and isinstance(self.element, int) and self.element < SLC_WORDS:
             slot, word = divmod(self.element, SLC_SLOT_WORDS)
             out.append(f":{slot}.{word}")
             if isinstance(self.bit, int):

@@ -25,7 +25,7 @@ import re
 from typing import Mapping
 
 from ..datatable import MAX_ELEMENTS, Address, AddressError, parse_address
-from ..datatable.address import SLC_MAX_SLOT, SLC_SLOT_WORDS
+from ..datatable.address import SLC_MAX_SLOT, SLC_SLOT_WORDS, SLC_WORDS
 from ..datatable.errors import DataTableError
 from ..datatable.filetypes import WORD_BITS
 
@@ -122,7 +122,7 @@ def apply_suffix(text: str, name: str, address: Address, m: re.Match) -> Address
         if element >= MAX_ELEMENTS:
             raise SymbolError(text, m.start(2), f"{what}: {name}[{offset}] is element {element}, past the "
                               f"last element {MAX_ELEMENTS - 1}")
-        if a.slc and element >= (SLC_MAX_SLOT + 1) * SLC_SLOT_WORDS:
+        if a.slc and element >= SLC_WORDS:
             raise SymbolError(text, m.start(2), f"{what}: {name}[{offset}] is word {element} of the I/O file, "
                               f"past the last SLC slot {SLC_MAX_SLOT} (I:{SLC_MAX_SLOT}.{SLC_SLOT_WORDS - 1})")
         a = a.with_element(element)
