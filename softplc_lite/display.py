@@ -58,19 +58,24 @@ def _block(table: DataTable, start: Address, count: int) -> Iterable[object]:
         yield table.read(start.with_element(start.element + k))
 
 
+def _split_item(text: str) -> tuple[str, int | None]:
+    """A [display] value as (address or symbol, block length or None):
+    ``#N11:0 10`` is ("N11:0", 10), ``FaultMap`` ("FaultMap", None)."""
+    text = text.strip()
+    m = _BLOCK.match(text)
+    return (m.group(1), int(m.group(2))) if m else (text, None)
+
+
 def parse_item(label: str, value: object, where: str, symbols=None) -> Item:
     if not isinstance(value, str):
         raise DataTableError(f"{where}: [display] {label} = {value!r}; expected an address such as \"N7:0\" "
                              "or a block such as \"#N11:0 10\"")
-    text = value.strip()
-    m = _BLOCK.match(text)
-    name = m.group(1) if m else text
+    name, count = _split_item(value)
     try:
         address = resolve_name(name, symbols)
     except DataTableError as e:
         raise DataTableError(f"{where}: [display] {label} = {value!r}: {e}") from None
-    if m:
-        count = int(m.group(2))
+    if count is not None:
         whole_word = isinstance(address.element, int) and address.member is None and address.bit is None
         if not 1 <= count <= 1000 or not whole_word or not address.is_direct:
             raise DataTableError(f"{where}: [display] {label} = {value!r}: a block is #FILE:ELEMENT LEN "
@@ -98,8 +103,7 @@ def display_names(section: object) -> set[str]:
     for value in (section or {}).values() if isinstance(section, dict) else ():
         for text in value.values() if isinstance(value, dict) else ():
             if isinstance(text, str):
-                m = _BLOCK.match(text.strip())
-                names.add(m.group(1) if m else text.strip())
+                names.add(_split_item(text)[0])
     return names
 
 
