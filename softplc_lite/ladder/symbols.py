@@ -58,6 +58,11 @@ class SymbolIndex:
     def get(self, name: str):
         return self.by_upper.get(name.upper())
 
+    def declaration(self, text: str):
+        """The declared symbol ``text`` names, suffix or not (``PollTimer.DN``
+        names PollTimer), or None."""
+        return self.get(symbol_base(text) or text)
+
     def nearest(self, name: str) -> str | None:
         """The declared symbol closest to ``name``, for "did you mean"."""
         spelt = {n.upper(): n for n in self.names}

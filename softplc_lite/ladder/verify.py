@@ -28,7 +28,7 @@ from ..datatable import Address, ValueKind
 from .ast import AddressRef, Const, Instruction, Program, SymbolRef, Text, leaves, walk
 from .errors import LadderError
 from .instructions import BUILTIN, InstructionSet, K
-from .symbols import SymbolIndex, symbol_base
+from .symbols import SymbolIndex
 
 # Instructions that use the element they name (a RES does not: it resets it).
 _ELEMENT_KINDS = (K.TIMER, K.COUNTER, K.CONTROL)
@@ -117,14 +117,14 @@ def _constant_warnings(ins: Instruction, overflow: str) -> list[LadderError]:
 
 def _unused_symbols(parsed: Program, instructions: InstructionSet, shown: Iterable[str]) -> list[LadderError]:
     names = SymbolIndex(parsed.symbols)
-    used = {decl.name for text in shown if (decl := names.get(symbol_base(text) or text)) is not None}
+    used = {decl.name for text in shown if (decl := names.declaration(text)) is not None}
     for pfile in parsed.files.values():
         for rung in pfile.rungs:
             for ins in walk(rung.elements):
                 spec = instructions.lookup(ins.mnemonic)
                 quoted = spec is not None and any(o.kind is K.EXPRESSION for o in spec.operands)
                 for ref in _symbol_refs(ins.operands, quoted):
-                    decl = names.get(symbol_base(ref.name) or ref.name)
+                    decl = names.declaration(ref.name)
                     if decl is not None:
                         used.add(decl.name)
     return [LadderError(decl.pos, f"symbol {decl.name} ({decl.address}) is never used in the program")
