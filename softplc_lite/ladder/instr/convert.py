@@ -72,7 +72,7 @@ def _bind_dcd(instr, access):
 def _bind_enc(instr, access):
     source = access.value(instr.operands[0])
     dest = access.location(instr.operands[1])
-    s = access.machine.s
+    m = access.machine
 
     def run(c: bool) -> bool:
         if c:
@@ -81,7 +81,7 @@ def _bind_enc(instr, access):
             lowest = (w & -w).bit_length() - 1 if w else 0
             d[i] = lowest
             # V: more than one bit on (the lowest one wins); no minor fault. C and S reset.
-            s[S.ARITH_FLAGS] = (s[S.ARITH_FLAGS] & -16) | (bool(w & (w - 1)) << S.OVERFLOW) | ((lowest == 0) << S.ZERO)
+            m.flags(False, bool(w & (w - 1)), lowest == 0, False)
         return c
     return run
 
