@@ -19,7 +19,7 @@ docs/instructions.md has each rule with its source.
 
 from __future__ import annotations
 
-
+from ...datatable.table import WORD_MAX, WORD_MIN
 from ..bound import BoundInstruction, unary_store
 from ..expr import FUNCTIONS
 from ..specs import K, _spec
@@ -30,7 +30,6 @@ _FUNCTIONS = (
     ("ASN", "arc sine"), ("ACS", "arc cosine"), ("ATN", "arc tangent"),
     ("LN", "natural log"), ("LOG", "log to the base 10"),
 )
-_WORD_MAX, _WORD_MIN = 32767, -32768
 
 
 def set_overflow(m) -> None:
@@ -82,7 +81,7 @@ def _bind_ddv(instr, access):
             _ddv_overflow(m, d, i)
             return c
         quotient = _round_half_away(dividend, divisor)
-        if not _WORD_MIN <= quotient <= _WORD_MAX:
+        if not WORD_MIN <= quotient <= WORD_MAX:
             _ddv_overflow(m, d, i)  # the math register keeps the dividend (softplc choice)
             return c
         unrounded = abs(dividend) // abs(divisor) * (1 if (dividend >= 0) == (divisor >= 0) else -1)
@@ -95,7 +94,7 @@ def _bind_ddv(instr, access):
 
 def _ddv_overflow(m, d, i) -> None:
     # 1747-RM001, DDV: "The value 32,767 is placed in the destination".
-    d[i] = _WORD_MAX
+    d[i] = WORD_MAX
     m.flags(False, True, False, False)
     m.overflow_fault()
 
@@ -112,12 +111,12 @@ def _bind_scl(instr, access):
         scaled = _round_half_away(get_source() * get_rate(), 10000)
         # Overflow is checked before and after the offset is added; either
         # way the destination gets the extreme of the result's sign.
-        value = scaled + get_offset() if _WORD_MIN <= scaled <= _WORD_MAX else scaled
-        if _WORD_MIN <= value <= _WORD_MAX:
+        value = scaled + get_offset() if WORD_MIN <= scaled <= WORD_MAX else scaled
+        if WORD_MIN <= value <= WORD_MAX:
             d[i] = value
             m.flags(False, False, value == 0, value < 0)
         else:
-            d[i] = _WORD_MAX if value > 0 else _WORD_MIN
+            d[i] = WORD_MAX if value > 0 else WORD_MIN
             m.flags(False, True, False, value < 0)
             m.overflow_fault()
         return c
