@@ -37,6 +37,7 @@ from ..datatable import Address, DataTable
 from ..datatable.errors import AddressRangeError
 from .ast import AddressRef, Const, Instruction, address_refs
 from .expr import evaluate
+from .resolvers import address_fault
 from .semantics import Machine, MajorFault
 from . import status as S
 
@@ -67,12 +68,6 @@ class BoundInstruction:
     initial: Callable[[Instruction], list[tuple[Address, int]]] | None = None
 
 
-def _fault(address: Address, error: AddressRangeError) -> MajorFault:
-    from .resolvers import address_fault
-
-    return address_fault(address, error)
-
-
 class Access:
     """How a bound instruction reaches its operands (see the module doc)."""
 
@@ -86,7 +81,7 @@ class Access:
         try:
             f, index, bit = self.table.resolve(address)
         except AddressRangeError as e:
-            raise _fault(address, e) from None
+            raise address_fault(address, e) from None
         return f.data, index, bit
 
     def location(self, operand) -> Callable[[], Location]:
