@@ -28,7 +28,9 @@ from ..datatable import Address, ValueKind
 from .ast import AddressRef, Const, Instruction, Program, SymbolRef, Text, leaves, walk
 from .errors import LadderError
 from .instructions import BUILTIN, InstructionSet, K
+from .parser import parse_expression
 from .symbols import SymbolIndex
+from .validate import constant_fits
 
 # Instructions that use the element they name (a RES does not: it resets it).
 _ELEMENT_KINDS = (K.TIMER, K.COUNTER, K.CONTROL)
@@ -101,8 +103,6 @@ def _direct(op) -> Address | None:
 
 def _constant_warnings(ins: Instruction, overflow: str) -> list[LadderError]:
     """MOV 40000 N7:0: the constant cannot be stored as written."""
-    from .validate import constant_fits  # validate imports the instruction table this module reads
-
     if len(ins.operands) < 2:
         return []
     source, dest = ins.operands[0], ins.operands[1]
@@ -134,8 +134,6 @@ def _unused_symbols(parsed: Program, instructions: InstructionSet, shown: Iterab
 def _symbol_refs(operands: Iterable, quoted: bool) -> Iterable[SymbolRef]:
     """The symbols of operands; ``quoted``: a Text operand is an expression
     (CPT, CMP) that only the validator parses."""
-    from .parser import parse_expression
-
     for op in operands:
         for leaf in leaves(op):
             if isinstance(leaf, SymbolRef):
