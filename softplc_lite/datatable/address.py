@@ -247,15 +247,12 @@ def _parse(sc: _Scanner, nested: bool) -> Address:
     member: str | None = None
     bit: Part | None = None
 
-    slc = False
     if sc.take(":"):
         slot_word = _slc_slot_word(sc, ftype)
         if slot_word is not None:
-            slc = True
-            element = slot_word
             if sc.take("/"):
                 bit = _number(sc, "bit number", False, WORD_BITS - 1)
-            addr = Address(ftype.letter, file_part, element, None, bit, indexed, slc=True)
+            addr = Address(ftype.letter, file_part, slot_word, None, bit, indexed, slc=True)
             return _checked_nested(sc, addr, nested, type_pos)
         element = _element_number(sc, ftype)
         if sc.take("."):
@@ -274,7 +271,7 @@ def _parse(sc: _Scanner, nested: bool) -> Address:
         example = "B3/17 or B3:1/1" if ftype.bits_across_file else f"{_example(ftype)}"
         raise sc.error(f"expected ':' and an element number after the file, as in {example}")
 
-    addr = Address(ftype.letter, file_part, element, member, bit, indexed, slc)
+    addr = Address(ftype.letter, file_part, element, member, bit, indexed)
     return _checked_nested(sc, addr, nested, type_pos)
 
 
