@@ -34,7 +34,7 @@ _FUNCTIONS = (
 
 def set_overflow(m) -> None:
     """S:0/1 and the overflow minor fault, after a store that did not see
-    the overflow itself (XPY's negative base, SCL's intermediate result)."""
+    the overflow itself (XPY's negative base)."""
     m.s[S.ARITH_FLAGS] |= 1 << S.OVERFLOW
     m.overflow_fault()
 
