@@ -240,7 +240,7 @@ class _Checker:
         if not spec.min_operands <= n <= spec.max_operands:
             extras = instr.operands[spec.max_operands:]
             stray = next((o for o in extras if isinstance(o, SymbolRef)
-                      and self.symbols.get(symbol_base(o.name) or o.name) is None), None)
+                      and self.symbols.declaration(o.name) is None), None)
             if stray is not None:
                 self.error(stray.pos, f"unknown instruction {stray.name!r}{self.instructions.hint(stray.name)}")
                 return instr
