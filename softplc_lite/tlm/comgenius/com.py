@@ -44,7 +44,7 @@ from .instructions import _PARAMS, _PARAMS_OUT, FormatSource, param_problem, par
 from .params import ParamError
 from .ports import ComPort, PortSet
 from .printf import MAX_PARAMS, compile_print
-from .scanf import MATCHED, MISMATCH, compile_scan
+from .scanf import MATCHED, MISMATCH, NEED_MORE, compile_scan
 from .strings import StringTable
 
 COMPRINT = spec("COMPRINT", "format and send to a port", ("control", K.CONTROL), ("port", K.PORT),
@@ -140,10 +140,23 @@ class ComPrint(_Controlled):
 
 class ComScan(_Controlled):
     port_obj: ComPort | None = None
+    # The receive buffer (the str object itself) of the last attempt and its
+    # result, kept only when that attempt needed more input and took no
+    # Param: matching the same buffer again would give the same result and
+    # change nothing, so it is not repeated until the buffer changes or the
+    # instruction starts again.
+    _tried_rx: str | None = None
+    _tried: object = None
+
+    def __init__(self, ctx: InstructionContext, ports: PortSet, strings: StringTable, log: Log) -> None:
+        super().__init__(ctx, ports, strings, log)
+        # Params of constants and direct addresses only: resolving them takes nothing from the table
+        self._fixed_params = all(op.address is None or op.address.is_direct for op in ctx.operands[3:])
 
     def start(self, ctl: ControlElement) -> bool:
         ctl.len = 0
         ctl.pos = 0
+        self._tried_rx = None
         self.started_ms = self.ctx.now_ms
         found = self._port_and_format(ctl)
         if found is None:
@@ -166,10 +179,18 @@ class ComScan(_Controlled):
         port = self.port_obj
         if not port.up:
             return self._error(ctl, f"port {port.number} is down: {port.error}")
-        try:
-            result = self.matcher.match(port.rx, self.params(), final=False)
-        except ParamError as e:
-            return self._error(ctl, f"format {self.index}: {e.reason}")
+        rx = port.rx
+        if rx is self._tried_rx:
+            result = self._tried
+        else:
+            try:
+                result, taken = self.matcher.match_counted(rx, self.params(), final=False)
+            except ParamError as e:
+                return self._error(ctl, f"format {self.index}: {e.reason}")
+            if result.status == NEED_MORE and not taken and self._fixed_params:
+                self._tried_rx, self._tried = rx, result
+            else:
+                self._tried_rx = None
         ctl.len = result.used
         ctl.pos = result.specs
         if result.status == MATCHED:

@@ -376,6 +376,13 @@ class ScanFormat:
     def match(self, data: str, params: Sequence[Param] = (), final: bool = False) -> ScanResult:
         """Match ``data`` from its start. Raises ParamError for a missing
         Param or one of the wrong kind."""
+        return self.match_counted(data, params, final)[0]
+
+    def match_counted(self, data: str, params: Sequence[Param] = (),
+                      final: bool = False) -> tuple[ScanResult, int]:
+        """``match``, and how many Params it took (read or wrote): with none
+        taken, the result depended on ``data`` and ``final`` alone and the
+        match changed nothing (COMSCAN need not repeat it on the same input)."""
         st = _Scan(data, final, params)
         pos = 0
         specs = 0
@@ -386,9 +393,9 @@ class ScanFormat:
                     specs += 1
         except _Stop as stop:
             if stop.need:
-                return ScanResult(NEED_MORE, stop.pos, specs)
-            return ScanResult(MISMATCH, stop.pos, specs)
-        return ScanResult(MATCHED, pos, specs)
+                return ScanResult(NEED_MORE, stop.pos, specs), st.k
+            return ScanResult(MISMATCH, stop.pos, specs), st.k
+        return ScanResult(MATCHED, pos, specs), st.k
 
 
 @lru_cache(maxsize=4096)
