@@ -232,6 +232,14 @@ class ModbusSlave(SimDevice):
             if self._frame and now_ns >= self._last + gap:
                 self._finish(self._last + gap)
 
+    def next_due(self, now_ns: int) -> int | None:
+        """When ``poll`` ends the frame being received (RTU, once the line
+        has been silent 3.5 characters); None with no frame, or in ASCII
+        (a frame ends on its own bytes there, in ``receive``)."""
+        if self.framing == "rtu" and self._frame:
+            return self._last + silence_ns(self.end.char_ns)
+        return None
+
     def cts(self, now_ns: int) -> tuple[bool, int]:
         on, since = self.end.rts()
         if not self.cts_enabled:

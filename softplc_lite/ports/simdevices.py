@@ -59,6 +59,13 @@ class SimDevice:
     def poll(self, now_ns: int) -> None:
         pass
 
+    def next_due(self, now_ns: int) -> int | None:
+        """The earliest time at which ``poll`` could do anything, given
+        nothing new is received before it (None: never). The link skips its
+        per-read work until then; a device that cannot tell returns
+        ``now_ns`` (polled at every read, the default)."""
+        return now_ns
+
     def cts(self, now_ns: int) -> tuple[bool, int]:
         """The port's CTS and when it last changed: by default it follows
         the port's RTS at once (a device that is always ready)."""

@@ -167,6 +167,15 @@ class Wire:
             chunks.popleft()
         return b"".join(parts), times
 
+    def next_arrival(self) -> int | None:
+        """When the first byte not yet taken arrives (it may have by now);
+        None when the wire is empty."""
+        chunks = self.chunks
+        if not chunks:
+            return None
+        chunk = chunks[0]
+        return chunk.start + (chunk.taken + 1) * chunk.char_ns if chunk.char_ns else chunk.start
+
     def pending(self, now: int) -> int:
         """Bytes sent but not yet arrived by ``now``."""
         total = 0
@@ -206,6 +215,27 @@ class Link:
         self.ports: list[PortEnd | None] = [None, None]
         self.device: SimDevice | None = None
         self.rts: list[tuple[bool, int]] = [(False, 0), (False, 0)]  # per end: (on, when it changed)
+        # Until this time (ns) a pump would do nothing and end 0 has nothing
+        # to read: no byte arrives on either wire and the device's poll is
+        # not due. Set by PortEnd.available and read_arrived when they find
+        # nothing (end 0, the port of a device link); reset to 0
+        # by whatever changes the link (a send, a reset, new settings).
+        self.quiet_until = 0
+
+    def quiet_from(self, now: int) -> int:
+        """When the next thing can happen on a device link pumped at ``now``
+        (0 when it may be now, or on a port-to-port link)."""
+        device = self.device
+        if device is None:
+            return 0
+        due = device.next_due(now)
+        for wire in self.wires:
+            t = wire.next_arrival()
+            if t is not None and (due is None or t < due):
+                due = t
+        if due is None:
+            return 1 << 62
+        return due if due > now else 0
 
     def pump(self, now: int) -> None:
         """Hand the device what has reached it by ``now``, then let it poll."""
@@ -320,29 +350,34 @@ class PortEnd:
         char_ns = char_time_ns(baudrate, bytesize, parity, stopbits)
         self.char_ns = 0 if unlimited else char_ns
         self._table = mask_table(bytesize)
+        self.link.quiet_until = 0  # the device's silence interval follows the character time
 
     def mask(self, data: bytes) -> bytes:
         return data if self._table is None else data.translate(self._table)
 
     def write(self, data: bytes, now: int) -> None:
         with self.link.lock:
+            self.link.quiet_until = 0
             self.link.pump(now)
             self._out.send(self.mask(data), now, self.char_ns)
             self.link.pump(now)
 
     def read(self, size: int, now: int) -> bytes:
         with self.link.lock:
+            self.link.quiet_until = 0
             self.link.pump(now)
             return self._in.take(size, now)
 
     def read_timed(self, now: int) -> tuple[bytes, list[int]]:
         """Everything arrived by ``now``, with each byte's arrival time."""
         with self.link.lock:
+            self.link.quiet_until = 0
             self.link.pump(now)
             return self._in.take_timed(now)
 
     def set_rts(self, on: bool, now: int) -> None:
         with self.link.lock:
+            self.link.quiet_until = 0
             self.link.pump(now)
             if self.link.rts[self.index][0] != on:
                 self.link.rts[self.index] = (on, now)
@@ -358,9 +393,34 @@ class PortEnd:
             return self.link.rts[1 - self.index]
 
     def available(self, now: int) -> int:
-        with self.link.lock:
-            self.link.pump(now)
-            return self._in.available(now)
+        link = self.link
+        with link.lock:
+            link.pump(now)
+            n = self._in.available(now)
+            if not n and self.index == 0:
+                link.quiet_until = link.quiet_from(now)
+            return n
+
+    def read_arrived(self, now: int) -> bytes:
+        """What ``available`` then ``read`` of that many bytes return, in one
+        call: the pump, the count, and (when there are bytes) the pump and the
+        take. While the link is quiet (see Link.quiet_until) both would do
+        nothing, so nothing is done."""
+        link = self.link
+        if now < link.quiet_until:
+            return b""
+        with link.lock:
+            link.pump(now)
+            n = self._in.available(now)
+            if not n:
+                if self.index == 0:
+                    link.quiet_until = link.quiet_from(now)
+                return b""
+            link.quiet_until = 0
+            due = link.device.next_due(now) if link.device is not None else now
+            if due is not None and due <= now:
+                link.pump(now)  # a device that cannot tell, or is due: polled again as read() would
+            return self._in.take(n, now)
 
     def pending(self, now: int) -> int:
         with self.link.lock:
@@ -369,11 +429,13 @@ class PortEnd:
 
     def reset_input(self, now: int) -> None:
         with self.link.lock:
+            self.link.quiet_until = 0
             self.link.pump(now)
             self._in.discard_arrived(now)
 
     def reset_output(self, now: int) -> None:
         with self.link.lock:
+            self.link.quiet_until = 0
             self.link.pump(now)
             self._out.abort(now)
 
@@ -422,6 +484,7 @@ class DeviceEnd:
         """Transmit ``data`` toward the port, timed like a port write at ``at_ns``
         (queued behind what the device sent before)."""
         with self._link.lock:
+            self._link.quiet_until = 0
             self._link.wires[1].send(self._port.mask(bytes(data)), at_ns, self._port.char_ns)
 
 
@@ -444,6 +507,13 @@ class ClockedSerial(SerialBase):
         """Use ``fn()`` (int ns) as this port's time; reads stop blocking."""
         self._clock = fn
         self._clock_set = True
+
+    def read_now(self) -> bytes:
+        """Everything that has arrived by the clock's time, never blocking:
+        ``read(in_waiting)`` (what a polling driver does), in one call."""
+        self._check_open()
+        n = self._available(self._clock())
+        return self._take(n, self._clock()) if n else b""
 
     # - - - open / close - - -
 

@@ -19,5 +19,8 @@ class SimulatedTransport(LoopTransport):
     def set_clock(self, now_ns: Callable[[], int]) -> None:
         self.serial.set_clock(now_ns)
 
+    def read(self) -> bytes:
+        return self.serial.read_now()  # read(in_waiting) in one call, nothing done while the wire is quiet
+
 
 TRANSPORT = SimulatedTransport

@@ -112,6 +112,10 @@ class Serial(wire.ClockedSerial):
     def _cts(self, now: int) -> tuple[bool, int]:
         return self._end.cts(now)
 
+    def read_now(self) -> bytes:
+        self._check_open()
+        return self._end.read_arrived(self._clock())
+
     def _available(self, now: int) -> int:
         return self._end.available(now)
 
