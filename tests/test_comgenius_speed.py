@@ -2,7 +2,8 @@
 test that fails if the work it skips was needed:
 
 - COMSCAN does not repeat a match on the same receive buffer when the last
-  attempt needed more input and took no Param; a changed buffer, a
+  attempt needed more input and took no Param, nor on one that only grew
+  while a fixed-size field still lacks characters; a changed buffer, a
   re-armed instruction or a Param-taking partial match is matched again,
   and the timeout still fires;
 - a device link (sim://...?device=) skips its pump while nothing can
@@ -102,6 +103,33 @@ def test_a_buffer_that_changed_after_a_failed_attempt_is_matched_again(scanner, 
     e.scan()
     e.scan()
     port.rx = "\x05"  # same length, other content: a mismatch now
+    e.scan()
+    assert len(matches) == 2
+    assert bits(e, "R6:1") == (1, 1, 1, 0)
+
+
+def test_a_buffer_growing_inside_a_fixed_field_is_not_matched_again(scanner, matches):
+    e, port = scanner()
+    port.rx = "\x02\x03\xfa" + "A" * 10  # %.250C stops: it needs 253 characters in all
+    e.table.write("B3/0", 1)
+    e.scan()
+    for n in (20, 100, 252):
+        port.rx += "A" * (n - len(port.rx))
+        e.scan()
+        assert e.table.read("R6:1.LEN") == n  # NEED_MORE at the buffer's end, as a match gives
+    assert len(matches) == 1
+    assert bits(e, "R6:1") == (1, 0, 0, 0)
+    port.rx += "A"  # 253: the field is there, now the CRC is needed: matched again
+    e.scan()
+    assert len(matches) == 2
+
+
+def test_a_grown_buffer_whose_start_changed_is_matched_again(scanner, matches):
+    e, port = scanner()
+    port.rx = "\x02\x03\xfa" + "A" * 10
+    e.table.write("B3/0", 1)
+    e.scan()
+    port.rx = "\x02\x05\xfa" + "A" * 20  # longer, but not the old buffer plus more
     e.scan()
     assert len(matches) == 2
     assert bits(e, "R6:1") == (1, 1, 1, 0)

@@ -44,7 +44,7 @@ from .instructions import _PARAMS, _PARAMS_OUT, FormatSource, param_problem, par
 from .params import ParamError
 from .ports import ComPort, PortSet
 from .printf import MAX_PARAMS, compile_print
-from .scanf import MATCHED, MISMATCH, NEED_MORE, compile_scan
+from .scanf import MATCHED, MISMATCH, NEED_MORE, ScanResult, compile_scan
 from .strings import StringTable
 
 COMPRINT = spec("COMPRINT", "format and send to a port", ("control", K.CONTROL), ("port", K.PORT),
@@ -144,9 +144,12 @@ class ComScan(_Controlled):
     # result, kept only when that attempt needed more input and took no
     # Param: matching the same buffer again would give the same result and
     # change nothing, so it is not repeated until the buffer changes or the
-    # instruction starts again.
+    # instruction starts again. With _tried_need (the length the stopped
+    # field needs, 0 when unknown), a buffer that only grew at its end and is
+    # still shorter gives NEED_MORE at its end, with the same specs.
     _tried_rx: str | None = None
     _tried: object = None
+    _tried_need = 0
 
     def __init__(self, ctx: InstructionContext, ports: PortSet, strings: StringTable, log: Log) -> None:
         super().__init__(ctx, ports, strings, log)
@@ -180,15 +183,19 @@ class ComScan(_Controlled):
         if not port.up:
             return self._error(ctl, f"port {port.number} is down: {port.error}")
         rx = port.rx
-        if rx is self._tried_rx:
+        tried = self._tried_rx
+        if rx is tried:
             result = self._tried
+        elif tried is not None and len(rx) < self._tried_need and rx.startswith(tried):
+            result = self._tried = ScanResult(NEED_MORE, len(rx), self._tried.specs)
+            self._tried_rx = rx
         else:
             try:
-                result, taken = self.matcher.match_counted(rx, self.params(), final=False)
+                result, taken, need = self.matcher.match_counted(rx, self.params(), final=False)
             except ParamError as e:
                 return self._error(ctl, f"format {self.index}: {e.reason}")
             if result.status == NEED_MORE and not taken and self._fixed_params:
-                self._tried_rx, self._tried = rx, result
+                self._tried_rx, self._tried, self._tried_need = rx, result, need
             else:
                 self._tried_rx = None
         ctl.len = result.used

@@ -80,7 +80,7 @@ _BASE = {"b": 2, "o": 8, "u": 10, "d": 10, "x": 16, "X": 16, "i": 0}
 class _Scan:
     """State of one match: the input, the Params and the position."""
 
-    __slots__ = ("data", "n", "final", "params", "k")
+    __slots__ = ("data", "n", "final", "params", "k", "need_len")
 
     def __init__(self, data: str, final: bool, params: Sequence[Param]) -> None:
         self.data = data
@@ -88,6 +88,7 @@ class _Scan:
         self.final = final
         self.params = params
         self.k = 0
+        self.need_len = 0  # set by an op that stops for input it has not looked at yet
 
     def end(self, pos: int):
         """The input ended at ``pos`` before a decision."""
@@ -295,6 +296,8 @@ def _chars(spec: Spec):
                 raise ParamError(f"{spec.text}: the byte count Param is {count}, below 0")
         end = pos + count
         if end > st.n:
+            if not star:
+                st.need_len = end  # nothing of the field is read before it is all there
             st.end(st.n)
         if store:
             raw = low_bytes(st.data[pos:end])
@@ -379,10 +382,14 @@ class ScanFormat:
         return self.match_counted(data, params, final)[0]
 
     def match_counted(self, data: str, params: Sequence[Param] = (),
-                      final: bool = False) -> tuple[ScanResult, int]:
-        """``match``, and how many Params it took (read or wrote): with none
-        taken, the result depended on ``data`` and ``final`` alone and the
-        match changed nothing (COMSCAN need not repeat it on the same input)."""
+                      final: bool = False) -> tuple[ScanResult, int, int]:
+        """``match``, how many Params it took (read or wrote) and, for a
+        NEED_MORE, the input length below which it stays NEED_MORE (0 when
+        unknown). With no Param taken the result depended on ``data`` and
+        ``final`` alone and the match changed nothing, so COMSCAN need not
+        repeat it on the same input; nor, while shorter than that length, on
+        input that only grew at its end (what the stopped field reads first
+        is not there yet, and the fields before it read only the old input)."""
         st = _Scan(data, final, params)
         pos = 0
         specs = 0
@@ -393,9 +400,9 @@ class ScanFormat:
                     specs += 1
         except _Stop as stop:
             if stop.need:
-                return ScanResult(NEED_MORE, stop.pos, specs), st.k
-            return ScanResult(MISMATCH, stop.pos, specs), st.k
-        return ScanResult(MATCHED, pos, specs), st.k
+                return ScanResult(NEED_MORE, stop.pos, specs), st.k, st.need_len
+            return ScanResult(MISMATCH, stop.pos, specs), st.k, 0
+        return ScanResult(MATCHED, pos, specs), st.k, 0
 
 
 @lru_cache(maxsize=4096)
