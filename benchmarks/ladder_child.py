@@ -1,0 +1,132 @@
+"""A child process of bench_ladder.py: one softplc_lite work tree, one
+program, in a fresh interpreter (so a baseline commit imports its own
+package, and a memory or cold-load figure starts from nothing).
+
+    python benchmarks/ladder_child.py TREE MODE PROGRAM_FILE
+
+MODE:
+
+- ``serve``: load the program (timed), build a compiled Engine with the
+  benchmark's initial table and input hook (ladder_programs), print one JSON
+  line, then answer commands read from stdin, one JSON line each:
+  ``scan N`` (N scans, each timed: ``{"ns": [...]}``), ``digest`` (a hash of
+  the table without the status file, and the mode), ``quit``. The parent
+  drives two or more children in turn, so their scans interleave.
+- ``memory``: tracemalloc's current size after loading (parse, validate,
+  Engine construction) and gc.collect(), the program tree kept alive as a
+  runner keeps it (``Runner`` holds the engine, the engine its program).
+- ``load``: the cold load times: parser set-up (a first one-rung parse),
+  then parse, validate, compile (Engine construction) of the program.
+
+Only the public API is used (parse_program, validate, Engine), the same in
+every tree compared.
+"""
+
+from __future__ import annotations
+
+import gc
+import json
+import sys
+import time
+from pathlib import Path
+
+TREE = Path(sys.argv[1]).resolve()
+sys.path.insert(0, str(TREE))
+
+import softplc_lite  # noqa: E402 (after the tree is put first on sys.path)
+
+if not softplc_lite.__file__.startswith(str(TREE)):
+    raise SystemExit(f"imported {softplc_lite.__file__}, not the tree {TREE}")
+
+import ladder_programs as L  # noqa: E402
+from softplc_lite.ladder import parse_program, validate  # noqa: E402
+
+
+def reply(doc: dict) -> None:
+    sys.stdout.write(json.dumps(doc) + "\n")
+    sys.stdout.flush()
+
+
+def load(text: str):
+    t0 = time.perf_counter()
+    parsed = parse_program(text, "<bench>")
+    t1 = time.perf_counter()
+    program = validate(parsed)
+    t2 = time.perf_counter()
+    engine = L.make_engine(program)
+    t3 = time.perf_counter()
+    times = {"parse_s": t1 - t0, "validate_s": t2 - t1, "compile_s": t3 - t2, "total_s": t3 - t0}
+    return program, engine, times
+
+
+def serve(text: str) -> None:
+    program, engine, times = load(text)
+    rungs, instructions = L.count_instructions(program)
+    del text
+    reply({"load": times, "rungs": rungs, "instructions": instructions})
+    for line in sys.stdin:
+        command, _, arg = line.strip().partition(" ")
+        if command == "scan":
+            samples = []
+            gc.collect()
+            gc.disable()
+            try:
+                for _ in range(int(arg)):
+                    t0 = time.perf_counter_ns()
+                    engine.scan()
+                    samples.append(time.perf_counter_ns() - t0)
+            finally:
+                gc.enable()
+            reply({"ns": samples, "mode": engine.mode.name})
+        elif command == "digest":
+            reply({"digest": L.table_digest(engine.table), "mode": engine.mode.name,
+                   "fault": str(engine.fault) if engine.fault else None})
+        elif command == "quit":
+            break
+
+
+def memory(text: str) -> None:
+    import tracemalloc
+
+    gc.collect()
+    tracemalloc.start()
+    program, engine, times = load(text)
+    rungs, instructions = L.count_instructions(program)
+    gc.collect()
+    with_tree, peak = tracemalloc.get_traced_memory()
+    # What the compiled engine alone holds, should it not keep the tree: the
+    # same measure with this script's own reference to the program dropped.
+    del program
+    gc.collect()
+    engine_only, _ = tracemalloc.get_traced_memory()
+    top = tracemalloc.take_snapshot().statistics("filename")[:6]
+    tracemalloc.stop()
+    reply({"rungs": rungs, "instructions": instructions, "bytes": with_tree, "peak_bytes": peak,
+           "bytes_engine_only": engine_only, "load_under_tracemalloc_s": times["total_s"],
+           "top_files": [{"file": str(s.traceback[0].filename).rsplit("/", 2)[-1] if s.traceback else "?",
+                          "bytes": s.size} for s in top],
+           "alive": engine is not None})
+
+
+def cold_load(text: str) -> None:
+    t0 = time.perf_counter()
+    parse_program("XIC B3/0 OTE B3/1\n", "<setup>")  # builds the parser (grammar, tables) once
+    setup = time.perf_counter() - t0
+    program, engine, times = load(text)
+    rungs, instructions = L.count_instructions(program)
+    # WARM LOAD (issue 17, the code cache kept beside the retentive state):
+    # not measured yet. When the cache lands, load the same text a second
+    # time through it here (a fresh process, the cache on disk from this
+    # one) and reply its times as "warm"; the target is <= 0.3 s.
+    reply({"parser_setup_s": setup, **times, "rungs": rungs, "instructions": instructions, "warm": None})
+
+
+def main() -> int:
+    mode, program_file = sys.argv[2], sys.argv[3]
+    text = Path(program_file).read_text(encoding="utf-8")
+    {"serve": serve, "memory": memory, "load": cold_load}[mode](text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

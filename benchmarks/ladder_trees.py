@@ -1,0 +1,186 @@
+"""The figures of bench_ladder.py that need fresh processes (issue 17):
+
+- against the commit before issue 17's compiler work (``baseline_speedup``):
+  a child per tree loads the same program text and the parent drives them
+  in turn, a block of scans each, so the two trees' scans interleave; the
+  figure is the median of the per-block ratios baseline / current, and the
+  two tables must agree after the same scans;
+- scaling (``scaling``): ns per instruction at 1,000, 10,000, 100,000 rungs,
+  one child per size, interleaved the same way;
+- memory (``memory``): bytes per instruction after load, tracemalloc in a
+  fresh child;
+- cold load (``cold_load``): parse, validate, compile in a fresh child.
+
+The children are ladder_child.py; the program text goes to them as a file
+written here, so every tree loads exactly the same text.
+"""
+
+from __future__ import annotations
+
+import json
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+CHILD = HERE / "ladder_child.py"
+
+
+class ChildFailed(RuntimeError):
+    """A child process died or answered nonsense; the message holds the end of its stderr."""
+
+
+class Child:
+    """One ladder_child.py process; ``ask`` sends a command, returns its JSON reply."""
+
+    def __init__(self, tree: Path, mode: str, program_file: Path, timeout_s: float = 1800) -> None:
+        self.tree = tree
+        self.stderr = tempfile.TemporaryFile(mode="w+")
+        self.proc = subprocess.Popen([sys.executable, str(CHILD), str(tree), mode, str(program_file)],
+                                     cwd=str(HERE), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                     stderr=self.stderr, text=True)
+        self.timeout_s = timeout_s
+
+    def read(self) -> dict:
+        line = self.proc.stdout.readline()
+        if not line:
+            self.proc.wait(timeout=60)
+            self.stderr.seek(0)
+            tail = "\n".join(self.stderr.read().strip().splitlines()[-6:])
+            raise ChildFailed(f"child on {self.tree} ended (exit {self.proc.returncode}):\n{tail}")
+        return json.loads(line)
+
+    def ask(self, command: str) -> dict:
+        self.proc.stdin.write(command + "\n")
+        self.proc.stdin.flush()
+        return self.read()
+
+    def close(self) -> None:
+        try:
+            if self.proc.poll() is None:
+                self.proc.stdin.write("quit\n")
+                self.proc.stdin.flush()
+                self.proc.wait(timeout=60)
+        except (OSError, subprocess.TimeoutExpired):
+            self.proc.kill()
+            self.proc.wait()
+        self.stderr.close()
+
+
+def run_child(tree: Path, mode: str, program_file: Path) -> dict:
+    """A one-shot child (memory, load): its one JSON reply."""
+    child = Child(tree, mode, program_file)
+    try:
+        return child.read()
+    finally:
+        child.close()
+
+
+def write_program(directory: Path, name: str, text: str) -> Path:
+    path = directory / f"{name}.lad"
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def interleaved_blocks(children: dict[str, Child], blocks: int, scans: dict[str, int]) -> dict[str, list[float]]:
+    """Per child, the median scan (ns) of each block; the children take
+    turns block by block, their order rotating every block."""
+    names = list(children)
+    out: dict[str, list[float]] = {name: [] for name in names}
+    for b in range(blocks):
+        for name in names[b % len(names):] + names[:b % len(names)]:
+            r = children[name].ask(f"scan {scans[name]}")
+            if r["mode"] != "RUN":
+                raise ChildFailed(f"{name}: the program left RUN ({r['mode']})")
+            out[name].append(statistics.median(r["ns"]))
+    return out
+
+
+def baseline_speedup(base_tree: Path, current_tree: Path, program_file: Path, warmup_scans: int,
+                     blocks: int, scans_per_block: int) -> dict:
+    """Scans of one program on the baseline tree and the current tree,
+    interleaved: per-block medians and the median of the per-block ratios."""
+    children = {"baseline": Child(base_tree, "serve", program_file),
+                "current": Child(current_tree, "serve", program_file)}
+    try:
+        loaded = {name: child.read() for name, child in children.items()}
+        for child in children.values():
+            child.ask(f"scan {warmup_scans}")
+        per_block = interleaved_blocks(children, blocks, {name: scans_per_block for name in children})
+        digests = {name: child.ask("digest") for name, child in children.items()}
+    finally:
+        for child in children.values():
+            child.close()
+    base, cur = per_block["baseline"], per_block["current"]
+    ratios = [b / c for b, c in zip(base, cur)]
+    instructions = loaded["current"]["instructions"]
+    return {
+        "instructions": instructions,
+        "baseline_scan_ns_median": int(statistics.median(base)),
+        "current_scan_ns_median": int(statistics.median(cur)),
+        "baseline_ns_per_instruction": round(statistics.median(base) / instructions, 1),
+        "current_ns_per_instruction": round(statistics.median(cur) / instructions, 1),
+        "speedup": round(statistics.median(ratios), 2),
+        "speedup_range": [round(min(ratios), 2), round(max(ratios), 2)],
+        "blocks": blocks,
+        "scans_per_block": scans_per_block,
+        "tables_equal": digests["baseline"]["digest"] == digests["current"]["digest"],
+        "digests": {name: d["digest"] for name, d in digests.items()},
+        "load_s": {name: round(r["load"]["total_s"], 2) for name, r in loaded.items()},
+    }
+
+
+def scaling(tree: Path, program_files: dict[int, Path], warmup_scans: int, blocks: int,
+            instructions_per_block: int) -> dict:
+    """ns per instruction of the compiled scan at each size (rungs ->
+    program file), one child each, interleaved; the ratio of the largest to
+    the smallest as the median of per-block ratios."""
+    children = {rungs: Child(tree, "serve", path) for rungs, path in sorted(program_files.items())}
+    try:
+        loaded = {rungs: child.read() for rungs, child in children.items()}
+        for child in children.values():
+            child.ask(f"scan {warmup_scans}")
+        # about the same work per block for every size, so each block of the
+        # small program is not a handful of microseconds of timer noise
+        scans = {rungs: max(3, instructions_per_block // loaded[rungs]["instructions"]) for rungs in children}
+        per_block = interleaved_blocks(children, blocks, scans)
+    finally:
+        for child in children.values():
+            child.close()
+    small, large = min(children), max(children)
+    ns = {rungs: [x / loaded[rungs]["instructions"] for x in per_block[rungs]] for rungs in children}
+    ratios = [a / b for a, b in zip(ns[large], ns[small])]
+    return {
+        "sizes": {str(rungs): {"instructions": loaded[rungs]["instructions"],
+                               "ns_per_instruction": round(statistics.median(ns[rungs]), 1),
+                               "ns_per_instruction_range": [round(min(ns[rungs]), 1), round(max(ns[rungs]), 1)],
+                               "scans_per_block": scans[rungs],
+                               "load_s": round(loaded[rungs]["load"]["total_s"], 1)}
+                  for rungs in children},
+        "largest_over_smallest": round(statistics.median(ratios), 2),
+        "ratio_range": [round(min(ratios), 2), round(max(ratios), 2)],
+        "largest": large,
+        "smallest": small,
+        "blocks": blocks,
+    }
+
+
+def memory(tree: Path, program_file: Path) -> dict:
+    r = run_child(tree, "memory", program_file)
+    r["bytes_per_instruction"] = round(r["bytes"] / r["instructions"])
+    r["bytes_per_instruction_engine_only"] = round(r["bytes_engine_only"] / r["instructions"])
+    return r
+
+
+def cold_load(tree: Path, program_file: Path, runs: int) -> dict:
+    """``runs`` fresh processes; the median and best of each stage."""
+    results = [run_child(tree, "load", program_file) for _ in range(runs)]
+    out: dict = {"runs": runs}
+    for key in ("parser_setup_s", "parse_s", "validate_s", "compile_s", "total_s"):
+        values = [r[key] for r in results]
+        out[key] = round(statistics.median(values), 3)
+        out[key.replace("_s", "_best_s")] = round(min(values), 3)
+    out["warm"] = results[-1]["warm"]  # None until the code cache lands (see ladder_child.cold_load)
+    return out
