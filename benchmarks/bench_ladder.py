@@ -58,8 +58,17 @@ import _common as C
 import ladder_trees as T
 import straight_line
 from ladder_programs import (  # noqa: F401 (re-exported: scripts import these from bench_ladder)
-    B3_WORDS, INPUT_WORDS, SEED, boolean_program, count_instructions, initial_table, input_hook,
-    make_engine, mixed_program, program_text, table_words,
+    B3_WORDS,
+    INPUT_WORDS,
+    SEED,
+    boolean_program,
+    count_instructions,
+    initial_table,
+    input_hook,
+    make_engine,
+    mixed_program,
+    program_text,
+    table_words,
 )
 
 from softplc_lite.ladder import Mode, parse_program, validate
@@ -135,7 +144,7 @@ def straight_line_figures(program, pairs: int) -> dict:
         for _ in range(pairs):
             file_ns.append(timed(lambda: engine.run_file(2)))
             fn_ns.append(timed(baseline.scan))
-    except Exception as exc:  # the engine's internals are being rewritten (issue 17): report, go on
+    except Exception as exc:  # noqa: BLE001 - the engine is being rewritten (issue 17): report it, go on
         file_error = f"{type(exc).__name__}: {exc}"
     finally:
         gc.enable()
@@ -345,7 +354,7 @@ def main() -> int:
     finally:
         subprocess.run(["git", "-C", str(C.REPO), "worktree", "remove", "--force", str(base_tree)], check=True)
 
-    print(f"--- load and memory, fresh processes", flush=True)
+    print("--- load and memory, fresh processes", flush=True)
     try:
         load = figures["load_cold"] = T.cold_load(C.REPO, files["boolean"], 1 if args.quick else LOAD_RUNS)
         load["verdict"] = verdict(load["total_s"] <= TARGET_LOAD_S)

@@ -33,13 +33,14 @@ from pathlib import Path
 TREE = Path(sys.argv[1]).resolve()
 sys.path.insert(0, str(TREE))
 
-import softplc_lite  # noqa: E402 (after the tree is put first on sys.path)
+import softplc_lite
 
 if not softplc_lite.__file__.startswith(str(TREE)):
     raise SystemExit(f"imported {softplc_lite.__file__}, not the tree {TREE}")
 
-import ladder_programs as L  # noqa: E402
-from softplc_lite.ladder import parse_program, validate  # noqa: E402
+import ladder_programs as L
+
+from softplc_lite.ladder import parse_program, validate
 
 
 def reply(doc: dict) -> None:
@@ -112,7 +113,7 @@ def cold_load(text: str) -> None:
     t0 = time.perf_counter()
     parse_program("XIC B3/0 OTE B3/1\n", "<setup>")  # builds the parser (grammar, tables) once
     setup = time.perf_counter() - t0
-    program, engine, times = load(text)
+    program, _engine, times = load(text)
     rungs, instructions = L.count_instructions(program)
     # WARM LOAD (issue 17, the code cache kept beside the retentive state):
     # not measured yet. When the cache lands, load the same text a second

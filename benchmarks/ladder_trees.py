@@ -37,7 +37,7 @@ class Child:
 
     def __init__(self, tree: Path, mode: str, program_file: Path, timeout_s: float = 1800) -> None:
         self.tree = tree
-        self.stderr = tempfile.TemporaryFile(mode="w+")
+        self.stderr = tempfile.TemporaryFile(mode="w+")  # noqa: SIM115 - lives as long as the child; close() ends it
         self.proc = subprocess.Popen([sys.executable, str(CHILD), str(tree), mode, str(program_file)],
                                      cwd=str(HERE), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      stderr=self.stderr, text=True)
