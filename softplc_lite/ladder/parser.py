@@ -41,6 +41,7 @@ from .ast import (
     UnaryOp,
 )
 from .errors import LadderError
+from .lalr_driver import FastLalr, NotFastPath
 from .syntax_errors import syntax_error
 from .limits import MAX_CONSTANT, MAX_EXPRESSION_DEPTH, MAX_NUMBER_DIGITS, expression_depth, limit_problem
 
@@ -184,6 +185,9 @@ class _ToAst(Transformer):
         # every problem (syntax_problems): a placeholder node stands in for
         # the bad one and the parse goes on. None: the first one is raised.
         self.problems: list[LadderError] | None = None
+        # Address text -> Address within one parse: a program names the same
+        # addresses many times (more distinct ones than parse_address's cache holds)
+        self.addresses: dict[str, object] = {}
 
     def _fail(self, error: LadderError, placeholder):
         if self.problems is None:
@@ -202,10 +206,12 @@ class _ToAst(Transformer):
         """The position of a token, or of an AST node already built."""
         if not isinstance(item, Token):
             return item.pos
+        return self._token_pos(item)
+
+    def _token_pos(self, tok: Token) -> Pos:
         source, line_offset, column_offset = self.context
-        line = item.line
-        column = item.column + column_offset if line == 1 else item.column
-        return Pos(source, line + line_offset, column)
+        line = tok.line
+        return Pos(source, line + line_offset, tok.column + column_offset if line == 1 else tok.column)
 
     def _small_int(self, tok: Token, what: str) -> int:
         """A file number or element count; one too long to be either is
@@ -218,19 +224,25 @@ class _ToAst(Transformer):
 
     # operands ------------------------------------------------------------------
     def _address(self, tok: Token) -> AddressRef:
+        text = str(tok)  # a plain str key: a Token compares with lark's own __eq__
+        address = self.addresses.get(text)
+        if address is not None:  # this text parsed before in this program: one shared Address
+            return AddressRef(address, self._token_pos(tok))
         try:
-            return AddressRef(parse_address(str(tok)), self._pos(tok))
+            address = self.addresses[text] = parse_address(text)
+            return AddressRef(address, self._token_pos(tok))
         except AddressError as e:
             p = self._pos(tok)
             return self._fail(LadderError(Pos(p.source, p.line, p.column + e.position), e.reason), Placeholder(0, p))
 
-    @v_args(inline=True)
-    def address(self, tok):
-        return self._address(tok)
+    # The rules below are reduced once per token of a program: they take
+    # lark's child list as it is (no v_args wrapper, one call less a token).
+    def address(self, children):
+        return self._address(children[0])
 
-    @v_args(inline=True)
-    def symbol(self, tok):
-        return SymbolRef(str(tok), self._pos(tok))
+    def symbol(self, children):
+        tok = children[0]
+        return SymbolRef(str(tok), self._token_pos(tok))
 
     @v_args(inline=True)
     def signed_number(self, tok):
@@ -301,38 +313,45 @@ class _ToAst(Transformer):
         return _RungDraft(self._pos(at), elements=series, comment=comment[0][2:].strip() if comment else None)
 
     # mnemonic --------------------------------------------------------------------------
-    @v_args(inline=True)
-    def mn_name(self, tok):
-        return _Name(str(tok), self._pos(tok))
+    # Once per token of a mnemonic rung: lark's child list as it is, as above.
+    def mn_name(self, children):
+        tok = children[0]
+        return _Name(str(tok), self._token_pos(tok))
 
-    @v_args(inline=True)
-    def mn_address(self, tok):
-        return self._address(tok)
+    def mn_address(self, children):
+        return self._address(children[0])
 
-    @v_args(inline=True)
-    def mn_symbol(self, tok):  # PollTimer/DN: never a mnemonic, so an operand at once
-        return SymbolRef(str(tok), self._pos(tok))
+    def mn_symbol(self, children):  # PollTimer/DN: never a mnemonic, so an operand at once
+        tok = children[0]
+        return SymbolRef(str(tok), self._token_pos(tok))
 
-    @v_args(inline=True)
-    def mn_string(self, tok):
-        return Text(_unquote(str(tok)), self._pos(tok))
+    def mn_string(self, children):
+        tok = children[0]
+        return Text(_unquote(str(tok)), self._token_pos(tok))
 
-    @v_args(inline=True)
-    def mn_bst(self, tok):
-        return _Marker(BST, self._pos(tok))
+    def mn_bst(self, children):
+        return _Marker(BST, self._token_pos(children[0]))
 
-    @v_args(inline=True)
-    def mn_nxb(self, tok):
-        return _Marker(NXB, self._pos(tok))
+    def mn_nxb(self, children):
+        return _Marker(NXB, self._token_pos(children[0]))
 
-    @v_args(inline=True)
-    def mn_bnd(self, tok):
-        return _Marker(BND, self._pos(tok))
+    def mn_bnd(self, children):
+        return _Marker(BND, self._token_pos(children[0]))
+
+    def mn_tokens(self, children):
+        """The tokens of a mnemonic rung, one list grown left to right."""
+        if len(children) == 1:
+            return children
+        tokens, token = children
+        tokens.append(token)
+        return tokens
 
     def mnemonic_rung(self, items):
-        pos = self._pos(items[0])  # the first token, or SOR
+        # [mn_tokens, COMMENT?, _NL] or ["SOR", mn_tokens?, "EOR", COMMENT?, _NL]
+        first = items[0]
+        pos = self._pos(first[0] if isinstance(first, list) else first)  # the first token, or SOR
         comment = _tokens(items, "COMMENT")
-        tokens = [i for i in items if not isinstance(i, Token)]
+        tokens = next((i for i in items if isinstance(i, list)), [])
         return _RungDraft(pos, tokens=tokens, comment=comment[0][2:].strip() if comment else None)
 
     # directives and comments -------------------------------------------------------------
@@ -380,11 +399,13 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
                 problems: list[LadderError] | None = None):
     parser = _ast_parser()
     builder = parser.options.transformer
-    saved = builder.context, builder.problems  # an expression parse happens inside a program parse
+    saved = builder.context, builder.problems, builder.addresses  # an expression parse happens inside a program parse
     builder.context = (source, line_offset, column_offset)
     builder.problems = problems
+    if start == "start":
+        builder.addresses = {}
     try:
-        result = parser.parse(text, start=start)
+        result = _parse_fast_or_lark(parser, text, start, problems)
         if isinstance(result, Token):  # a bare number as a whole expression: in this parse's context
             result = builder._atomize(result)
     except UnexpectedInput as e:
@@ -394,8 +415,27 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
             raise e.orig_exc from None
         raise
     finally:
-        builder.context, builder.problems = saved
+        builder.context, builder.problems, builder.addresses = saved
     return result
+
+
+@lru_cache(maxsize=1)
+def _fast_parser() -> FastLalr:
+    return FastLalr(_ast_parser())
+
+
+def _parse_fast_or_lark(parser: Lark, text: str, start: str, problems: list[LadderError] | None):
+    """The same parse as ``parser.parse``, by lalr_driver's faster loop over
+    the same tables; a text that loop cannot take (a syntax error) is parsed
+    again by lark itself, for lark's error, after undoing what the first try
+    added to ``problems``."""
+    found = len(problems) if problems is not None else 0
+    try:
+        return _fast_parser().parse(text, start)
+    except NotFastPath:
+        if problems is not None:
+            del problems[found:]
+        return parser.parse(text, start=start)
 
 
 def parse_expression(text: str, pos: Pos) -> Operand:
