@@ -150,12 +150,17 @@ def initial_table(seed: int = SEED):
     return table
 
 
+def input_rows(seed: int = SEED) -> list[list[int]]:
+    """The 64 rows of I:0..7 words the input hook cycles through."""
+    rng = random.Random(seed)
+    return [[rng.randrange(-32768, 32768) for _ in range(INPUT_WORDS)] for _ in range(64)]
+
+
 def input_hook(seed: int = SEED):
     """An input hook writing I:0..7 with the next of 64 seeded rows every
     scan. Each executor gets its own (the row counter is per hook), so two
     executors scanned the same number of times saw the same inputs."""
-    rng = random.Random(seed)
-    words = [[rng.randrange(-32768, 32768) for _ in range(INPUT_WORDS)] for _ in range(64)]
+    words = input_rows(seed)
     state = {"scan": 0}
 
     def hook(engine) -> None:

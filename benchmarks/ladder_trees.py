@@ -35,13 +35,13 @@ class ChildFailed(RuntimeError):
 class Child:
     """One ladder_child.py process; ``ask`` sends a command, returns its JSON reply."""
 
-    def __init__(self, tree: Path, mode: str, program_file: Path, timeout_s: float = 1800) -> None:
+    def __init__(self, tree: Path, mode: str, program_file: Path, argv: list[str] | None = None) -> None:
+        """ladder_child.py on ``tree``, or any other ``argv`` speaking the same protocol."""
         self.tree = tree
         self.stderr = tempfile.TemporaryFile(mode="w+")  # noqa: SIM115 - lives as long as the child; close() ends it
-        self.proc = subprocess.Popen([sys.executable, str(CHILD), str(tree), mode, str(program_file)],
-                                     cwd=str(HERE), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+        argv = argv or [sys.executable, str(CHILD), str(tree), mode, str(program_file)]
+        self.proc = subprocess.Popen(argv, cwd=str(HERE), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      stderr=self.stderr, text=True)
-        self.timeout_s = timeout_s
 
     def read(self) -> dict:
         line = self.proc.stdout.readline()
