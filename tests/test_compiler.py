@@ -12,7 +12,7 @@ from softplc_lite.ladder import Engine, load_text
 # functions, bound kernels, module (TLM) instruction instances and
 # expression helpers.
 ALLOWED = re.compile(
-    r"^(f\d+|_d\d+|_i\d+|_m\d+|b\d+|o\d+|r\d+|c|_env|_factory|_loc\d+|_tli\d+|_bi\d+|_jsr|_zone|_x_div|_x_mod|_x_pow|_int|"
+    r"^(f\d+|w\d+_\d+|z|_m|_block|_d\d+|_i\d+|_m\d+|b\d+|o\d+|r\d+|c|_env|_factory|_loc\d+|_tli\d+|_bi\d+|_jsr|_zone|_x_div|_x_mod|_x_pow|_int|"
     r"_fn_[A-Z]+|_[a-z]+(?:_[a-z]+)*|abs|bool)$"
 )
 
@@ -71,7 +71,7 @@ def test_line_table_names_the_failing_instruction():
     compiled = engine.files[2][0]
     # The contact branch is one generated line, mapped to its first contact.
     assert {ins.mnemonic for ins in compiled.line_table.values()} == {"MOV", "XIC", "ADD", "OTE"}
-    assert "c = c and (f3[0] & 1 != 0 or not f3[0] & 1)" in compiled.source
+    assert "c = (w3_0 & 1 != 0 or not w3_0 & 1)" in compiled.source  # B3:0 held in a local
     engine.set_mode(Mode.RUN)
     engine.scan()
     fault = engine.fault

@@ -1,29 +1,34 @@
-"""Stage 3 (fast path): validated AST -> Python functions, one per rung.
+"""Stage 3 (fast path): validated AST -> Python functions, one per block
+of rungs (ladder/blocks.py).
 
-Each program file becomes one generated module whose factory binds the data
-arrays, bound kernel methods and resolvers as closure variables, then
-defines ``r0, r1, ...``: ``def rK(c)`` takes the rung-in condition and returns
-None, a rung index to jump to, or RET/TND. Direct addresses are resolved
-once, at compile time, to ``fN[index]`` and literal masks. Indirect and
-indexed addresses call a resolver each time they run.
+Each block is one generated function over up to CHUNK_RUNGS consecutive
+rungs. The data-table words its contacts and coils use (direct bit
+addresses in 16-bit word files other than S) live in locals of that
+function: each is read into its local at its first use and written back
+("flushed") at the block's end, before a JMP/RET/TND leaves it, and before
+any instruction that is not block code runs (a kernel, a bound or module
+instruction, a JSR, an indirect or indexed address); after such an
+instruction the locals are read again at their next use. So every write a
+rung makes is seen by the next rung, and the data table is exact whenever
+anything else can look at it. docs/engine.md, "Compiled code".
 
 Nothing from program text reaches the generated source except validated
 tokens: file numbers, indexes, masks and constants are printed from ints
 and floats with repr(), mnemonics select fixed templates, and expressions
-are built from fixed operator tables (expr.to_python). A line table maps
-each generated line back to its instruction for fault messages.
+are built from fixed operator tables (expr.to_python). A line table per
+block maps each generated line back to its rung and instruction for fault
+messages.
 """
 
 from __future__ import annotations
-
-import re
-from dataclasses import dataclass, field
 
 from ..gcpause import gc_paused
 from ..datatable import DataTable, ValueKind, bit_mask
 from ..datatable.filetypes import Storage
 from . import status as S
+from . import blocks
 from .ast import AddressRef, BinOp, Branch, Const, Element, Instruction, Program, Rung, UnaryOp, walk
+from .blocks import BlockCode, CompiledFile
 from .bound import BoundAccess
 from .expr import namespace as expr_namespace
 from .expr import to_python
@@ -40,15 +45,6 @@ class EndScan(Exception):
     through JSR calls (both executors) to the engine."""
 
 
-@dataclass
-class CompiledFile:
-    number: int
-    rungs: list  # callables rK(c)
-    has_mcr: bool
-    source: str
-    line_table: dict[int, Instruction] = field(default_factory=dict)
-
-
 def describe(instr: Instruction) -> str:
     from .fmt import format_instruction
 
@@ -56,46 +52,97 @@ def describe(instr: Instruction) -> str:
 
 
 class _FileCompiler:
-    def __init__(self, table: DataTable, machine: Machine, number: int, labels: dict[int, int], zone: list,
+    def __init__(self, table: DataTable, machine: Machine, number: int, rungs: list[Rung], zone: list, jsr,
                  module_instance=None) -> None:
         self.table = table
-        self.module_instance = module_instance  # TLM instructions: Instruction -> callable(c) -> c
-        self.zone = zone  # the file's MCR zone cell, shared with the engine's runner
-        self.rung_elements: list = []
         self.machine = machine
         self.number = number
-        self.labels = labels
-        self.env: dict[str, object] = {}
-        self.lines: list[str] = []
-        self.line_instr: dict[int, Instruction] = {}
+        self.rungs = rungs
+        self.labels = labels_of(rungs)
+        self.module_instance = module_instance  # TLM instructions: Instruction -> callable(c) -> c
+        self.has_mcr = any(ins.mnemonic == "MCR" for r in rungs for ins in walk(r.elements))
+        self.env: dict[str, object] = {"_jsr": jsr, "_zone": zone, "_m": machine, **expr_namespace(machine)}
+        self.named: dict[tuple, str] = {}  # per-instruction objects, made once (a block compiled again reuses them)
+        self.rung_elements: list = []
         self.current: Instruction | None = None
-        self.temp = 0
-        self.has_mcr = False
 
     # -- emitting ------------------------------------------------------------------------
     def emit(self, indent: int, text: str) -> None:
         self.lines.append("    " * indent + text)
-        if self.current is not None:
-            self.line_instr[len(self.lines)] = self.current
+        self.line_instr.append(self.current)
+        self.line_rung.append(self.rung_index)
 
     def bind(self, name: str, value: object) -> str:
         self.env[name] = value
         return name
 
+    def bind_once(self, key: tuple, prefix: str, make) -> str:
+        """A name for an object made once per instruction (or operand):
+        compiling a block again must not make a second one."""
+        name = self.named.get(key)
+        if name is None:
+            name = self.named[key] = f"{prefix}{len(self.named)}"
+            self.env[name] = make()
+        return name
+
     def array_name(self, file) -> str:
         return self.bind(f"f{file.number}", file.data)
+
+    # -- words held in locals ---------------------------------------------------------------
+    def word_local(self, ind: int, ref: AddressRef) -> tuple[str, int] | None:
+        """(local, mask) for a direct bit address whose word a block may hold
+        in a local (a 16-bit word file other than S: S words are written by
+        kernels and the engine behind the block's back), loading it at its
+        first use; None for any other address."""
+        a = ref.address
+        if not a.is_direct:
+            return None
+        f, index, bit = self.table.resolve(a)
+        if bit is None or f.ftype.storage is not Storage.WORD or f.ftype.letter == "S":
+            return None
+        key = (f.number, index)
+        name = self.words.get(key)
+        if name is None:
+            name = self.words[key] = f"w{f.number}_{index}"
+            self.emit(ind, f"{name} = {self.array_name(f)}[{index!r}]")
+        return name, bit_mask(bit)
+
+    def mark_written(self, key_name: str) -> None:
+        self.dirty.add(key_name)
+
+    def flush_lines(self, ind: int) -> None:
+        """Write back every local a rung may have changed."""
+        for (number, index), name in self.words.items():
+            if name in self.dirty:
+                self.emit(ind, f"f{number}[{index!r}] = {name}")
+
+    def barrier(self, ind: int) -> None:
+        """Before code that is not block code: the table made exact, the
+        locals forgotten (that code may write any word), and the rung
+        recorded for a minor fault it may set."""
+        self.flush_lines(ind)
+        self.words.clear()
+        self.dirty.clear()
+        self.mark_rung(ind)
+
+    def mark_rung(self, ind: int) -> None:
+        """``_m.rung``: the rung being scanned, for what is not block code."""
+        if self.rung_marked != self.rung_index:
+            self.rung_marked = self.rung_index
+            self.emit(ind, f"_m.rung = {self.rung_index!r}")
 
     # -- operands ----------------------------------------------------------------------------
     def location(self, ind: int, ref: AddressRef) -> tuple[str, str, str | None]:
         """Code for (array, index, mask) of an address operand; emits a
-        resolver call first for indirect/indexed addresses."""
+        resolver call first for indirect/indexed addresses. Only after a
+        barrier: the table is exact."""
         a = ref.address
         if a.is_direct:
             f, index, bit = self.table.resolve(a)
             return self.array_name(f), repr(index), (repr(bit_mask(bit)) if bit is not None else None)
         k = self.temp
         self.temp += 1
-        name = self.bind(f"_loc{len(self.env)}", resolver(self.table, a))
+        name = self.bind_once((id(ref), "loc"), "_loc", lambda: resolver(self.table, a))
         self.emit(ind, f"_d{k}, _i{k}, _m{k} = {name}()")
         return f"_d{k}", f"_i{k}", (f"_m{k}" if a.kind is ValueKind.BIT else None)
 
@@ -110,14 +157,35 @@ class _FileCompiler:
     def expression(self, ind: int, node) -> str:
         return to_python(node, lambda ref: self.value(ind, ref))
 
+    def bit(self, ind: int, ref: AddressRef) -> tuple[str, int, bool] | None:
+        """A bit instruction's word as (code of the word, mask, held in a
+        local): a local, or an S word read in place; None: not direct."""
+        held = self.word_local(ind, ref)
+        if held is not None:
+            return held[0], held[1], True
+        a = ref.address
+        if not a.is_direct:
+            return None
+        f, index, bit = self.table.resolve(a)
+        return f"{self.array_name(f)}[{index!r}]", bit_mask(bit), False
+
     # -- rungs -------------------------------------------------------------------------------
     def rung(self, index: int, rung: Rung) -> None:
+        self.rung_index = index
+        self.rung_elements = rung.elements
         self.current = None
-        self.emit(1, f"def r{index}(c):")
-        body_start = len(self.lines)
+        self.rung_in = "z" if self.has_mcr else "True"
+        first = rung.elements[0] if rung.elements else None
+        if first is None or self.contact_expression(first) is None:
+            self.start_rung()
         self.series(2, rung.elements)
-        if len(self.lines) == body_start:
-            self.emit(2, "pass")
+
+    def start_rung(self) -> None:
+        """Give ``c`` its rung-in (left pending while a rung's first contacts
+        can assign it in one line)."""
+        if self.rung_in is not None:
+            self.emit(2, f"c = {self.rung_in}")
+            self.rung_in = None
 
     def series(self, ind: int, elements) -> None:
         run: list[tuple[Element, str]] = []  # contacts waiting to be emitted as one expression
@@ -136,13 +204,17 @@ class _FileCompiler:
         self.contact_run(ind, run)
 
     def contact_run(self, ind: int, run: list) -> None:
-        """Emit a run of contacts as one short-circuit line. Fewer generated
-        lines: CPython's compile() was most of the load of a large program."""
+        """Emit a run of contacts as one short-circuit line."""
         if not run:
             return
         first = run[0][0]
         self.current = first if isinstance(first, Instruction) else next(walk([first]))
-        self.emit(ind, "c = c and " + " and ".join(expr for _, expr in run))
+        terms = " and ".join(expr for _, expr in run)
+        if self.rung_in is not None:  # the rung's first contacts
+            self.emit(ind, f"c = {terms}" if self.rung_in == "True" else f"c = z and {terms}")
+            self.rung_in = None
+        else:
+            self.emit(ind, "c = c and " + terms)
         self.current = None
         run.clear()
 
@@ -150,8 +222,8 @@ class _FileCompiler:
         """A Python boolean for an XIC/XIO on a direct address, or a branch
         whose legs hold only such contacts; None for anything else. These
         read one bit and write nothing, so they can short-circuit as one
-        expression (as the line-per-contact code already did): the result
-        is the same whatever order, or whether, they are evaluated."""
+        expression: the result is the same whatever order, or whether, they
+        are evaluated. (Their words are loaded into locals first.)"""
         if isinstance(el, Branch):
             legs = []
             for leg in el.legs:
@@ -160,12 +232,16 @@ class _FileCompiler:
                     return None
                 legs.append("True" if not terms else terms[0] if len(terms) == 1 else f"({' and '.join(terms)})")
             return f"({' or '.join(legs)})"
-        if el.mnemonic not in ("XIC", "XIO") or not el.operands[0].address.is_direct:
+        if el.mnemonic not in ("XIC", "XIO"):
             return None
-        d, i, mk = self.location(0, el.operands[0])  # direct: emits nothing
-        return f"{d}[{i}] & {mk} != 0" if el.mnemonic == "XIC" else f"not {d}[{i}] & {mk}"
+        held = self.bit(2, el.operands[0])
+        if held is None:
+            return None
+        word, mk, _ = held
+        return f"{word} & {mk!r} != 0" if el.mnemonic == "XIC" else f"not {word} & {mk!r}"
 
     def branch(self, ind: int, branch: Branch) -> None:
+        self.start_rung()
         if all(isinstance(e, Instruction) and e.mnemonic in _PASS_THROUGH for leg in branch.legs for e in leg):
             # Parallel coils: every leg passes its rung-in on unchanged, so the
             # branch's rung-out is its rung-in; no bookkeeping needed.
@@ -186,6 +262,12 @@ class _FileCompiler:
     def instruction(self, ind: int, ins: Instruction) -> None:
         m = ins.mnemonic
         ops = ins.operands
+        self.start_rung()
+        if m in _BIT_OPS and all(self.bit(ind, op) is not None for op in ops):
+            getattr(self, f"bit_{m}")(ind, *(self.bit(ind, op) for op in ops))
+            return
+        if m not in _NO_BARRIER:
+            self.barrier(ind)
         handler = getattr(self, f"i_{m}", None)
         if handler is not None:
             handler(ind, ops)
@@ -197,16 +279,65 @@ class _FileCompiler:
         bound = BOUND.get(m)
         if bound is not None:
             # A bound instruction (ladder/instr/): one object per instruction.
-            run = bound.bind(ins, BoundAccess(self.table, self.machine))
-            self.emit(ind, f"c = {self.bind(f'_bi{len(self.env)}', run)}(c)")
+            name = self.bind_once((id(ins), "bi"), "_bi", lambda: bound.bind(ins, BoundAccess(self.table, self.machine)))
+            self.emit(ind, f"c = {name}(c)")
             return
-        instance = self.module_instance(ins) if self.module_instance is not None else None
-        if instance is not None:
-            # A module (TLM) instruction: its instance takes the rung-in and gives the rung-out.
-            self.emit(ind, f"c = {self.bind(f'_tli{len(self.env)}', instance)}(c)")
-            return
-        raise NotImplementedError(f"no compiler template for {m}")  # validated programs never get here
+        key = (id(ins), "tli")
+        if key not in self.named:
+            instance = self.module_instance(ins) if self.module_instance is not None else None
+            if instance is None:
+                raise NotImplementedError(f"no compiler template for {m}")  # validated programs never get here
+            self.bind_once(key, "_tli", lambda: instance)
+        # A module (TLM) instruction: its instance takes the rung-in and gives the rung-out.
+        self.emit(ind, f"c = {self.named[key]}(c)")
 
+    # Bit instructions on words held in locals (or S words in place): each
+    # operand is (word code, mask, held in a local).
+    def written(self, word: tuple) -> None:
+        if word[2]:
+            self.dirty.add(word[0])
+
+    def bit_XIC(self, ind, w):
+        self.emit(ind, f"c = c and {w[0]} & {w[1]!r} != 0")
+
+    def bit_XIO(self, ind, w):
+        self.emit(ind, f"c = c and not {w[0]} & {w[1]!r}")
+
+    def bit_OTE(self, ind, w):
+        self.emit(ind, f"{w[0]} = ({w[0]} | {w[1]!r}) if c else ({w[0]} & {~w[1]!r})")
+        self.written(w)
+
+    def bit_OTL(self, ind, w):
+        self.emit(ind, f"if c: {w[0]} |= {w[1]!r}")
+        self.written(w)
+
+    def bit_OTU(self, ind, w):
+        self.emit(ind, f"if c: {w[0]} &= {~w[1]!r}")
+        self.written(w)
+
+    def bit_ONS(self, ind, w):
+        self.emit(ind, "if c:")
+        self.emit(ind + 1, f"if {w[0]} & {w[1]!r}: c = False")
+        self.emit(ind + 1, f"else: {w[0]} |= {w[1]!r}")
+        self.emit(ind, f"else: {w[0]} &= {~w[1]!r}")
+        self.written(w)
+
+    def _bit_one_shot(self, ind, storage, output, rising: bool):
+        stored = f"{storage[0]} & {storage[1]!r}"
+        fire = f"c and not {stored}" if rising else f"not c and {stored}"
+        o, om = output[0], output[1]
+        self.emit(ind, f"{o} = ({o} | {om!r}) if ({fire}) else ({o} & {~om!r})")
+        self.emit(ind, f"{storage[0]} = ({storage[0]} | {storage[1]!r}) if c else ({storage[0]} & {~storage[1]!r})")
+        self.written(storage)
+        self.written(output)
+
+    def bit_OSR(self, ind, storage, output):
+        self._bit_one_shot(ind, storage, output, True)
+
+    def bit_OSF(self, ind, storage, output):
+        self._bit_one_shot(ind, storage, output, False)
+
+    # The same on indirect or indexed addresses, on the table (after a barrier).
     def i_XIC(self, ind, ops):
         d, i, mk = self.location(ind, ops[0])
         self.emit(ind, f"c = c and {d}[{i}] & {mk} != 0")
@@ -407,9 +538,14 @@ class _FileCompiler:
         self.emit(ind + 1, f"{self.bind('_btd', self.machine.btd)}({src}, {ops[1].value!r}, {d}, {i}, "
                   f"{ops[3].value!r}, {ops[4].value!r})")
 
-    # program control
+    # program control: leaving the block writes its locals back first
+    def leave(self, ind: int, value: str) -> None:
+        self.emit(ind, "if c:")
+        self.flush_lines(ind + 1)
+        self.emit(ind + 1, f"return {value}")
+
     def i_JMP(self, ind, ops):
-        self.emit(ind, f"if c: return {self.labels[ops[0].value]!r}")
+        self.leave(ind, repr(self.labels[ops[0].value]))
 
     def i_LBL(self, ind, ops):
         pass
@@ -421,8 +557,11 @@ class _FileCompiler:
         """``_calls[k]``: the instruction being compiled, for the engine to
         move its parameters (JSR inputs and returns, RET values)."""
         calls = self.env.setdefault("_calls", [])
-        calls.append(self.current)
-        return f"_calls[{len(calls) - 1}]"
+        key = (id(self.current), "call")
+        if key not in self.named:
+            self.named[key] = f"_calls[{len(calls)}]"
+            calls.append(self.current)
+        return self.named[key]
 
     def i_JSR(self, ind, ops):
         if len(ops) > 1:
@@ -431,17 +570,19 @@ class _FileCompiler:
             self.emit(ind, f"if c: _jsr({ops[0].value!r})")
 
     def i_RET(self, ind, ops):
-        # A RET with values returns itself: run_file reads them, the JSR stores them.
-        self.emit(ind, f"if c: return {self._call() if ops else repr(RET)}")
+        # A RET with values returns itself: run_file reads them (a fault there names this rung), the JSR stores them.
+        if ops:
+            self.mark_rung(ind)
+        self.leave(ind, self._call() if ops else repr(RET))
 
     def i_TND(self, ind, ops):
-        self.emit(ind, f"if c: return {TND!r}")
+        self.leave(ind, repr(TND))
 
     def i_MCR(self, ind, ops):
-        self.has_mcr = True
         # An MCR alone on its rung ends the zone; with conditions before it, it starts one.
         conditional = self.rung_elements[0] is not self.current
-        self.emit(ind, f"_zone[0] = {'c' if conditional else 'True'}")
+        self.emit(ind, f"z = {'c' if conditional else 'True'}")
+        self.emit(ind, "_zone[0] = z")
 
     def i_AFI(self, ind, ops):
         self.emit(ind, "c = False")
@@ -479,47 +620,35 @@ class _FileCompiler:
         (ad, ai, _), (bd, bi, _) = self.location(ind + 1, ops[0]), self.location(ind + 1, ops[1])
         self.emit(ind + 1, f"c = {self.bind('_asr', self.machine.asr)}({ad}, {ai}, {bd}, {bi})")
 
-    # -- the whole file -----------------------------------------------------------------------------
-    def compile(self, rungs: list[Rung], jsr) -> CompiledFile:
-        self.lines = ["def _factory(_env):"]
-        header_at = len(self.lines)
-        for k, rung in enumerate(rungs):
-            self.rung_elements = rung.elements
-            self.rung(k, rung)
-        self.lines.append(f"    return [{', '.join(f'r{k}' for k in range(len(rungs)))}]")
-        self.env["_jsr"] = jsr
-        self.env["_zone"] = self.zone
-        self.env.update(expr_namespace(self.machine))
-        bindings = [f"    {name} = _env[{name!r}]" for name in sorted(self.env)]
-        shift = len(bindings)
-        line_table = {line + shift: ins for line, ins in self.line_instr.items()}
-        functions = self._compile_chunks(len(rungs), shift)
-        self.lines[header_at:header_at] = bindings
-        source = "\n".join(self.lines) + "\n"
-        return CompiledFile(self.number, functions, self.has_mcr, source, line_table)
+    # -- blocks -----------------------------------------------------------------------------------
+    def block(self, first: int, end: int) -> BlockCode:
+        """The code of one block function over rungs first..end-1."""
+        self.lines, self.line_instr, self.line_rung = [], [], []
+        self.words: dict[tuple[int, int], str] = {}  # (file, word) -> the local holding it
+        self.dirty: set[str] = set()  # locals a rung may have changed since the last write-back
+        self.temp = 0
+        self.rung_index = first
+        self.rung_marked = None
+        self.current = None
+        self.emit(1, "def _block(z):")
+        for k in range(first, end):
+            self.rung(k, self.rungs[k])
+        self.current = None
+        self.flush_lines(2)
+        if len(self.lines) == 1:
+            self.emit(2, "pass")
+        return BlockCode(first, end, self.lines, self.line_instr, self.line_rung)
 
-    def _compile_chunks(self, count: int, shift: int) -> list:
-        """Compile the rung functions CHUNK_RUNGS at a time, each chunk its own
-        factory binding only the names it uses: CPython compiles one huge
-        function body several times slower than the same code in small
-        ones. Blank lines in front of each chunk keep every line at its
-        number in the whole file's source (``source``, ``line_table``)."""
-        starts = [i for i, line in enumerate(self.lines) if line.startswith("    def r")]
-        starts.append(len(self.lines) - 1)  # the whole file's return line
-        name = f"<ladder file {self.number}>"
-        functions: list = []
-        for a in range(0, count, CHUNK_RUNGS):
-            b = min(a + CHUNK_RUNGS, count)
-            body = self.lines[starts[a]:starts[b]]
-            used = set(_IDENTIFIER.findall("\n".join(body)))
-            bindings = [f"    {n} = _env[{n!r}]" for n in sorted(self.env) if n in used]
-            pad = starts[a] + shift - 1 - len(bindings)
-            text = "\n".join(["\n" * pad + "def _factory(_env):", *bindings, *body,
-                              f"    return [{', '.join(f'r{k}' for k in range(a, b))}]"]) + "\n"
-            scope: dict[str, object] = {}
-            exec(compile(text, name, "exec"), scope)  # noqa: S102 - source built only from validated tokens
-            functions += scope["_factory"](self.env)
-        return functions
+    def compile(self) -> CompiledFile:
+        cf = CompiledFile(self.number, len(self.rungs), self.has_mcr, self)
+        # A block starts at every label (a JMP lands at a block's start) and
+        # holds at most CHUNK_RUNGS rungs.
+        cuts = sorted({0, len(self.rungs), *self.labels.values(),
+                       *range(0, len(self.rungs), blocks.CHUNK_RUNGS)})
+        for a, b in zip(cuts, cuts[1:]):
+            cf.add(self.block(a, b))
+        self.lines = self.line_instr = self.line_rung = None  # the code is compiled: keep no text
+        return cf
 
 
 def _is_word(operand) -> bool:
@@ -544,9 +673,11 @@ def _word_valued(node) -> bool:
 # Outputs: they leave the rung condition as they found it.
 _PASS_THROUGH = frozenset({"OTE", "OTL", "OTU"})
 
-# Rungs per compiled chunk (see _FileCompiler._compile_chunks).
-CHUNK_RUNGS = 200
-_IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+# Bit instructions that work on words held in locals, when their operands are direct.
+_BIT_OPS = frozenset({"XIC", "XIO", "OTE", "OTL", "OTU", "ONS", "OSR", "OSF"})
+# Instructions that touch no data-table word (or only leave the block,
+# writing back first): no barrier before them.
+_NO_BARRIER = frozenset({"JMP", "LBL", "RET", "TND", "MCR", "AFI", "SBR"})
 
 
 def _block_check(d, i, n, text) -> None:
@@ -569,6 +700,5 @@ def labels_of(rungs: list[Rung]) -> dict[int, int]:
 @gc_paused
 def compile_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list,
                  module_instance=None) -> CompiledFile:
-    pfile = program.files[number]
-    fc = _FileCompiler(table, machine, number, labels_of(pfile.rungs), zone, module_instance)
-    return fc.compile(pfile.rungs, jsr)
+    fc = _FileCompiler(table, machine, number, program.files[number].rungs, zone, jsr, module_instance)
+    return fc.compile()

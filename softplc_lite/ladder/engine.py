@@ -432,50 +432,59 @@ class Engine:
         the addresses of the file's SBR first. Returns the values of the RET
         that ended it, or None (a RET without values, the end of the file)."""
         compiled, zone = self.files[number]
-        rungs = compiled.rungs
+        blocks = compiled.blocks  # one function per block of rungs (per rung in the reference executor)
         m = self.machine
         saved_zone = zone[0]
         # A JSR runs inside its caller's rung: where the caller stands is put
         # back on return, so a minor fault later in that rung names it.
         saved_at = (m.file, m.rung)
         zone[0] = True
-        i = 0
-        count = len(rungs)
+        k = 0
+        count = len(blocks)
         returned = None
         try:
             if inputs:
                 m.file, m.rung = number, 0
                 self._receive(number, inputs)
-            while i < count:
+            while k < count:
                 m.file = number
-                m.rung = i
-                r = rungs[i](zone[0])
+                m.rung = compiled.starts[k]
+                r = blocks[k](zone[0])
                 if r is None:
-                    i += 1
-                elif r.__class__ is not int:  # a RET with values: the instruction itself
+                    k += 1
+                elif r.__class__ is not int:  # a RET with values: the instruction itself (m.rung: its rung)
                     returned = [self._parameter_value(op, r) for op in r.operands]
                     break
-                elif r >= 0:
-                    if r <= i and time.perf_counter() > self._deadline:
+                elif r >= 0:  # a JMP to rung r (a label: a block starts there)
+                    target = compiled.block_index(r)
+                    if target <= k and time.perf_counter() > self._deadline:
                         raise MajorFault(S.FAULT_WATCHDOG, "watchdog: the scan is stuck in a backward JMP loop "
                                          f"(longer than S:28 = {self.s[S.WATCHDOG_MS]} ms)")
-                    i = r
+                    k = target
+                    blocks = compiled.blocks  # a breakpoint set meanwhile may have split a block
+                    count = len(blocks)
                 elif r == RET:
                     break
                 else:  # TND
                     raise _EndScan
         except MajorFault as fault:
             if fault.file is None:
-                fault.file, fault.rung = number, i
-                if fault.instruction is None:
-                    fault.instruction = self._which_instruction(compiled, fault)
+                fault.file = number
+                fault.rung, ins = self._which_instruction(compiled, fault)
+                if fault.rung is None:
+                    fault.rung = m.rung
+                if fault.instruction is None and ins is not None:
+                    fault.instruction = describe(ins)
             raise
         except (_EndScan, RecursionError):
             raise
         except Exception as exc:
             fault = MajorFault(S.FAULT_INTERNAL, f"internal error: {type(exc).__name__}: {exc}")
-            fault.file, fault.rung = number, i
-            fault.instruction = self._which_instruction(compiled, exc)
+            fault.file = number
+            fault.rung, ins = self._which_instruction(compiled, exc)
+            if fault.rung is None:
+                fault.rung = m.rung
+            fault.instruction = describe(ins) if ins is not None else None
             raise fault from exc
         finally:
             zone[0] = saved_zone
@@ -539,14 +548,15 @@ class Engine:
         return d[i]
 
     @staticmethod
-    def _which_instruction(compiled, exc: BaseException) -> str | None:
-        """Map the generated source line where it failed back to its instruction."""
-        name = f"<ladder file {compiled.number}>"
-        found = None
+    def _which_instruction(compiled, exc: BaseException):
+        """(rung, instruction) where it failed: the innermost generated line
+        of this file in the traceback, through the block's line table."""
+        found = (None, None)
         for frame, lineno in traceback.walk_tb(exc.__traceback__):
-            if frame.f_code.co_filename == name and lineno in compiled.line_table:
-                found = compiled.line_table[lineno]
-        return describe(found) if found is not None else None
+            rung, ins = compiled.where(frame.f_code.co_filename, lineno)
+            if ins is not None:
+                found = (rung, ins)
+        return found
 
     def _major(self, fault: MajorFault, cause: BaseException | None = None) -> None:
         s = self.s

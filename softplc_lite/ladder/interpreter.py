@@ -36,7 +36,8 @@ class _Jump(Exception):
 
 
 class ReferenceFile:
-    """One program file as rung callables, like a CompiledFile."""
+    """One program file as rung callables, each its own block, like a
+    CompiledFile (ladder/blocks.py)."""
 
     def __init__(self, interp: "Interpreter", number: int, rungs: list[Rung]) -> None:
         self.number = number
@@ -44,8 +45,17 @@ class ReferenceFile:
         self.has_mcr = any(
             isinstance(el, Instruction) and el.mnemonic == "MCR" for r in rungs for el in r.elements
         )
-        self.rungs = [self._callable(interp, r) for r in rungs]
-        self.line_table: dict = {}
+        self.blocks = [self._callable(interp, r) for r in rungs]  # a block per rung
+        self.starts = range(len(rungs))
+
+    def block_index(self, rung: int) -> int:
+        return rung
+
+    def isolate(self, rung: int) -> int:
+        return rung
+
+    def where(self, filename: str, lineno: int):
+        return None, None  # the interpreter names the instruction itself
 
     def _callable(self, interp: "Interpreter", rung: Rung):
         def run(c: bool):

@@ -133,13 +133,15 @@ class Breakpoints:
     def toggle(self, file: int, rung: int) -> bool:
         """Set or clear a rung breakpoint; True when it is now set."""
         key = (file, rung)
+        compiled = self.engine.files[file][0]
         if key in self.rungs:
             self.rungs.discard(key)
-            self.engine.files[file][0].rungs[rung] = self._original.pop(key)
+            compiled.blocks[compiled.block_index(rung)] = self._original.pop(key)
             return False
         self.rungs.add(key)
-        compiled = self.engine.files[file][0]
-        original = compiled.rungs[rung]
+        # The rung alone in its block: the table is exact when it starts.
+        k = compiled.isolate(rung)
+        original = compiled.blocks[k]
         self._original[key] = original
         source = self.engine.program.files[file].rungs[rung]
         table = self.engine.table
@@ -153,7 +155,7 @@ class Breakpoints:
                 self.hits.append(Hit(self.engine.scans + 1, key[0], key[1]))
             return result
 
-        compiled.rungs[rung] = watched
+        compiled.blocks[k] = watched
         return True
 
     # -- conditions -------------------------------------------------------------------------

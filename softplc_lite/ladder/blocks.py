@@ -1,0 +1,145 @@
+"""Compiled program files as blocks of rungs (the compiler's output).
+
+One generated Python function runs a block of consecutive rungs (at most
+CHUNK_RUNGS, and a block starts at every LBL rung, so a JMP lands at the
+start of one). Inside a block the data-table words its contacts and coils
+use are held in locals: read once, written back before anything that is
+not block code can look (docs/engine.md, "Compiled code"). Calling one
+function per block instead of one per rung is most of what issue 17 asked:
+the per-call cost was half of a boolean scan.
+
+A block function ``fn(z)`` takes the rung-in of its rungs (the file's MCR
+zone) and returns None when its last rung is done, or what ended it early:
+a rung index (JMP), RET, TND, or a RET instruction with values.
+
+Faults name their rung and instruction through a line table per block: each
+block is compiled under its own file name, ``<ladder file N rungs A-B>``.
+"""
+
+from __future__ import annotations
+
+import bisect
+import re
+from dataclasses import dataclass
+
+# Rungs per block (at most). Bigger blocks load a few more words than they
+# use per rung; smaller ones pay the call more often. CPython compiles one
+# huge function body several times slower than the same code in pieces.
+CHUNK_RUNGS = 200
+
+IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+@dataclass
+class BlockCode:
+    """What the file compiler emitted for one block: source lines, and for
+    each line the instruction (or None) and rung it belongs to."""
+
+    first: int  # first rung
+    end: int  # one past the last rung
+    lines: list[str]
+    line_instr: list  # per line (0-based): Instruction or None
+    line_rung: list[int]
+
+
+class LineTable:
+    """Line -> (rung, instruction) of one compiled block."""
+
+    __slots__ = ("instr", "rung")
+
+    def __init__(self, instr: list, rung: list[int]) -> None:
+        self.instr = instr
+        self.rung = rung
+
+    def at(self, lineno: int):
+        k = lineno - 2  # line 1 is the factory's def
+        if 0 <= k < len(self.instr):
+            return self.rung[k], self.instr[k]
+        return None, None
+
+
+def block_name(number: int, first: int, end: int) -> str:
+    return f"<ladder file {number} rungs {first}-{end - 1}>"
+
+
+def build_block(number: int, code: BlockCode, env: dict):
+    """Compile one block: a factory binding the names the body uses, so the
+    body reads them as closure cells (fast), and the block function."""
+    used = set(IDENTIFIER.findall("\n".join(code.lines)))
+    bindings = "; ".join(f"{n} = _env[{n!r}]" for n in sorted(env) if n in used) or "pass"
+    # The bindings come after the body so every body line keeps its number
+    # (line k + 2 is code.lines[k]); the block reads them as closure cells,
+    # filled before it first runs.
+    text = "\n".join(["def _factory(_env):", *code.lines, "    " + bindings, "    return _block"]) + "\n"
+    name = block_name(number, code.first, code.end)
+    scope: dict[str, object] = {}
+    exec(compile(text, name, "exec"), scope)  # noqa: S102 - source built only from validated tokens
+    return scope["_factory"](env), name, LineTable(code.line_instr, code.line_rung)
+
+
+class CompiledFile:
+    """A program file as block functions, with what maps faults back to
+    rungs and instructions, and what the watch view's breakpoints need to
+    run one rung alone."""
+
+    def __init__(self, number: int, rung_count: int, has_mcr: bool, compiler) -> None:
+        self.number = number
+        self.rung_count = rung_count
+        self.has_mcr = has_mcr
+        self.blocks: list = []  # block functions, in rung order
+        self.starts: list[int] = []  # first rung of each block
+        self.tables: dict[str, LineTable] = {}  # block file name -> its line table
+        self._compiler = compiler  # kept to compile a block again, split (isolate)
+
+    def add(self, code: BlockCode) -> None:
+        fn, name, table = build_block(self.number, code, self._compiler.env)
+        self.blocks.append(fn)
+        self.starts.append(code.first)
+        self.tables[name] = table
+
+    # -- the engine's view ----------------------------------------------------------------------
+    def block_index(self, rung: int) -> int:
+        """The block holding ``rung``."""
+        return bisect.bisect_right(self.starts, rung) - 1
+
+    def where(self, filename: str, lineno: int):
+        """(rung, instruction) of a generated line, or (None, None)."""
+        table = self.tables.get(filename)
+        return table.at(lineno) if table is not None else (None, None)
+
+    # -- breakpoints -------------------------------------------------------------------------------
+    def isolate(self, rung: int) -> int:
+        """Make ``rung`` a block of its own (compiling its old block again in
+        up to three parts) and return its block index: a breakpoint wraps it,
+        and sees the data table exact when the rung starts."""
+        k = self.block_index(rung)
+        first = self.starts[k]
+        end = self.starts[k + 1] if k + 1 < len(self.starts) else self.rung_count
+        if first == rung and end == rung + 1:
+            return k
+        parts = [(a, b) for a, b in ((first, rung), (rung, rung + 1), (rung + 1, end)) if a < b]
+        old = CompiledFile(self.number, self.rung_count, self.has_mcr, self._compiler)
+        for a, b in parts:
+            old.add(self._compiler.block(a, b))
+        del self.tables[block_name(self.number, first, end)]
+        self.blocks[k:k + 1] = old.blocks
+        self.starts[k:k + 1] = old.starts
+        self.tables.update(old.tables)
+        return self.block_index(rung)
+
+    # -- for people and tests ---------------------------------------------------------------------
+    @property
+    def source(self) -> str:
+        """The generated code of every block, emitted again (not kept: it is
+        as big as the program text)."""
+        out = []
+        bounds = self.starts + [self.rung_count]
+        for a, b in zip(bounds, bounds[1:]):
+            out += ["def _factory(_env):", *self._compiler.block(a, b).lines]
+        return "\n".join(out) + "\n"
+
+    @property
+    def line_table(self) -> dict:
+        """(block name, line) -> instruction, for every line that has one."""
+        return {(name, line + 2): ins for name, t in self.tables.items()
+                for line, ins in enumerate(t.instr) if ins is not None}
