@@ -265,7 +265,7 @@ class ControlElement:
 
     @len.setter
     def len(self, value: int) -> None:
-        self.d[self.i + 1] = _word(value)
+        self.d[self.i + 1] = signed_word(value)
 
     @property
     def pos(self) -> int:
@@ -273,7 +273,7 @@ class ControlElement:
 
     @pos.setter
     def pos(self, value: int) -> None:
-        self.d[self.i + 2] = _word(value)
+        self.d[self.i + 2] = signed_word(value)
 
     def finish(self, error: bool = False, empty: bool = False) -> None:
         """Completion: DN, with ER on error and EM when ``empty`` (a timeout)."""
@@ -285,7 +285,11 @@ class ControlElement:
         self.d[self.i] = w
 
 
-def _word(value: int) -> int:
+_R_BITS = R_EN | R_DN | R_ER | R_EM
+
+
+def signed_word(value: int) -> int:
+    """``value`` as a signed 16-bit word (its low 16 bits)."""
     value &= 0xFFFF
     return value - 0x10000 if value & 0x8000 else value
 
@@ -312,32 +316,42 @@ class ControlledInstruction:
     def __init__(self, control: BoundOperand) -> None:
         self.control = control
         self.busy = False
+        # A direct CONTROL address is bound once (BoundOperand): its word and
+        # its ControlElement are kept, so a scan's call allocates and looks up
+        # nothing (issue 17). An indirect one is resolved at every call.
+        location = control._location
+        self._d = location[0] if location is not None else None
+        self._i = location[1] if location is not None else 0
+        self._ctl = ControlElement(self._d, self._i) if location is not None else None
 
     def __call__(self, c: bool) -> bool:
-        d, i, _ = self.control.location()
+        d = self._d
+        if d is None:
+            d, i, _ = self.control.location()
+            ctl = None
+        else:
+            i = self._i
+            ctl = self._ctl
         w = d[i]
         if not c:
             if self.busy:
                 self.busy = False
                 self.cancel()
-            if w & (R_EN | R_DN | R_ER | R_EM):
-                d[i] = w & ~(R_EN | R_DN | R_ER | R_EM)
+            if w & _R_BITS:
+                d[i] = w & ~_R_BITS
             return c
-        ctl = None
         if not w & R_EN:
             d[i] = (w | R_EN) & ~(R_DN | R_ER | R_EM)
-            ctl = ControlElement(d, i)
-            self.busy = not self.start(ctl)
+            self.busy = not self.start(ctl or ControlElement(d, i))
         elif self.busy:
-            ctl = ControlElement(d, i)
-            self.busy = not self.step(ctl)
+            self.busy = not self.step(ctl or ControlElement(d, i))
         elif not w & (R_DN | R_ER):
             # EN on, nothing in progress, no completion: the operation was
             # lost, e.g. the data table was restored from a retentive
             # snapshot taken mid-operation. Start it again, or the rung would
             # wait for a completion that can never come.
             d[i] = w & ~R_EM
-            self.busy = not self.start(ControlElement(d, i))
+            self.busy = not self.start(ctl or ControlElement(d, i))
         return c
 
     def start(self, ctl: ControlElement) -> bool:

@@ -38,13 +38,13 @@ from typing import Callable
 from ...ladder import status as S
 from ...ladder.instructions import K
 from ...ladder.semantics import OV
-from ..api import BoundOperand, ControlElement, ControlledInstruction, InstructionContext
+from ..api import BoundOperand, ControlElement, ControlledInstruction, InstructionContext, signed_word
 from .formats import FormatError
 from .instructions import _PARAMS, _PARAMS_OUT, FormatSource, param_problem, param_sources, spec
 from .params import ParamError
 from .ports import ComPort, PortSet
 from .printf import MAX_PARAMS, compile_print
-from .scanf import MATCHED, MISMATCH, NEED_MORE, ScanResult, compile_scan
+from .scanf import MATCHED, NEED_MORE, compile_scan
 from .strings import StringTable
 
 COMPRINT = spec("COMPRINT", "format and send to a port", ("control", K.CONTROL), ("port", K.PORT),
@@ -141,20 +141,23 @@ class ComPrint(_Controlled):
 class ComScan(_Controlled):
     port_obj: ComPort | None = None
     # The receive buffer (the str object itself) of the last attempt and its
-    # result, kept only when that attempt needed more input and took no
-    # Param: matching the same buffer again would give the same result and
-    # change nothing, so it is not repeated until the buffer changes or the
-    # instruction starts again. With _tried_need (the length the stopped
-    # field needs, 0 when unknown), a buffer that only grew at its end and is
-    # still shorter gives NEED_MORE at its end, with the same specs.
+    # result (status, used, specs), kept only when that attempt needed more
+    # input and took no Param: matching the same buffer again would give the
+    # same result and change nothing, so it is not repeated until the buffer
+    # changes or the instruction starts again. With _tried_need (the length
+    # the stopped field needs, 0 when unknown), a buffer that only grew at its
+    # end and is still shorter gives NEED_MORE at its end, with the same specs.
     _tried_rx: str | None = None
-    _tried: object = None
+    _tried_used = 0
+    _tried_specs = 0
     _tried_need = 0
 
     def __init__(self, ctx: InstructionContext, ports: PortSet, strings: StringTable, log: Log) -> None:
         super().__init__(ctx, ports, strings, log)
         # Params of constants and direct addresses only: resolving them takes nothing from the table
         self._fixed_params = all(op.address is None or op.address.is_direct for op in ctx.operands[3:])
+        self._clock = ctx.engine.clock  # the engine's clock object, read at every step (ctx.now_ms)
+        self._deadline_ms = 0
 
     def start(self, ctl: ControlElement) -> bool:
         ctl.len = 0
@@ -176,43 +179,49 @@ class ComScan(_Controlled):
             return self._error(ctl, f"format {index}: {problem}")
         self.index = index
         self.port_obj = port
+        self._deadline_ms = self.started_ms + port.config.timeout_ms
         return self.step(ctl)
 
     def step(self, ctl: ControlElement) -> bool:
+        # Run on every true scan while a reply arrives: the common outcome
+        # (NEED_MORE on a buffer seen before, or one that only grew) is worked
+        # out without a match, a result object or a property call (issue 17).
         port = self.port_obj
-        if not port.up:
+        if port.error is not None:
             return self._error(ctl, f"port {port.number} is down: {port.error}")
         rx = port.rx
         tried = self._tried_rx
         if rx is tried:
-            result = self._tried
+            status, used, specs = NEED_MORE, self._tried_used, self._tried_specs
         elif tried is not None and len(rx) < self._tried_need and rx.startswith(tried):
-            result = self._tried = ScanResult(NEED_MORE, len(rx), self._tried.specs)
-            self._tried_rx = rx
+            status, used, specs = NEED_MORE, len(rx), self._tried_specs
+            self._tried_rx, self._tried_used = rx, used
         else:
             try:
                 result, taken, need = self.matcher.match_counted(rx, self.params(), final=False)
             except ParamError as e:
                 return self._error(ctl, f"format {self.index}: {e.reason}")
-            if result.status == NEED_MORE and not taken and self._fixed_params:
-                self._tried_rx, self._tried, self._tried_need = rx, result, need
+            status, used, specs = result
+            if status == NEED_MORE and not taken and self._fixed_params:
+                self._tried_rx, self._tried_used, self._tried_specs, self._tried_need = rx, used, specs, need
             else:
                 self._tried_rx = None
-        ctl.len = result.used
-        ctl.pos = result.specs
-        if result.status == MATCHED:
-            port.take(result.used)
+        d, i = ctl.d, ctl.i
+        d[i + 1] = used if used <= 0x7FFF else signed_word(used)  # LEN
+        d[i + 2] = specs if specs <= 0x7FFF else signed_word(specs)  # POS
+        if status == NEED_MORE:
+            if self._clock.now_ms >= self._deadline_ms:
+                return self._error(ctl, f"timeout after {port.config.timeout_ms} ms with {len(port.rx)} "
+                                        f"characters waiting", empty=True)
+            return False
+        if status == MATCHED:
+            port.take(used)
             ctl.finish()
-            self.log(2, f"{self.where}: matched {result.used} characters, {result.specs} specs")
+            self.log(2, f"{self.where}: matched {used} characters, {specs} specs")
             return True
-        if result.status == MISMATCH:
-            ctl.finish(error=True)
-            self.log(2, f"{self.where}: mismatch at offset {result.used} after {result.specs} specs (ER)")
-            return True
-        if self.ctx.now_ms - self.started_ms >= port.config.timeout_ms:
-            return self._error(ctl, f"timeout after {port.config.timeout_ms} ms with {len(port.rx)} "
-                                    f"characters waiting", empty=True)
-        return False
+        ctl.finish(error=True)  # MISMATCH
+        self.log(2, f"{self.where}: mismatch at offset {used} after {specs} specs (ER)")
+        return True
 
 
 class _PortAction:
