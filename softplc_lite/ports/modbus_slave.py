@@ -227,9 +227,9 @@ class ModbusSlave(SimDevice):
                     self._finish(t)
 
     def poll(self, now_ns: int) -> None:
-        if self.framing == "rtu":
+        if self._frame and self.framing == "rtu":  # idle (no frame) at most polls: nothing computed
             gap = silence_ns(self.end.char_ns)
-            if self._frame and now_ns >= self._last + gap:
+            if now_ns >= self._last + gap:
                 self._finish(self._last + gap)
 
     def next_due(self, now_ns: int) -> int | None:

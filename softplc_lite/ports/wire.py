@@ -145,6 +145,40 @@ class Wire:
                 break
         return parts[0] if len(parts) == 1 else b"".join(parts)
 
+    def take_arrived(self, now: int) -> bytes:
+        """Every byte arrived by ``now``, removed: ``take(available(now), now)``
+        in one pass over the chunks (the read of a polling port at every scan
+        while a reply arrives, issue 17)."""
+        chunks = self.chunks
+        parts = None
+        got = b""
+        while chunks:
+            chunk = chunks[0]
+            data = chunk.data
+            size = len(data)
+            c = chunk.char_ns
+            if c:
+                n = (now - chunk.start) // c
+                if n > size:
+                    n = size
+            else:
+                n = size if now >= chunk.start else 0
+            taken = chunk.taken
+            if n <= taken:
+                break
+            part = data if taken == 0 and n == size else data[taken:n]
+            chunk.taken = n
+            if not got:
+                got = part
+            else:
+                if parts is None:
+                    parts = [got]
+                parts.append(part)
+            if n < size:
+                break
+            chunks.popleft()
+        return got if parts is None else b"".join(parts)
+
     def take_timed(self, now: int) -> tuple[bytes, list[int]]:
         """All arrived bytes, removed, with each byte's arrival time."""
         chunks = self.chunks
@@ -242,9 +276,11 @@ class Link:
         device = self.device
         if device is None:
             return
-        data, times = self.wires[0].take_timed(now)
-        if data:
-            device.receive(data, times)
+        wire = self.wires[0]
+        if wire.chunks:  # most pumps find the port's wire empty: no call for it
+            data, times = wire.take_timed(now)
+            if data:
+                device.receive(data, times)
         device.poll(now)
 
     def __repr__(self) -> str:
@@ -403,24 +439,30 @@ class PortEnd:
 
     def read_arrived(self, now: int) -> bytes:
         """What ``available`` then ``read`` of that many bytes return, in one
-        call: the pump, the count, and (when there are bytes) the pump and the
-        take. While the link is quiet (see Link.quiet_until) both would do
-        nothing, so nothing is done."""
+        call: the pump, the take of every arrived byte, and (when there were
+        bytes and the device's poll is due) the pump ``read`` would run. While
+        the link is quiet (see Link.quiet_until) none of it would do
+        anything, so nothing is done."""
         link = self.link
         if now < link.quiet_until:
             return b""
         with link.lock:
             link.pump(now)
-            n = self._in.available(now)
-            if not n:
+            data = self._in.take_arrived(now)
+            if not data:
                 if self.index == 0:
                     link.quiet_until = link.quiet_from(now)
                 return b""
             link.quiet_until = 0
-            due = link.device.next_due(now) if link.device is not None else now
+            device = link.device
+            due = device.next_due(now) if device is not None else now
             if due is not None and due <= now:
-                link.pump(now)  # a device that cannot tell, or is due: polled again as read() would
-            return self._in.take(n, now)
+                # a device that cannot tell, or is due: polled again as read()
+                # would (read() pumps after the count and before the take;
+                # what the device sends then queues behind the bytes counted,
+                # so taking them first changes nothing)
+                link.pump(now)
+            return data
 
     def pending(self, now: int) -> int:
         with self.link.lock:

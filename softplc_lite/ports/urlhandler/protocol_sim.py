@@ -19,7 +19,7 @@ from __future__ import annotations
 import re
 from urllib.parse import parse_qsl
 
-from serial.serialutil import SerialException
+from serial.serialutil import PortNotOpenError, SerialException
 
 from .. import simdevices, wire
 
@@ -113,7 +113,8 @@ class Serial(wire.ClockedSerial):
         return self._end.cts(now)
 
     def read_now(self) -> bytes:
-        self._check_open()
+        if not self.is_open:  # _check_open, inline: this runs at every scan
+            raise PortNotOpenError()
         return self._end.read_arrived(self._clock())
 
     def _available(self, now: int) -> int:
