@@ -96,8 +96,11 @@ class ComGenius(TLM):
     def on_output(self, engine, outputs_enabled: bool) -> None:
         # Ports are communication, not outputs: TEST mode still talks (as a
         # SoftPLC does in its test mode, where only the I/O image is held).
-        if self.ports is not None:
-            self.ports.flush_output()
+        ports = self.ports
+        if ports is not None:
+            for port in ports.port_list:  # PortSet.flush_output, inline: most scans have nothing to send
+                if port.tx:
+                    port.flush_output()
         if self.recorder is not None:
             self.recorder.flush()
 

@@ -136,6 +136,7 @@ class PortSet:
             physical = (overrides or {}).get(number, pc.physical)
             url = port_url(physical, config.com_devices)
             self.ports[number] = ComPort(pc, url, log, now_ns, config.retry_ms, log_frames=config.debug >= 2)
+        self.port_list = list(self.ports.values())  # the driver's two points walk it at every scan
 
     def open_all(self, keep_going: bool | None = None) -> list[str]:
         """Open every port. A port that cannot be opened raises ModuleError
@@ -158,14 +159,14 @@ class PortSet:
         return warnings
 
     def poll_input(self) -> None:
-        for port in self.ports.values():
+        for port in self.port_list:
             if port.error is None:
                 port.poll_input()
             elif port.error != "closed":
                 port.retry()
 
     def flush_output(self) -> None:
-        for port in self.ports.values():
+        for port in self.port_list:
             if port.tx:
                 port.flush_output()
 
