@@ -25,7 +25,7 @@ from dataclasses import dataclass
 # Rungs per block (at most). Bigger blocks load a few more words than they
 # use per rung; smaller ones pay the call more often. CPython compiles one
 # huge function body several times slower than the same code in pieces.
-CHUNK_RUNGS = 200
+CHUNK_RUNGS = 1000
 
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 

@@ -27,7 +27,7 @@ from ..datatable import DataTable, ValueKind, bit_mask
 from ..datatable.filetypes import Storage
 from . import status as S
 from . import blocks
-from .ast import AddressRef, BinOp, Branch, Const, Element, Instruction, Program, Rung, UnaryOp, walk
+from .ast import AddressRef, BinOp, Branch, Const, Element, Instruction, Program, Rung, UnaryOp, address_refs, walk
 from .blocks import BlockCode, CompiledFile
 from .bound import BoundAccess
 from .expr import namespace as expr_namespace
@@ -89,23 +89,24 @@ class _FileCompiler:
         return self.bind(f"f{file.number}", file.data)
 
     # -- words held in locals ---------------------------------------------------------------
-    def word_local(self, ind: int, ref: AddressRef) -> tuple[str, int] | None:
-        """(local, mask) for a direct bit address whose word a block may hold
-        in a local (a 16-bit word file other than S: S words are written by
-        kernels and the engine behind the block's back), loading it at its
-        first use; None for any other address."""
+    def word_local(self, ind: int, ref: AddressRef) -> tuple[str, int | None] | None:
+        """(local, mask or None) for a direct address whose word a block may
+        hold in a local (a 16-bit word file other than S: S words are written
+        by kernels and the engine behind the block's back), loading it at its
+        first use (at rung level: every path after it has it); None for any
+        other address."""
         a = ref.address
         if not a.is_direct:
             return None
         f, index, bit = self.table.resolve(a)
-        if bit is None or f.ftype.storage is not Storage.WORD or f.ftype.letter == "S":
+        if f.ftype.storage is not Storage.WORD or f.ftype.letter == "S":
             return None
         key = (f.number, index)
         name = self.words.get(key)
         if name is None:
             name = self.words[key] = f"w{f.number}_{index}"
             self.emit(ind, f"{name} = {self.array_name(f)}[{index!r}]")
-        return name, bit_mask(bit)
+        return name, (bit_mask(bit) if bit is not None else None)
 
     def mark_written(self, key_name: str) -> None:
         self.dirty.add(key_name)
@@ -149,6 +150,12 @@ class _FileCompiler:
     def value(self, ind: int, operand) -> str:
         if isinstance(operand, Const):
             return repr(operand.value)
+        a = operand.address
+        if a.is_direct:
+            f, index, bit = self.table.resolve(a)
+            name = self.words.get((f.number, index))
+            if name is not None:  # held in a local (loaded at rung level before this instruction)
+                return name if bit is None else f"(1 if {name} & {bit_mask(bit)!r} else 0)"
         d, i, m = self.location(ind, operand)
         if m is not None:
             return f"(1 if {d}[{i}] & {m} else 0)"
@@ -232,6 +239,13 @@ class _FileCompiler:
                     return None
                 legs.append("True" if not terms else terms[0] if len(terms) == 1 else f"({' and '.join(terms)})")
             return f"({' or '.join(legs)})"
+        if el.mnemonic in _COMPARE and all(isinstance(op, Const) or op.address.is_direct for op in el.operands):
+            # A compare of direct words reads and writes nothing else: a contact too.
+            for op in el.operands:
+                if isinstance(op, AddressRef):
+                    self.word_local(2, op)
+            a, b = (self.value(2, op) for op in el.operands)
+            return f"{a} {_COMPARE[el.mnemonic]} {b}"
         if el.mnemonic not in ("XIC", "XIO"):
             return None
         held = self.bit(2, el.operands[0])
@@ -266,8 +280,55 @@ class _FileCompiler:
         if m in _BIT_OPS and all(self.bit(ind, op) is not None for op in ops):
             getattr(self, f"bit_{m}")(ind, *(self.bit(ind, op) for op in ops))
             return
+        dest = self.local_safe(ins)
+        if dest is not False:
+            self.in_place(ind, ins, dest)
+            return
         if m not in _NO_BARRIER:
             self.barrier(ind)
+        self.dispatch(ind, ins)
+
+    def local_safe(self, ins: Instruction):
+        """For an instruction that reads and writes only its operands (and
+        S:0, minor fault words) and cannot fault, on direct addresses: its
+        destination operand (None: none). False for any other instruction:
+        it runs after a barrier."""
+        m = ins.mnemonic
+        where = _LOCAL_SAFE.get(m)
+        if where is None:
+            return False
+        for op in ins.operands:
+            for ref in address_refs(op):
+                if not ref.address.is_direct:
+                    return False
+            if m == "CPT" and not isinstance(op, (AddressRef, Const)) and not _cannot_fault(op):
+                return False
+        return ins.operands[where] if where >= 0 else None
+
+    def in_place(self, ind: int, ins: Instruction, dest) -> None:
+        """A safe instruction beside the locals: the words it reads are
+        loaded (at rung level), its destination word is written back first
+        if held and changed, and forgotten after (its kernel writes the
+        table)."""
+        for op in ins.operands:
+            if op is not dest:
+                for ref in address_refs(op):
+                    self.word_local(ind, ref)
+        if dest is not None:
+            self.mark_rung(ind)  # a store may set a minor fault (overflow)
+            f, index, _ = self.table.resolve(dest.address)
+            key = (f.number, index)
+            name = self.words.get(key)
+            if name is not None and name in self.dirty:
+                self.emit(ind, f"f{f.number}[{index!r}] = {name}")
+        self.dispatch(ind, ins)
+        if dest is not None and name is not None:
+            del self.words[key]
+            self.dirty.discard(name)
+
+    def dispatch(self, ind: int, ins: Instruction) -> None:
+        m = ins.mnemonic
+        ops = ins.operands
         handler = getattr(self, f"i_{m}", None)
         if handler is not None:
             handler(ind, ops)
@@ -675,6 +736,29 @@ _PASS_THROUGH = frozenset({"OTE", "OTL", "OTU"})
 
 # Bit instructions that work on words held in locals, when their operands are direct.
 _BIT_OPS = frozenset({"XIC", "XIO", "OTE", "OTL", "OTU", "ONS", "OSR", "OSF"})
+# Instructions that read their operands, write only their destination (and
+# S:0 and the minor fault words, which no local holds) and cannot raise a
+# major fault: run beside the locals (in_place). The number is the index of
+# the destination operand (-1: none). DIV, MOD and SQR... fault or may: not here.
+_LOCAL_SAFE = {
+    "EQU": -1, "NEQ": -1, "LES": -1, "LEQ": -1, "GRT": -1, "GEQ": -1, "LIM": -1, "MEQ": -1,
+    "MOV": 1, "ADD": 2, "SUB": 2, "MUL": 2, "NEG": 1, "ABS": 1, "CLR": 0,
+    "AND": 2, "OR": 2, "XOR": 2, "NOT": 1, "MVM": 2, "CPT": 0,
+}
+
+
+def _cannot_fault(node) -> bool:
+    """An expression of + - * and bitwise operators only: no division by
+    zero, no function that can fault."""
+    if isinstance(node, (AddressRef, Const)):
+        return True
+    if isinstance(node, BinOp):
+        return node.op in ("+", "-", "*", "AND", "OR", "XOR") and _cannot_fault(node.left) and _cannot_fault(node.right)
+    if isinstance(node, UnaryOp):
+        return _cannot_fault(node.operand)
+    return False
+
+
 # Instructions that touch no data-table word (or only leave the block,
 # writing back first): no barrier before them.
 _NO_BARRIER = frozenset({"JMP", "LBL", "RET", "TND", "MCR", "AFI", "SBR"})
