@@ -65,6 +65,7 @@ class _FileCompiler:
         self.named: dict[tuple, str] = {}  # per-instruction objects, made once (a block compiled again reuses them)
         self.rung_elements: list = []
         self.current: Instruction | None = None
+        self.inline_dest: str | None = None  # the local a word store writes (in_place)
 
     # -- emitting ------------------------------------------------------------------------
     def emit(self, indent: int, text: str) -> None:
@@ -314,17 +315,46 @@ class _FileCompiler:
             if op is not dest:
                 for ref in address_refs(op):
                     self.word_local(ind, ref)
+        name = None
         if dest is not None:
             self.mark_rung(ind)  # a store may set a minor fault (overflow)
+            if _word_store(ins) and self.word_local(ind, dest) is not None:
+                # A 16-bit result into a held word: stored in its local (i_MOV, i_CPT, _math2).
+                self.inline_dest = self.word_local(ind, dest)[0]
+                self.dispatch(ind, ins)
+                self.dirty.add(self.inline_dest)
+                self.inline_dest = None
+                return
             f, index, _ = self.table.resolve(dest.address)
             key = (f.number, index)
             name = self.words.get(key)
             if name is not None and name in self.dirty:
                 self.emit(ind, f"f{f.number}[{index!r}] = {name}")
         self.dispatch(ind, ins)
-        if dest is not None and name is not None:
+        if name is not None:
             del self.words[key]
             self.dirty.discard(name)
+
+    def store_in_local(self, ind: int, dest, value_code: str, fallback: str, in_range: bool = False,
+                       carry: str | None = None) -> None:
+        """``value_code`` into the destination's local, with S:0 as the
+        kernel sets it; out of range, the kernel (``fallback``, given the
+        value as ``_v``) stores it in the table, and the local reads it back.
+        ``in_range``: the value is a word already (no range test)."""
+        name = self.inline_dest
+        f, index, _ = self.table.resolve(dest.address)
+        flags = f"((_v == 0) << 2) | ((_v < 0) << 3)" if carry is None else f"({carry}) | ((_v == 0) << 2) | ((_v < 0) << 3)"
+        self.emit(ind, f"_v = {value_code}")
+        if in_range:
+            self.emit(ind, f"{name} = _v")
+            self.emit(ind, f"_s[0] = (_s[0] & -16) | {flags}")
+            return
+        self.emit(ind, "if -32768 <= _v <= 32767:")
+        self.emit(ind + 1, f"{name} = _v")
+        self.emit(ind + 1, f"_s[0] = (_s[0] & -16) | {flags}")
+        self.emit(ind, "else:")
+        self.emit(ind + 1, fallback.replace("_D_", f"{self.array_name(f)}, {index!r}"))
+        self.emit(ind + 1, f"{name} = f{f.number}[{index!r}]")
 
     def dispatch(self, ind: int, ins: Instruction) -> None:
         m = ins.mnemonic
@@ -483,6 +513,11 @@ class _FileCompiler:
         self.emit(ind + 1, f"c = bool({self.expression(ind + 1, ops[0])})")
 
     def _store(self, ind, dest, value_code: str, kernel: str = "store", value=None):
+        if self.inline_dest is not None:  # MOV/CPT of a word value into a held word (in_place)
+            self.bind("_s", self.machine.s)
+            fn = self.bind("_store", self.machine.store)
+            self.store_in_local(ind + 1, dest, value_code, f"{fn}(_v, _D_)", in_range=_is_word(value))
+            return
         d, i, _ = self.location(ind + 1, dest)
         if kernel == "store" and value is not None and _is_word(dest) and _word_valued(value):
             kernel = "store_word"
@@ -492,6 +527,13 @@ class _FileCompiler:
     def _math2(self, ind, ops, kernel: str):
         self.emit(ind, "if c:")
         a, b = self.value(ind + 1, ops[0]), self.value(ind + 1, ops[1])
+        if self.inline_dest is not None:  # ADD/SUB of words into a held word (in_place)
+            self.bind("_s", self.machine.s)
+            fn = self.bind(f"_{kernel}", getattr(self.machine, kernel))
+            symbol, carry = ("+", f"({a} & 65535) + ({b} & 65535) > 65535") if kernel == "add" else \
+                ("-", f"({a} & 65535) < ({b} & 65535)")
+            self.store_in_local(ind + 1, ops[2], f"{a} {symbol} {b}", f"{fn}({a}, {b}, _D_)", carry=carry)
+            return
         d, i, _ = self.location(ind + 1, ops[2])
         if kernel in ("add", "sub") and all(_is_word(op) for op in ops):
             kernel += "_words"
@@ -745,6 +787,16 @@ _LOCAL_SAFE = {
     "MOV": 1, "ADD": 2, "SUB": 2, "MUL": 2, "NEG": 1, "ABS": 1, "CLR": 0,
     "AND": 2, "OR": 2, "XOR": 2, "NOT": 1, "MVM": 2, "CPT": 0,
 }
+
+
+def _word_store(ins: Instruction) -> bool:
+    """A MOV or CPT of a word value, or an ADD/SUB of words, into a word:
+    compiled to store into the destination's local (in_place)."""
+    m, ops = ins.mnemonic, ins.operands
+    if m in ("MOV", "CPT"):
+        dest, value = (ops[1], ops[0]) if m == "MOV" else (ops[0], ops[1])
+        return _is_word(dest) and _word_valued(value)
+    return m in ("ADD", "SUB") and all(_is_word(op) for op in ops)
 
 
 def _cannot_fault(node) -> bool:
