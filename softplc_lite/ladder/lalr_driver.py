@@ -14,13 +14,22 @@ lark's exception, position and context (softplc choice: the correct
 program is the common, large case; a wrong one is parsed twice).
 
 What lark does per token that this loop skips: a generator frame per
-lexer layer, a ``LineCounter`` object, the ``Token`` constructor's keyword
-handling, the keyword ``UnlessCallback`` regex (memoised here per lexer and
-text: it depends on nothing else), and the ``Rule`` attribute look-ups of
-each reduction (precomputed into one table).
+lexer layer (lexer, post-lexer, parser are one loop here), a second regex
+match for the blanks before a token (skipped in the same match, see
+``_StateLexer``), a ``LineCounter`` object, the ``Token`` constructor's
+keyword handling, the keyword ``UnlessCallback`` regex (memoised here per
+lexer and text: it depends on nothing else), and the ``Rule`` attribute
+look-ups of each reduction (precomputed into one table, keyed by plain
+str: lark names rules with Tokens, which compare through Token.__eq__).
+
+The post-lexer is read as a table (``span_changes``: the token kinds that
+open or close a span; ``dropped_inside``: the kinds dropped while a span is
+open), as parser.py's LadderPostLex declares it.
 """
 
 from __future__ import annotations
+
+import re
 
 from lark import Lark, Token
 from lark.lexer import UnlessCallback
@@ -35,44 +44,68 @@ class NotFastPath(Exception):
 
 
 class _StateLexer:
-    """One state's terminals, from lark's BasicLexer for that state."""
+    """One parser state's terminals, from lark's BasicLexer for that state.
 
-    __slots__ = ("match", "ignore", "newline", "keyword_of", "callbacks")
+    Lark tries the terminals as one alternation in its order and takes the
+    first that matches; an ignored terminal (blanks) is one more match. Here
+    one regex does both: ``(?:(?!B)(?>I))*+`` skips, while the first
+    terminal to match is the ignored one ``I`` (``B``: the terminals lark
+    tries before ``I``; atomic and possessive, so nothing is given back),
+    then lark's own alternation follows, unchanged.
+    """
+
+    __slots__ = ("match", "skip", "newline", "skip_has_newline", "keyword_of")
 
     def __init__(self, basic) -> None:
         scanner = basic.scanner  # built on first use, as lark does
-        if len(scanner._mres) != 1:
-            raise NotFastPath("more terminals than one regex holds")
-        self.match = scanner._mres[0].match
-        self.ignore = basic.ignore_types
+        terminals = scanner.terminals
+        alternation = "|".join("(?P<%s>%s)" % (t.name, t.pattern.to_regexp()) for t in terminals)
+        flags = basic.g_regex_flags
+        if len(scanner._mres) != 1 or scanner._mres[0].pattern != alternation or scanner.use_bytes:
+            raise NotFastPath("a lexer unlike lark 1.3's")
+        skips = []
+        for i, t in enumerate(terminals):
+            if t.name in basic.ignore_types:
+                before = "|".join(u.pattern.to_regexp() for u in terminals[:i])
+                skips.append(("(?!%s)" % before if before else "") + "(?>%s)" % t.pattern.to_regexp())
+        skip = "(?:%s)*+" % "|".join(skips) if skips else ""
+        self.match = re.compile(skip + "(?:" + alternation + ")", flags).match
+        self.skip = re.compile(skip, flags).match  # the blanks at the end of a text
         self.newline = basic.newline_types
-        # NAME -> {"bst": "BST", "Motor": "NAME", ...}: lark's UnlessCallback
-        # turns a NAME spelt like a keyword into the keyword's terminal.
+        self.skip_has_newline = bool(basic.newline_types & basic.ignore_types)
+        # NAME -> ({"bst": "BST", "Motor": "NAME", ...}, keyword scanner):
+        # lark's UnlessCallback turns a NAME spelt like a keyword into the keyword.
         self.keyword_of = {}
-        self.callbacks = {}
         for name, callback in basic.callback.items():
-            if isinstance(callback, UnlessCallback):
-                self.keyword_of[name] = ({}, callback.scanner)
-            else:
-                self.callbacks[name] = callback
+            if not isinstance(callback, UnlessCallback):
+                raise NotFastPath("a lexer callback")
+            self.keyword_of[name] = ({}, callback.scanner)
 
 
 class FastLalr:
     """Parses with one ``Lark`` object (parser="lalr", lexer="contextual",
-    a post-lexer with ``process``), giving exactly what ``lark.parse`` gives
-    for a text it accepts."""
+    a post-lexer declaring ``span_changes`` and ``dropped_inside``), giving
+    exactly what ``lark.parse`` gives for a text it accepts. Construction
+    raises NotFastPath for a ``Lark`` set up otherwise."""
 
     def __init__(self, lark: Lark) -> None:
         frontend = lark.parser
         connector = frontend.lexer
-        self.postlex = connector.postlexer
+        postlex = connector.postlexer
+        self.span_changes = postlex.span_changes
+        self.dropped_inside = postlex.dropped_inside
         contextual = connector.lexer
-        shared: dict[int, _StateLexer] = {}
-        self.lexers = {state: shared.setdefault(id(basic), _StateLexer(basic))
-                       for state, basic in contextual.lexers.items()}
+        shared: dict[int, _StateLexer] = {}  # lark shares one BasicLexer among states with one terminal set
+        self.lexers: dict[int, _StateLexer] = {}
+        for state, basic in contextual.lexers.items():
+            if id(basic) not in shared:
+                shared[id(basic)] = _StateLexer(basic)
+            self.lexers[state] = shared[id(basic)]
         parser = frontend.parser.parser
         table = parser.parse_table
         callbacks = parser.callbacks
+        if any(isinstance(k, str) for k in callbacks):
+            raise NotFastPath("terminal callbacks")
         self.start_states = table.start_states
         self.end_states = table.end_states
         # state -> {symbol: (shift_to, None) or (None, (size, origin, callback))}
@@ -81,30 +114,79 @@ class FastLalr:
             compiled = {}
             for symbol, (action, arg) in row.items():
                 if action is Shift:
-                    compiled[symbol] = (arg, None)
+                    compiled[str(symbol)] = (arg, None)
                 else:
-                    compiled[symbol] = (None, (len(arg.expansion), arg.origin.name, callbacks[arg]))
+                    compiled[str(symbol)] = (None, (len(arg.expansion), str(arg.origin.name), callbacks[arg]))
             self.actions[state] = compiled
-        self.token_callbacks = {k: v for k, v in callbacks.items() if isinstance(k, str)}
 
     def parse(self, text: str, start: str):
+        """Lark's contextual lexer, post-lexer and LALR parser as one loop."""
         actions = self.actions
-        state_stack = [self.start_states[start]]
+        lexers = self.lexers
+        span_changes = self.span_changes
+        dropped_inside = self.dropped_inside
+        spans = [False] * (1 + max((i for i, _ in span_changes.values()), default=0))
+        state = self.start_states[start]
+        state_stack = [state]
         value_stack: list = []
-        end_state = self.end_states[start]
-        token_callbacks = self.token_callbacks
-
-        def feed(token: Token) -> None:
-            kind = token.type
+        push_state = state_stack.append
+        push_value = value_stack.append
+        pos = 0
+        end = len(text)
+        line = 1
+        line_start = 0  # where the current line starts
+        token = None
+        while pos < end:
+            lexer = lexers[state]
+            m = lexer.match(text, pos)
+            if m is None:
+                blanks = lexer.skip(text, pos)
+                if blanks is not None and blanks.end() == end:
+                    if lexer.skip_has_newline:
+                        line, line_start = _count_lines(text, pos, end, line, line_start)
+                    break
+                raise NotFastPath("no terminal")
+            kind = m.lastgroup
+            start_pos = m.start(kind)
+            if start_pos != pos and lexer.skip_has_newline:
+                line, line_start = _count_lines(text, pos, start_pos, line, line_start)
+            value = m.group(kind)
+            token_line = line
+            column = start_pos - line_start + 1
+            pos = m.end()
+            if kind in lexer.newline and "\n" in value:
+                line, line_start = _count_lines(text, start_pos, pos, line, line_start)
+            keyword = lexer.keyword_of.get(kind)
+            if keyword is not None:
+                known, scanner = keyword
+                found = known.get(value)
+                if found is None:
+                    found = known[value] = scanner.fullmatch(value) or kind
+                kind = found
+            # the post-lexer
+            change = span_changes.get(kind)
+            if change is not None:
+                spans[change[0]] = change[1]
+            elif kind in dropped_inside and True in spans:
+                continue
+            token = _new_str(Token, value)
+            token.type = kind
+            token.start_pos = start_pos
+            token.value = value
+            token.line = token_line
+            token.column = column
+            token.end_line = line
+            token.end_column = pos - line_start + 1
+            token.end_pos = pos
+            # the parser: reduce while the table says so, then shift
+            row = actions[state]
             while True:
-                try:
-                    shift_to, reduce = actions[state_stack[-1]][kind]
-                except KeyError:
-                    raise NotFastPath(kind) from None
+                action = row.get(kind)
+                if action is None:
+                    raise NotFastPath(kind)
+                shift_to, reduce = action
                 if shift_to is not None:
-                    state_stack.append(shift_to)
-                    value_stack.append(token_callbacks[kind](token) if kind in token_callbacks else token)
-                    return
+                    break
                 size, origin, callback = reduce
                 if size:
                     children = value_stack[-size:]
@@ -112,25 +194,24 @@ class FastLalr:
                     del value_stack[-size:]
                 else:
                     children = []
-                value_stack.append(callback(children))
-                state_stack.append(actions[state_stack[-1]][origin][0])
+                push_value(callback(children))
+                state = actions[state_stack[-1]][origin][0]
+                push_state(state)
+                row = actions[state]
+            state = shift_to
+            push_state(state)
+            push_value(token)
+        return self._end(token, state_stack, value_stack, self.end_states[start])
 
-        last = None
-        for token in self.postlex.process(self._lex(text, state_stack)):
-            feed(token)
-            last = token
-        if last is None:
-            end = Token("$END", "", 0, 1, 1)
-        else:
-            end = Token.new_borrow_pos("$END", "", last)
+    def _end(self, last: Token | None, state_stack: list, value_stack: list, end_state: int):
+        """Lark's "$END": reduce until the start rule is complete."""
+        end = Token("$END", "", 0, 1, 1) if last is None else Token.new_borrow_pos("$END", "", last)
+        actions = self.actions
         while True:
-            try:
-                shift_to, reduce = actions[state_stack[-1]]["$END"]
-            except KeyError:
-                raise NotFastPath("$END") from None
-            if shift_to is not None:
-                raise NotFastPath("$END shifted")
-            size, origin, callback = reduce
+            action = actions[state_stack[-1]].get(end.type)
+            if action is None or action[0] is not None:
+                raise NotFastPath("$END")
+            size, origin, callback = action[1]
             if size:
                 children = value_stack[-size:]
                 del state_stack[-size:]
@@ -142,48 +223,10 @@ class FastLalr:
             if state_stack[-1] == end_state:
                 return value_stack[-1]
 
-    def _lex(self, text: str, state_stack: list):
-        """Lark's contextual lexer: the terminals of the parser's current
-        state, tried at each position in lark's order (one regex)."""
-        lexers = self.lexers
-        pos = 0
-        end = len(text)
-        line = 1
-        line_start = 0  # where the current line starts
-        while pos < end:
-            lexer = lexers[state_stack[-1]]
-            m = lexer.match(text, pos)
-            if m is None:
-                raise NotFastPath("no terminal")
-            kind = m.lastgroup
-            value = m.group()
-            start = pos
-            token_line = line
-            column = pos - line_start + 1
-            pos = m.end()
-            if kind in lexer.newline:
-                newlines = value.count("\n")
-                if newlines:
-                    line += newlines
-                    line_start = start + value.rindex("\n") + 1
-            if kind in lexer.ignore:
-                continue
-            keyword = lexer.keyword_of.get(kind)
-            if keyword is not None:
-                known, scanner = keyword
-                found = known.get(value)
-                if found is None:
-                    found = known[value] = scanner.fullmatch(value) or kind
-                kind = found
-            token = _new_str(Token, value)
-            token.type = kind
-            token.start_pos = start
-            token.value = value
-            token.line = token_line
-            token.column = column
-            token.end_line = line
-            token.end_column = pos - line_start + 1
-            token.end_pos = pos
-            if kind in lexer.callbacks:
-                token = lexer.callbacks[kind](token)
-            yield token
+
+def _count_lines(text: str, begin: int, stop: int, line: int, line_start: int) -> tuple[int, int]:
+    """The line and line start after text[begin:stop], as lark's LineCounter."""
+    newlines = text.count("\n", begin, stop)
+    if newlines:
+        return line + newlines, text.rindex("\n", begin, stop) + 1
+    return line, line_start

@@ -54,24 +54,24 @@ class LadderPostLex:
     A neutral-text rung opens at its first "(" or "[" and closes at ";"; a
     mnemonic rung may be wrapped in SOR ... EOR. Inside either, line ends
     carry no meaning (and comments inside a rung are not rung comments).
+
+    Written as a table (``span_changes``, ``dropped_inside``) that both
+    ``process`` (lark's post-lexer interface) and lalr_driver's loop read.
     """
 
     always_accept = ("_NL", "COMMENT")
+    # token kind -> (which span, open?): 0 a neutral-text rung, 1 SOR...EOR
+    span_changes = {"LPAR": (0, True), "LSQB": (0, True), "SEMICOLON": (0, False), "SOR": (1, True), "EOR": (1, False)}
+    dropped_inside = frozenset(("_NL", "COMMENT"))
 
     def process(self, stream: Iterator[Token]) -> Iterator[Token]:
-        neutral = False
-        wrapped = False
+        spans = [False, False]
         for tok in stream:
             kind = tok.type
-            if kind in ("LPAR", "LSQB"):
-                neutral = True
-            elif kind == "SEMICOLON":
-                neutral = False
-            elif kind == "SOR":
-                wrapped = True
-            elif kind == "EOR":
-                wrapped = False
-            elif kind in ("_NL", "COMMENT") and (neutral or wrapped):
+            change = self.span_changes.get(kind)
+            if change is not None:
+                spans[change[0]] = change[1]
+            elif kind in self.dropped_inside and True in spans:
                 continue
             yield tok
 
@@ -112,13 +112,13 @@ def _lark(transformer) -> Lark:
 BST, NXB, BND = "BST", "NXB", "BND"
 
 
-@dataclass
+@dataclass(slots=True)  # one a mnemonic or symbol name in a mnemonic rung
 class _Name:
     text: str
     pos: Pos
 
 
-@dataclass
+@dataclass(slots=True)
 class _Marker:
     kind: str
     pos: Pos
@@ -210,6 +210,8 @@ class _ToAst(Transformer):
 
     def _token_pos(self, tok: Token) -> Pos:
         source, line_offset, column_offset = self.context
+        if not (line_offset or column_offset):  # a whole file
+            return Pos(source, tok.line, tok.column)
         line = tok.line
         return Pos(source, line + line_offset, tok.column + column_offset if line == 1 else tok.column)
 
@@ -313,37 +315,26 @@ class _ToAst(Transformer):
         return _RungDraft(self._pos(at), elements=series, comment=comment[0][2:].strip() if comment else None)
 
     # mnemonic --------------------------------------------------------------------------
-    # Once per token of a mnemonic rung: lark's child list as it is, as above.
-    def mn_name(self, children):
-        tok = children[0]
-        return _Name(str(tok), self._token_pos(tok))
-
-    def mn_address(self, children):
-        return self._address(children[0])
-
-    def mn_symbol(self, children):  # PollTimer/DN: never a mnemonic, so an operand at once
-        tok = children[0]
-        return SymbolRef(str(tok), self._token_pos(tok))
-
-    def mn_string(self, children):
-        tok = children[0]
-        return Text(_unquote(str(tok)), self._token_pos(tok))
-
-    def mn_bst(self, children):
-        return _Marker(BST, self._token_pos(children[0]))
-
-    def mn_nxb(self, children):
-        return _Marker(NXB, self._token_pos(children[0]))
-
-    def mn_bnd(self, children):
-        return _Marker(BND, self._token_pos(children[0]))
-
     def mn_tokens(self, children):
-        """The tokens of a mnemonic rung, one list grown left to right."""
+        """The tokens of a mnemonic rung, one list grown left to right (one
+        call a token): [token] or [tokens so far, token]."""
         if len(children) == 1:
-            return children
-        tokens, token = children
-        tokens.append(token)
+            tokens, tok = [], children[0]
+        else:
+            tokens, tok = children
+        if isinstance(tok, Token):
+            kind = tok.type
+            if kind == "NAME":
+                tok = _Name(str(tok), self._token_pos(tok))
+            elif kind == "ADDRESS":
+                tok = self._address(tok)
+            elif kind == "SYMBOL_MEMBER":  # PollTimer/DN: never a mnemonic, so an operand at once
+                tok = SymbolRef(str(tok), self._token_pos(tok))
+            elif kind == "STRING":
+                tok = Text(_unquote(str(tok)), self._token_pos(tok))
+            else:  # BST, NXB, BND
+                tok = _Marker(kind, self._token_pos(tok))
+        tokens.append(tok)  # or a signed number, already a Const
         return tokens
 
     def mnemonic_rung(self, items):
