@@ -102,10 +102,13 @@ def baseline_speedup(base_tree: Path, current_tree: Path, program_file: Path, wa
                      blocks: int, scans_per_block: int) -> dict:
     """Scans of one program on the baseline tree and the current tree,
     interleaved: per-block medians and the median of the per-block ratios."""
-    children = {"baseline": Child(base_tree, "serve", program_file),
-                "current": Child(current_tree, "serve", program_file)}
+    children: dict[str, Child] = {}
+    loaded: dict[str, dict] = {}
     try:
-        loaded = {name: child.read() for name, child in children.items()}
+        # one load at a time: on two cores, loads side by side would slow each other
+        for name, tree in (("baseline", base_tree), ("current", current_tree)):
+            children[name] = Child(tree, "serve", program_file)
+            loaded[name] = children[name].read()
         for child in children.values():
             child.ask(f"scan {warmup_scans}")
         per_block = interleaved_blocks(children, blocks, {name: scans_per_block for name in children})
@@ -137,9 +140,12 @@ def scaling(tree: Path, program_files: dict[int, Path], warmup_scans: int, block
     """ns per instruction of the compiled scan at each size (rungs ->
     program file), one child each, interleaved; the ratio of the largest to
     the smallest as the median of per-block ratios."""
-    children = {rungs: Child(tree, "serve", path) for rungs, path in sorted(program_files.items())}
+    children: dict[int, Child] = {}
+    loaded: dict[int, dict] = {}
     try:
-        loaded = {rungs: child.read() for rungs, child in children.items()}
+        for rungs, path in sorted(program_files.items()):  # one load at a time, as in baseline_speedup
+            children[rungs] = Child(tree, "serve", path)
+            loaded[rungs] = children[rungs].read()
         for child in children.values():
             child.ask(f"scan {warmup_scans}")
         # about the same work per block for every size, so each block of the
