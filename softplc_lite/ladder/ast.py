@@ -4,18 +4,31 @@ Every node carries its source position (``pos``: file, line, column) for
 error messages; positions take no part in equality, so the mnemonic and the
 neutral-text forms of one rung compare equal and ``fmt`` round trips can be
 checked with ``==``.
+
+The nodes a program has one of per instruction (operands, instructions,
+branches, rungs) are compact (issue 17: at most 300 bytes an instruction
+after load): ``__slots__`` classes that keep their position as three slots
+(source, line, column) and build the ``Pos`` when asked, not one Pos object
+per node. Nodes on one source line share one line number object. Operand
+nodes are immutable and hashable (as frozen dataclasses were); instructions,
+branches and rungs may be changed (the parser appends to them). A sequence
+field (operands, elements, legs) may be a list (the parser's tree) or a
+tuple (the validated tree, which keeps no spare list capacity); the two
+compare equal item by item.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Union
+from dataclasses import FrozenInstanceError, dataclass, field
+from typing import NamedTuple, Union
 
 from ..datatable import Address
 
 
-@dataclass(frozen=True)
-class Pos:
+class Pos(NamedTuple):
+    """A source position. A tuple: made for every token while parsing, so
+    it is cheap to build."""
+
     source: str
     line: int
     column: int
@@ -31,69 +44,190 @@ def _pos() -> Pos:
     return field(default=NOWHERE, compare=False, repr=False)
 
 
+# The line number object the previous node kept: nodes are built in source
+# order, so most share it and a program keeps one int per line, not one per
+# node (a line past 256 is an object of its own in CPython).
+_last_line = 0
+
+
+def _line_of(pos: Pos) -> int:
+    global _last_line
+    line = pos.line
+    if line == _last_line:
+        return _last_line
+    _last_line = line
+    return line
+
+
+class _Node:
+    """Position storage shared by the compact nodes."""
+
+    __slots__ = ("_source", "_line", "_column")
+    _fields: tuple[str, ...] = ()  # the fields that take part in equality and repr, in constructor order
+
+    @property
+    def pos(self) -> Pos:
+        return Pos(self._source, self._line, self._column)
+
+    def __repr__(self) -> str:
+        inner = ", ".join(f"{name}={getattr(self, name)!r}" for name in self._fields)
+        return f"{type(self).__name__}({inner})"
+
+
 # -- operands ------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
-class Const:
+class _Operand(_Node):
+    """An immutable, hashable operand node (value semantics, position aside)."""
+
+    __slots__ = ()
+
+    def __setattr__(self, name, value):
+        raise FrozenInstanceError(f"cannot assign to field {name!r}")
+
+    def __delattr__(self, name):
+        raise FrozenInstanceError(f"cannot delete field {name!r}")
+
+    def _values(self) -> tuple:
+        return tuple(getattr(self, name) for name in self._fields)
+
+    def __eq__(self, other):
+        if other.__class__ is not self.__class__:
+            return NotImplemented
+        return self._values() == other._values()
+
+    def __hash__(self) -> int:
+        return hash(self._values())
+
+    def __reduce__(self):
+        # Through the constructor: the slots refuse pickle's setattr.
+        return _rebuild, (type(self), self._values(), self.pos, self._extra())
+
+    def _extra(self) -> dict:
+        return {}
+
+
+def _rebuild(cls, values, pos, extra):
+    return cls(*values, pos, **extra)
+
+
+_set_source = _Node._source.__set__
+_set_line = _Node._line.__set__
+_set_column = _Node._column.__set__
+
+
+def _place(node: _Node, pos: Pos) -> None:
+    """Store ``pos`` in an immutable node (its __setattr__ refuses)."""
+    _set_source(node, pos.source)
+    _set_line(node, _line_of(pos))
+    _set_column(node, pos.column)
+
+
+class Const(_Operand):
     """A number: an int (decimal or 0x hex) or a float. ``hex`` says it was
     written 0x...: a hex constant is a 16-bit pattern (0xFFFF is -1), a
     decimal one its value (docs/language.md); fmt prints it back in hex."""
 
-    value: int | float
-    pos: Pos = _pos()
-    hex: bool = field(default=False, compare=False, repr=False)
+    __slots__ = ("value", "hex")
+    _fields = ("value",)
+    __match_args__ = ("value",)
+
+    def __init__(self, value: int | float, pos: Pos = NOWHERE, hex: bool = False) -> None:
+        _set_const_value(self, value)
+        _set_const_hex(self, hex)
+        _place(self, pos)
+
+    def _values(self) -> tuple:
+        return (self.value,)
+
+    def _extra(self) -> dict:
+        return {"hex": self.hex} if self.hex else {}
 
 
-@dataclass(frozen=True)
+_set_const_value = Const.value.__set__
+_set_const_hex = Const.hex.__set__
+
+
 class Placeholder(Const):
     """Stands in for an operand the parser refused (a bad address, an
     unknown function) while it goes on to list every problem: that problem
     is already reported, so the validator says nothing more about it."""
 
-
-@dataclass(frozen=True)
-class AddressRef:
-    address: Address
-    pos: Pos = _pos()
+    __slots__ = ()
 
 
-@dataclass(frozen=True)
-class SymbolRef:
+class AddressRef(_Operand):
+    __slots__ = ("address",)
+    _fields = ("address",)
+    __match_args__ = ("address",)
+
+    def __init__(self, address: Address, pos: Pos = NOWHERE) -> None:
+        _set_address(self, address)
+        _place(self, pos)
+
+    def _values(self) -> tuple:
+        return (self.address,)
+
+
+_set_address = AddressRef.address.__set__
+
+
+class SymbolRef(_Operand):
     """A name: a declared symbol, resolved to an address by the validator."""
 
-    name: str
-    pos: Pos = _pos()
+    __slots__ = ("name",)
+    _fields = ("name",)
+    __match_args__ = ("name",)
+
+    def __init__(self, name: str, pos: Pos = NOWHERE) -> None:
+        SymbolRef.name.__set__(self, name)
+        _place(self, pos)
 
 
-@dataclass(frozen=True)
-class Text:
+class Text(_Operand):
     """A quoted string operand in mnemonic form (kept for TLMs)."""
 
-    value: str
-    pos: Pos = _pos()
+    __slots__ = ("value",)
+    _fields = ("value",)
+    __match_args__ = ("value",)
+
+    def __init__(self, value: str, pos: Pos = NOWHERE) -> None:
+        Text.value.__set__(self, value)
+        _place(self, pos)
 
 
-@dataclass(frozen=True)
-class BinOp:
-    op: str  # + - * | MOD ** AND OR XOR = <> < <= > >=
-    left: "Expr"
-    right: "Expr"
-    pos: Pos = _pos()
+class BinOp(_Operand):
+    __slots__ = ("op", "left", "right")  # op: + - * | MOD ** AND OR XOR = <> < <= > >=
+    _fields = ("op", "left", "right")
+    __match_args__ = _fields
+
+    def __init__(self, op: str, left: "Expr", right: "Expr", pos: Pos = NOWHERE) -> None:
+        BinOp.op.__set__(self, op)
+        BinOp.left.__set__(self, left)
+        BinOp.right.__set__(self, right)
+        _place(self, pos)
 
 
-@dataclass(frozen=True)
-class UnaryOp:
-    op: str  # NEG NOT
-    operand: "Expr"
-    pos: Pos = _pos()
+class UnaryOp(_Operand):
+    __slots__ = ("op", "operand")  # op: NEG NOT
+    _fields = ("op", "operand")
+    __match_args__ = _fields
+
+    def __init__(self, op: str, operand: "Expr", pos: Pos = NOWHERE) -> None:
+        UnaryOp.op.__set__(self, op)
+        UnaryOp.operand.__set__(self, operand)
+        _place(self, pos)
 
 
-@dataclass(frozen=True)
-class Call:
-    func: str  # SQR ABS ...
-    arg: "Expr"
-    pos: Pos = _pos()
+class Call(_Operand):
+    __slots__ = ("func", "arg")  # func: SQR ABS ...
+    _fields = ("func", "arg")
+    __match_args__ = _fields
+
+    def __init__(self, func: str, arg: "Expr", pos: Pos = NOWHERE) -> None:
+        Call.func.__set__(self, func)
+        Call.arg.__set__(self, arg)
+        _place(self, pos)
 
 
 Expr = Union[Const, AddressRef, SymbolRef, BinOp, UnaryOp, Call]
@@ -103,29 +237,108 @@ Operand = Union[Const, AddressRef, SymbolRef, Text, BinOp, UnaryOp, Call]
 # -- rungs -----------------------------------------------------------------------
 
 
-@dataclass
-class Instruction:
-    mnemonic: str
-    operands: list[Operand]
-    pos: Pos = _pos()
+def _same_items(a, b) -> bool:
+    """Sequence fields compare item by item, list or tuple alike."""
+    if type(a) is type(b):
+        return a == b
+    return len(a) == len(b) and all(x == y for x, y in zip(a, b))
 
 
-@dataclass
-class Branch:
+class _Mutable(_Node):
+    """A node the parser builds up and a library user may change in place
+    (instructions, branches, rungs): unhashable, as mutable dataclasses are."""
+
+    __slots__ = ()
+    __hash__ = None  # type: ignore[assignment]
+
+    @_Node.pos.setter
+    def pos(self, pos: Pos) -> None:
+        self._source, self._line, self._column = pos.source, _line_of(pos), pos.column
+
+    def __reduce__(self):
+        return _rebuild, (type(self), tuple(getattr(self, name) for name in self._fields), self.pos, {})
+
+
+class Instruction(_Mutable):
+    __slots__ = ("mnemonic", "operands")
+    _fields = ("mnemonic", "operands")
+    __match_args__ = _fields
+
+    def __init__(self, mnemonic: str, operands: list[Operand] | tuple[Operand, ...], pos: Pos = NOWHERE) -> None:
+        self.mnemonic = mnemonic
+        self.operands = operands
+        self._source = pos.source
+        self._line = _line_of(pos)
+        self._column = pos.column
+
+    def __eq__(self, other):
+        if other.__class__ is not Instruction:
+            return NotImplemented
+        return self.mnemonic == other.mnemonic and _same_items(self.operands, other.operands)
+
+    def copy_with(self, mnemonic: str, operands) -> "Instruction":
+        """This instruction, at its position, with other fields (the
+        validator's resolved copy; no Pos built on the way)."""
+        new = _new(Instruction)
+        new.mnemonic, new.operands = mnemonic, operands
+        new._source, new._line, new._column = self._source, self._line, self._column
+        return new
+
+
+class Branch(_Mutable):
     """Parallel legs; the branch passes power if any leg does."""
 
-    legs: list[list["Element"]]
-    pos: Pos = _pos()
+    __slots__ = ("legs",)
+    _fields = ("legs",)
+    __match_args__ = _fields
+
+    def __init__(self, legs: list[list["Element"]], pos: Pos = NOWHERE) -> None:
+        self.legs = legs
+        self._source = pos.source
+        self._line = _line_of(pos)
+        self._column = pos.column
+
+    def __eq__(self, other):
+        if other.__class__ is not Branch:
+            return NotImplemented
+        mine, theirs = self.legs, other.legs
+        return len(mine) == len(theirs) and all(_same_items(a, b) for a, b in zip(mine, theirs))
+
+    def copy_with(self, legs) -> "Branch":
+        new = _new(Branch)
+        new.legs = legs
+        new._source, new._line, new._column = self._source, self._line, self._column
+        return new
 
 
 Element = Union[Instruction, Branch]
 
 
-@dataclass
-class Rung:
-    elements: list[Element]
-    comment: str | None = None
-    pos: Pos = _pos()
+class Rung(_Mutable):
+    __slots__ = ("elements", "comment")
+    _fields = ("elements", "comment")
+    __match_args__ = _fields
+
+    def __init__(self, elements: list[Element], comment: str | None = None, pos: Pos = NOWHERE) -> None:
+        self.elements = elements
+        self.comment = comment
+        self._source = pos.source
+        self._line = _line_of(pos)
+        self._column = pos.column
+
+    def __eq__(self, other):
+        if other.__class__ is not Rung:
+            return NotImplemented
+        return self.comment == other.comment and _same_items(self.elements, other.elements)
+
+    def copy_with(self, elements) -> "Rung":
+        new = _new(Rung)
+        new.elements, new.comment = elements, self.comment
+        new._source, new._line, new._column = self._source, self._line, self._column
+        return new
+
+
+_new = object.__new__
 
 
 @dataclass

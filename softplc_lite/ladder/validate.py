@@ -39,13 +39,12 @@ from .ast import (
 )
 from .errors import LadderError, ProgramErrors
 from .instructions import BUILTIN, MAX_PARAMETERS, InstructionSet, K
-from .limits import limit_problem
+from .limits import MAX_BRANCH_DEPTH, MAX_EXPRESSION_DEPTH, expression_depth, limit_problem
 from .parser import parse_expression
 from .symbols import SymbolIndex, resolve_name, symbol_base
 
 _NUMERIC = (ValueKind.WORD, ValueKind.FLOAT, ValueKind.LONG)  # LONG: SLC/MicroLogix L elements
 COMPARISONS = ("=", "<>", "<", "<=", ">", ">=")
-
 
 
 # Operand kinds that must be constants, and the value kinds each address
@@ -63,8 +62,36 @@ _WANT = {
     K.PARAM: (ValueKind.WORD, ValueKind.FLOAT, ValueKind.STRING),
     K.PARAM_OUT: (ValueKind.WORD, ValueKind.FLOAT, ValueKind.STRING),
 }
+_FILE_KINDS = (K.FILE, K.FILE_SOURCE, K.WORD_FILE)  # '#' marks a file operand here, not indexing
 # Integer constants allowed where an operand may be a constant or a word.
 _CONSTANT_RANGE = {K.PORT: (0, 35), K.FORMAT: (0, 32000)}
+
+_UNPLANNED = object()
+_EXPRESSIONS = (BinOp, UnaryOp, Call)
+
+
+class _OverLimit(Exception):
+    """A rung past a limit of the language (limits.py), found while validating it."""
+
+
+class _Plan:
+    """One instruction's operand checks, worked out from its spec once per
+    validation rather than for every instruction (validate asks for each):
+    the kind of each operand, the value kinds an address there may have
+    (None: not a plain address operand), and whether a '#' there marks a
+    file operand rather than indexing. ``mnemonic`` is the spec's string
+    when spelt the same, so every validated instruction shares it."""
+
+    __slots__ = ("spec", "mnemonic", "min_operands", "max_operands", "kinds", "wants", "unindexed")
+
+    def __init__(self, spec, mnemonic: str) -> None:
+        self.spec = spec
+        self.mnemonic = spec.mnemonic if spec.mnemonic == mnemonic else mnemonic
+        self.min_operands, self.max_operands = spec.min_operands, spec.max_operands
+        self.kinds = tuple(o.kind for o in spec.operands)
+        self.wants = tuple(_WANT.get(kind) for kind in self.kinds)
+        self.unindexed = tuple(kind in _FILE_KINDS for kind in self.kinds)
+
 
 class _Checker:
     def __init__(self, program: Program, instructions: InstructionSet = BUILTIN) -> None:
@@ -73,6 +100,7 @@ class _Checker:
         self.errors: list[LadderError] = []
         self.symbols = SymbolIndex(program.symbols)
         self._shapes: dict[int, tuple] = {}  # subroutine_shape, per program file
+        self._plans: dict[str, _Plan | None] = {}  # plan, per mnemonic as written
 
     def error(self, pos, message: str) -> None:
         self.errors.append(LadderError(pos, message))
@@ -84,13 +112,21 @@ class _Checker:
             return self.symbol(operand)
         if isinstance(operand, BinOp):
             left, right = self.resolve(operand.left), self.resolve(operand.right)
-            return None if left is None or right is None else replace(operand, left=left, right=right)
+            if left is None or right is None:
+                return None
+            if left is operand.left and right is operand.right:
+                return operand  # nothing to resolve: keep the parsed node
+            return BinOp(operand.op, left, right, operand.pos)
         if isinstance(operand, UnaryOp):
             inner = self.resolve(operand.operand)
-            return None if inner is None else replace(operand, operand=inner)
+            if inner is None:
+                return None
+            return operand if inner is operand.operand else UnaryOp(operand.op, inner, operand.pos)
         if isinstance(operand, Call):
             inner = self.resolve(operand.arg)
-            return None if inner is None else replace(operand, arg=inner)
+            if inner is None:
+                return None
+            return operand if inner is operand.arg else Call(operand.func, inner, operand.pos)
         return operand
 
     def symbol(self, ref: SymbolRef) -> AddressRef | None:
@@ -201,7 +237,7 @@ class _Checker:
         if a.kind not in want:
             bad(kind.value)
             return None
-        if kind in (K.FILE, K.FILE_SOURCE, K.WORD_FILE) and a.indexed:
+        if kind in _FILE_KINDS and a.indexed:
             # '#' marks a file operand here (PLC-5 file instructions), not indexing.
             return AddressRef(replace(a, indexed=False), resolved.pos)  # keeps an SLC address's form
         return resolved
@@ -231,13 +267,26 @@ class _Checker:
         return None
 
     # -- instructions and rungs ---------------------------------------------------------
+    def plan(self, mnemonic: str) -> _Plan | None:
+        """How to check the operands of ``mnemonic`` (None: no such
+        instruction), worked out once per mnemonic as written."""
+        plan = self._plans.get(mnemonic, _UNPLANNED)
+        if plan is _UNPLANNED:
+            spec = self.instructions.lookup(mnemonic)
+            plan = self._plans[mnemonic] = None if spec is None else _Plan(spec, mnemonic)
+        return plan
+
     def instruction(self, instr: Instruction, file_number: int, labels: set[int], first: bool) -> Instruction:
-        spec = self.instructions.lookup(instr.mnemonic)
-        if spec is None:
+        for op in instr.operands:
+            if isinstance(op, _EXPRESSIONS) and expression_depth(op) > MAX_EXPRESSION_DEPTH:
+                raise _OverLimit  # before anything walks it recursively
+        plan = self.plan(instr.mnemonic)
+        if plan is None:
             self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}{self.instructions.hint(instr.mnemonic)}")
             return instr
+        spec = plan.spec
         n = len(instr.operands)
-        if not spec.min_operands <= n <= spec.max_operands:
+        if not plan.min_operands <= n <= plan.max_operands:
             extras = instr.operands[spec.max_operands:]
             stray = next((o for o in extras if isinstance(o, SymbolRef)
                       and self.symbols.declaration(o.name) is None), None)
@@ -251,14 +300,32 @@ class _Checker:
                      if n > spec.max_operands and any(o.kind is K.EXPRESSION for o in spec.operands) else "")
             self.error(instr.pos, f"{spec.mnemonic} takes {want} operand{plural} ({spec.signature()}), got {n}{quote}")
             return instr
-        # An operand the parser refused (and reported) is a Placeholder: not checked again.
-        refused = [_refused(op) for op in instr.operands]
-        operands = []
+        kinds, wants, unindexed = plan.kinds, plan.wants, plan.unindexed
+        last = len(kinds) - 1  # a repeated last operand covers every position from its own on
+        checked_operands = []
+        refused = changed = False
         for i, op in enumerate(instr.operands):
-            checked = None if refused[i] else self.operand(instr, i, spec.operand_at(i).kind, op)
-            operands.append(checked if checked is not None else op)
-        if any(refused):
-            return Instruction(instr.mnemonic, operands, instr.pos)
+            j = i if i < last else last
+            if op.__class__ is AddressRef:
+                # The common case, answered here: an address of a kind the operand takes.
+                want, address = wants[j], op.address
+                if want is not None and address.kind in want and not (address.indexed and unindexed[j]):
+                    checked_operands.append(op)
+                    continue
+            elif _refused(op):
+                # An operand the parser refused (and reported) is a Placeholder: not checked again.
+                refused = True
+                checked_operands.append(op)
+                continue
+            checked = self.operand(instr, i, kinds[j], op)
+            if checked is None or checked is op:
+                checked_operands.append(op)
+            else:
+                checked_operands.append(checked)
+                changed = True
+        operands = tuple(checked_operands)  # no spare capacity: the validated tree is kept
+        if refused:
+            return instr.copy_with(plan.mnemonic, operands)
         if spec.mnemonic == "LBL" and not first:
             self.error(instr.pos, "LBL must be the first instruction of its rung")
         if spec.mnemonic == "JSR" and operands and isinstance(operands[0], Const):
@@ -276,7 +343,9 @@ class _Checker:
         if spec.mnemonic == "JMP" and operands and isinstance(operands[0], Const):
             if operands[0].value not in labels:
                 self.error(_pos(operands[0]), f"JMP to label {operands[0].value}, which is not in program file {file_number}")
-        return Instruction(instr.mnemonic, operands, instr.pos)
+        if not changed and instr.mnemonic is plan.mnemonic and type(instr.operands) is tuple:
+            return instr  # already in its validated form: the validated tree shares it
+        return instr.copy_with(plan.mnemonic, operands)
 
     def jsr_parameters(self, instr: Instruction, operands: list, target: int) -> None:
         """A JSR's parameters against its subroutine: as many inputs as the
@@ -325,20 +394,26 @@ class _Checker:
             shape = self._shapes[number] = (sbr, rets)
         return shape
 
-    def series(self, elements: list[Element], file_number: int, labels: set[int], first: bool) -> list[Element]:
+    def series(self, elements: list[Element], file_number: int, labels: set[int], first: bool,
+               depth: int = 0) -> tuple[Element, ...]:
+        """The validated series (``depth``: branches around it). Raises
+        _OverLimit past the language's limits (limits.py), checked on the
+        way rather than by a walk of every rung beforehand."""
         out: list[Element] = []
         for el in elements:
             if isinstance(el, Branch):
+                if depth >= MAX_BRANCH_DEPTH:
+                    raise _OverLimit
                 if len(el.legs) < 2:
                     self.error(el.pos, "a branch needs at least two legs (BST ... NXB ... BND)")
-                legs = [self.series(leg, file_number, labels, False) for leg in el.legs]
+                legs = tuple([self.series(leg, file_number, labels, False, depth + 1) for leg in el.legs])
                 for leg in el.legs:
                     if not leg:
                         self.error(el.pos, "empty branch leg")
-                out.append(Branch(legs, el.pos))
+                out.append(el.copy_with(legs))
             else:
                 out.append(self.instruction(el, file_number, labels, first and not out))
-        return out
+        return tuple(out)  # no spare capacity: the validated tree is kept
 
     def run(self) -> Program:
         prog = self.program
@@ -368,15 +443,20 @@ class _Checker:
                                        f"(first at {labels[ops[0].value].pos})")
                         labels[ops[0].value] = rung
             rungs = []
+            label_numbers = set(labels)
             for rung in pfile.rungs:
                 if not rung.elements:
                     self.error(rung.pos, "empty rung")
-                over = limit_problem(rung.elements)  # a tree built through the library, not the parser
-                if over is not None:
+                reported = len(self.errors)
+                try:
+                    rungs.append(rung.copy_with(self.series(rung.elements, number, label_numbers, True)))
+                except _OverLimit:
+                    # A tree built through the library, not the parser (which refuses it):
+                    # the problems found on the way are dropped, the rung is reported once.
+                    del self.errors[reported:]
+                    over = limit_problem(rung.elements)
                     self.error(over[0].pos, over[1])
                     rungs.append(rung)
-                    continue
-                rungs.append(Rung(self.series(rung.elements, number, set(labels), True), rung.comment, rung.pos))
             resolved.files[number] = replace(pfile, rungs=rungs)
         return resolved
 
