@@ -102,7 +102,7 @@ class _Writer:
             return False
 
         for el in elements:
-            if _is_branch(el) and _contacts_only([el]) or not _is_branch(el) and el.mnemonic in CONTACTS:
+            if _contacts_only([el]):  # a contact, or a branch of contacts only: one term of an `and`
                 terms.append(self.term(el))
             elif _is_branch(el):
                 c_is_true = flush(c_is_true)
