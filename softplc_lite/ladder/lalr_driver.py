@@ -147,13 +147,14 @@ class FastLalr:
                     break
                 raise NotFastPath("no terminal")
             kind = m.lastgroup
-            start_pos = m.start(kind)
-            if start_pos != pos and lexer.skip_has_newline:
-                line, line_start = _count_lines(text, pos, start_pos, line, line_start)
             value = m.group(kind)
+            skipped_from = pos
+            pos = m.end()
+            start_pos = pos - len(value)
+            if lexer.skip_has_newline and start_pos != skipped_from:
+                line, line_start = _count_lines(text, skipped_from, start_pos, line, line_start)
             token_line = line
             column = start_pos - line_start + 1
-            pos = m.end()
             if kind in lexer.newline and "\n" in value:
                 line, line_start = _count_lines(text, start_pos, pos, line, line_start)
             keyword = lexer.keyword_of.get(kind)

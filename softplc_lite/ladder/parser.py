@@ -43,7 +43,8 @@ from .ast import (
 from .errors import LadderError
 from .lalr_driver import FastLalr, NotFastPath
 from .syntax_errors import syntax_error
-from .limits import MAX_CONSTANT, MAX_EXPRESSION_DEPTH, MAX_NUMBER_DIGITS, expression_depth, limit_problem
+from .limits import (MAX_BRANCH_DEPTH, MAX_CONSTANT, MAX_EXPRESSION_DEPTH, MAX_NUMBER_DIGITS, expression_depth,
+                     limit_problem)
 
 # -- the post-lexer ---------------------------------------------------------------
 
@@ -324,16 +325,19 @@ class _ToAst(Transformer):
             tokens, tok = children
         if isinstance(tok, Token):
             kind = tok.type
-            if kind == "NAME":
-                tok = _Name(str(tok), self._token_pos(tok))
-            elif kind == "ADDRESS":
-                tok = self._address(tok)
+            source, line_offset, column_offset = self.context
+            pos = self._token_pos(tok) if line_offset or column_offset else Pos(source, tok.line, tok.column)
+            if kind == "ADDRESS":
+                address = self.addresses.get(tok.value)
+                tok = self._address(tok) if address is None else AddressRef(address, pos)
+            elif kind == "NAME":
+                tok = _Name(tok.value, pos)
             elif kind == "SYMBOL_MEMBER":  # PollTimer/DN: never a mnemonic, so an operand at once
-                tok = SymbolRef(str(tok), self._token_pos(tok))
+                tok = SymbolRef(tok.value, pos)
             elif kind == "STRING":
-                tok = Text(_unquote(str(tok)), self._token_pos(tok))
+                tok = Text(_unquote(tok.value), pos)
             else:  # BST, NXB, BND
-                tok = _Marker(kind, self._token_pos(tok))
+                tok = _Marker(kind, pos)
         tokens.append(tok)  # or a signed number, already a Const
         return tokens
 
@@ -375,8 +379,21 @@ class _ToAst(Transformer):
         ref = self._address(addr)
         return SymbolDecl(str(name), ref.address, self._pos(name)) if isinstance(ref, AddressRef) else None
 
+    def lines(self, children):
+        """[], [line], [lines so far] or [lines so far, line] (the newline
+        between is filtered out): one list grown left to right. A line is
+        an item, or None for a header or declaration already reported."""
+        if not children:
+            return []
+        if len(children) == 2:
+            lines, line = children
+            lines.append(line)
+            return lines
+        first = children[0]
+        return first if isinstance(first, list) else [first]
+
     def start(self, items):
-        return list(items)
+        return items[0] if items else []
 
 
 def _unquote(text: str) -> str:
@@ -473,6 +490,7 @@ def parse_program(
     current: ProgramFile | None = None
     comments: list[_Comment] = []
     declared = {d.name.upper(): d for d in program.symbols.values()}  # other files' symbols too
+    mnemonics: dict[str, bool] = {}  # name -> is it an instruction (the same few names, many times)
 
     def file_for_rungs(pos: Pos) -> ProgramFile:
         nonlocal current
@@ -499,8 +517,11 @@ def parse_program(
             rung_comment = _comment_above(comments, item.pos.line)
             if item.comment:
                 rung_comment = f"{rung_comment}\n{item.comment}" if rung_comment else item.comment
-            elements = item.elements if item.elements is not None else _group(item.tokens, instructions, item.pos)
-            problem = limit_problem(elements)
+            if item.elements is not None:
+                elements, check_limits = item.elements, True
+            else:
+                elements, check_limits = _group(item.tokens, instructions, item.pos, mnemonics)
+            problem = limit_problem(elements) if check_limits else None
             if problem is not None:
                 raise LadderError(problem[0].pos, problem[1])
             file_for_rungs(item.pos).rungs.append(Rung(elements, rung_comment, item.pos))
@@ -581,20 +602,28 @@ def _comment_above(comments: list[_Comment], rung_line: int) -> str | None:
     return "\n".join(reversed(lines)) if lines else None
 
 
-def _group(tokens: list, instructions, rung_pos: Pos) -> list[Element]:
-    """Turn a flat mnemonic token run into instructions and branches."""
+def _group(tokens: list, instructions, rung_pos: Pos, mnemonics: dict[str, bool]) -> tuple[list[Element], bool]:
+    """Turn a flat mnemonic token run into instructions and branches; and
+    whether limit_problem must look at them (branches nested deeper than
+    its limit, or an expression: nothing else in a mnemonic rung can be over
+    a limit). ``mnemonics``: name -> is it an instruction, for this parse."""
     root: list[Element] = []
     stack: list[tuple[list[Element], Branch]] = []  # (series to return to, open branch)
     series = root
     current: Instruction | None = None
+    deepest = 0
+    expression = False
     for tok in tokens:
-        if isinstance(tok, _Marker):
+        kind = type(tok)
+        if kind is _Marker:
             current = None
             if tok.kind == BST:
                 branch = Branch([[]], tok.pos)
                 series.append(branch)
                 stack.append((series, branch))
                 series = branch.legs[0]
+                if len(stack) > deepest:
+                    deepest = len(stack)
             elif not stack:
                 raise LadderError(tok.pos, f"{tok.kind} without a BST to open the branch")
             elif tok.kind == NXB:
@@ -604,23 +633,31 @@ def _group(tokens: list, instructions, rung_pos: Pos) -> list[Element]:
             else:  # BND
                 series, _ = stack.pop()
             continue
-        if isinstance(tok, _Name) and instructions.is_mnemonic(tok.text):
-            current = Instruction(tok.text.upper(), [], tok.pos)
-            series.append(current)
-            continue
-        operand = SymbolRef(tok.text, tok.pos) if isinstance(tok, _Name) else tok
+        if kind is _Name:
+            text = tok.text
+            known = mnemonics.get(text)
+            if known is None:
+                known = mnemonics[text] = instructions.is_mnemonic(text)
+            if known:
+                current = Instruction(text.upper(), [], tok.pos)
+                series.append(current)
+                continue
+            operand = SymbolRef(text, tok.pos)
+        else:
+            operand = tok
         if isinstance(operand, Text) and current is not None and _takes_expression(current, instructions):
             # CPT "N7:1 + 5": the quoted text is an expression; parse it now
             # so both rung syntaxes give the same tree.
             operand = parse_expression(operand.value, operand.pos)
+            expression = True
         if current is None:
-            if isinstance(tok, _Name):
+            if kind is _Name:
                 raise LadderError(tok.pos, f"unknown instruction {tok.text!r}{instructions.hint(tok.text)}")
             raise LadderError(_operand_pos(operand), "an operand with no instruction before it")
         current.operands.append(operand)
     if stack:
         raise LadderError(stack[-1][1].pos, "BST without a matching BND (unclosed branch)")
-    return root
+    return root, expression or deepest > MAX_BRANCH_DEPTH
 
 
 def _takes_expression(instr: Instruction, instructions) -> bool:
