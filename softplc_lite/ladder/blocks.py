@@ -26,6 +26,8 @@ from dataclasses import dataclass
 # use per rung; smaller ones pay the call more often. CPython compiles one
 # huge function body several times slower than the same code in pieces.
 CHUNK_RUNGS = 1000
+# Word locals per block (about: a block ends after the rung that passes it).
+LOCALS_BUDGET = 300
 
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 

@@ -22,6 +22,8 @@ messages.
 
 from __future__ import annotations
 
+import re
+
 from ..gcpause import gc_paused
 from ..datatable import DataTable, ValueKind, bit_mask
 from ..datatable.filetypes import Storage
@@ -34,7 +36,7 @@ from .expr import namespace as expr_namespace
 from .expr import to_python
 from .instr import BOUND
 from .resolvers import resolver
-from .semantics import BASE_MS, Machine, MajorFault, lim, source_units
+from .semantics import BASE_MS, CD, CU, DN, EN, OV, STAMP, STAMP_MODULO, TT, UN, Machine, MajorFault, lim, source_units
 
 RET = -1
 TND = -2
@@ -100,14 +102,23 @@ class _FileCompiler:
         if not a.is_direct:
             return None
         f, index, bit = self.table.resolve(a)
+        name = self.word_at(ind, f, index)
+        if name is None:
+            return None
+        return name, (bit_mask(bit) if bit is not None else None)
+
+    def word_at(self, ind: int, f, index: int) -> str | None:
+        """The local holding word ``index`` of file ``f`` (loaded now if not
+        held), or None if no local may hold that file's words."""
         if f.ftype.storage is not Storage.WORD or f.ftype.letter == "S":
             return None
         key = (f.number, index)
         name = self.words.get(key)
         if name is None:
             name = self.words[key] = f"w{f.number}_{index}"
+            self.local_names.add(name)
             self.emit(ind, f"{name} = {self.array_name(f)}[{index!r}]")
-        return name, (bit_mask(bit) if bit is not None else None)
+        return name
 
     def mark_written(self, key_name: str) -> None:
         self.dirty.add(key_name)
@@ -281,6 +292,11 @@ class _FileCompiler:
         if m in _BIT_OPS and all(self.bit(ind, op) is not None for op in ops):
             getattr(self, f"bit_{m}")(ind, *(self.bit(ind, op) for op in ops))
             return
+        inline = getattr(self, f"local_{m}", None)
+        if inline is not None and all(isinstance(op, Const) or op.address.is_direct for op in ops) and \
+                self.table.resolve(ops[0].address).file.ftype.storage is Storage.WORD:
+            inline(ind, ins)  # on the element's words held in locals
+            return
         dest = self.local_safe(ins)
         if dest is not False:
             self.in_place(ind, ins, dest)
@@ -317,14 +333,17 @@ class _FileCompiler:
                     self.word_local(ind, ref)
         name = None
         if dest is not None:
-            self.mark_rung(ind)  # a store may set a minor fault (overflow)
-            if _word_store(ins) and self.word_local(ind, dest) is not None:
-                # A 16-bit result into a held word: stored in its local (i_MOV, i_CPT, _math2).
-                self.inline_dest = self.word_local(ind, dest)[0]
+            if _word_store(ins) and self.holdable(dest):
+                # A 16-bit result into a word: stored inline (i_MOV, i_CPT, _math2),
+                # into its local if held, else into the table.
+                f, index, _ = self.table.resolve(dest.address)
+                self.inline_dest = self.words.get((f.number, index), "")
                 self.dispatch(ind, ins)
-                self.dirty.add(self.inline_dest)
+                if self.inline_dest:
+                    self.dirty.add(self.inline_dest)
                 self.inline_dest = None
                 return
+            self.mark_rung(ind)  # a store may set a minor fault (overflow)
             f, index, _ = self.table.resolve(dest.address)
             key = (f.number, index)
             name = self.words.get(key)
@@ -335,26 +354,40 @@ class _FileCompiler:
             del self.words[key]
             self.dirty.discard(name)
 
+    def holdable(self, ref: AddressRef) -> bool:
+        f = self.table.resolve(ref.address).file
+        return f.ftype.storage is Storage.WORD and f.ftype.letter != "S"
+
     def store_in_local(self, ind: int, dest, value_code: str, fallback: str, in_range: bool = False,
                        carry: str | None = None) -> None:
-        """``value_code`` into the destination's local, with S:0 as the
-        kernel sets it; out of range, the kernel (``fallback``, given the
-        value as ``_v``) stores it in the table, and the local reads it back.
-        ``in_range``: the value is a word already (no range test)."""
+        """``value_code`` into the destination word (its local if held, else
+        the table), with S:0 as the kernel sets it; out of range, the kernel
+        (``fallback``, given the value as ``_v``) stores it and sets the
+        overflow minor fault, and a held local reads it back. ``in_range``:
+        the value is a word already (no range test)."""
         name = self.inline_dest
         f, index, _ = self.table.resolve(dest.address)
-        flags = f"((_v == 0) << 2) | ((_v < 0) << 3)" if carry is None else f"({carry}) | ((_v == 0) << 2) | ((_v < 0) << 3)"
-        self.emit(ind, f"_v = {value_code}")
+        target = name or f"{self.array_name(f)}[{index!r}]"
+        if in_range and _SIMPLE.match(value_code):
+            v = value_code  # a local or a constant: no temporary
+        else:
+            v = "_v"
+            self.emit(ind, f"_v = {value_code}")
+        flags = f"(({v} == 0) << 2) | (({v} < 0) << 3)"
+        if carry is not None:
+            flags = f"({carry}) | {flags}"
         if in_range:
-            self.emit(ind, f"{name} = _v")
+            self.emit(ind, f"{target} = {v}")
             self.emit(ind, f"_s[0] = (_s[0] & -16) | {flags}")
             return
         self.emit(ind, "if -32768 <= _v <= 32767:")
-        self.emit(ind + 1, f"{name} = _v")
+        self.emit(ind + 1, f"{target} = _v")
         self.emit(ind + 1, f"_s[0] = (_s[0] & -16) | {flags}")
         self.emit(ind, "else:")
+        self.emit(ind + 1, f"_m.rung = {self.rung_index!r}")  # the minor fault names this rung
         self.emit(ind + 1, fallback.replace("_D_", f"{self.array_name(f)}, {index!r}"))
-        self.emit(ind + 1, f"{name} = f{f.number}[{index!r}]")
+        if name:
+            self.emit(ind + 1, f"{name} = f{f.number}[{index!r}]")
 
     def dispatch(self, ind: int, ins: Instruction) -> None:
         m = ins.mnemonic
@@ -723,33 +756,136 @@ class _FileCompiler:
         (ad, ai, _), (bd, bi, _) = self.location(ind + 1, ops[0]), self.location(ind + 1, ops[1])
         self.emit(ind + 1, f"c = {self.bind('_asr', self.machine.asr)}({ad}, {ai}, {bd}, {bi})")
 
+    # -- timers, counters and COP on held words ------------------------------------------------------
+    def element_words(self, ind: int, ref: AddressRef) -> list[str]:
+        """The locals of a timer or counter element's three words (control, PRE, ACC)."""
+        f, index, _ = self.table.resolve(ref.address)
+        return [self.word_at(ind, f, index + k) for k in range(3)]
+
+    def local_TON(self, ind: int, ins: Instruction) -> None:
+        """Semantics.ton written out on the element's locals (the kernel is
+        the reference: the differential test holds them equal). The time is
+        the engine's clock of this scan, _m.now_ms."""
+        wc, wp, wa = self.element_words(ind, ins.operands[0])
+        base = BASE_MS[ins.operands[1].value]
+        self.uses_now = True
+        self.emit(ind, f"if {wp} < 0 or {wa} < 0:")  # the kernel raises the fault, on an exact table
+        self.flush_lines(ind + 1)
+        d, i, _ = self.location(ind + 1, ins.operands[0])
+        self.emit(ind + 1, f"{self.bind('_ton', self.machine.ton)}({d}, {i}, c, {base!r})")
+        self.emit(ind, "if c:")
+        self.emit(ind + 1, f"if {wc} & {EN!r} and {wa} < {wp}:")
+        self.emit(ind + 2, f"_t, _r = divmod((_now - ({wc} & {STAMP!r})) % {STAMP_MODULO!r}, {base!r})")
+        self.emit(ind + 2, f"{wa} += _t")
+        self.emit(ind + 2, f"if {wa} >= {wp}: {wa} = {wp}; _r = 0")
+        self.emit(ind + 2, f"{wc} = ({wc} & {~STAMP!r}) | ((_now - _r) & {STAMP!r}) | {EN!r}")
+        self.emit(ind + 1, "else:")
+        self.emit(ind + 2, f"{wc} = ({wc} & {~STAMP!r}) | (_now & {STAMP!r}) | {EN!r}")
+        self.emit(ind + 1, f"if {wa} >= {wp}: {wc} = ((({wc} | {DN!r}) & {~STAMP!r}) | (_now & {STAMP!r})) & {~TT!r}")
+        self.emit(ind + 1, f"else: {wc} = ({wc} | {TT!r}) & {~DN!r}")
+        assert EN | TT | DN | STAMP == -1
+        self.emit(ind, "else:")
+        self.emit(ind + 1, f"{wc} = 0")  # EN TT DN and the stamp are every bit of the word
+        self.emit(ind + 1, f"{wa} = 0")
+        self.dirty.update((wc, wa))
+
+    def _local_count(self, ind: int, ins: Instruction, up: bool) -> None:
+        """Semantics.ctu / ctd written out on the element's locals."""
+        wc, wp, wa = self.element_words(ind, ins.operands[0])
+        edge, limit, wrapped, flag, other = (CU, 32767, -32768, OV, UN) if up else (CD, -32768, 32767, UN, OV)
+        self.emit(ind, "if c:")
+        self.emit(ind + 1, f"if not {wc} & {edge!r}:")
+        self.emit(ind + 2, f"if {wa} == {limit!r}:")
+        self.emit(ind + 3, f"{wa} = {wrapped!r}")
+        self.emit(ind + 3, f"{wc} = ({wc} | {flag!r}) if not {wc} & {other!r} else ({wc} & {~other!r})")
+        self.emit(ind + 2, f"else: {wa} {'+' if up else '-'}= 1")
+        self.emit(ind + 1, f"{wc} |= {edge!r}")
+        self.emit(ind, f"else: {wc} &= {~edge!r}")
+        self.emit(ind, f"{wc} = ({wc} | {DN!r}) if {wa} >= {wp} else ({wc} & {~DN!r})")
+        self.dirty.update((wc, wa))
+
+    def local_COP(self, ind: int, ins: Instruction) -> None:
+        """COP between direct blocks of one storage, whose ranges fit their
+        files (known at load: the table's files do not change size while a
+        program runs): a slice assignment. Held words of both blocks are
+        written back first; those of the destination are forgotten after.
+        Anything else runs the kernel after a barrier."""
+        src, dest, length = ins.operands
+        sf, si, _ = self.table.resolve(src.address)
+        df, di, _ = self.table.resolve(dest.address)
+        n = length.value * dest.address.ftype.words_per_element
+        if sf.data.typecode != df.data.typecode or si + n > len(sf.data) or di + n > len(df.data):
+            self.barrier(ind)
+            self.dispatch(ind, ins)
+            return
+        held = [(key, name) for key, name in self.words.items()
+                if (key[0] == sf.number and si <= key[1] < si + n) or (key[0] == df.number and di <= key[1] < di + n)]
+        for (number, index), name in held:
+            if name in self.dirty:
+                self.emit(ind, f"f{number}[{index!r}] = {name}")
+        self.emit(ind, f"if c: {self.array_name(df)}[{di!r}:{di + n!r}] = {self.array_name(sf)}[{si!r}:{si + n!r}]")
+        for key, name in held:
+            if key[0] == df.number:
+                del self.words[key]
+                self.dirty.discard(name)
+
+    def local_CTU(self, ind: int, ins: Instruction) -> None:
+        self._local_count(ind, ins, True)
+
+    def local_CTD(self, ind: int, ins: Instruction) -> None:
+        self._local_count(ind, ins, False)
+
     # -- blocks -----------------------------------------------------------------------------------
     def block(self, first: int, end: int) -> BlockCode:
         """The code of one block function over rungs first..end-1."""
+        self.begin_block(first)
+        for k in range(first, end):
+            self.rung(k, self.rungs[k])
+        return self.end_block(end)
+
+    def begin_block(self, first: int) -> None:
         self.lines, self.line_instr, self.line_rung = [], [], []
         self.words: dict[tuple[int, int], str] = {}  # (file, word) -> the local holding it
+        self.local_names: set[str] = set()  # every word local of the block, held now or not
         self.dirty: set[str] = set()  # locals a rung may have changed since the last write-back
         self.temp = 0
         self.rung_index = first
         self.rung_marked = None
+        self.uses_now = False
         self.current = None
         self.emit(1, "def _block(z):")
-        for k in range(first, end):
-            self.rung(k, self.rungs[k])
+
+    def end_block(self, end: int) -> BlockCode:
         self.current = None
         self.flush_lines(2)
+        if self.uses_now:  # the engine's clock of this scan, read once per block (TON)
+            self.lines.insert(1, "        _now = _m.now_ms")
+            self.line_instr.insert(1, None)
+            self.line_rung.insert(1, self.line_rung[0])
         if len(self.lines) == 1:
             self.emit(2, "pass")
-        return BlockCode(first, end, self.lines, self.line_instr, self.line_rung)
+        return BlockCode(self.line_rung[0], end, self.lines, self.line_instr, self.line_rung)
 
     def compile(self) -> CompiledFile:
         cf = CompiledFile(self.number, len(self.rungs), self.has_mcr, self)
         # A block starts at every label (a JMP lands at a block's start) and
-        # holds at most CHUNK_RUNGS rungs.
-        cuts = sorted({0, len(self.rungs), *self.labels.values(),
-                       *range(0, len(self.rungs), blocks.CHUNK_RUNGS)})
-        for a, b in zip(cuts, cuts[1:]):
-            cf.add(self.block(a, b))
+        # holds at most CHUNK_RUNGS rungs and about LOCALS_BUDGET word locals:
+        # CPython's compile() slows down more than linearly with the number of
+        # locals of one function, and a call's frame is made and cleared
+        # local by local.
+        labels = set(self.labels.values())
+        count = len(self.rungs)
+        k = 0
+        while k < count:
+            first = k
+            self.begin_block(first)
+            self.rung(k, self.rungs[k])
+            k += 1
+            while k < count and k not in labels and k - first < blocks.CHUNK_RUNGS and \
+                    len(self.local_names) < blocks.LOCALS_BUDGET:
+                self.rung(k, self.rungs[k])
+                k += 1
+            cf.add(self.end_block(k))
         self.lines = self.line_instr = self.line_rung = None  # the code is compiled: keep no text
         return cf
 
@@ -787,6 +923,9 @@ _LOCAL_SAFE = {
     "MOV": 1, "ADD": 2, "SUB": 2, "MUL": 2, "NEG": 1, "ABS": 1, "CLR": 0,
     "AND": 2, "OR": 2, "XOR": 2, "NOT": 1, "MVM": 2, "CPT": 0,
 }
+
+
+_SIMPLE = re.compile(r"^(w\d+_\d+|-?\d+)$")
 
 
 def _word_store(ins: Instruction) -> bool:
