@@ -54,12 +54,12 @@ class _StateLexer:
     then lark's own alternation follows, unchanged.
     """
 
-    __slots__ = ("match", "skip", "newline", "skip_has_newline", "keyword_of")
+    __slots__ = ("keyword_of", "match", "newline", "skip", "skip_has_newline")
 
     def __init__(self, basic) -> None:
         scanner = basic.scanner  # built on first use, as lark does
         terminals = scanner.terminals
-        alternation = "|".join("(?P<%s>%s)" % (t.name, t.pattern.to_regexp()) for t in terminals)
+        alternation = "|".join(f"(?P<{t.name}>{t.pattern.to_regexp()})" for t in terminals)
         flags = basic.g_regex_flags
         if len(scanner._mres) != 1 or scanner._mres[0].pattern != alternation or scanner.use_bytes:
             raise NotFastPath("a lexer unlike lark 1.3's")
@@ -67,8 +67,8 @@ class _StateLexer:
         for i, t in enumerate(terminals):
             if t.name in basic.ignore_types:
                 before = "|".join(u.pattern.to_regexp() for u in terminals[:i])
-                skips.append(("(?!%s)" % before if before else "") + "(?>%s)" % t.pattern.to_regexp())
-        skip = "(?:%s)*+" % "|".join(skips) if skips else ""
+                skips.append((f"(?!{before})" if before else "") + f"(?>{t.pattern.to_regexp()})")
+        skip = f"(?:{'|'.join(skips)})*+" if skips else ""
         self.match = re.compile(skip + "(?:" + alternation + ")", flags).match
         self.skip = re.compile(skip, flags).match  # the blanks at the end of a text
         self.newline = basic.newline_types
@@ -92,7 +92,7 @@ class FastLalr:
         frontend = lark.parser
         connector = frontend.lexer
         postlex = connector.postlexer
-        self.span_changes = postlex.span_changes
+        self.span_changes = dict(postlex.span_changes)
         self.dropped_inside = postlex.dropped_inside
         contextual = connector.lexer
         shared: dict[int, _StateLexer] = {}  # lark shares one BasicLexer among states with one terminal set

@@ -1,0 +1,132 @@
+"""The fast parse loop (lalr_driver.py, issue 17) gives exactly what Lark's
+own parser gives over the same grammar: the same AST with the same
+positions for every shipped program, the benchmark programs and thousands
+of damaged copies of them, and the same errors (message, file:line:col,
+lark's context) for every text it refuses. Not timed."""
+
+from __future__ import annotations
+
+import inspect
+import random
+import sys
+from pathlib import Path
+
+import pytest
+
+from softplc_lite.ladder import parser
+from softplc_lite.ladder.ast import Pos
+from softplc_lite.ladder.errors import LadderError
+from softplc_lite.ladder.lalr_driver import FastLalr, NotFastPath
+from softplc_lite.ladder.parser import parse_expression, parse_program, syntax_problems
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import ladder_programs  # noqa: E402
+
+PROGRAMS = sorted([*ROOT.glob("programs/**/*.lad"), *ROOT.glob("tests/data/**/*.lad")])
+
+
+def dump(node) -> str:
+    """A node with every constructor field and its position, recursively
+    (``==`` on AST nodes ignores positions; this does not)."""
+    if isinstance(node, (list, tuple)) and not hasattr(node, "_fields"):
+        return "[" + ",".join(dump(x) for x in node) + "]"
+    if isinstance(node, dict):
+        return "{" + ",".join(f"{k!r}:{dump(v)}" for k, v in node.items()) + "}"
+    if type(node).__module__.startswith("softplc_lite") and not isinstance(node, type):
+        names = list(inspect.signature(type(node)).parameters)
+        if hasattr(node, "pos") and "pos" not in names:
+            names.append("pos")
+        return f"{type(node).__name__}(" + ",".join(f"{n}={dump(getattr(node, n))}" for n in names) + ")"
+    return repr(node)
+
+
+class _LarkOnly:
+    def parse(self, text, start):
+        raise NotFastPath("this test parses with Lark's own loop")
+
+
+@pytest.fixture
+def lark_only(monkeypatch):
+    """Within the fixture, every parse goes through Lark's own parser."""
+
+    def use_lark():
+        monkeypatch.setattr(parser, "_fast_parser", lambda: _LarkOnly())
+
+    return use_lark
+
+
+def outcome(text: str, source: str) -> str:
+    try:
+        result = dump(parse_program(text, source))
+    except LadderError as e:
+        result = f"error {e.pos} {e.message} {e.context!r}"
+    problems = syntax_problems(text, source)
+    return result + " | " + " ; ".join(f"{e.pos} {e.message} {e.context!r}" for e in problems)
+
+
+def damaged(text: str, rnd: random.Random) -> str:
+    pieces = list("()[];,:/.\n \"#+-*|=<>0123456789ABNXIOTCSE") + [
+        "BST ", "NXB ", "BND ", "SOR ", "EOR ", "MOD ", "1e999 ", "0x", "\r\n", "//", "XIC ", "CPT ", "\t", "\f"]
+    for _ in range(rnd.randint(1, 3)):
+        i = rnd.randrange(len(text) + 1)
+        choice = rnd.random()
+        if choice < 0.4:
+            text = text[:i] + text[i + 1:]
+        elif choice < 0.8:
+            text = text[:i] + rnd.choice(pieces) + text[i:]
+        else:
+            text = text[:i] + text[min(len(text), i + rnd.randint(1, 20)):]
+    return text
+
+
+def corpus() -> list[tuple[str, str]]:
+    texts = [(str(p.relative_to(ROOT)), p.read_text()) for p in PROGRAMS]
+    texts.append(("boolean", ladder_programs.boolean_program(300)))
+    texts.append(("mixed", ladder_programs.mixed_program(300)))
+    texts += [("blank", ""), ("blanks", " \t\n\n  "), ("no newline", "XIC B3/0 OTE B3/1"),
+              ("tail blanks", "XIC B3/0 OTE B3/1\n   "), ("crlf", "XIC B3/0\r\nOTE B3/1\r\n")]
+    return texts
+
+
+def test_the_driver_runs_this_grammar():
+    # Built at first use: a Lark set up otherwise would make every parse go to Lark.
+    assert isinstance(parser._fast_parser(), FastLalr)
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_the_fast_loop_and_lark_give_the_same_programs_and_errors(lark_only, seed):
+    rnd = random.Random(seed)
+    texts = corpus() if seed == 0 else []
+    for name, text in corpus():
+        texts += [(f"{name}#{seed}.{k}", damaged(text, rnd)) for k in range(6 if len(text) < 5000 else 2)]
+    fast = [outcome(text, name) for name, text in texts]
+    lark_only()
+    slow = [outcome(text, name) for name, text in texts]
+    for (name, _), a, b in zip(texts, fast, slow):
+        assert a == b, name
+
+
+@pytest.mark.parametrize("text", ["N7:0 + 5", "1e999", "(N7:1", "SQR(N7:0) ** 2", "-0x10", "NOT N7:0 AND 3",
+                                  "FOO(1)", "5 MOD 3", "5 mod3", "N7:0 ", "", "  ", "N7:0 +", "Timer/DN = 1"])
+def test_expressions_too(lark_only, text):
+    def parsed():
+        try:
+            return dump(parse_expression(text, Pos("e.lad", 3, 7)))
+        except LadderError as e:
+            return f"error {e.pos} {e.message} {e.context!r}"
+
+    fast = parsed()
+    lark_only()
+    assert fast == parsed()
+
+
+def test_a_syntax_error_is_lark_s_with_every_problem_found_before_it_once():
+    # The fast loop gives up at the ";" and Lark parses the text again: the
+    # problems the first try found are not listed twice.
+    text = "MOV 1e999 N7:0\nXIC B3/0 OTE B3/1 ;\n"
+    problems = syntax_problems(text, "t.lad")
+    assert [(p.pos.line, p.pos.column) for p in problems] == [(1, 5), (2, 19)]
+    assert "out of range" in problems[0].message and "unexpected ';'" in problems[1].message
+    assert problems[1].context and "^" in problems[1].context
