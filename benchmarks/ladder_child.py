@@ -9,7 +9,9 @@ MODE:
 - ``serve``: load the program (timed), build a compiled Engine with the
   benchmark's initial table and input hook (ladder_programs), print one JSON
   line, then answer commands read from stdin, one JSON line each:
-  ``scan N`` (N scans, each timed: ``{"ns": [...]}``), ``digest`` (a hash of
+  ``scan N`` (N scans, each timed: ``{"ns": [...]}``), ``baseline N`` (the
+  same with the straight-line baseline, built at its first use; boolean
+  programs only), ``digest`` (a hash of
   the table without the status file, and the mode), ``quit``. The parent
   drives two or more children in turn, so their scans interleave.
 - ``memory``: tracemalloc's current size after loading (parse, validate,
@@ -61,25 +63,53 @@ def load(text: str):
     return program, engine, times
 
 
+def timed_scans(scan, count: int) -> list[int]:
+    samples = []
+    gc.collect()
+    gc.disable()
+    try:
+        for _ in range(count):
+            t0 = time.perf_counter_ns()
+            scan()
+            samples.append(time.perf_counter_ns() - t0)
+    finally:
+        gc.enable()
+    return samples
+
+
+def straight_line_scan(program):
+    """The straight-line baseline (straight_line.py) on its own copy of the
+    initial table, with its own input hook: one call is one scan."""
+    import types
+
+    import straight_line
+
+    table = L.initial_table(L.SEED)
+    function = straight_line.build(program, table).scan
+    hook = L.input_hook(L.SEED)
+    holder = types.SimpleNamespace(table=table)
+
+    def scan() -> None:
+        hook(holder)
+        function()
+
+    return scan
+
+
 def serve(text: str) -> None:
     program, engine, times = load(text)
     rungs, instructions = L.count_instructions(program)
     del text
     reply({"load": times, "rungs": rungs, "instructions": instructions})
+    baseline_scan = None
     for line in sys.stdin:
         command, _, arg = line.strip().partition(" ")
         if command == "scan":
-            samples = []
-            gc.collect()
-            gc.disable()
-            try:
-                for _ in range(int(arg)):
-                    t0 = time.perf_counter_ns()
-                    engine.scan()
-                    samples.append(time.perf_counter_ns() - t0)
-            finally:
-                gc.enable()
-            reply({"ns": samples, "mode": engine.mode.name})
+            reply({"ns": timed_scans(engine.scan, int(arg)), "mode": engine.mode.name})
+        elif command == "baseline":
+            if baseline_scan is None:
+                baseline_scan = straight_line_scan(program)
+            reply({"ns": timed_scans(baseline_scan, int(arg)), "mode": "RUN"})
         elif command == "digest":
             reply({"digest": L.table_digest(engine.table), "mode": engine.mode.name,
                    "fault": str(engine.fault) if engine.fault else None})

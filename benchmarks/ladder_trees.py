@@ -84,14 +84,17 @@ def write_program(directory: Path, name: str, text: str) -> Path:
     return path
 
 
-def interleaved_blocks(children: dict[str, Child], blocks: int, scans: dict[str, int]) -> dict[str, list[float]]:
-    """Per child, the median scan (ns) of each block; the children take
-    turns block by block, their order rotating every block."""
+def interleaved_blocks(children: dict, blocks: int, scans: dict, commands: dict | None = None) -> dict[str, list[float]]:
+    """Per key, the median scan (ns) of each block; the keys take turns
+    block by block, their order rotating every block. A key names a child
+    (``children[key]``) and what it runs (``commands[key]``, default
+    ``scan``: the engine; ``baseline``: the straight-line baseline)."""
     names = list(children)
-    out: dict[str, list[float]] = {name: [] for name in names}
+    commands = commands or {}
+    out: dict = {name: [] for name in names}
     for b in range(blocks):
         for name in names[b % len(names):] + names[:b % len(names)]:
-            r = children[name].ask(f"scan {scans[name]}")
+            r = children[name].ask(f"{commands.get(name, 'scan')} {scans[name]}")
             if r["mode"] != "RUN":
                 raise ChildFailed(f"{name}: the program left RUN ({r['mode']})")
             out[name].append(statistics.median(r["ns"]))
@@ -138,35 +141,52 @@ def baseline_speedup(base_tree: Path, current_tree: Path, program_file: Path, wa
 def scaling(tree: Path, program_files: dict[int, Path], warmup_scans: int, blocks: int,
             instructions_per_block: int) -> dict:
     """ns per instruction of the compiled scan at each size (rungs ->
-    program file), one child each, interleaved; the ratio of the largest to
-    the smallest as the median of per-block ratios."""
+    program file), one child each, and of the straight-line baseline built
+    from the same rungs in the same child, all interleaved; the ratio of the
+    largest size to the smallest as the median of per-block ratios, for the
+    engine and for the baseline (what CPython itself does at that size)."""
     children: dict[int, Child] = {}
     loaded: dict[int, dict] = {}
     try:
         for rungs, path in sorted(program_files.items()):  # one load at a time, as in baseline_speedup
             children[rungs] = Child(tree, "serve", path)
             loaded[rungs] = children[rungs].read()
-        for child in children.values():
-            child.ask(f"scan {warmup_scans}")
+            children[rungs].ask(f"scan {warmup_scans}")
+            children[rungs].ask(f"baseline {warmup_scans}")  # builds it
         # about the same work per block for every size, so each block of the
         # small program is not a handful of microseconds of timer noise
         scans = {rungs: max(3, instructions_per_block // loaded[rungs]["instructions"]) for rungs in children}
-        per_block = interleaved_blocks(children, blocks, scans)
+        keys = [(rungs, what) for rungs in children for what in ("scan", "baseline")]
+        per_block = interleaved_blocks({k: children[k[0]] for k in keys}, blocks, {k: scans[k[0]] for k in keys},
+                                       {k: k[1] for k in keys})
     finally:
         for child in children.values():
             child.close()
     small, large = min(children), max(children)
-    ns = {rungs: [x / loaded[rungs]["instructions"] for x in per_block[rungs]] for rungs in children}
-    ratios = [a / b for a, b in zip(ns[large], ns[small])]
+    ns = {k: [x / loaded[k[0]]["instructions"] for x in per_block[k]] for k in keys}
+
+    def growth(what: str) -> list[float]:
+        return [a / b for a, b in zip(ns[(large, what)], ns[(small, what)])]
+
+    def med(k) -> float:
+        return round(statistics.median(ns[k]), 1)
+
+    engine_growth, baseline_growth = growth("scan"), growth("baseline")
     return {
         "sizes": {str(rungs): {"instructions": loaded[rungs]["instructions"],
-                               "ns_per_instruction": round(statistics.median(ns[rungs]), 1),
-                               "ns_per_instruction_range": [round(min(ns[rungs]), 1), round(max(ns[rungs]), 1)],
+                               "ns_per_instruction": med((rungs, "scan")),
+                               "ns_per_instruction_range": [round(min(ns[(rungs, "scan")]), 1),
+                                                            round(max(ns[(rungs, "scan")]), 1)],
+                               "baseline_ns_per_instruction": med((rungs, "baseline")),
+                               "engine_over_baseline": round(statistics.median(
+                                   a / b for a, b in zip(ns[(rungs, "scan")], ns[(rungs, "baseline")])), 2),
                                "scans_per_block": scans[rungs],
                                "load_s": round(loaded[rungs]["load"]["total_s"], 1)}
                   for rungs in children},
-        "largest_over_smallest": round(statistics.median(ratios), 2),
-        "ratio_range": [round(min(ratios), 2), round(max(ratios), 2)],
+        "largest_over_smallest": round(statistics.median(engine_growth), 2),
+        "ratio_range": [round(min(engine_growth), 2), round(max(engine_growth), 2)],
+        "baseline_largest_over_smallest": round(statistics.median(baseline_growth), 2),
+        "baseline_ratio_range": [round(min(baseline_growth), 2), round(max(baseline_growth), 2)],
         "largest": large,
         "smallest": small,
         "blocks": blocks,
