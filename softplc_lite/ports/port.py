@@ -93,6 +93,9 @@ class SerialPort:
         self.history: deque[tuple[float, str, bytes]] = deque(maxlen=HISTORY)
         self.record: Callable[..., None] | None = None  # record(label, direction, data, at_ns=None)
         self.clocked = False  # a simulated port on the clock it was given (exact arrival times)
+        # A simulated link's quiet time (wire.Link.quiet_until): a driver
+        # polling at every scan reads nothing before it (see read_at).
+        self.quiet = None
 
     def __repr__(self) -> str:
         state = "up" if self.up else f"down ({self.error})"
@@ -126,6 +129,7 @@ class SerialPort:
             raise serial.SerialException(self.error) from None
         self.serial, self.transport = s, transport
         self.clocked = transport.kind == "sim"
+        self.quiet = transport.quiet_link()
         self.error = None
         self.opened()
         self.log(1, f"port {self.label}: opened {self.url} ({c})")
@@ -136,7 +140,7 @@ class SerialPort:
     def _down(self, why: str) -> None:
         if self.serial is not None:
             quiet_close(self.serial)
-        self.serial = self.transport = None
+        self.serial = self.transport = self.quiet = None
         was_up = self.error is None
         self.error = why
         self.next_try = time.monotonic() + self.retry_s
@@ -166,7 +170,7 @@ class SerialPort:
     def close(self) -> None:
         if self.serial is not None:
             quiet_close(self.serial)
-        self.serial = self.transport = None
+        self.serial = self.transport = self.quiet = None
         self.error = "closed"
 
     # -- bytes ---------------------------------------------------------------------------
@@ -182,6 +186,25 @@ class SerialPort:
         if data:
             self.rx_bytes += len(data)
             self._traffic("RX", data)
+        return data
+
+    def read_at(self, now: int) -> bytes:
+        """``read()`` on a clocked port, given its clock's reading ``now``
+        (ns): a driver polling at every scan reads the clock once, tests
+        ``quiet`` with it and reads (issue 17). Elsewhere, ``read()``."""
+        transport = self.transport
+        if transport is None:
+            return b""
+        if not self.clocked:
+            return self.read()
+        try:
+            data = transport.read_at(now)
+        except PORT_ERRORS as e:
+            self._down(reason(e))
+            return b""
+        if data:
+            self.rx_bytes += len(data)
+            self._traffic("RX", data, now)  # what read() stamps: the clock is at now
         return data
 
     def read_timed(self) -> tuple[bytes, list[int] | None]:

@@ -442,20 +442,28 @@ class PortEnd:
         call: the pump, the take of every arrived byte, and (when there were
         bytes and the device's poll is due) the pump ``read`` would run. While
         the link is quiet (see Link.quiet_until) none of it would do
-        anything, so nothing is done."""
+        anything, so nothing is done; nor is a pump that would hand the device
+        nothing and find its poll not due (SimDevice.next_due), e.g. the
+        Modbus slave's while its reply arrives."""
         link = self.link
         if now < link.quiet_until:
             return b""
         with link.lock:
-            link.pump(now)
+            device = link.device
+            if device is None:  # a port-to-port link: no pump, never quiet
+                return self._in.take_arrived(now)
+            due = device.next_due(now)
+            pumped = bool(link.wires[0].chunks) or (due is not None and due <= now)
+            if pumped:
+                link.pump(now)
             data = self._in.take_arrived(now)
             if not data:
                 if self.index == 0:
                     link.quiet_until = link.quiet_from(now)
                 return b""
             link.quiet_until = 0
-            device = link.device
-            due = device.next_due(now) if device is not None else now
+            if pumped:
+                due = device.next_due(now)
             if due is not None and due <= now:
                 # a device that cannot tell, or is due: polled again as read()
                 # would (read() pumps after the count and before the take;
@@ -556,6 +564,10 @@ class ClockedSerial(SerialBase):
         self._check_open()
         n = self._available(self._clock())
         return self._take(n, self._clock()) if n else b""
+
+    def read_at(self, now: int) -> bytes:
+        """``read_now``, given the clock's reading ``now`` (the same clock)."""
+        return self.read_now()
 
     # - - - open / close - - -
 

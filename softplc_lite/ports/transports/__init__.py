@@ -44,6 +44,15 @@ class Transport:
         """What has arrived, at most READ_CHUNK bytes; b"" when nothing."""
         return self.serial.read(READ_CHUNK)
 
+    def read_at(self, now_ns: int) -> bytes:
+        """``read()`` on a port on the engine's clock, which reads ``now_ns``."""
+        return self.read()
+
+    def quiet_link(self):
+        """An object whose ``quiet_until`` (ns on the port's clock) says until
+        when a read surely finds nothing (a simulated link), or None."""
+        return None
+
     def write(self, data: bytes) -> int:
         """Write what the port takes now; return how many bytes."""
         return self.serial.write(data) or 0

@@ -21,12 +21,19 @@ class SimulatedTransport(LoopTransport):
         # read(in_waiting) in one call, nothing done while the wire is quiet;
         # bound here so that a port's read at every scan is one call less
         self.read = serial.read_now
+        self.read_at = serial.read_at
 
     def set_clock(self, now_ns: Callable[[], int]) -> None:
         self.serial.set_clock(now_ns)
 
     def read(self) -> bytes:  # replaced by serial.read_now in __init__
         return self.serial.read_now()
+
+    def read_at(self, now_ns: int) -> bytes:  # replaced by serial.read_at in __init__
+        return self.serial.read_at(now_ns)
+
+    def quiet_link(self):
+        return getattr(self.serial, "sim_link", None)  # replay:// has none
 
 
 TRANSPORT = SimulatedTransport

@@ -113,9 +113,24 @@ class Serial(wire.ClockedSerial):
         return self._end.cts(now)
 
     def read_now(self) -> bytes:
-        if not self.is_open:  # _check_open, inline: this runs at every scan
+        return self.read_at(self._clock())
+
+    def read_at(self, now: int) -> bytes:
+        """``read_now`` at ``now``, the clock read by the caller (a driver
+        polling at every scan reads it once for the quiet test and the read).
+        While the link is quiet nothing is looked at but its quiet time."""
+        if not self.is_open:
             raise PortNotOpenError()
-        return self._end.read_arrived(self._clock())
+        end = self._end
+        if now < end.link.quiet_until:
+            return b""
+        return end.read_arrived(now)
+
+    @property
+    def sim_link(self) -> wire.Link | None:
+        """The link this port is an end of (its ``quiet_until`` says until when
+        a read finds nothing); None when closed."""
+        return self._end.link if self._end is not None else None
 
     def _available(self, now: int) -> int:
         return self._end.available(now)

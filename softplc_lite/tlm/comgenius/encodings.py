@@ -24,6 +24,7 @@ SoftPLC's encoding names come from.
 from __future__ import annotations
 
 import codecs
+import functools
 import re
 
 _ASTRAL = re.compile("[\U00010000-\U0010FFFF]")
@@ -91,8 +92,9 @@ class _Latin1Decoder(Decoder):
     def __init__(self) -> None:
         pass
 
-    def decode(self, data: bytes) -> str:
-        return data.decode("latin-1")
+    # bytes.decode itself, called without a Python frame (a port's input
+    # decodes at every scan while a reply arrives, issue 17)
+    decode = staticmethod(functools.partial(bytes.decode, encoding="latin-1"))
 
     def reset(self) -> None:
         pass

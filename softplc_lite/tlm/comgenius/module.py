@@ -90,15 +90,20 @@ class ComGenius(TLM):
         return warnings
 
     def on_input(self, engine) -> None:
-        if self.ports is not None:
-            self.ports.poll_input()
+        ports = self.ports
+        if ports is not None:
+            for port in ports.port_list:  # a down port is retried (ports.py)
+                if port.error is None:
+                    port.poll_input()
+                elif port.error != "closed":
+                    port.retry()
 
     def on_output(self, engine, outputs_enabled: bool) -> None:
         # Ports are communication, not outputs: TEST mode still talks (as a
         # SoftPLC does in its test mode, where only the I/O image is held).
         ports = self.ports
         if ports is not None:
-            for port in ports.port_list:  # PortSet.flush_output, inline: most scans have nothing to send
+            for port in ports.port_list:  # most scans have nothing to send
                 if port.tx:
                     port.flush_output()
         if self.recorder is not None:

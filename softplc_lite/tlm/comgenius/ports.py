@@ -74,7 +74,14 @@ class ComPort(SerialPort):
 
     # -- the driver's two points ---------------------------------------------------------
     def poll_input(self) -> None:
-        data = self.read()
+        if self.clocked:  # the clock read once; a quiet simulated link is not read at all
+            now = self.now_ns()
+            quiet = self.quiet
+            if quiet is not None and now < quiet.quiet_until:
+                return
+            data = self.read_at(now)
+        else:
+            data = self.read()
         if not data:
             return
         text = self.decoder.decode(data)
@@ -136,7 +143,8 @@ class PortSet:
             physical = (overrides or {}).get(number, pc.physical)
             url = port_url(physical, config.com_devices)
             self.ports[number] = ComPort(pc, url, log, now_ns, config.retry_ms, log_frames=config.debug >= 2)
-        self.port_list = list(self.ports.values())  # the driver's two points walk it at every scan
+        # the driver's input and output points (ComGenius.on_input, on_output) walk it at every scan
+        self.port_list = list(self.ports.values())
 
     def open_all(self, keep_going: bool | None = None) -> list[str]:
         """Open every port. A port that cannot be opened raises ModuleError
@@ -157,18 +165,6 @@ class PortSet:
                 warnings.append(f"{self.config.path}:{port.config.line}: [PORTS]: {message}; running on, "
                                 f"its instructions set ER and it is retried every {self.config.retry_ms} ms")
         return warnings
-
-    def poll_input(self) -> None:
-        for port in self.port_list:
-            if port.error is None:
-                port.poll_input()
-            elif port.error != "closed":
-                port.retry()
-
-    def flush_output(self) -> None:
-        for port in self.port_list:
-            if port.tx:
-                port.flush_output()
 
     def close(self) -> None:
         for port in self.ports.values():
