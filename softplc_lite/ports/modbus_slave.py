@@ -151,6 +151,7 @@ class ModbusUnit:
         self.input_registers: list[int] = [initial_value(k, "input", values, position) for k in range(size)]
         self.coils: list[bool] = [initial_value(k, "coil", values, position) for k in range(size)]
         self.discrete_inputs: list[bool] = [initial_value(k, "discrete", values, position) for k in range(size)]
+        self.last_read: tuple[bytes, tuple, bytes] | None = None  # (request PDU, values, reply PDU)
 
     def __repr__(self) -> str:
         return f"<ModbusUnit id={self.slave_id}{'' if self.online else ' offline'}>"
@@ -190,6 +191,7 @@ class ModbusSlave(SimDevice):
         self.ignored = 0  # frames dropped: too short or long, bad CRC, another slave's
         self._frame = bytearray()
         self._last = 0  # arrival time of the frame's last byte
+        self._last_reply: tuple | None = None  # (address, reply PDU, framer, frame) of the last reply
 
     # the first id's tables, as the device's own
     holding_registers = property(lambda self: self.units[self.slave_id].holding_registers)
@@ -311,7 +313,16 @@ def respond(request: bytes, slave: ModbusSlave) -> bytes | None:
         return None
     slave.requests += 1
     replies = [_execute(unit, pdu, slave.size) for unit in units]
-    return None if address == 0 else framer.encode(address, replies[0])
+    if address == 0:
+        return None
+    # A master polling the same registers gets the same reply frame while the
+    # values stay the same: framed (and its CRC computed) once (issue 17).
+    last = slave._last_reply
+    if last is not None and last[0] == address and last[1] == replies[0] and last[2] is framer:
+        return last[3]
+    frame = framer.encode(address, replies[0])
+    slave._last_reply = (address, replies[0], framer, frame)
+    return frame
 
 
 def _execute(unit: ModbusUnit, pdu: bytes, size: int) -> bytes:
@@ -332,7 +343,14 @@ def _execute(unit: ModbusUnit, pdu: bytes, size: int) -> bytes:
     if isinstance(request, (ReadHoldingRegistersRequest, ReadInputRegistersRequest)):
         table = unit.holding_registers if f == 3 else unit.input_registers
         values = tuple(table[request.address:request.address + request.count])
-        return (ReadHoldingRegistersResponse if f == 3 else ReadInputRegistersResponse)(values).encode()
+        # the same request on the same values: the reply PDU built (and its
+        # values checked) before (issue 17: a master polls the same block)
+        last = unit.last_read
+        if last is not None and last[0] == pdu and last[1] == values:
+            return last[2]
+        reply = (ReadHoldingRegistersResponse if f == 3 else ReadInputRegistersResponse)(values).encode()
+        unit.last_read = (pdu, values, reply)
+        return reply
     if isinstance(request, WriteSingleCoilRequest):
         unit.coils[request.address] = request.value
         return WriteSingleCoilResponse(request.address, request.value).encode()

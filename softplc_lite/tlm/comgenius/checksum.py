@@ -36,10 +36,23 @@ def crc16(chars: str, preload: int = 0) -> int:
     return crc16_bytes(low_bytes(chars), preload)
 
 
+# The last CRC of bytes computed: (data, preload, crc). A master polling the
+# same registers checks the same reply again and again (a 255-byte Modbus
+# reply is a 253-byte Python loop), so an equal input is not run again.
+_last_crc: tuple[bytes, int, int] = (b"", -1, 0)
+
+
 def crc16_bytes(data: bytes | Iterable[int], preload: int = 0) -> int:
     """The same over bytes: the Modbus codec's table-driven CRC, with this
     module's default preload of 0."""
-    return modbus_crc16(data, preload)
+    global _last_crc
+    last = _last_crc
+    if last[1] == preload and last[0] == data:
+        return last[2]
+    crc = modbus_crc16(data, preload)
+    if type(data) is bytes:
+        _last_crc = (data, preload, crc)
+    return crc
 
 
 def sum16(chars: str, negate: bool = False, one_byte: bool = False) -> int:
