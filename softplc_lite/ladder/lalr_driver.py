@@ -61,7 +61,8 @@ class _StateLexer:
         terminals = scanner.terminals
         alternation = "|".join(f"(?P<{t.name}>{t.pattern.to_regexp()})" for t in terminals)
         flags = basic.g_regex_flags
-        if len(scanner._mres) != 1 or scanner._mres[0].pattern != alternation or scanner.use_bytes:
+        if (len(scanner._mres) != 1 or scanner._mres[0].pattern != alternation or scanner.use_bytes
+                or scanner.re_ is not re):
             raise NotFastPath("a lexer unlike lark 1.3's")
         skips = []
         for i, t in enumerate(terminals):
