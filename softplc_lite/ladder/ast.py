@@ -7,9 +7,9 @@ checked with ``==``.
 
 The nodes a program has one of per instruction (operands, instructions,
 branches, rungs) are compact (issue 17: at most 300 bytes an instruction
-after load): ``__slots__`` classes that keep their position as three slots
-(source, line, column) and build the ``Pos`` when asked, not one Pos object
-per node. Nodes on one source line share one line number object. Operand
+after load): ``__slots__`` classes that keep their position as two slots
+(source and line as one int shared by the nodes of a line, and the column)
+and build the ``Pos`` when asked, not one Pos object per node. Operand
 nodes are immutable and hashable (as frozen dataclasses were); instructions,
 branches and rungs may be changed (the parser appends to them). A sequence
 field (operands, elements, legs) may be a list (the parser's tree) or a
@@ -19,6 +19,7 @@ compare equal item by item.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import FrozenInstanceError, dataclass, field
 from typing import NamedTuple, Union
 
@@ -44,30 +45,49 @@ def _pos() -> Pos:
     return field(default=NOWHERE, compare=False, repr=False)
 
 
-# The line number object the previous node kept: nodes are built in source
-# order, so most share it and a program keeps one int per line, not one per
-# node (a line past 256 is an object of its own in CPython).
-_last_line = 0
+# A node keeps its source and line as one int, ``_where``: the source's
+# number in _SOURCES (each source name is kept once per process) above
+# _LINE_BITS bits of line. The int of the previous node is reused when the
+# next is on the same line: nodes are built in source order, so a program
+# keeps about one such int per line, not one per node.
+_LINE_BITS = 32
+_LINE_BIAS = 1 << (_LINE_BITS - 1)  # lines -2**31 .. 2**31-1 fit
+_LINE_MASK = (1 << _LINE_BITS) - 1
+_SOURCES: list[str] = []
+_SOURCE_NUMBERS: dict[str, int] = {}
+_registering = threading.Lock()
+_last: tuple = (None, None, 0)  # (source, line, where) of the previous node
 
 
-def _line_of(pos: Pos) -> int:
-    global _last_line
-    line = pos.line
-    if line == _last_line:
-        return _last_line
-    _last_line = line
-    return line
+def _where_of(pos: Pos) -> int:
+    global _last
+    source, line = pos.source, pos.line
+    last = _last
+    if line == last[1] and source is last[0]:
+        return last[2]
+    number = _SOURCE_NUMBERS.get(source)
+    if number is None:
+        with _registering:
+            number = _SOURCE_NUMBERS.setdefault(source, len(_SOURCES))
+            if number == len(_SOURCES):
+                _SOURCES.append(source)
+    if not -_LINE_BIAS <= line < _LINE_BIAS:
+        raise ValueError(f"line {line} out of range")
+    where = number << _LINE_BITS | (line + _LINE_BIAS)
+    _last = (source, line, where)
+    return where
 
 
 class _Node:
     """Position storage shared by the compact nodes."""
 
-    __slots__ = ("_source", "_line", "_column")
+    __slots__ = ("_where", "_column")
     _fields: tuple[str, ...] = ()  # the fields that take part in equality and repr, in constructor order
 
     @property
     def pos(self) -> Pos:
-        return Pos(self._source, self._line, self._column)
+        where = self._where
+        return Pos(_SOURCES[where >> _LINE_BITS], (where & _LINE_MASK) - _LINE_BIAS, self._column)
 
     def __repr__(self) -> str:
         inner = ", ".join(f"{name}={getattr(self, name)!r}" for name in self._fields)
@@ -111,15 +131,13 @@ def _rebuild(cls, values, pos, extra):
     return cls(*values, pos, **extra)
 
 
-_set_source = _Node._source.__set__
-_set_line = _Node._line.__set__
+_set_where = _Node._where.__set__
 _set_column = _Node._column.__set__
 
 
 def _place(node: _Node, pos: Pos) -> None:
     """Store ``pos`` in an immutable node (its __setattr__ refuses)."""
-    _set_source(node, pos.source)
-    _set_line(node, _line_of(pos))
+    _set_where(node, _where_of(pos))
     _set_column(node, pos.column)
 
 
@@ -253,23 +271,37 @@ class _Mutable(_Node):
 
     @_Node.pos.setter
     def pos(self, pos: Pos) -> None:
-        self._source, self._line, self._column = pos.source, _line_of(pos), pos.column
+        self._where, self._column = _where_of(pos), pos.column
 
     def __reduce__(self):
         return _rebuild, (type(self), tuple(getattr(self, name) for name in self._fields), self.pos, {})
 
 
 class Instruction(_Mutable):
-    __slots__ = ("mnemonic", "operands")
+    """``operands`` is kept as given (the parser's list grows as it reads),
+    except that a tuple of one operand node, the most common instruction
+    (XIC B3/0) in a validated tree, is kept as that node alone: ``operands``
+    gives it back as a 1-tuple (issue 17: a tuple object less per
+    instruction)."""
+
+    __slots__ = ("mnemonic", "_operands")
     _fields = ("mnemonic", "operands")
     __match_args__ = _fields
 
     def __init__(self, mnemonic: str, operands: list[Operand] | tuple[Operand, ...], pos: Pos = NOWHERE) -> None:
         self.mnemonic = mnemonic
-        self.operands = operands
-        self._source = pos.source
-        self._line = _line_of(pos)
+        self._operands = _kept(operands)
+        self._where = _where_of(pos)
         self._column = pos.column
+
+    @property
+    def operands(self) -> list[Operand] | tuple[Operand, ...]:
+        operands = self._operands
+        return (operands,) if isinstance(operands, _Operand) else operands
+
+    @operands.setter
+    def operands(self, operands: list[Operand] | tuple[Operand, ...]) -> None:
+        self._operands = _kept(operands)
 
     def __eq__(self, other):
         if other.__class__ is not Instruction:
@@ -280,9 +312,16 @@ class Instruction(_Mutable):
         """This instruction, at its position, with other fields (the
         validator's resolved copy; no Pos built on the way)."""
         new = _new(Instruction)
-        new.mnemonic, new.operands = mnemonic, operands
-        new._source, new._line, new._column = self._source, self._line, self._column
+        new.mnemonic, new._operands = mnemonic, _kept(operands)
+        new._where, new._column = self._where, self._column
         return new
+
+
+def _kept(operands):
+    """How an instruction keeps ``operands``: a 1-tuple of a node as the node."""
+    if operands.__class__ is tuple and len(operands) == 1 and isinstance(operands[0], _Operand):
+        return operands[0]
+    return operands
 
 
 class Branch(_Mutable):
@@ -294,8 +333,7 @@ class Branch(_Mutable):
 
     def __init__(self, legs: list[list["Element"]], pos: Pos = NOWHERE) -> None:
         self.legs = legs
-        self._source = pos.source
-        self._line = _line_of(pos)
+        self._where = _where_of(pos)
         self._column = pos.column
 
     def __eq__(self, other):
@@ -307,7 +345,7 @@ class Branch(_Mutable):
     def copy_with(self, legs) -> "Branch":
         new = _new(Branch)
         new.legs = legs
-        new._source, new._line, new._column = self._source, self._line, self._column
+        new._where, new._column = self._where, self._column
         return new
 
 
@@ -322,8 +360,7 @@ class Rung(_Mutable):
     def __init__(self, elements: list[Element], comment: str | None = None, pos: Pos = NOWHERE) -> None:
         self.elements = elements
         self.comment = comment
-        self._source = pos.source
-        self._line = _line_of(pos)
+        self._where = _where_of(pos)
         self._column = pos.column
 
     def __eq__(self, other):
@@ -334,7 +371,7 @@ class Rung(_Mutable):
     def copy_with(self, elements) -> "Rung":
         new = _new(Rung)
         new.elements, new.comment = elements, self.comment
-        new._source, new._line, new._column = self._source, self._line, self._column
+        new._where, new._column = self._where, self._column
         return new
 
 
