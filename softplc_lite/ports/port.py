@@ -202,9 +202,13 @@ class SerialPort:
         except PORT_ERRORS as e:
             self._down(reason(e))
             return b""
-        if data:
+        if data:  # what read() does, with _traffic inline and stamped now (the clock's reading)
             self.rx_bytes += len(data)
-            self._traffic("RX", data, now)  # what read() stamps: the clock is at now
+            self.history.append((now / 1e6, "RX", data))
+            if self.record is not None:
+                self.record(self.label, "RX", data, now)
+            if self.log_frames:
+                self.log(2, f"port {self.label} RX {len(data):4d} bytes: {hexdump(data)}")
         return data
 
     def read_timed(self) -> tuple[bytes, list[int] | None]:

@@ -150,6 +150,17 @@ class Wire:
         in one pass over the chunks (the read of a polling port at every scan
         while a reply arrives, issue 17)."""
         chunks = self.chunks
+        if not chunks:
+            return b""
+        chunk = chunks[0]
+        if chunk.char_ns:  # the usual read while a reply arrives: more of one chunk, not all of it
+            n = (now - chunk.start) // chunk.char_ns
+            taken = chunk.taken
+            if n < len(chunk.data):
+                if n <= taken:
+                    return b""
+                chunk.taken = n
+                return chunk.data[taken:n]
         parts = None
         got = b""
         while chunks:
@@ -453,17 +464,15 @@ class PortEnd:
             if device is None:  # a port-to-port link: no pump, never quiet
                 return self._in.take_arrived(now)
             due = device.next_due(now)
-            pumped = bool(link.wires[0].chunks) or (due is not None and due <= now)
-            if pumped:
+            if link.wires[0].chunks or (due is not None and due <= now):
                 link.pump(now)
+                due = device.next_due(now)  # the take below changes nothing the device sees
             data = self._in.take_arrived(now)
             if not data:
                 if self.index == 0:
                     link.quiet_until = link.quiet_from(now)
                 return b""
             link.quiet_until = 0
-            if pumped:
-                due = device.next_due(now)
             if due is not None and due <= now:
                 # a device that cannot tell, or is due: polled again as read()
                 # would (read() pumps after the count and before the take;

@@ -36,10 +36,12 @@ def crc16(chars: str, preload: int = 0) -> int:
     return crc16_bytes(low_bytes(chars), preload)
 
 
-# The last CRC of bytes computed: (data, preload, crc). A master polling the
-# same registers checks the same reply again and again (a 255-byte Modbus
+# The last CRC of a long run of bytes: (data, preload, crc). A master polling
+# the same registers checks the same reply again and again (a 255-byte Modbus
 # reply is a 253-byte Python loop), so an equal input is not run again.
+# Short inputs (a query) are cheap and kept out, so they do not evict it.
 _last_crc: tuple[bytes, int, int] = (b"", -1, 0)
+_MEMO_FROM = 32  # bytes
 
 
 def crc16_bytes(data: bytes | Iterable[int], preload: int = 0) -> int:
@@ -50,7 +52,7 @@ def crc16_bytes(data: bytes | Iterable[int], preload: int = 0) -> int:
     if last[1] == preload and last[0] == data:
         return last[2]
     crc = modbus_crc16(data, preload)
-    if type(data) is bytes:
+    if type(data) is bytes and len(data) >= _MEMO_FROM:
         _last_crc = (data, preload, crc)
     return crc
 

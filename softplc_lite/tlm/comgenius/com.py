@@ -191,29 +191,35 @@ class ComScan(_Controlled):
             return self._error(ctl, f"port {port.number} is down: {port.error}")
         rx = port.rx
         tried = self._tried_rx
-        if rx is tried:
-            status, used, specs = NEED_MORE, self._tried_used, self._tried_specs
-        elif tried is not None and len(rx) < self._tried_need and rx.startswith(tried):
-            status, used, specs = NEED_MORE, len(rx), self._tried_specs
-            self._tried_rx, self._tried_used = rx, used
-        else:
-            try:
-                result, taken, need = self.matcher.match_counted(rx, self.params(), final=False)
-            except ParamError as e:
-                return self._error(ctl, f"format {self.index}: {e.reason}")
-            status, used, specs = result
-            if status == NEED_MORE and not taken and self._fixed_params:
-                self._tried_rx, self._tried_used, self._tried_specs, self._tried_need = rx, used, specs, need
+        if tried is not None and (rx is tried or (len(rx) < self._tried_need and rx.startswith(tried))):
+            if rx is not tried:  # NEED_MORE at its end, with the same specs
+                self._tried_rx = rx
+                n = len(rx)
+                self._tried_used = n if n <= 0x7FFF else signed_word(n)
+            d, i = ctl.d, ctl.i
+            d[i + 1] = self._tried_used  # LEN
+            d[i + 2] = self._tried_specs  # POS
+            if self._clock.now_ms < self._deadline_ms:
+                return False
+            return self._timeout(ctl, port)
+        try:
+            result, taken, need = self.matcher.match_counted(rx, self.params(), final=False)
+        except ParamError as e:
+            return self._error(ctl, f"format {self.index}: {e.reason}")
+        status, used, specs = result
+        d, i = ctl.d, ctl.i
+        d[i + 1] = signed_word(used)  # LEN
+        d[i + 2] = signed_word(specs)  # POS
+        if status == NEED_MORE:
+            if not taken and self._fixed_params:
+                self._tried_rx, self._tried_used, self._tried_specs, self._tried_need = \
+                    rx, d[i + 1], d[i + 2], need
             else:
                 self._tried_rx = None
-        d, i = ctl.d, ctl.i
-        d[i + 1] = used if used <= 0x7FFF else signed_word(used)  # LEN
-        d[i + 2] = specs if specs <= 0x7FFF else signed_word(specs)  # POS
-        if status == NEED_MORE:
-            if self._clock.now_ms >= self._deadline_ms:
-                return self._error(ctl, f"timeout after {port.config.timeout_ms} ms with {len(port.rx)} "
-                                        f"characters waiting", empty=True)
-            return False
+            if self._clock.now_ms < self._deadline_ms:
+                return False
+            return self._timeout(ctl, port)
+        self._tried_rx = None
         if status == MATCHED:
             port.take(used)
             ctl.finish()
@@ -222,6 +228,10 @@ class ComScan(_Controlled):
         ctl.finish(error=True)  # MISMATCH
         self.log(2, f"{self.where}: mismatch at offset {used} after {specs} specs (ER)")
         return True
+
+    def _timeout(self, ctl: ControlElement, port: ComPort) -> bool:
+        return self._error(ctl, f"timeout after {port.config.timeout_ms} ms with {len(port.rx)} "
+                                f"characters waiting", empty=True)
 
 
 class _PortAction:
