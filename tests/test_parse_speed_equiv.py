@@ -22,7 +22,7 @@ from softplc_lite.ladder.parser import parse_expression, parse_program, syntax_p
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-import ladder_programs  # noqa: E402
+import ladder_programs
 
 PROGRAMS = sorted([*ROOT.glob("programs/**/*.lad"), *ROOT.glob("tests/data/**/*.lad")])
 
