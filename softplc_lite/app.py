@@ -17,7 +17,7 @@ import tomllib
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 
-from .datatable import DataTableError, jsonio
+from .datatable import DataTable, DataTableError, jsonio
 from .errors import LocatedError
 from .display import Display, display_names, parse_display
 from .ladder.ast import Pos, Program, walk
@@ -26,6 +26,7 @@ from .ladder.instructions import BUILTIN, InstructionSet
 from .ladder.parser import parse_program, syntax_problems
 from .ladder.semantics import MAX_JSR_DEPTH, Settings
 from .ladder.validate import check
+from .ladder.codecache import CodeCache, apply_layout, cache_key, export_engine
 from .ladder.verify import verify
 from .ladder.engine import layout_problems
 from .ports import claim_conflicts
@@ -57,7 +58,7 @@ class App:
     lad_files: list[Path]
     program: Program  # validated
     settings: Settings
-    source_program: Program  # as parsed (for fmt)
+    source_program: Program | None  # as parsed (for fmt); None when loaded from the code cache
     datatable_json: Path | None = None
     state_dir: Path | None = None
     problems: list[LadderError] = field(default_factory=list)
@@ -65,6 +66,12 @@ class App:
     instructions: InstructionSet = BUILTIN
     warnings: list[str] = field(default_factory=list)  # from module configs and checks
     display: Display = field(default_factory=Display)  # softplc.toml [display]: run's status line and summary
+    # The code cache (ladder/codecache.py): compiled code loaded from it (None:
+    # compiled at this load), its key, and the program's own warnings.
+    code: dict | None = None
+    cache_key: str | None = None
+    program_warnings: list[str] = field(default_factory=list)
+    code_cache: CodeCache | None = None
 
     @property
     def name(self) -> str:
@@ -285,8 +292,10 @@ def display_problems(display: Display, table, path: Path, doc: dict) -> list[Loc
     return found
 
 
-def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
-    """Parse, validate and configure an app; AppError lists every problem."""
+def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: bool = True) -> App:
+    """Parse, validate and configure an app; AppError lists every problem.
+    With ``use_cache``, a program loaded before comes from the code cache in
+    the state directory (ladder/codecache.py; check passes False)."""
     path = Path(path)
     if not path.exists():
         raise AppError(f"{path}: no such app directory or .lad file")
@@ -310,10 +319,25 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
         config_problems += [ModuleError(f"{c.where}: {c.module} port {c.number}: {problem}") for c in claims
                             if c.url.lower().startswith("sim://") and (problem := sim_url_problem(c.url))]
     warnings += _unused_configs(module_dir, modules)
-    parsed, errors = parse_files(files, path, instructions)
-    resolved, problems = check(parsed, instructions)
-    errors += problems
-    if not errors:
+    state = Path(state_dir) if state_dir is not None else (path / STATE_DIR if is_dir else None)
+    cache = CodeCache(state) if use_cache and state is not None and not config_problems else None
+    key = cached = None
+    if cache is not None:
+        key = cache_key(_cache_parts(files, path, modules))
+        cached = cache.load(key)
+    if cached is not None:
+        # Loaded before from these very files: the validated program, its
+        # warnings and compiled code (ladder/codecache.py), no parse or check.
+        resolved, program_warnings, code = cached
+        parsed, errors = None, []
+        table = DataTable()
+        apply_layout(table, code["layout"])  # the table check validates [display] and datatable.json against
+    else:
+        parsed, errors = parse_files(files, path, instructions)
+        resolved, problems = check(parsed, instructions)
+        errors += problems
+        code = None
+    if not errors and cached is None:
         # What run would refuse when it builds the table (N9 beside ST9, a
         # DATA string that is not UCS-2): check reports it first, located.
         table, layout = layout_problems(resolved, modules)
@@ -339,16 +363,43 @@ def load_app(path: str | Path, state_dir: str | Path | None = None) -> App:
     if errors or config_problems or settings_problems:
         raise AppError(config_problems + settings_problems
                        + sorted(errors, key=lambda e: (e.pos.source, e.pos.line, e.pos.column)))
-    warnings += [w.report() for w in _module_checks(resolved, modules)]
-    # RSLogix-style verify (duplicate OTE, shared timers, rungs without output, unused symbols): warnings
-    shown = display_names(settings_doc.get("display")) if is_dir and isinstance(settings_doc, dict) else set()
-    warnings += [w.report() for w in verify(resolved, instructions, parsed, settings.overflow, shown)]
-    if state_dir is not None:
-        state = Path(state_dir)
-    else:
-        state = path / STATE_DIR if is_dir else None
-    return App(path, is_dir, files, resolved, settings, parsed, table_json, state,
-               modules=modules, instructions=instructions, warnings=warnings, display=display)
+    if cached is None:
+        program_warnings = [w.report() for w in _module_checks(resolved, modules)]
+        # RSLogix-style verify (duplicate OTE, shared timers, rungs without output, unused symbols): warnings
+        shown = display_names(settings_doc.get("display")) if is_dir and isinstance(settings_doc, dict) else set()
+        program_warnings += [w.report() for w in verify(resolved, instructions, parsed, settings.overflow, shown)]
+    warnings += program_warnings
+    app = App(path, is_dir, files, resolved, settings, parsed, table_json, state,
+              modules=modules, instructions=instructions, warnings=warnings, display=display)
+    app.code, app.cache_key, app.program_warnings = code, key, program_warnings
+    app.code_cache = cache
+    return app
+
+
+def _cache_parts(files: list[Path], path: Path, modules) -> list[tuple[str, bytes]]:
+    """What an app's compiled code depends on, for its code cache key: every
+    program file, the settings file, and each enabled module with its
+    version and config file."""
+    base = path if path.is_dir() else path.parent
+    parts = [(str(f.relative_to(base)), f.read_bytes()) for f in files]
+    for name in (SETTINGS_FILE,):
+        f = base / name
+        parts.append((name, f.read_bytes() if f.exists() else b""))
+    for m in modules:
+        config = base / m.config_file if getattr(m, "config_file", None) else None
+        parts.append((f"module {m.name} {getattr(m, 'version', '')} {type(m).__module__}",
+                      config.read_bytes() if config is not None and config.exists() else b""))
+    return parts
+
+
+def save_code_cache(app: App, engine) -> None:
+    """After a run's engine is built from a freshly checked program: keep its
+    compiled code for the next load (nothing if it came from the cache)."""
+    if app.code_cache is None or app.code is not None or app.cache_key is None:
+        return
+    code = export_engine(engine)
+    if code is not None:
+        app.code_cache.save(app.cache_key, app.program, app.program_warnings, code)
 
 
 def app_instructions(path: Path) -> InstructionSet:

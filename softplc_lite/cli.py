@@ -159,7 +159,7 @@ def _cmd_watch(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     try:
-        app = load_app(args.app)
+        app = load_app(args.app, use_cache=False)  # check reads every text, whatever was cached
     except AppError as e:
         print(str(e), file=sys.stderr)
         count = len(e.errors) or 1

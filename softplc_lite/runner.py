@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from .app import App
+from .app import App, save_code_cache
 from .datatable import DataTable, DataTableError
 from .datatable import jsonio, snapshot
 from .ladder import status as S
@@ -74,7 +74,9 @@ class Runner:
         clock = RealClock() if options.realtime else SimulatedClock(settings.scan_ms)
         self.table = DataTable()
         self.engine = Engine(app.program, self.table, settings, clock, executor=options.executor,
-                             modules=app.modules, module_options=options.module_options())
+                             modules=app.modules, module_options=options.module_options(), code=app.code)
+        if options.executor == "compiled":
+            save_code_cache(app, self.engine)  # before a table is restored into it: the program's own layout
         for warning in self.engine.module_warnings:
             self.log(f"warning: {warning}")
         self.faults = StorageFaults(self.engine.s, self.log)

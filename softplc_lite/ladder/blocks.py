@@ -55,7 +55,7 @@ class LineTable:
 
     def at(self, lineno: int):
         k = lineno - 2  # line 1 is the factory's def
-        if 0 <= k < len(self.instr):
+        if 0 <= k < len(self.rung):
             return self.rung[k], self.instr[k]
         return None, None
 
@@ -74,9 +74,16 @@ def build_block(number: int, code: BlockCode, env: dict):
     # filled before it first runs.
     text = "\n".join(["def _factory(_env):", *code.lines, "    " + bindings, "    return _block"]) + "\n"
     name = block_name(number, code.first, code.end)
+    module = compile(text, name, "exec")
+    return run_block(module, env), name, module, LineTable(code.line_instr, code.line_rung)
+
+
+def run_block(module, env: dict):
+    """The block function of a compiled block module (compiled now, or
+    read from the code cache)."""
     scope: dict[str, object] = {}
-    exec(compile(text, name, "exec"), scope)  # noqa: S102 - source built only from validated tokens
-    return scope["_factory"](env), name, LineTable(code.line_instr, code.line_rung)
+    exec(module, scope)  # noqa: S102 - source built only from validated tokens
+    return scope["_factory"](env)
 
 
 class CompiledFile:
@@ -91,12 +98,23 @@ class CompiledFile:
         self.blocks: list = []  # block functions, in rung order
         self.starts: list[int] = []  # first rung of each block
         self.tables: dict[str, LineTable] = {}  # block file name -> its line table
-        self._compiler = compiler  # kept to compile a block again, split (isolate)
+        self.modules: list = []  # each block's compiled module code (what the code cache keeps)
+        self._compiler = compiler  # kept to compile a block again, split (isolate); may be a maker of one
+
+    @property
+    def compiler(self):
+        if callable(self._compiler):  # loaded from the code cache: made when first needed
+            self._compiler = self._compiler()
+        return self._compiler
 
     def add(self, code: BlockCode) -> None:
-        fn, name, table = build_block(self.number, code, self._compiler.env)
+        fn, name, module, table = build_block(self.number, code, self.compiler.env)
+        self.add_compiled(fn, code.first, name, module, table)
+
+    def add_compiled(self, fn, first: int, name: str, module, table: LineTable) -> None:
         self.blocks.append(fn)
-        self.starts.append(code.first)
+        self.starts.append(first)
+        self.modules.append(module)
         self.tables[name] = table
 
     # -- the engine's view ----------------------------------------------------------------------
@@ -120,12 +138,13 @@ class CompiledFile:
         if first == rung and end == rung + 1:
             return k
         parts = [(a, b) for a, b in ((first, rung), (rung, rung + 1), (rung + 1, end)) if a < b]
-        old = CompiledFile(self.number, self.rung_count, self.has_mcr, self._compiler)
+        old = CompiledFile(self.number, self.rung_count, self.has_mcr, self.compiler)
         for a, b in parts:
-            old.add(self._compiler.block(a, b))
+            old.add(self.compiler.block(a, b))
         del self.tables[block_name(self.number, first, end)]
         self.blocks[k:k + 1] = old.blocks
         self.starts[k:k + 1] = old.starts
+        self.modules[k:k + 1] = old.modules
         self.tables.update(old.tables)
         return self.block_index(rung)
 
@@ -137,11 +156,16 @@ class CompiledFile:
         out = []
         bounds = self.starts + [self.rung_count]
         for a, b in zip(bounds, bounds[1:]):
-            out += ["def _factory(_env):", *self._compiler.block(a, b).lines]
+            out += ["def _factory(_env):", *self.compiler.block(a, b).lines]
         return "\n".join(out) + "\n"
 
     @property
     def line_table(self) -> dict:
         """(block name, line) -> instruction, for every line that has one."""
-        return {(name, line + 2): ins for name, t in self.tables.items()
-                for line, ins in enumerate(t.instr) if ins is not None}
+        out = {}
+        for name, t in self.tables.items():
+            for line in range(len(t.rung)):
+                ins = t.at(line + 2)[1]
+                if ins is not None:
+                    out[(name, line + 2)] = ins
+        return out

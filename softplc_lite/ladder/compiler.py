@@ -47,6 +47,20 @@ class EndScan(Exception):
     through JSR calls (both executors) to the engine."""
 
 
+def instructions_of(elements, out: list | None = None) -> list:
+    """Every instruction of ``elements`` (branches opened), in scan order:
+    ast.walk as a list, several times faster on a big program's load."""
+    if out is None:
+        out = []
+    for el in elements:
+        if el.__class__ is Instruction:
+            out.append(el)
+        else:
+            for leg in el.legs:
+                instructions_of(leg, out)
+    return out
+
+
 def describe(instr: Instruction) -> str:
     from .fmt import format_instruction
 
@@ -62,18 +76,27 @@ class _FileCompiler:
         self.rungs = rungs
         self.labels = labels_of(rungs)
         self.module_instance = module_instance  # TLM instructions: Instruction -> callable(c) -> c
-        self.has_mcr = any(ins.mnemonic == "MCR" for r in rungs for ins in walk(r.elements))
+        self.has_mcr = any(ins.mnemonic == "MCR" for r in rungs for ins in instructions_of(r.elements))
         self.env: dict[str, object] = {"_jsr": jsr, "_zone": zone, "_m": machine, **expr_namespace(machine)}
         self.named: dict[tuple, str] = {}  # per-instruction objects, made once (a block compiled again reuses them)
         self.rung_elements: list = []
         self.current: Instruction | None = None
         self.inline_dest: str | None = None  # the local a word store writes (in_place)
+        self._locations: dict[int, object] = {}  # id(Address) -> Location, for direct addresses
 
     # -- emitting ------------------------------------------------------------------------
     def emit(self, indent: int, text: str) -> None:
         self.lines.append("    " * indent + text)
         self.line_instr.append(self.current)
         self.line_rung.append(self.rung_index)
+
+    def resolve(self, a):
+        """``table.resolve`` of a direct address, once per Address object
+        (the parser makes one per address text): load time."""
+        loc = self._locations.get(id(a))
+        if loc is None:
+            loc = self._locations[id(a)] = self.table.resolve(a)
+        return loc
 
     def bind(self, name: str, value: object) -> str:
         self.env[name] = value
@@ -101,7 +124,7 @@ class _FileCompiler:
         a = ref.address
         if not a.is_direct:
             return None
-        f, index, bit = self.table.resolve(a)
+        f, index, bit = self.resolve(a)
         name = self.word_at(ind, f, index)
         if name is None:
             return None
@@ -151,7 +174,7 @@ class _FileCompiler:
         barrier: the table is exact."""
         a = ref.address
         if a.is_direct:
-            f, index, bit = self.table.resolve(a)
+            f, index, bit = self.resolve(a)
             return self.array_name(f), repr(index), (repr(bit_mask(bit)) if bit is not None else None)
         k = self.temp
         self.temp += 1
@@ -164,7 +187,7 @@ class _FileCompiler:
             return repr(operand.value)
         a = operand.address
         if a.is_direct:
-            f, index, bit = self.table.resolve(a)
+            f, index, bit = self.resolve(a)
             name = self.words.get((f.number, index))
             if name is not None:  # held in a local (loaded at rung level before this instruction)
                 return name if bit is None else f"(1 if {name} & {bit_mask(bit)!r} else 0)"
@@ -185,7 +208,7 @@ class _FileCompiler:
         a = ref.address
         if not a.is_direct:
             return None
-        f, index, bit = self.table.resolve(a)
+        f, index, bit = self.resolve(a)
         return f"{self.array_name(f)}[{index!r}]", bit_mask(bit), False
 
     # -- rungs -------------------------------------------------------------------------------
@@ -294,7 +317,7 @@ class _FileCompiler:
             return
         inline = getattr(self, f"local_{m}", None)
         if inline is not None and all(isinstance(op, Const) or op.address.is_direct for op in ops) and \
-                self.table.resolve(ops[0].address).file.ftype.storage is Storage.WORD:
+                self.resolve(ops[0].address).file.ftype.storage is Storage.WORD:
             inline(ind, ins)  # on the element's words held in locals
             return
         dest = self.local_safe(ins)
@@ -336,7 +359,7 @@ class _FileCompiler:
             if _word_store(ins) and self.holdable(dest):
                 # A 16-bit result into a word: stored inline (i_MOV, i_CPT, _math2),
                 # into its local if held, else into the table.
-                f, index, _ = self.table.resolve(dest.address)
+                f, index, _ = self.resolve(dest.address)
                 self.inline_dest = self.words.get((f.number, index), "")
                 self.dispatch(ind, ins)
                 if self.inline_dest:
@@ -344,7 +367,7 @@ class _FileCompiler:
                 self.inline_dest = None
                 return
             self.mark_rung(ind)  # a store may set a minor fault (overflow)
-            f, index, _ = self.table.resolve(dest.address)
+            f, index, _ = self.resolve(dest.address)
             key = (f.number, index)
             name = self.words.get(key)
             if name is not None and name in self.dirty:
@@ -355,7 +378,7 @@ class _FileCompiler:
             self.dirty.discard(name)
 
     def holdable(self, ref: AddressRef) -> bool:
-        f = self.table.resolve(ref.address).file
+        f = self.resolve(ref.address).file
         return f.ftype.storage is Storage.WORD and f.ftype.letter != "S"
 
     def store_in_local(self, ind: int, dest, value_code: str, fallback: str, in_range: bool = False,
@@ -366,7 +389,7 @@ class _FileCompiler:
         overflow minor fault, and a held local reads it back. ``in_range``:
         the value is a word already (no range test)."""
         name = self.inline_dest
-        f, index, _ = self.table.resolve(dest.address)
+        f, index, _ = self.resolve(dest.address)
         target = name or f"{self.array_name(f)}[{index!r}]"
         if in_range and _SIMPLE.match(value_code):
             v = value_code  # a local or a constant: no temporary
@@ -759,7 +782,7 @@ class _FileCompiler:
     # -- timers, counters and COP on held words ------------------------------------------------------
     def element_words(self, ind: int, ref: AddressRef) -> list[str]:
         """The locals of a timer or counter element's three words (control, PRE, ACC)."""
-        f, index, _ = self.table.resolve(ref.address)
+        f, index, _ = self.resolve(ref.address)
         return [self.word_at(ind, f, index + k) for k in range(3)]
 
     def local_TON(self, ind: int, ins: Instruction) -> None:
@@ -811,8 +834,8 @@ class _FileCompiler:
         written back first; those of the destination are forgotten after.
         Anything else runs the kernel after a barrier."""
         src, dest, length = ins.operands
-        sf, si, _ = self.table.resolve(src.address)
-        df, di, _ = self.table.resolve(dest.address)
+        sf, si, _ = self.resolve(src.address)
+        df, di, _ = self.resolve(dest.address)
         n = length.value * dest.address.ftype.words_per_element
         if sf.data.typecode != df.data.typecode or si + n > len(sf.data) or di + n > len(df.data):
             self.barrier(ind)

@@ -23,7 +23,7 @@ from ..datatable.errors import AddressRangeError
 from ..datatable.table import to_signed
 from . import status as S
 from .ast import MAIN_FILE, AddressRef, Const, Instruction, Pos, Program, address_refs, walk
-from .compiler import RET, EndScan, compile_file, describe
+from .compiler import RET, EndScan, compile_file, describe, instructions_of
 from .resolvers import address_fault
 from .errors import LadderError
 from .instr import BOUND
@@ -116,17 +116,30 @@ def reference_program(program: Program, table: DataTable, problems: list | None 
         letter = "ST" if decl.file.startswith("ST") else decl.file[:1]
         with _located(decl.pos, problems):
             table.create_file(letter, int(decl.file[len(letter):]), decl.size)
+    seen: set[int] = set()  # ids of addresses referenced: the parser makes one Address per text
     for pfile in program.files.values():
         for rung in pfile.rungs:
-            for ins in walk(rung.elements):
-                with _located(ins.pos, problems):
-                    _reference_instruction(ins, table)
+            for ins in instructions_of(rung.elements):
+                try:
+                    _reference_instruction(ins, table, seen)
+                except DataTableError as e:  # (a try, not a with per instruction: load time)
+                    with _located(ins.pos, problems):
+                        raise e from None
 
 
-def _reference_instruction(ins, table: DataTable) -> None:
+def _reference_instruction(ins, table: DataTable, seen: set[int]) -> None:
     for op in ins.operands:
-        for ref in address_refs(op):
-            table.reference(ref.address)
+        if op.__class__ is AddressRef:
+            refs = (op,)
+        elif op.__class__ is Const:
+            continue
+        else:
+            refs = address_refs(op)
+        for ref in refs:
+            a = ref.address
+            if id(a) not in seen:
+                table.reference(a)
+                seen.add(id(a))
     bound = BOUND.get(ins.mnemonic)
     if bound is not None and bound.references is not None:
         for address in bound.references(ins):
@@ -139,6 +152,9 @@ def _reference_instruction(ins, table: DataTable) -> None:
                 # a COP source in another storage (F vs words) spans the same bytes
                 count = source_units(n, ref.address.ftype, dest.ftype)
                 table.reference(ref.address.with_element(ref.address.element + count - 1))
+
+
+_PRESET = frozenset({"TON", "TOF", "RTO", "CTU", "CTD"})
 
 
 def initial_values(program: Program, table: DataTable, problems: list | None = None) -> None:
@@ -155,8 +171,8 @@ def initial_values(program: Program, table: DataTable, problems: list | None = N
                     table.write(addr, v)
     for pfile in program.files.values():
         for rung in pfile.rungs:
-            for ins in walk(rung.elements):
-                if ins.mnemonic in ("TON", "TOF", "RTO", "CTU", "CTD") and ins.operands[0].address.is_direct:
+            for ins in instructions_of(rung.elements):
+                if ins.mnemonic in _PRESET and ins.operands[0].address.is_direct:
                     pre, acc = ins.operands[-2], ins.operands[-1]
                     with _located(ins.pos, problems):
                         table.write(ins.operands[0].address, {"PRE": pre.value, "ACC": acc.value})
@@ -229,14 +245,24 @@ class Engine:
         fresh: bool = True,
         modules=(),
         module_options=None,
+        code: dict | None = None,
     ) -> None:
+        """``code``: the program files' compiled code from the code cache
+        (ladder/codecache.py), used instead of compiling them."""
         self.program = program
         self.modules = list(modules)  # enabled TLMs (softplc_lite.tlm.TLM)
         self.table = table if table is not None else DataTable()
         self.settings = settings or Settings()
         self.clock = clock or SimulatedClock(self.settings.scan_ms)
         self.executor = executor
-        reference_program(program, self.table)
+        if code is not None and executor != "compiled":
+            code = None
+        if code is not None:
+            from .codecache import apply_layout
+
+            apply_layout(self.table, code["layout"])  # what reference_program made when it was cached
+        else:
+            reference_program(program, self.table)
         if fresh:
             initial_values(program, self.table)
         self.machine = Machine(self.table, self.settings)
@@ -263,6 +289,11 @@ class Engine:
         self._attach_hooks()
         self.files = {}
         build = compile_file if executor == "compiled" else interpret_file
+        if code is not None:
+            from .codecache import import_file as build_cached
+
+            def build(program, number, *args, build_cached=build_cached):
+                return build_cached(code["files"][number], program, number, *args)
         for number in sorted(program.files):
             zone = [True]
             self.files[number] = (build(program, number, self.table, self.machine, self._jsr, zone,

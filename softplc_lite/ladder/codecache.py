@@ -1,0 +1,296 @@
+"""The code cache (issue 17): a program loaded before loads without being
+parsed, validated or compiled again.
+
+An app's cache is one file, ``APP/.softplc/codecache.bin``, beside the
+retentive snapshot. It holds, under a key, the validated program (as plain
+data, ladder/treecodec.py), the warnings its checks gave, and each program
+file's compiled blocks: their code objects (``marshal``), line tables (as
+rung and instruction numbers), and a recipe for every name the code uses
+(a data file's array, a kernel, a bound or module instruction, a resolver),
+from which the names are bound again to this run's table and machine.
+
+The key is a SHA-256 of everything the cached result depends on: the text
+of every program file and of the settings and module config files, the
+module set (names and versions), softplc_lite's version, and Python's
+version and marshal format (code objects are only valid in the Python that
+made them). Any change of any of them is a different key: the cache is
+rebuilt, never used stale. A cache file that cannot be read, does not
+match, or is damaged is ignored (and replaced by the next successful
+load); it never stops a run. docs/performance.md, "Code cache".
+"""
+
+from __future__ import annotations
+
+import hashlib
+import marshal
+import os
+import sys
+from pathlib import Path
+
+from ..gcpause import gc_paused
+from . import treecodec
+from .ast import AddressRef, Program, address_refs
+from .blocks import CompiledFile, LineTable, run_block
+from .compiler import instructions_of
+
+CACHE_FILE = "codecache.bin"
+FORMAT = 1  # of the cache file; part of the key
+
+
+def softplc_version() -> str:
+    try:
+        from importlib.metadata import version
+
+        return version("softplc_lite")
+    except Exception:  # an uninstalled tree: the package's own files decide
+        return "unknown"
+
+
+def cache_key(parts) -> str:
+    """The key of ``parts`` (name, text or bytes) with the versions that
+    make compiled code valid."""
+    h = hashlib.sha256()
+    for item in (f"format {FORMAT}", f"softplc_lite {softplc_version()}", sys.version,
+                 f"marshal {marshal.version}", sys.implementation.cache_tag or ""):
+        h.update(item.encode() + b"\0")
+    for name, data in parts:
+        data = data.encode("utf-8", "surrogatepass") if isinstance(data, str) else data
+        h.update(f"{name}\0{len(data)}\0".encode() + data)
+    return h.hexdigest()
+
+
+# -- what a compiled file becomes in the cache ------------------------------------------------
+
+
+def _locators(rungs) -> dict[int, tuple]:
+    """id(node) -> (rung, instruction number in walk order[, address number])."""
+    out: dict[int, tuple] = {}
+    for k, rung in enumerate(rungs):
+        for i, ins in enumerate(instructions_of(rung.elements)):
+            out[id(ins)] = (k, i)
+            j = 0
+            for op in ins.operands:
+                for ref in address_refs(op):
+                    out.setdefault(id(ref), (k, i, j))
+                    j += 1
+    return out
+
+
+class _Nodes:
+    """Locator -> node of one program file (each rung walked once, when asked)."""
+
+    def __init__(self, rungs) -> None:
+        self.rungs = rungs
+        self.walked: dict[int, list] = {}
+
+    def instruction(self, k: int, i: int):
+        ins = self.walked.get(k)
+        if ins is None:
+            ins = self.walked[k] = instructions_of(self.rungs[k].elements)
+        return ins[i]
+
+    def __call__(self, loc):
+        ins = self.instruction(loc[0], loc[1])
+        if len(loc) == 2:
+            return ins
+        refs = [ref for op in ins.operands for ref in address_refs(op)]
+        return refs[loc[2]]
+
+
+def export_file(compiled: CompiledFile, rungs, machine, table) -> tuple | None:
+    """The cache's form of a compiled file, or None when some name in its
+    code cannot be bound again from a recipe (then nothing is cached)."""
+    from .expr import namespace
+    from .semantics import lim
+    from . import compiler as C
+
+    fc = compiled.compiler
+    loc = _locators(rungs)
+    named = {name: (kind, key_id) for (key_id, kind), name in fc.named.items() if kind != "call"}
+    functions = {"_lim": lim, "_block_check": C._block_check}
+    expr_names = set(namespace(machine))
+    arrays = {id(f.data): f.number for f in table.files()}
+    recipe = {}
+    for name, value in fc.env.items():
+        if name in named:
+            kind, key_id = named[name]
+            if key_id not in loc:
+                return None
+            recipe[name] = (kind, loc[key_id])
+        elif name in ("_jsr", "_zone", "_m"):
+            recipe[name] = (name,)
+        elif name in expr_names:
+            recipe[name] = ("expr",)
+        elif name == "_calls":
+            if any(id(ins) not in loc for ins in value):
+                return None
+            recipe[name] = ("calls", tuple(loc[id(ins)] for ins in value))
+        elif id(value) in arrays:
+            recipe[name] = ("array", arrays[id(value)])
+        elif getattr(value, "__self__", None) is machine:
+            recipe[name] = ("machine", value.__name__)
+        elif functions.get(name) is value:
+            recipe[name] = ("function",)
+        else:
+            return None
+    blocks = []
+    bounds = compiled.starts + [compiled.rung_count]
+    for k, module in enumerate(compiled.modules):
+        name = module.co_filename
+        t = compiled.tables[name]
+        if isinstance(t, _CachedLines):
+            lines = tuple(t.locators)
+        else:
+            lines = tuple(None if ins is None else loc[id(ins)] for ins in t.instr)
+        blocks.append((bounds[k], bounds[k + 1], name, module, lines, tuple(t.rung)))
+    return (compiled.rung_count, compiled.has_mcr, tuple(blocks), recipe)
+
+
+def import_file(data: tuple, program: Program, number: int, table, machine, jsr, zone,
+                module_instance=None) -> CompiledFile:
+    """A compiled file from its cached form, its names bound to this run's
+    table, machine and instructions."""
+    from .bound import BoundAccess
+    from .expr import namespace
+    from .instr import BOUND
+    from .resolvers import resolver
+    from .semantics import lim
+    from . import compiler as C
+
+    rung_count, has_mcr, blocks, recipe = data
+    rungs = program.files[number].rungs
+    node = _Nodes(rungs)
+    expr = namespace(machine)
+    functions = {"_lim": lim, "_block_check": C._block_check}
+    env: dict[str, object] = {}
+    named: dict[tuple, str] = {}
+    for name, (kind, *args) in recipe.items():
+        if kind == "_jsr":
+            env[name] = jsr
+        elif kind == "_zone":
+            env[name] = zone
+        elif kind == "_m":
+            env[name] = machine
+        elif kind == "expr":
+            env[name] = expr[name]
+        elif kind == "array":
+            env[name] = table.file(args[0]).data
+        elif kind == "machine":
+            env[name] = getattr(machine, args[0])
+        elif kind == "function":
+            env[name] = functions[name]
+        elif kind == "calls":
+            calls = [node(loc) for loc in args[0]]
+            env[name] = calls
+            for k, ins in enumerate(calls):
+                named[(id(ins), "call")] = f"_calls[{k}]"
+        else:
+            target = node(args[0])
+            named[(id(target), kind)] = name
+            if kind == "bi":
+                env[name] = BOUND[target.mnemonic].bind(target, BoundAccess(table, machine))
+            elif kind == "tli":
+                env[name] = module_instance(target)
+            elif kind == "loc":
+                env[name] = resolver(table, target.address)
+            else:
+                raise ValueError(f"unknown recipe {kind}")
+
+    def make_compiler():
+        fc = C._FileCompiler(table, machine, number, rungs, zone, jsr, module_instance)
+        fc.env, fc.named = env, named  # the same objects the cached code uses
+        return fc
+
+    cf = CompiledFile(number, rung_count, has_mcr, make_compiler)
+    for first, end, name, module, lines, line_rungs in blocks:
+        fn = run_block(module, env)
+        cf.add_compiled(fn, first, name, module, _CachedLines(lines, line_rungs, node))
+    return cf
+
+
+class _CachedLines(LineTable):
+    """A cached block's line table: instruction locators, turned into the
+    instructions when a fault asks (most runs never do)."""
+
+    __slots__ = ("locators", "node")
+
+    def __init__(self, locators, rungs, node) -> None:
+        self.locators, self.node = locators, node
+        self.rung = rungs
+        self.instr = None
+
+    def at(self, lineno: int):
+        if self.instr is None:
+            self.instr = [None if loc is None else self.node(loc) for loc in self.locators]
+        return LineTable.at(self, lineno)
+
+
+# -- the file ----------------------------------------------------------------------------------
+
+
+class CodeCache:
+    """One app's cache file. ``load`` and ``save`` never raise for a
+    problem with the file: a cache is an optimisation."""
+
+    def __init__(self, directory: str | Path) -> None:
+        self.path = Path(directory) / CACHE_FILE
+        self.problem: str | None = None  # why the last load or save did not use the file
+
+    @gc_paused
+    def load(self, key: str) -> tuple[Program, list, dict] | None:
+        """(program, warnings, compiled files' data) cached under ``key``, or None."""
+        try:
+            blob = self.path.read_bytes()
+        except FileNotFoundError:
+            return None
+        except OSError as e:
+            self.problem = f"{self.path}: {e.strerror or e}"
+            return None
+        try:
+            stored_key, tree, extra, warnings, files = marshal.loads(blob)
+            if stored_key != key:
+                return None
+            return treecodec.decode(tree, extra), list(warnings), files
+        except Exception as e:  # damaged, truncated, another format: rebuilt by the next save
+            self.problem = f"{self.path}: unreadable code cache ({type(e).__name__}), rebuilt"
+            return None
+
+    @gc_paused
+    def save(self, key: str, program: Program, warnings: list, files: dict) -> bool:
+        try:
+            tree, extra = treecodec.encode(program)
+            blob = marshal.dumps((key, tree, extra, tuple(warnings), files))
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = self.path.with_name(self.path.name + ".tmp")
+            tmp.write_bytes(blob)
+            os.replace(tmp, self.path)
+            return True
+        except Exception as e:  # unwritable state directory, a tree the codec does not take: no cache
+            self.problem = f"{self.path}: code cache not written ({type(e).__name__}: {e})"
+            return False
+
+
+def export_engine(engine) -> dict | None:
+    """A compiled engine's code in the cache's form (every program file, and
+    the data table's layout the program makes), or None. Call it on a new
+    engine, before a table is restored into it."""
+    files = {}
+    for number, (compiled, _) in engine.files.items():
+        if not isinstance(compiled, CompiledFile):
+            return None
+        data = export_file(compiled, engine.program.files[number].rungs, engine.machine, engine.table)
+        if data is None:
+            return None
+        files[number] = data
+    layout = tuple((f.ftype.letter, f.number, f.size) for f in engine.table.files())
+    return {"files": files, "layout": layout}
+
+
+def apply_layout(table, layout) -> None:
+    """Create and grow the table's files as the program's references did
+    (Engine: reference_program) when the code was cached."""
+    for letter, number, size in layout:
+        table.create_file(letter, number, size)
+
+
+__all__ = ["CodeCache", "cache_key", "export_engine", "import_file", "AddressRef"]
