@@ -22,6 +22,11 @@ import bisect
 import re
 from dataclasses import dataclass
 
+# What a block function returns besides None (ran to its end) and a rung
+# index (a JMP): the RET and TND of the file.
+RET = -1
+TND = -2
+
 # Rungs per block (at most). Bigger blocks load a few more words than they
 # use per rung; smaller ones pay the call more often. CPython compiles one
 # huge function body several times slower than the same code in pieces.
