@@ -24,7 +24,10 @@ A link is forgotten when its ports are closed, so its name can be reused.
 The device side is "pumped" whenever its port end is used (``read``,
 ``available``, ``write``, ``pending``): every byte that has arrived at the
 device by the port's clock is handed to ``device.receive(data, times_ns)``,
-then ``device.poll(now_ns)`` runs. A device answers with
+then ``device.poll(now_ns)`` runs. A polling driver's read
+(``PortEnd.read_arrived``) leaves out a pump that could do nothing: while
+nothing is on its way to the device and its ``next_due`` is later, and while
+the whole link is quiet (``Link.quiet_until``). A device answers with
 ``DeviceEnd.send(data, at_ns)``, timed from ``at_ns`` even when that is
 already in the past of the port's clock (turnaround is exact, not rounded up
 to when the port next looks).
