@@ -319,7 +319,7 @@ class ControlledInstruction:
         # A direct CONTROL address is bound once (BoundOperand): its word and
         # its ControlElement are kept, so a scan's call allocates and looks up
         # nothing (issue 17). An indirect one is resolved at every call.
-        location = control._location
+        location = getattr(control, "_location", None)  # None: resolved at every call (location())
         self._d = location[0] if location is not None else None
         self._i = location[1] if location is not None else 0
         self._ctl = ControlElement(self._d, self._i) if location is not None else None
