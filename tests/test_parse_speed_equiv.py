@@ -134,3 +134,38 @@ def test_a_syntax_error_is_lark_s_with_every_problem_found_before_it_once():
     assert [(p.pos.line, p.pos.column) for p in problems] == [(1, 5), (2, 19)]
     assert "out of range" in problems[0].message and "unexpected ';'" in problems[1].message
     assert problems[1].context and "^" in problems[1].context
+
+
+def test_a_mnemonic_rung_skips_limit_problem_only_when_nothing_can_be_over_a_limit():
+    # parser._group tells limit_problem's work is needed from the branch
+    # depth and the expressions it saw; at and past each limit it is asked.
+    from softplc_lite.ladder.instructions import BUILTIN
+    from softplc_lite.ladder.limits import (
+        MAX_BRANCH_DEPTH,
+        MAX_EXPRESSION_DEPTH,
+        limit_problem,
+    )
+
+    def grouped(text):
+        tokens = parser._ast_parser().parse(text + "\n", start="start")[0].tokens
+        return parser._group(tokens, BUILTIN, Pos("t.lad", 1, 1), {})
+
+    def nested(depth):
+        return "XIC B3/0 " + "BST XIC B3/1 NXB " * depth + "OTE B3/2 " + "BND " * depth
+
+    for depth in (0, 1, MAX_BRANCH_DEPTH - 1, MAX_BRANCH_DEPTH):
+        elements, check = grouped(nested(depth))
+        assert not check and limit_problem(elements) is None
+    elements, check = grouped(nested(MAX_BRANCH_DEPTH + 1))
+    assert check and "branches nested" in limit_problem(elements)[1]
+    # An expression (CPT's, parsed by parse_expression, which refuses one
+    # past MAX_EXPRESSION_DEPTH itself) is always handed to limit_problem.
+    elements, check = grouped('CPT N7:0 "' + "ABS(" * MAX_EXPRESSION_DEPTH + "N7:1" + ")" * MAX_EXPRESSION_DEPTH + '"')
+    assert check and limit_problem(elements) is None
+    for name, text in corpus():
+        for line in text.splitlines():
+            try:
+                elements, check = grouped(line)
+            except Exception:  # not a mnemonic rung, or a problem of its own
+                continue
+            assert check or limit_problem(elements) is None, (name, line)
