@@ -164,8 +164,19 @@ def test_a_mnemonic_rung_skips_limit_problem_only_when_nothing_can_be_over_a_lim
     assert check and limit_problem(elements) is None
     for name, text in corpus():
         for line in text.splitlines():
-            try:
-                elements, check = grouped(line)
-            except Exception:  # not a mnemonic rung, or a problem of its own
-                continue
-            assert check or limit_problem(elements) is None, (name, line)
+            result = grouped_or_none(line)
+            assert result is None or result[1] or limit_problem(result[0]) is None, (name, line)
+
+
+def grouped_or_none(line: str):
+    """_group's answer for a one-line mnemonic rung; None for any other line
+    (a line of a multi-line rung, a directive, one with a problem)."""
+    from lark.exceptions import UnexpectedInput
+
+    from softplc_lite.ladder.instructions import BUILTIN
+
+    try:
+        drafts = [i for i in parser._ast_parser().parse(line + "\n", start="start") if getattr(i, "tokens", None)]
+        return parser._group(drafts[0].tokens, BUILTIN, drafts[0].pos, {}) if drafts else None
+    except (UnexpectedInput, LadderError):
+        return None
