@@ -62,6 +62,9 @@ IN_BITS = [f"I:0/{b:o}" for b in range(16)]
 N7_BITS = [f"N7:{e}/{b}" for e in range(10) for b in (0, 1, 2, 7, 15)]
 TIMER_BITS = [f"T4:{k}/{b}" for k in range(4) for b in ("EN", "TT", "DN")]
 COUNTER_BITS = [f"C5:{k}/{b}" for k in range(4) for b in ("CU", "CD", "DN", "OV", "UN")]
+# The arithmetic flags (carry, overflow, zero, sign), which math sets and the
+# compiled code may hold in a local (issue 17).
+STATUS_BITS = [f"S:0/{b}" for b in range(4)]
 STRUCT_WORDS = [f"T4:{k}.{m}" for k in range(4) for m in ("PRE", "ACC")] + [
     f"C5:{k}.{m}" for k in range(4) for m in ("PRE", "ACC")]
 B3_WORDS = [f"B3:{k}" for k in range(4)]
@@ -141,7 +144,7 @@ class Gen:
         return f"N7:[N7:{self.int(0, 3)}]" if self.chance(2) else f"N7:[{self._idx()}]"
 
     def bit_read(self):
-        pool = self.pick([B3_BITS, IN_BITS, OUT_BITS, N7_BITS, TIMER_BITS, COUNTER_BITS])
+        pool = self.pick([B3_BITS, IN_BITS, OUT_BITS, N7_BITS, TIMER_BITS, COUNTER_BITS, STATUS_BITS])
         return self._operand("bit", pool, self._indirect_bit)
 
     def bit_write(self):

@@ -16,7 +16,7 @@ from softplc_lite.datatable.display import format_read
 from softplc_lite.datatable.errors import AddressError, DataTableError
 from softplc_lite.ladder import load_text, run_text
 from softplc_lite.ladder.ast import AddressRef
-from softplc_lite.ladder.compiler import _is_word
+from softplc_lite.ladder.held_words import _is_word
 from softplc_lite.ladder.errors import LadderError, ProgramErrors
 from softplc_lite.ladder.semantics import Settings
 from softplc_lite.watch.rungs import RungView

@@ -444,3 +444,17 @@ def leaves(operand):
 def address_refs(operand):
     """The addresses an operand or expression reads, left to right."""
     return (leaf for leaf in leaves(operand) if isinstance(leaf, AddressRef))
+
+
+def instructions_of(elements, out: list | None = None) -> list:
+    """Every instruction of ``elements`` (branches opened), in scan order:
+    ast.walk as a list, several times faster on a big program's load."""
+    if out is None:
+        out = []
+    for el in elements:
+        if el.__class__ is Instruction:
+            out.append(el)
+        else:
+            for leg in el.legs:
+                instructions_of(leg, out)
+    return out

@@ -22,11 +22,13 @@ messages.
 
 from __future__ import annotations
 
+from collections import Counter
+
 from ..gcpause import gc_paused
 from ..datatable import DataTable, ValueKind, bit_mask
 from ..datatable.filetypes import Storage
 from . import blocks
-from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, walk
+from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, instructions_of, walk  # noqa: F401 (instructions_of: imported from here too)
 from .blocks import RET, TND, BlockCode, CompiledFile  # noqa: F401 (RET, TND: the block protocol, imported from here)
 from .held_words import _BIT_OPS, _NO_BARRIER, HeldWords
 from .templates import _COMPARE, _block_check, TableTemplates  # noqa: F401 (_block_check: the code cache binds it)
@@ -41,20 +43,6 @@ from .semantics import Machine
 class EndScan(Exception):
     """TND: end this scan now. Control flow, not an error: it passes up
     through JSR calls (both executors) to the engine."""
-
-
-def instructions_of(elements, out: list | None = None) -> list:
-    """Every instruction of ``elements`` (branches opened), in scan order:
-    ast.walk as a list, several times faster on a big program's load."""
-    if out is None:
-        out = []
-    for el in elements:
-        if el.__class__ is Instruction:
-            out.append(el)
-        else:
-            for leg in el.legs:
-                instructions_of(leg, out)
-    return out
 
 
 def describe(instr: Instruction) -> str:
@@ -78,6 +66,8 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.rung_elements: list = []
         self.current: Instruction | None = None
         self.inline_dest: str | None = None  # the local a word store writes (in_place)
+        self.inline_flags: str | None = None  # the local holding S:0, if held, for that store
+        self.uses: Counter = Counter()  # how often the block being compiled addresses each word
         self._locations: dict[int, object] = {}  # id(Address) -> Location, for direct addresses
 
     # -- emitting ------------------------------------------------------------------------
@@ -298,9 +288,12 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.emit(ind, f"c = {self.named[key]}(c)")
 
     # -- blocks -----------------------------------------------------------------------------------
-    def block(self, first: int, end: int) -> BlockCode:
-        """The code of one block function over rungs first..end-1."""
+    def block(self, first: int, end: int, words=None) -> BlockCode:
+        """The code of one block function over rungs first..end-1
+        (``words``: each rung's rung_words, when known)."""
         self.begin_block(first)
+        self.uses = Counter(key for k in range(first, end)
+                            for key in (words[k] if words is not None else self.rung_words(k)))
         for k in range(first, end):
             self.rung(k, self.rungs[k])
         return self.end_block(end)
@@ -337,17 +330,17 @@ class _FileCompiler(HeldWords, TableTemplates):
         # local by local.
         labels = set(self.labels.values())
         count = len(self.rungs)
+        words = [self.rung_words(k) for k in range(count)]
         k = 0
         while k < count:
             first = k
-            self.begin_block(first)
-            self.rung(k, self.rungs[k])
+            distinct = set(words[k])
             k += 1
             while k < count and k not in labels and k - first < blocks.CHUNK_RUNGS and \
-                    len(self.local_names) < blocks.LOCALS_BUDGET:
-                self.rung(k, self.rungs[k])
+                    len(distinct) < blocks.LOCALS_BUDGET:
+                distinct.update(words[k])
                 k += 1
-            cf.add(self.end_block(k))
+            cf.add(self.block(first, k, words))
         self.lines = self.line_instr = self.line_rung = None  # the code is compiled: keep no text
         return cf
 

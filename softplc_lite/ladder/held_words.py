@@ -14,7 +14,7 @@ import re
 
 from ..datatable import bit_mask
 from ..datatable.filetypes import Storage
-from .ast import AddressRef, BinOp, Const, Instruction, UnaryOp, address_refs
+from .ast import AddressRef, BinOp, Const, Instruction, UnaryOp, address_refs, instructions_of
 from .semantics import BASE_MS, CD, CU, DN, EN, OV, STAMP, STAMP_MODULO, TT, UN
 
 
@@ -37,21 +37,44 @@ class HeldWords:
             return None
         return name, (bit_mask(bit) if bit is not None else None)
 
-    def word_at(self, ind: int, f, index: int) -> str | None:
+    def word_at(self, ind: int, f, index: int, force: bool = False) -> str | None:
         """The local holding word ``index`` of file ``f`` (loaded now if not
-        held), or None if no local may hold that file's words."""
-        if f.ftype.storage is not Storage.WORD or f.ftype.letter == "S":
-            return None
+        held), or None if no local may hold that file's words, or (unless
+        ``force``) the block uses the word only once: a local would cost a
+        load and a write-back for one use, the table in place costs neither."""
+        if f.ftype.storage is not Storage.WORD or (f.ftype.letter == "S" and index != 0):
+            return None  # S:0 (the math flags) may be held; S words kernels and the engine write, not
         key = (f.number, index)
         name = self.words.get(key)
         if name is None:
+            if not force and self.uses.get(key, 0) < 2:
+                return None
             name = self.words[key] = f"w{f.number}_{index}"
             self.local_names.add(name)
             self.emit(ind, f"{name} = {self.array_name(f)}[{index!r}]")
         return name
 
-    def mark_written(self, key_name: str) -> None:
-        self.dirty.add(key_name)
+    def rung_words(self, k: int) -> list[tuple[int, int]]:
+        """The words rung ``k`` addresses directly that a local could hold,
+        once per use (a timer's or counter's three words count twice: its
+        code uses them more than once)."""
+        out: list[tuple[int, int]] = []
+        for ins in instructions_of(self.rungs[k].elements):
+            element = ins.mnemonic in ("TON", "CTU", "CTD")
+            for op in ins.operands:
+                for ref in address_refs(op):
+                    a = ref.address
+                    if not a.is_direct:
+                        continue
+                    f, index, _ = self.resolve(a)
+                    if f.ftype.storage is Storage.WORD and (f.ftype.letter != "S" or index == 0):
+                        if element:
+                            out += [(f.number, index + j) for j in (0, 0, 1, 1, 2, 2)]
+                        else:
+                            out.append((f.number, index))
+            if _word_store(ins):
+                out.append(_FLAGS)  # it sets S:0's arithmetic flags
+        return out
 
     def flush_lines(self, ind: int) -> None:
         """Write back every local a rung may have changed."""
@@ -100,32 +123,42 @@ class HeldWords:
             if op is not dest:
                 for ref in address_refs(op):
                     self.word_local(ind, ref)
-        name = None
+        forget = []
         if dest is not None:
             if _word_store(ins) and self.holdable(dest):
                 # A 16-bit result into a word: stored inline (i_MOV, i_CPT, _math2),
-                # into its local if held, else into the table.
+                # into its local if held, else into the table; S:0 likewise.
                 f, index, _ = self.resolve(dest.address)
                 self.inline_dest = self.words.get((f.number, index), "")
+                self.inline_flags = self.word_at(ind, self.status_file, 0) or ""
                 self.dispatch(ind, ins)
-                if self.inline_dest:
-                    self.dirty.add(self.inline_dest)
-                self.inline_dest = None
+                for name in (self.inline_dest, self.inline_flags):
+                    if name:
+                        self.dirty.add(name)
+                self.inline_dest = self.inline_flags = None
                 return
             self.mark_rung(ind)  # a store may set a minor fault (overflow)
+            # Its kernel writes the destination and S:0 in the table: held, they
+            # are written back first and forgotten after.
             f, index, _ = self.resolve(dest.address)
-            key = (f.number, index)
-            name = self.words.get(key)
-            if name is not None and name in self.dirty:
-                self.emit(ind, f"f{f.number}[{index!r}] = {name}")
+            for key in ((f.number, index), _FLAGS):
+                name = self.words.get(key)
+                if name is not None:
+                    if name in self.dirty:
+                        self.emit(ind, f"f{key[0]}[{key[1]!r}] = {name}")
+                    forget.append((key, name))
         self.dispatch(ind, ins)
-        if name is not None:
-            del self.words[key]
+        for key, name in forget:
+            self.words.pop(key, None)
             self.dirty.discard(name)
 
     def holdable(self, ref: AddressRef) -> bool:
         f = self.resolve(ref.address).file
         return f.ftype.storage is Storage.WORD and f.ftype.letter != "S"
+
+    @property
+    def status_file(self):
+        return self.table.file(_FLAGS[0])
 
     def store_in_local(self, ind: int, dest, value_code: str, fallback: str, in_range: bool = False,
                        carry: str | None = None) -> None:
@@ -137,26 +170,31 @@ class HeldWords:
         name = self.inline_dest
         f, index, _ = self.resolve(dest.address)
         target = name or f"{self.array_name(f)}[{index!r}]"
+        s0 = self.inline_flags or "_s[0]"
         if in_range and _SIMPLE.match(value_code):
             v = value_code  # a local or a constant: no temporary
         else:
             v = "_v"
             self.emit(ind, f"_v = {value_code}")
-        flags = f"(({v} == 0) << 2) | (({v} < 0) << 3)"
+        flags = f"(4 if {v} == 0 else 8 if {v} < 0 else 0)"  # Z S:0/2, S S:0/3
         if carry is not None:
             flags = f"({carry}) | {flags}"
         if in_range:
             self.emit(ind, f"{target} = {v}")
-            self.emit(ind, f"_s[0] = (_s[0] & -16) | {flags}")
+            self.emit(ind, f"{s0} = ({s0} & -16) | {flags}")
             return
         self.emit(ind, "if -32768 <= _v <= 32767:")
         self.emit(ind + 1, f"{target} = _v")
-        self.emit(ind + 1, f"_s[0] = (_s[0] & -16) | {flags}")
+        self.emit(ind + 1, f"{s0} = ({s0} & -16) | {flags}")
         self.emit(ind, "else:")
         self.emit(ind + 1, f"_m.rung = {self.rung_index!r}")  # the minor fault names this rung
+        if self.inline_flags:  # the kernel sets S:0 in the table
+            self.emit(ind + 1, f"_s[0] = {s0}")
         self.emit(ind + 1, fallback.replace("_D_", f"{self.array_name(f)}, {index!r}"))
         if name:
             self.emit(ind + 1, f"{name} = f{f.number}[{index!r}]")
+        if self.inline_flags:
+            self.emit(ind + 1, f"{s0} = _s[0]")
 
     # Bit instructions on words held in locals (or S words in place): each
     # operand is (word code, mask, held in a local).
@@ -208,7 +246,7 @@ class HeldWords:
     def element_words(self, ind: int, ref: AddressRef) -> list[str]:
         """The locals of a timer or counter element's three words (control, PRE, ACC)."""
         f, index, _ = self.resolve(ref.address)
-        return [self.word_at(ind, f, index + k) for k in range(3)]
+        return [self.word_at(ind, f, index + k, force=True) for k in range(3)]
 
     def local_TON(self, ind: int, ins: Instruction) -> None:
         """Semantics.ton written out on the element's locals (the kernel is
@@ -217,13 +255,15 @@ class HeldWords:
         wc, wp, wa = self.element_words(ind, ins.operands[0])
         base = BASE_MS[ins.operands[1].value]
         self.uses_now = True
-        self.emit(ind, f"if {wp} < 0 or {wa} < 0:")  # the kernel raises the fault, on an exact table
+        self.emit(ind, f"if ({wp} | {wa}) < 0:")  # either negative: the kernel raises the fault, on an exact table
         self.flush_lines(ind + 1)
         d, i, _ = self.location(ind + 1, ins.operands[0])
         self.emit(ind + 1, f"{self.bind('_ton', self.machine.ton)}({d}, {i}, c, {base!r})")
         self.emit(ind, "if c:")
         self.emit(ind + 1, f"if {wc} & {EN!r} and {wa} < {wp}:")
-        self.emit(ind + 2, f"_t, _r = divmod((_now - ({wc} & {STAMP!r})) % {STAMP_MODULO!r}, {base!r})")
+        self.emit(ind + 2, f"_r = (_now - ({wc} & {STAMP!r})) % {STAMP_MODULO!r}")  # ms since its last update
+        self.emit(ind + 2, f"_t = _r // {base!r}")
+        self.emit(ind + 2, f"_r -= _t * {base!r}")
         self.emit(ind + 2, f"{wa} += _t")
         self.emit(ind + 2, f"if {wa} >= {wp}: {wa} = {wp}; _r = 0")
         self.emit(ind + 2, f"{wc} = ({wc} & {~STAMP!r}) | ((_now - _r) & {STAMP!r}) | {EN!r}")
@@ -315,6 +355,10 @@ _LOCAL_SAFE = {
     "AND": 2, "OR": 2, "XOR": 2, "NOT": 1, "MVM": 2, "CPT": 0,
 }
 
+
+# S:0, the arithmetic flags word: held in a local like a data word (the
+# kernels that set it are called with it written back, and read it after).
+_FLAGS = (2, 0)
 
 _SIMPLE = re.compile(r"^(w\d+_\d+|-?\d+)$")
 

@@ -119,8 +119,8 @@ class TableTemplates:
         if self.inline_dest is not None:  # ADD/SUB of words into a held word (in_place)
             self.bind("_s", self.machine.s)
             fn = self.bind(f"_{kernel}", getattr(self.machine, kernel))
-            symbol, carry = ("+", f"({a} & 65535) + ({b} & 65535) > 65535") if kernel == "add" else \
-                ("-", f"({a} & 65535) < ({b} & 65535)")
+            a16, b16 = (repr(int(x) & 65535) if x.lstrip("-").isdigit() else f"({x} & 65535)" for x in (a, b))
+            symbol, carry = ("+", f"{a16} + {b16} > 65535") if kernel == "add" else ("-", f"{a16} < {b16}")
             self.store_in_local(ind + 1, ops[2], f"{a} {symbol} {b}", f"{fn}({a}, {b}, _D_)", carry=carry)
             return
         d, i, _ = self.location(ind + 1, ops[2])
