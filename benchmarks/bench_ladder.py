@@ -371,7 +371,7 @@ def section_load_memory(figures: dict, program_file: Path, rungs: int, runs: int
               f"CPU {load['total_cpu_s']:.2f} s (best {load['total_cpu_best_s']:.2f}) [{load['verdict']} <= "
               f"{TARGET_LOAD_S} s, on CPU time]; wall parse {load['parse_s']:.2f} + validate {load['validate_s']:.2f} "
               f"+ compile {load['compile_s']:.2f} = {load['total_s']:.2f} s (best {load['total_best_s']:.2f}); "
-              f"parser set-up before it {load['parser_setup_s']:.2f} s")
+              f"a one-rung load before it (imports, parser tables) {load['parser_setup_s']:.2f} s")
         warm = load["warm"]
         if warm is None:
             print(f"warm load (code cache): not measured (no code cache in this tree) [target <= {TARGET_WARM_LOAD_S} s]")
