@@ -138,3 +138,21 @@ def test_instructions_branches_and_rungs_can_be_changed_in_place():
     instr.pos = Pos("b", 2, 3)
     instr.mnemonic = "XIO"
     assert instr == Instruction("XIO", [SymbolRef("Go")]) and str(instr.pos) == "b:2:3"
+
+
+def test_validate_shares_a_tree_already_in_validated_form():
+    """A tree of tuples with nothing to resolve (as a parser building
+    tuples would give) is kept, not copied; one with symbols is copied."""
+    b0, b1 = AddressRef(parse_address("B3/0"), Pos("t", 1, 5)), AddressRef(parse_address("B3/1"), Pos("t", 1, 30))
+    xic = Instruction("XIC", (b0,), Pos("t", 1, 1))
+    branch = Branch(((xic,), (Instruction("XIO", (b1,), Pos("t", 1, 20)),)), Pos("t", 1, 10))
+    ote = Instruction("OTE", (b1,), Pos("t", 1, 40))
+    parsed = parse_program("XIC B3/0 OTE B3/1\n")
+    parsed.main.rungs[:] = [Rung((branch, ote), None, Pos("t", 1, 1))]
+    rung = validate(parsed).main.rungs[0]
+    assert rung is parsed.main.rungs[0]
+    with_symbol = parse_program("SYMBOL Go B3/7\nXIC Go OTE B3/1\n")
+    validated = validate(with_symbol).main.rungs[0]
+    assert validated is not with_symbol.main.rungs[0]
+    assert validated.elements[0].operands == (AddressRef(parse_address("B3/7")),)
+    assert str(validated.elements[0].operands[0].pos) == "<program>:2:5"

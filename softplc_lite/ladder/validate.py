@@ -10,6 +10,7 @@ constants and expression trees.
 
 from __future__ import annotations
 
+import operator
 from dataclasses import replace
 
 from ..gcpause import gc_paused
@@ -344,7 +345,7 @@ class _Checker:
             if operands[0].value not in labels:
                 self.error(_pos(operands[0]), f"JMP to label {operands[0].value}, which is not in program file {file_number}")
         if not changed and instr.mnemonic is plan.mnemonic and type(instr.operands) is tuple:
-            return instr  # already in its validated form: the validated tree shares it
+            return instr  # already in validated form, the spec's mnemonic string included: kept
         return instr.copy_with(plan.mnemonic, operands)
 
     def jsr_parameters(self, instr: Instruction, operands: list, target: int) -> None:
@@ -398,7 +399,8 @@ class _Checker:
                depth: int = 0) -> tuple[Element, ...]:
         """The validated series (``depth``: branches around it). Raises
         _OverLimit past the language's limits (limits.py), checked on the
-        way rather than by a walk of every rung beforehand."""
+        way rather than by a walk of every rung beforehand. A part already
+        in validated form (tuples, nothing to resolve) is shared, not copied."""
         out: list[Element] = []
         for el in elements:
             if isinstance(el, Branch):
@@ -410,10 +412,10 @@ class _Checker:
                 for leg in el.legs:
                     if not leg:
                         self.error(el.pos, "empty branch leg")
-                out.append(el.copy_with(legs))
+                out.append(el if _same(legs, el.legs) else el.copy_with(legs))
             else:
                 out.append(self.instruction(el, file_number, labels, first and not out))
-        return tuple(out)  # no spare capacity: the validated tree is kept
+        return elements if _same(out, elements) else tuple(out)  # a tuple: no spare capacity
 
     def run(self) -> Program:
         prog = self.program
@@ -449,7 +451,8 @@ class _Checker:
                     self.error(rung.pos, "empty rung")
                 reported = len(self.errors)
                 try:
-                    rungs.append(rung.copy_with(self.series(rung.elements, number, label_numbers, True)))
+                    elements = self.series(rung.elements, number, label_numbers, True)
+                    rungs.append(rung if elements is rung.elements else rung.copy_with(elements))
                 except _OverLimit:
                     # A tree built through the library, not the parser (which refuses it):
                     # the problems found on the way are dropped, the rung is reported once.
@@ -505,6 +508,12 @@ class _Checker:
             else:
                 self.error(decl.pos, f"DATA {text}: initial values are for N, B, F, ST, L, D and A files")
                 return
+
+
+def _same(checked, given) -> bool:
+    """Is ``given`` a tuple holding exactly the ``checked`` parts (so it can
+    be kept as it is)?"""
+    return type(given) is tuple and len(checked) == len(given) and all(map(operator.is_, checked, given))
 
 
 def _refused(operand: Operand) -> bool:
