@@ -202,3 +202,13 @@ def test_every_shipped_app_caches_and_compiles_the_same_code(tmp_path, app_name)
             assert again.files[number][0].source == compiled.source
     finally:
         again.close()
+
+
+def test_code_that_does_not_fit_the_program_is_compiled_afresh():
+    program = load_text("XIC B3/0 TON T4:0 0.01 5 0\nXIC T4:0/DN OTE B3/1\n")
+    fresh = _engine(program)
+    odd = _engine(program, {"files": {2: ("not", "a", "compiled", "file")}, "layout": ()})
+    for _ in range(10):
+        fresh.scan()
+        odd.scan()
+    assert odd.table == fresh.table and odd.table.read("B3/1") == 1

@@ -49,22 +49,6 @@ class BlockCode:
     line_rung: list[int]
 
 
-class LineTable:
-    """Line -> (rung, instruction) of one compiled block."""
-
-    __slots__ = ("instr", "rung")
-
-    def __init__(self, instr: list, rung: list[int]) -> None:
-        self.instr = instr
-        self.rung = rung
-
-    def at(self, lineno: int):
-        k = lineno - 2  # line 1 is the factory's def
-        if 0 <= k < len(self.rung):
-            return self.rung[k], self.instr[k]
-        return None, None
-
-
 def block_name(number: int, first: int, end: int) -> str:
     return f"<ladder file {number} rungs {first}-{end - 1}>"
 
@@ -80,7 +64,7 @@ def build_block(number: int, code: BlockCode, env: dict):
     text = "\n".join(["def _factory(_env):", *code.lines, "    " + bindings, "    return _block"]) + "\n"
     name = block_name(number, code.first, code.end)
     module = compile(text, name, "exec")
-    return run_block(module, env), name, module, LineTable(code.line_instr, code.line_rung)
+    return run_block(module, env), name, module
 
 
 def run_block(module, env: dict):
@@ -102,7 +86,9 @@ class CompiledFile:
         self.has_mcr = has_mcr
         self.blocks: list = []  # block functions, in rung order
         self.starts: list[int] = []  # first rung of each block
-        self.tables: dict[str, LineTable] = {}  # block file name -> its line table
+        # Block file name -> (first rung, end): a fault's line is mapped back by
+        # compiling that block's text again (where): no line table is kept.
+        self.tables: dict[str, tuple[int, int]] = {}
         self.modules: list = []  # each block's compiled module code (what the code cache keeps)
         self._compiler = compiler  # kept to compile a block again, split (isolate); may be a maker of one
 
@@ -113,14 +99,14 @@ class CompiledFile:
         return self._compiler
 
     def add(self, code: BlockCode) -> None:
-        fn, name, module, table = build_block(self.number, code, self.compiler.env)
-        self.add_compiled(fn, code.first, name, module, table)
+        fn, name, module = build_block(self.number, code, self.compiler.env)
+        self.add_compiled(fn, code.first, code.end, name, module)
 
-    def add_compiled(self, fn, first: int, name: str, module, table: LineTable) -> None:
+    def add_compiled(self, fn, first: int, end: int, name: str, module) -> None:
         self.blocks.append(fn)
         self.starts.append(first)
         self.modules.append(module)
-        self.tables[name] = table
+        self.tables[name] = (first, end)
 
     # -- the engine's view ----------------------------------------------------------------------
     def block_index(self, rung: int) -> int:
@@ -128,9 +114,18 @@ class CompiledFile:
         return bisect.bisect_right(self.starts, rung) - 1
 
     def where(self, filename: str, lineno: int):
-        """(rung, instruction) of a generated line, or (None, None)."""
-        table = self.tables.get(filename)
-        return table.at(lineno) if table is not None else (None, None)
+        """(rung, instruction) of a generated line, or (None, None). The
+        block's code is emitted again (the same text, line for line: the
+        compiler is deterministic) rather than a line table kept for every
+        line of every block: faults are rare, memory is not."""
+        span = self.tables.get(filename)
+        if span is None:
+            return None, None
+        code = self.compiler.block(*span)
+        k = lineno - 2  # line 1 is the factory's def
+        if 0 <= k < len(code.lines):
+            return code.line_rung[k], code.line_instr[k]
+        return None, None
 
     # -- breakpoints -------------------------------------------------------------------------------
     def isolate(self, rung: int) -> int:
@@ -168,9 +163,9 @@ class CompiledFile:
     def line_table(self) -> dict:
         """(block name, line) -> instruction, for every line that has one."""
         out = {}
-        for name, t in self.tables.items():
-            for line in range(len(t.rung)):
-                ins = t.at(line + 2)[1]
+        for name, span in self.tables.items():
+            code = self.compiler.block(*span)
+            for k, ins in enumerate(code.line_instr):
                 if ins is not None:
-                    out[(name, line + 2)] = ins
+                    out[(name, k + 2)] = ins
         return out

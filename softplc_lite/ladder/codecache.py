@@ -4,8 +4,8 @@ parsed, validated or compiled again.
 An app's cache is one file, ``APP/.softplc/codecache.bin``, beside the
 retentive snapshot. It holds, under a key, the validated program (as plain
 data, ladder/treecodec.py), the warnings its checks gave, and each program
-file's compiled blocks: their code objects (``marshal``), line tables (as
-rung and instruction numbers), and a recipe for every name the code uses
+file's compiled blocks: their code objects (``marshal``) and a recipe for
+every name the code uses
 (a data file's array, a kernel, a bound or module instruction, a resolver),
 from which the names are bound again to this run's table and machine.
 
@@ -30,11 +30,11 @@ from pathlib import Path
 from ..gcpause import gc_paused
 from . import treecodec
 from .ast import AddressRef, Program, address_refs
-from .blocks import CompiledFile, LineTable, run_block
+from .blocks import CompiledFile, run_block
 from .compiler import instructions_of
 
 CACHE_FILE = "codecache.bin"
-FORMAT = 1  # of the cache file; part of the key
+FORMAT = 2  # of the cache file; part of the key
 
 
 def softplc_version() -> str:
@@ -136,13 +136,7 @@ def export_file(compiled: CompiledFile, rungs, machine, table) -> tuple | None:
     blocks = []
     bounds = compiled.starts + [compiled.rung_count]
     for k, module in enumerate(compiled.modules):
-        name = module.co_filename
-        t = compiled.tables[name]
-        if isinstance(t, _CachedLines):
-            lines = tuple(t.locators)
-        else:
-            lines = tuple(None if ins is None else loc[id(ins)] for ins in t.instr)
-        blocks.append((bounds[k], bounds[k + 1], name, module, lines, tuple(t.rung)))
+        blocks.append((bounds[k], bounds[k + 1], module.co_filename, module))
     return (compiled.rung_count, compiled.has_mcr, tuple(blocks), recipe)
 
 
@@ -202,27 +196,9 @@ def import_file(data: tuple, program: Program, number: int, table, machine, jsr,
         return fc
 
     cf = CompiledFile(number, rung_count, has_mcr, make_compiler)
-    for first, end, name, module, lines, line_rungs in blocks:
-        fn = run_block(module, env)
-        cf.add_compiled(fn, first, name, module, _CachedLines(lines, line_rungs, node))
+    for first, end, name, module in blocks:
+        cf.add_compiled(run_block(module, env), first, end, name, module)
     return cf
-
-
-class _CachedLines(LineTable):
-    """A cached block's line table: instruction locators, turned into the
-    instructions when a fault asks (most runs never do)."""
-
-    __slots__ = ("locators", "node")
-
-    def __init__(self, locators, rungs, node) -> None:
-        self.locators, self.node = locators, node
-        self.rung = rungs
-        self.instr = None
-
-    def at(self, lineno: int):
-        if self.instr is None:
-            self.instr = [None if loc is None else self.node(loc) for loc in self.locators]
-        return LineTable.at(self, lineno)
 
 
 # -- the file ----------------------------------------------------------------------------------

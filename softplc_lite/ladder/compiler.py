@@ -341,7 +341,9 @@ class _FileCompiler(HeldWords, TableTemplates):
                 distinct.update(words[k])
                 k += 1
             cf.add(self.block(first, k, words))
-        self.lines = self.line_instr = self.line_rung = None  # the code is compiled: keep no text
+        # The code is compiled: keep no text, and no caches a later isolate() can rebuild.
+        self.lines = self.line_instr = self.line_rung = None
+        self._locations, self.uses = {}, Counter()
         return cf
 
 

@@ -287,17 +287,30 @@ class Engine:
         reference_module_blocks(program, self.table, self._owner)
         self._attach_modules(module_options or {})
         self._attach_hooks()
-        self.files = {}
         build = compile_file if executor == "compiled" else interpret_file
         if code is not None:
-            from .codecache import import_file as build_cached
+            try:
+                self._build_files(program, self._cached_build(code))
+            except Exception:  # a cache that does not fit after all: compile, as without one
+                reference_program(program, self.table)
+                self._build_files(program, build)
+        else:
+            self._build_files(program, build)
 
-            def build(program, number, *args, build_cached=build_cached):
-                return build_cached(code["files"][number], program, number, *args)
+    def _build_files(self, program: Program, build) -> None:
+        self.files = {}
         for number in sorted(program.files):
             zone = [True]
             self.files[number] = (build(program, number, self.table, self.machine, self._jsr, zone,
                                         self._module_instance), zone)
+
+    @staticmethod
+    def _cached_build(code: dict):
+        from .codecache import import_file
+
+        def build(program, number, *args):
+            return import_file(code["files"][number], program, number, *args)
+        return build
 
     # -- plug-in modules (TLMs) --------------------------------------------------------
     def _attach_modules(self, options) -> None:
