@@ -68,6 +68,8 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.inline_dest: str | None = None  # the local a word store writes (in_place)
         self.inline_flags: str | None = None  # the local holding S:0, if held, for that store
         self.uses: Counter = Counter()  # how often the block being compiled addresses each word
+        self._word_keys: dict[int, tuple | None] = {}  # id(Address) -> (file, word) a local could hold, or None
+        self.first_contact = (None, None)  # a rung's first element and its contact expression
         self._locations: dict[int, object] = {}  # id(Address) -> Location, for direct addresses
 
     # -- emitting ------------------------------------------------------------------------
@@ -151,8 +153,10 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.current = None
         self.rung_in = "z" if self.has_mcr else "True"
         first = rung.elements[0] if rung.elements else None
-        if first is None or self.contact_expression(first) is None:
+        expr = self.contact_expression(first) if first is not None else None
+        if expr is None:
             self.start_rung()
+        self.first_contact = (first, expr)  # series takes it as computed, not twice
         self.series(2, rung.elements)
 
     def start_rung(self) -> None:
@@ -165,7 +169,11 @@ class _FileCompiler(HeldWords, TableTemplates):
     def series(self, ind: int, elements) -> None:
         run: list[tuple[Element, str]] = []  # contacts waiting to be emitted as one expression
         for el in elements:
-            expr = self.contact_expression(el)
+            if el is self.first_contact[0]:
+                expr = self.first_contact[1]
+                self.first_contact = (None, None)
+            else:
+                expr = self.contact_expression(el)
             if expr is not None:
                 run.append((el, expr))
                 continue
@@ -343,7 +351,7 @@ class _FileCompiler(HeldWords, TableTemplates):
             cf.add(self.block(first, k, words))
         # The code is compiled: keep no text, and no caches a later isolate() can rebuild.
         self.lines = self.line_instr = self.line_rung = None
-        self._locations, self.uses = {}, Counter()
+        self._locations, self.uses, self._word_keys = {}, Counter(), {}
         return cf
 
 

@@ -59,22 +59,33 @@ class HeldWords:
         once per use (a timer's or counter's three words count twice: its
         code uses them more than once)."""
         out: list[tuple[int, int]] = []
+        keys = self._word_keys
         for ins in instructions_of(self.rungs[k].elements):
-            element = ins.mnemonic in ("TON", "CTU", "CTD")
+            m = ins.mnemonic
+            element = m in ("TON", "CTU", "CTD")
             for op in ins.operands:
-                for ref in address_refs(op):
+                for ref in ((op,) if op.__class__ is AddressRef else () if op.__class__ is Const else address_refs(op)):
                     a = ref.address
-                    if not a.is_direct:
+                    key = keys.get(id(a), 0)
+                    if key == 0:  # not looked at yet (None: not a word a local could hold)
+                        key = keys[id(a)] = self._word_key(a)
+                    if key is None:
                         continue
-                    f, index, _ = self.resolve(a)
-                    if f.ftype.storage is Storage.WORD and (f.ftype.letter != "S" or index == 0):
-                        if element:
-                            out += [(f.number, index + j) for j in (0, 0, 1, 1, 2, 2)]
-                        else:
-                            out.append((f.number, index))
-            if _word_store(ins):
+                    if element:
+                        out += [(key[0], key[1] + j) for j in (0, 0, 1, 1, 2, 2)]
+                    else:
+                        out.append(key)
+            if m in _STORES and _word_store(ins):
                 out.append(_FLAGS)  # it sets S:0's arithmetic flags
         return out
+
+    def _word_key(self, a) -> tuple[int, int] | None:
+        if not a.is_direct:
+            return None
+        f, index, _ = self.resolve(a)
+        if f.ftype.storage is Storage.WORD and (f.ftype.letter != "S" or index == 0):
+            return (f.number, index)
+        return None
 
     def flush_lines(self, ind: int) -> None:
         """Write back every local a rung may have changed."""
@@ -355,6 +366,8 @@ _LOCAL_SAFE = {
     "AND": 2, "OR": 2, "XOR": 2, "NOT": 1, "MVM": 2, "CPT": 0,
 }
 
+
+_STORES = frozenset({"MOV", "CPT", "ADD", "SUB"})  # the instructions _word_store may accept
 
 # S:0, the arithmetic flags word: held in a local like a data word (the
 # kernels that set it are called with it written back, and read it after).
