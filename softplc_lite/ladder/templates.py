@@ -10,7 +10,7 @@ from __future__ import annotations
 from . import status as S
 from .ast import AddressRef
 from .blocks import RET, TND
-from .held_words import _is_word, _word_valued
+from .held_words import _SIMPLE, _is_word, _word_valued
 from .semantics import BASE_MS, MajorFault, lim, source_units
 
 
@@ -117,6 +117,13 @@ class TableTemplates:
         self.emit(ind, "if c:")
         a, b = self.value(ind + 1, ops[0]), self.value(ind + 1, ops[1])
         if self.inline_dest is not None:  # ADD/SUB of words into a held word (in_place)
+            # Operands read in place are read once (the sum, the carry and a fallback use them).
+            if not _SIMPLE.match(a):
+                self.emit(ind + 1, f"_a = {a}")
+                a = "_a"
+            if not _SIMPLE.match(b):
+                self.emit(ind + 1, f"_b = {b}")
+                b = "_b"
             self.bind("_s", self.machine.s)
             fn = self.bind(f"_{kernel}", getattr(self.machine, kernel))
             a16, b16 = (repr(int(x) & 65535) if x.lstrip("-").isdigit() else f"({x} & 65535)" for x in (a, b))
