@@ -19,7 +19,8 @@ import time
 import _common as C
 
 BENCHMARKS = (
-    "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_comgenius_format",
+    "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_load_cache",
+    "bench_comgenius_format",
     "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_watch",
 )
 
@@ -88,6 +89,11 @@ def main() -> int:
                 f"{r['ratio_reference_over_compiled']:.1f}x the reference [{v['ratio']}], load "
                 f"{r['load']['parse_validate_compile_s']:.2f} s [{v['load']} <= {r['targets']['load_s']:.0f} s]"
             )
+
+    cache = load("bench_load_cache")
+    if cache:
+        lines.append(f"load      {cache['rungs']:,} boolean rungs, CPU: cold {cache['cold_cpu_s']['median']:.2f} s, "
+                     f"warm (code cache) {cache['warm_cpu_s']['median']:.2f} s [<= 0.3 s]")
 
     fmt = load("bench_comgenius_format")
     if fmt:
