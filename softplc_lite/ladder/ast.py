@@ -313,8 +313,18 @@ class Instruction(_Mutable):
         validator's resolved copy; no Pos built on the way)."""
         new = _new(Instruction)
         new.mnemonic, new._operands = mnemonic, _kept(operands)
-        new._where, new._column = self._where, self._column
+        new._where, new._column = _shared_where(self._where, operands), self._column
         return new
+
+
+def _shared_where(where: int, parts) -> int:
+    """``where``, or the equal int its first part keeps: a parser that builds
+    operands, instructions and rungs in separate passes over the text gives
+    each pass an int per line; the validated copy keeps one."""
+    first = parts[0] if parts else None
+    if first is not None and getattr(first, "_where", None) == where:
+        return first._where
+    return where
 
 
 def _kept(operands):
@@ -345,7 +355,7 @@ class Branch(_Mutable):
     def copy_with(self, legs) -> "Branch":
         new = _new(Branch)
         new.legs = legs
-        new._where, new._column = self._where, self._column
+        new._where, new._column = _shared_where(self._where, legs[0] if legs else ()), self._column
         return new
 
 
@@ -371,7 +381,7 @@ class Rung(_Mutable):
     def copy_with(self, elements) -> "Rung":
         new = _new(Rung)
         new.elements, new.comment = elements, self.comment
-        new._where, new._column = self._where, self._column
+        new._where, new._column = _shared_where(self._where, elements), self._column
         return new
 
 
