@@ -278,7 +278,8 @@ class _Checker:
         return plan
 
     def instruction(self, instr: Instruction, file_number: int, labels: set[int], first: bool) -> Instruction:
-        for op in instr.operands:
+        given = instr.operands  # once: a property (ast.Instruction)
+        for op in given:
             if isinstance(op, _EXPRESSIONS) and expression_depth(op) > MAX_EXPRESSION_DEPTH:
                 raise _OverLimit  # before anything walks it recursively
         plan = self.plan(instr.mnemonic)
@@ -286,9 +287,9 @@ class _Checker:
             self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}{self.instructions.hint(instr.mnemonic)}")
             return instr
         spec = plan.spec
-        n = len(instr.operands)
+        n = len(given)
         if not plan.min_operands <= n <= plan.max_operands:
-            extras = instr.operands[spec.max_operands:]
+            extras = given[spec.max_operands:]
             stray = next((o for o in extras if isinstance(o, SymbolRef)
                       and self.symbols.declaration(o.name) is None), None)
             if stray is not None:
@@ -305,7 +306,7 @@ class _Checker:
         last = len(kinds) - 1  # a repeated last operand covers every position from its own on
         checked_operands = []
         refused = changed = False
-        for i, op in enumerate(instr.operands):
+        for i, op in enumerate(given):
             j = i if i < last else last
             if op.__class__ is AddressRef:
                 # The common case, answered here: an address of a kind the operand takes.
@@ -344,7 +345,7 @@ class _Checker:
         if spec.mnemonic == "JMP" and operands and isinstance(operands[0], Const):
             if operands[0].value not in labels:
                 self.error(_pos(operands[0]), f"JMP to label {operands[0].value}, which is not in program file {file_number}")
-        if not changed and instr.mnemonic is plan.mnemonic and type(instr.operands) is tuple:
+        if not changed and instr.mnemonic is plan.mnemonic and type(given) is tuple:
             return instr  # already in validated form, the spec's mnemonic string included: kept
         return instr.copy_with(plan.mnemonic, operands)
 
