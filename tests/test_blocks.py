@@ -1,0 +1,92 @@
+"""The block code shapes (issue 17): words held in locals are written back
+wherever anything else can look at the table, on both executors alike
+(docs/engine.md, "Compiled code")."""
+
+from __future__ import annotations
+
+import pytest
+
+from instr_helpers import EXECUTORS
+from softplc_lite.ladder import Engine, Mode, blocks, load_text
+from softplc_lite.ladder import status as S
+
+
+def _run(text: str, executor: str, scans: int = 1, values: dict | None = None) -> Engine:
+    e = Engine(load_text(text, "t.lad"), executor=executor)
+    for addr, v in (values or {}).items():
+        e.table.write(addr, v)
+    e.set_mode(Mode.RUN)
+    e.run(scans)
+    return e
+
+
+def _both(text: str, scans: int = 1, values: dict | None = None) -> Engine:
+    compiled, reference = (_run(text, ex, scans, values) for ex in EXECUTORS)
+    assert compiled.table == reference.table
+    assert (compiled.fault is None) == (reference.fault is None)
+    if compiled.fault is not None:
+        assert (compiled.fault.code, compiled.fault.rung, compiled.fault.instruction) == \
+            (reference.fault.code, reference.fault.rung, reference.fault.instruction)
+    return compiled
+
+
+def test_a_fault_leaves_the_writes_of_earlier_rungs_of_its_block_in_the_table():
+    e = _both("OTE B3/0\nXIC B3/0 OTL B3/1\nMOV N7:[N7:9] N7:1\nOTE B3/2\n", values={"N7:9": 500})
+    assert e.mode is Mode.FAULTED and e.fault.rung == 2
+    assert e.table.read("B3/0") == 1 and e.table.read("B3/1") == 1 and e.table.read("B3/2") == 0
+
+
+def test_a_negative_timer_preset_faults_with_the_table_exact():
+    e = _both("OTE B3/0\nMOV -5 T4:0.PRE\nXIC B3/0 TON T4:0 0.01 10 0\nOTE B3/9\n")
+    assert e.mode is Mode.FAULTED and e.fault.code == S.FAULT_NEGATIVE_TIMER and e.fault.rung == 2
+    assert e.table.read("B3/0") == 1 and e.table.read("T4:0.PRE") == -5 and e.table.read("B3/9") == 0
+
+
+def test_a_jump_out_of_a_block_writes_its_words_back_first():
+    text = "OTE B3/0\nXIC B3/0 OTL B3/1\nXIC B3/1 JMP 5\nOTE B3/2\nLBL 5 XIC B3/1 OTE B3/3\n"
+    e = _both(text, scans=2)
+    assert (e.table.read("B3/1"), e.table.read("B3/2"), e.table.read("B3/3")) == (1, 0, 1)
+
+
+def test_cop_sees_and_overwrites_held_words():
+    # N7:0 and N7:5 are held in locals around the COP, which reads and writes the table.
+    text = ("XIC B3/0 OTE N7:0/1\nXIC N7:0/1 OTE N7:5/3\nCOP #N7:0 #N7:5 3\n"
+            "XIC N7:5/1 OTE B3/1\nXIC N7:5/3 OTE B3/2\n")
+    e = _both(text, values={"B3/0": 1})
+    assert e.table.read("N7:5") == 2 and e.table.read("B3/1") == 1 and e.table.read("B3/2") == 0
+
+
+def test_the_flags_held_in_a_local_follow_every_store():
+    text = ("MOV 0 N7:0\nXIC S:0/2 OTE B3/0\nSUB N7:0 1 N7:1\nXIC S:0/3 OTE B3/1\n"
+            "MUL N7:1 N7:1 N7:2\nXIC S:0/3 OTE B3/2\nXIC S:0/2 OTE B3/3\n"
+            "ADD 32767 N7:1 N7:3\nXIC S:0/2 OTE B3/4\nADD 32767 1 N7:4\nXIC S:0/1 OTE B3/5\n")
+    e = _both(text)
+    bits = [e.table.read(f"B3/{k}") for k in range(6)]
+    assert bits == [1, 1, 0, 0, 0, 1]  # zero, sign, 1*1 neither, 32766 neither, overflow
+    assert e.table.read("S:10") & (1 << 14)  # the overflow minor fault, from the kernel path
+
+
+def test_a_bit_the_program_sets_in_s0_survives_a_kernel_setting_the_flags():
+    # S:0/5 is set through the block's local; the overflowing ADD's kernel keeps S:0's upper bits.
+    e = _both("OTE S:0/5\nADD 32767 1 N7:4\nXIC S:0/5 OTE B3/0\nXIC S:0/1 OTE B3/1\n")
+    assert e.table.read("S:0/5") == 1 and e.table.read("B3/0") == 1 and e.table.read("B3/1") == 1
+
+
+@pytest.mark.parametrize("chunk", [1, 3, 1000])
+def test_words_used_once_or_often_give_the_same_table(monkeypatch, chunk):
+    monkeypatch.setattr(blocks, "CHUNK_RUNGS", chunk)
+    text = "".join(f"XIC B3/{k % 7} ADD N7:{k % 5} {k} N7:{k % 5}\nEQU N7:{k % 5} {k} OTE B3/{20 + k}\n"
+                   for k in range(12))
+    _both(text, scans=3, values={"B3/0": 1, "B3/3": 1})
+
+
+def test_a_rung_made_a_block_of_its_own_runs_the_same(monkeypatch):
+    text = "OTE B3/0\nXIC B3/0 TON T4:0 0.01 3 0\nXIC T4:0/DN CTU C5:0 5 0\nXIC C5:0/DN OTE B3/1\n"
+    program = load_text(text)
+    whole, split = Engine(program), Engine(program)
+    split.files[2][0].isolate(2)
+    assert len(split.files[2][0].blocks) == 3
+    for e in (whole, split):
+        e.set_mode(Mode.RUN)
+        e.run(40)
+    assert whole.table == split.table and whole.table.read("C5:0.ACC") > 0
