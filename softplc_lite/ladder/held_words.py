@@ -62,7 +62,7 @@ class HeldWords:
         keys = self._word_keys
         for ins in instructions_of(self.rungs[k].elements):
             m = ins.mnemonic
-            element = m in ("TON", "CTU", "CTD")
+            element = _ELEMENT_USES.get(m)
             for op in ins.operands:
                 for ref in ((op,) if op.__class__ is AddressRef else () if op.__class__ is Const else address_refs(op)):
                     a = ref.address
@@ -72,7 +72,7 @@ class HeldWords:
                     if key is None:
                         continue
                     if element:
-                        out += [(key[0], key[1] + j) for j in (0, 0, 1, 1, 2, 2)]
+                        out += [(key[0], key[1] + j) for j in element]
                     else:
                         out.append(key)
             if m in _STORES and _word_store(ins):
@@ -254,10 +254,20 @@ class HeldWords:
         self._bit_one_shot(ind, storage, output, False)
 
     # -- timers, counters and COP on held words ------------------------------------------------------
-    def element_words(self, ind: int, ref: AddressRef) -> list[str]:
-        """The locals of a timer or counter element's three words (control, PRE, ACC)."""
+    def element_words(self, ind: int, ref: AddressRef, force=(True, True, True)) -> list[str]:
+        """Code for a timer or counter element's three words (control, PRE,
+        ACC): each its local, or (where ``force`` is False and the block uses
+        the word only here) the table in place."""
         f, index, _ = self.resolve(ref.address)
-        return [self.word_at(ind, f, index + k, force=True) for k in range(3)]
+        out = []
+        for k in range(3):
+            name = self.word_at(ind, f, index + k, force=force[k])
+            out.append(name if name is not None else f"{self.array_name(f)}[{index + k!r}]")
+        return out
+
+    def held(self, *codes: str) -> None:
+        """Mark the locals among ``codes`` changed (words in place need nothing)."""
+        self.dirty.update(c for c in codes if c.startswith("w"))
 
     def local_TON(self, ind: int, ins: Instruction) -> None:
         """Semantics.ton written out on the element's locals (the kernel is
@@ -289,8 +299,10 @@ class HeldWords:
         self.dirty.update((wc, wa))
 
     def _local_count(self, ind: int, ins: Instruction, up: bool) -> None:
-        """Semantics.ctu / ctd written out on the element's locals."""
-        wc, wp, wa = self.element_words(ind, ins.operands[0])
+        """Semantics.ctu / ctd written out on the element's words: the
+        control word in a local; PRE and ACC in place unless the block uses
+        them elsewhere (a counting edge, which writes ACC, is rare)."""
+        wc, wp, wa = self.element_words(ind, ins.operands[0], force=(True, False, False))
         edge, limit, wrapped, flag, other = (CU, 32767, -32768, OV, UN) if up else (CD, -32768, 32767, UN, OV)
         self.emit(ind, "if c:")
         self.emit(ind + 1, f"if not {wc} & {edge!r}:")
@@ -301,7 +313,7 @@ class HeldWords:
         self.emit(ind + 1, f"{wc} |= {edge!r}")
         self.emit(ind, f"else: {wc} &= {~edge!r}")
         self.emit(ind, f"{wc} = ({wc} | {DN!r}) if {wa} >= {wp} else ({wc} & {~DN!r})")
-        self.dirty.update((wc, wa))
+        self.held(wc, wa)
 
     def local_COP(self, ind: int, ins: Instruction) -> None:
         """COP between direct blocks of one storage, whose ranges fit their
@@ -366,6 +378,11 @@ _LOCAL_SAFE = {
     "AND": 2, "OR": 2, "XOR": 2, "NOT": 1, "MVM": 2, "CPT": 0,
 }
 
+
+# How often a TON's or counter's code uses each word of its element
+# (control, PRE, ACC), for the block's count of uses: TON all three more
+# than once; a counter its control word.
+_ELEMENT_USES = {"TON": (0, 0, 1, 1, 2, 2), "CTU": (0, 0, 1, 2), "CTD": (0, 0, 1, 2)}
 
 _STORES = frozenset({"MOV", "CPT", "ADD", "SUB"})  # the instructions _word_store may accept
 
