@@ -87,15 +87,21 @@ def decode(data: tuple, extra: bytes) -> Program:
     set_value, set_hex = Const.value.__set__, Const.hex.__set__
     set_where, set_column = A._set_where, A._set_column
 
+    memo: dict[int, int] = {}
+
     def where(w: int) -> int:
-        return shift[w >> _BITS] | (w & _MASK)
+        # One int per line, shared by its nodes, as the parser makes them.
+        here = memo.get(w)
+        if here is None:
+            here = memo[w] = shift[w >> _BITS] | (w & _MASK)
+        return here
 
     def operand(e):
         tag = e[0]
         if tag == _ADDRESS:
             node = _new(AddressRef)
             set_address(node, addresses[e[1]])
-            set_where(node, shift[e[2] >> _BITS] | (e[2] & _MASK))
+            set_where(node, where(e[2]))
             set_column(node, e[3])
             return node
         if tag == _CONST:
@@ -112,12 +118,23 @@ def decode(data: tuple, extra: bytes) -> Program:
             node = _new(Instruction)
             node.mnemonic = e[1]
             ops = e[2]
-            node._operands = operand(ops[0]) if len(ops) == 1 else tuple(operand(op) for op in ops)
-            node._where = shift[e[3] >> _BITS] | (e[3] & _MASK)
+            if len(ops) == 1:
+                op = ops[0]
+                if op[0] == _ADDRESS:  # the common instruction, XIC B3/0: written out
+                    ref = _new(AddressRef)
+                    set_address(ref, addresses[op[1]])
+                    set_where(ref, where(op[2]))
+                    set_column(ref, op[3])
+                    node._operands = ref
+                else:
+                    node._operands = operand(op)
+            else:
+                node._operands = tuple([operand(op) for op in ops])
+            node._where = where(e[3])
             node._column = e[4]
             return node
         node = _new(Branch)
-        node.legs = tuple(tuple(element(x) for x in leg) for leg in e[1])
+        node.legs = tuple([tuple([element(x) for x in leg]) for leg in e[1]])
         node._where = where(e[2])
         node._column = e[3]
         return node
@@ -126,7 +143,7 @@ def decode(data: tuple, extra: bytes) -> Program:
         out = program.files[number].rungs
         for elements, comment, w, column in rungs:
             r = _new(Rung)
-            r.elements = tuple(element(x) for x in elements)
+            r.elements = tuple([element(x) for x in elements])
             r.comment = comment
             r._where = where(w)
             r._column = column
