@@ -29,7 +29,7 @@ from pathlib import Path
 
 from ..gcpause import gc_paused
 from . import treecodec
-from .ast import AddressRef, Program, address_refs
+from .ast import Program, address_refs
 from .blocks import CompiledFile, run_block
 from .compiler import instructions_of
 
@@ -269,4 +269,4 @@ def apply_layout(table, layout) -> None:
         table.create_file(letter, number, size)
 
 
-__all__ = ["CodeCache", "cache_key", "export_engine", "import_file", "AddressRef"]
+__all__ = ["CodeCache", "apply_layout", "cache_key", "export_engine", "import_file"]

@@ -23,11 +23,11 @@ class HeldWords:
 
     # -- words held in locals ---------------------------------------------------------------
     def word_local(self, ind: int, ref: AddressRef) -> tuple[str, int | None] | None:
-        """(local, mask or None) for a direct address whose word a block may
-        hold in a local (a 16-bit word file other than S: S words are written
-        by kernels and the engine behind the block's back), loading it at its
-        first use (at rung level: every path after it has it); None for any
-        other address."""
+        """(local, mask or None) for a direct address whose word a block
+        holds in a local (a 16-bit word file other than S, whose words kernels
+        and the engine write behind the block's back, S:0 excepted; and a word
+        the block uses more than once), loading it at its first use (at rung
+        level: every path after it has it); None for any other address."""
         a = ref.address
         if not a.is_direct:
             return None
@@ -43,7 +43,7 @@ class HeldWords:
         ``force``) the block uses the word only once: a local would cost a
         load and a write-back for one use, the table in place costs neither."""
         if f.ftype.storage is not Storage.WORD or (f.ftype.letter == "S" and index != 0):
-            return None  # S:0 (the math flags) may be held; S words kernels and the engine write, not
+            return None  # S:0 (the math flags) may be held; the S words kernels and the engine write may not
         key = (f.number, index)
         name = self.words.get(key)
         if name is None:
@@ -56,8 +56,8 @@ class HeldWords:
 
     def rung_words(self, k: int) -> list[tuple[int, int]]:
         """The words rung ``k`` addresses directly that a local could hold,
-        once per use (a timer's or counter's three words count twice: its
-        code uses them more than once)."""
+        once per use (a TON's or counter's element words as _ELEMENT_USES
+        says; a word store adds S:0)."""
         out: list[tuple[int, int]] = []
         keys = self._word_keys
         for ins in instructions_of(self.rungs[k].elements):
