@@ -323,16 +323,23 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
     cache = CodeCache(state) if use_cache and state is not None and not config_problems else None
     key = cached = None
     if cache is not None:
-        key = cache_key(_cache_parts(files, path, modules))
-        cached = cache.load(key)
+        try:
+            key = cache_key(_cache_parts(files, path, modules))
+        except OSError:  # a file the parse below reports, in words
+            cache = None
+        else:
+            cached = cache.load(key)
     if cached is not None:
         # Loaded before from these very files: the validated program, its
         # warnings and compiled code (ladder/codecache.py), no parse or check.
         resolved, program_warnings, code = cached
         parsed, errors = None, []
         table = DataTable()
-        apply_layout(table, code["layout"])  # the table check validates [display] and datatable.json against
-    else:
+        try:
+            apply_layout(table, code["layout"])  # the table check validates [display] and datatable.json against
+        except Exception:  # not what a cache holds after all: load from the text
+            cached = None
+    if cached is None:
         parsed, errors = parse_files(files, path, instructions)
         resolved, problems = check(parsed, instructions)
         errors += problems

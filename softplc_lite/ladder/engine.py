@@ -260,8 +260,11 @@ class Engine:
         if code is not None:
             from .codecache import apply_layout
 
-            apply_layout(self.table, code["layout"])  # what reference_program made when it was cached
-        else:
+            try:
+                apply_layout(self.table, code["layout"])  # what reference_program made when it was cached
+            except Exception:  # not a layout after all: compile, as without a cache
+                code = None
+        if code is None:
             reference_program(program, self.table)
         if fresh:
             initial_values(program, self.table)
