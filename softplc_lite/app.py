@@ -389,9 +389,8 @@ def _cache_parts(files: list[Path], path: Path, modules) -> list[tuple[str, byte
     version and config file."""
     base = path if path.is_dir() else path.parent
     parts = [(str(f.relative_to(base)), f.read_bytes()) for f in files]
-    for name in (SETTINGS_FILE,):
-        f = base / name
-        parts.append((name, f.read_bytes() if f.exists() else b""))
+    settings = base / SETTINGS_FILE
+    parts.append((SETTINGS_FILE, settings.read_bytes() if settings.exists() else b""))
     for m in modules:
         config = base / m.config_file if getattr(m, "config_file", None) else None
         parts.append((f"module {m.name} {getattr(m, 'version', '')} {type(m).__module__}",

@@ -23,7 +23,6 @@ from softplc_lite.app import load_app
 from softplc_lite.datatable import DataTable
 from softplc_lite.ladder import Engine, Mode, load_text
 from softplc_lite.ladder.engine import SimulatedClock
-from softplc_lite.ports import wire
 from softplc_lite.ports.modbus_slave import ModbusSlave, respond, with_crc
 from softplc_lite.runner import RunOptions, Runner
 from softplc_lite.tlm.comgenius import ComGenius, checksum

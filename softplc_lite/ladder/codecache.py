@@ -23,15 +23,14 @@ from __future__ import annotations
 
 import hashlib
 import marshal
-import os
 import sys
 from pathlib import Path
 
+from ..datatable.snapshot import write as write_atomically
 from ..gcpause import gc_paused
 from . import treecodec
-from .ast import Program, address_refs
+from .ast import Program, address_refs, instructions_of
 from .blocks import CompiledFile, run_block
-from .compiler import instructions_of
 
 CACHE_FILE = "codecache.bin"
 FORMAT = 2  # of the cache file; part of the key
@@ -97,17 +96,23 @@ class _Nodes:
         return refs[loc[2]]
 
 
+def _functions() -> dict:
+    """The module functions compiled code binds by name (recipe "function")."""
+    from .semantics import lim
+    from .templates import _block_check
+
+    return {"_lim": lim, "_block_check": _block_check}
+
+
 def export_file(compiled: CompiledFile, rungs, machine, table) -> tuple | None:
     """The cache's form of a compiled file, or None when some name in its
     code cannot be bound again from a recipe (then nothing is cached)."""
     from .expr import namespace
-    from .semantics import lim
-    from . import compiler as C
 
     fc = compiled.compiler
     loc = _locators(rungs)
     named = {name: (kind, key_id) for (key_id, kind), name in fc.named.items() if kind != "call"}
-    functions = {"_lim": lim, "_block_check": C._block_check}
+    functions = _functions()
     expr_names = set(namespace(machine))
     arrays = {id(f.data): f.number for f in table.files()}
     recipe = {}
@@ -148,14 +153,13 @@ def import_file(data: tuple, program: Program, number: int, table, machine, jsr,
     from .expr import namespace
     from .instr import BOUND
     from .resolvers import resolver
-    from .semantics import lim
     from . import compiler as C
 
     rung_count, has_mcr, blocks, recipe = data
     rungs = program.files[number].rungs
     node = _Nodes(rungs)
     expr = namespace(machine)
-    functions = {"_lim": lim, "_block_check": C._block_check}
+    functions = _functions()
     env: dict[str, object] = {}
     named: dict[tuple, str] = {}
     for name, (kind, *args) in recipe.items():
@@ -236,10 +240,7 @@ class CodeCache:
         try:
             tree, extra = treecodec.encode(program)
             blob = marshal.dumps((key, tree, extra, tuple(warnings), files))
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = self.path.with_name(self.path.name + ".tmp")
-            tmp.write_bytes(blob)
-            os.replace(tmp, self.path)
+            write_atomically(blob, self.path, durable=False)  # a cache: a lost write costs a compile
             return True
         except Exception as e:  # unwritable state directory, a tree the codec does not take: no cache
             self.problem = f"{self.path}: code cache not written ({type(e).__name__}: {e})"

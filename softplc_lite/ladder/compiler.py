@@ -28,10 +28,10 @@ from ..gcpause import gc_paused
 from ..datatable import DataTable, ValueKind, bit_mask
 from ..datatable.filetypes import Storage
 from . import blocks
-from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, instructions_of, walk  # noqa: F401 (instructions_of: imported from here too)
+from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, instructions_of, walk
 from .blocks import RET, TND, BlockCode, CompiledFile  # noqa: F401 (RET, TND: the block protocol, imported from here)
 from .held_words import _BIT_OPS, _NO_BARRIER, HeldWords
-from .templates import _COMPARE, _block_check, TableTemplates  # noqa: F401 (_block_check: the code cache binds it)
+from .templates import _COMPARE, TableTemplates
 from .bound import BoundAccess
 from .expr import namespace as expr_namespace
 from .expr import to_python

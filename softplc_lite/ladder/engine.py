@@ -22,8 +22,8 @@ from ..datatable import DataTable, DataTableError, parse_address
 from ..datatable.errors import AddressRangeError
 from ..datatable.table import to_signed
 from . import status as S
-from .ast import MAIN_FILE, AddressRef, Const, Instruction, Pos, Program, address_refs, walk
-from .compiler import RET, EndScan, compile_file, describe, instructions_of
+from .ast import MAIN_FILE, AddressRef, Const, Instruction, Pos, Program, address_refs, instructions_of, walk
+from .compiler import RET, EndScan, compile_file, describe
 from .resolvers import address_fault
 from .errors import LadderError
 from .instr import BOUND

@@ -42,8 +42,8 @@ class HeldWords:
         held), or None if no local may hold that file's words, or (unless
         ``force``) the block uses the word only once: a local would cost a
         load and a write-back for one use, the table in place costs neither."""
-        if f.ftype.storage is not Storage.WORD or (f.ftype.letter == "S" and index != 0):
-            return None  # S:0 (the math flags) may be held; the S words kernels and the engine write may not
+        if not _may_hold(f, index):
+            return None
         key = (f.number, index)
         name = self.words.get(key)
         if name is None:
@@ -83,9 +83,7 @@ class HeldWords:
         if not a.is_direct:
             return None
         f, index, _ = self.resolve(a)
-        if f.ftype.storage is Storage.WORD and (f.ftype.letter != "S" or index == 0):
-            return (f.number, index)
-        return None
+        return (f.number, index) if _may_hold(f, index) else None
 
     def flush_lines(self, ind: int) -> None:
         """Write back every local a rung may have changed."""
@@ -385,6 +383,13 @@ _LOCAL_SAFE = {
 _ELEMENT_USES = {"TON": (0, 0, 1, 1, 2, 2), "CTU": (0, 0, 1, 2), "CTD": (0, 0, 1, 2)}
 
 _STORES = frozenset({"MOV", "CPT", "ADD", "SUB"})  # the instructions _word_store may accept
+
+def _may_hold(f, index: int) -> bool:
+    """Whether a local may hold word ``index`` of file ``f``: a 16-bit word
+    file's, not an S word (kernels and the engine write those behind the
+    block's back) but S:0, the math flags (held like a data word, below)."""
+    return f.ftype.storage is Storage.WORD and (f.ftype.letter != "S" or index == 0)
+
 
 # S:0, the arithmetic flags word: held in a local like a data word (the
 # kernels that set it are called with it written back, and read it after).
