@@ -23,6 +23,7 @@ messages.
 from __future__ import annotations
 
 from collections import Counter
+from functools import cached_property
 
 from ..gcpause import gc_paused
 from ..datatable import DataTable, ValueKind, bit_mask
@@ -30,7 +31,7 @@ from ..datatable.filetypes import Storage
 from . import blocks
 from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, instructions_of, walk
 from .blocks import RET, TND, BlockCode, CompiledFile  # noqa: F401 (RET, TND: the block protocol, imported from here)
-from .held_words import _BIT_OPS, _NO_BARRIER, HeldWords
+from .held_words import _BIT_OPS, _NO_BARRIER, HeldWords, _may_hold
 from .templates import _COMPARE, TableTemplates
 from .bound import BoundAccess
 from .expr import namespace as expr_namespace
@@ -60,7 +61,7 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.rungs = rungs
         self.labels = labels_of(rungs)
         self.module_instance = module_instance  # TLM instructions: Instruction -> callable(c) -> c
-        self.has_mcr = any(ins.mnemonic == "MCR" for r in rungs for ins in instructions_of(r.elements))
+        self.saw_mcr = False  # set by rung_words: compile() learns has_mcr in its first pass
         self.env: dict[str, object] = {"_jsr": jsr, "_zone": zone, "_m": machine, **expr_namespace(machine)}
         self.named: dict[tuple, str] = {}  # per-instruction objects, made once (a block compiled again reuses them)
         self.rung_elements: list = []
@@ -71,6 +72,12 @@ class _FileCompiler(HeldWords, TableTemplates):
         self._word_keys: dict[int, tuple | None] = {}  # id(Address) -> (file, word) a local could hold, or None
         self.first_contact = (None, None)  # a rung's first element and its contact expression
         self._locations: dict[int, object] = {}  # id(Address) -> Location, for direct addresses
+        self._bits: dict[int, tuple] = {}  # id(Address) -> what bit() needs of a direct bit address
+
+    @cached_property
+    def has_mcr(self) -> bool:
+        """Whether an MCR zone may be open: every rung then takes ``z``."""
+        return any(ins.mnemonic == "MCR" for r in self.rungs for ins in instructions_of(r.elements))
 
     # -- emitting ------------------------------------------------------------------------
     def emit(self, indent: int, text: str) -> None:
@@ -137,14 +144,27 @@ class _FileCompiler(HeldWords, TableTemplates):
     def bit(self, ind: int, ref: AddressRef) -> tuple[str, int, bool] | None:
         """A bit instruction's word as (code of the word, mask, held in a
         local): a local, or an S word read in place; None: not direct."""
-        held = self.word_local(ind, ref)
-        if held is not None:
-            return held[0], held[1], True
         a = ref.address
-        if not a.is_direct:
-            return None
-        f, index, bit = self.resolve(a)
-        return f"{self.array_name(f)}[{index!r}]", bit_mask(bit), False
+        # What does not change within a compile, looked up once per Address
+        # (the parser makes one per address text; contacts are most of a
+        # program): the word's key if a local may hold it, its mask, and
+        # its code in place.
+        known = self._bits.get(id(a))
+        if known is None:
+            if not a.is_direct:
+                return None
+            f, index, bit = self.resolve(a)
+            known = self._bits[id(a)] = (
+                (f.number, index) if _may_hold(f, index) else None, f, index,
+                bit_mask(bit) if bit is not None else None, f"{self.array_name(f)}[{index!r}]")
+        key, f, index, mask, in_place = known
+        if key is not None:
+            name = self.words.get(key)
+            if name is None and self.uses.get(key, 0) >= 2:
+                name = self.word_at(ind, f, index)  # loaded now, at rung level
+            if name is not None:
+                return name, mask, True
+        return in_place, mask, False
 
     # -- rungs -------------------------------------------------------------------------------
     def rung(self, index: int, rung: Rung) -> None:
@@ -207,28 +227,28 @@ class _FileCompiler(HeldWords, TableTemplates):
         read one bit and write nothing, so they can short-circuit as one
         expression: the result is the same whatever order, or whether, they
         are evaluated. (Their words are loaded into locals first.)"""
-        if isinstance(el, Branch):
-            legs = []
-            for leg in el.legs:
-                terms = [self.contact_expression(e) for e in leg]
-                if None in terms:
+        if el.__class__ is Instruction:
+            m = el.mnemonic
+            if m == "XIC" or m == "XIO":  # most of a program: first
+                held = self.bit(2, el.operands[0])
+                if held is None:
                     return None
-                legs.append("True" if not terms else terms[0] if len(terms) == 1 else f"({' and '.join(terms)})")
-            return f"({' or '.join(legs)})"
-        if el.mnemonic in _COMPARE and all(isinstance(op, Const) or op.address.is_direct for op in el.operands):
-            # A compare of direct words reads and writes nothing else: a contact too.
-            for op in el.operands:
-                if isinstance(op, AddressRef):
-                    self.word_local(2, op)
-            a, b = (self.value(2, op) for op in el.operands)
-            return f"{a} {_COMPARE[el.mnemonic]} {b}"
-        if el.mnemonic not in ("XIC", "XIO"):
+                return f"{held[0]} & {held[1]!r} != 0" if m == "XIC" else f"not {held[0]} & {held[1]!r}"
+            if m in _COMPARE and all(isinstance(op, Const) or op.address.is_direct for op in el.operands):
+                # A compare of direct words reads and writes nothing else: a contact too.
+                for op in el.operands:
+                    if isinstance(op, AddressRef):
+                        self.word_local(2, op)
+                a, b = (self.value(2, op) for op in el.operands)
+                return f"{a} {_COMPARE[m]} {b}"
             return None
-        held = self.bit(2, el.operands[0])
-        if held is None:
-            return None
-        word, mk, _ = held
-        return f"{word} & {mk!r} != 0" if el.mnemonic == "XIC" else f"not {word} & {mk!r}"
+        legs = []  # a branch
+        for leg in el.legs:
+            terms = [self.contact_expression(e) for e in leg]
+            if None in terms:
+                return None
+            legs.append("True" if not terms else terms[0] if len(terms) == 1 else f"({' and '.join(terms)})")
+        return f"({' or '.join(legs)})"
 
     def branch(self, ind: int, branch: Branch) -> None:
         self.start_rung()
@@ -253,9 +273,11 @@ class _FileCompiler(HeldWords, TableTemplates):
         m = ins.mnemonic
         ops = ins.operands
         self.start_rung()
-        if m in _BIT_OPS and all(self.bit(ind, op) is not None for op in ops):
-            getattr(self, f"bit_{m}")(ind, *(self.bit(ind, op) for op in ops))
-            return
+        if m in _BIT_OPS:
+            words = [self.bit(ind, op) for op in ops]
+            if None not in words:
+                getattr(self, f"bit_{m}")(ind, *words)
+                return
         inline = getattr(self, f"local_{m}", None)
         if inline is not None and all(isinstance(op, Const) or op.address.is_direct for op in ops) and \
                 self.resolve(ops[0].address).file.ftype.storage is Storage.WORD:
@@ -339,6 +361,7 @@ class _FileCompiler(HeldWords, TableTemplates):
         labels = set(self.labels.values())
         count = len(self.rungs)
         words = [self.rung_words(k) for k in range(count)]
+        self.has_mcr = self.saw_mcr  # (the pass just made saw every instruction)
         k = 0
         while k < count:
             first = k
@@ -351,7 +374,7 @@ class _FileCompiler(HeldWords, TableTemplates):
             cf.add(self.block(first, k, words))
         # The code is compiled: keep no text, and no caches a later isolate() can rebuild.
         self.lines = self.line_instr = self.line_rung = None
-        self._locations, self.uses, self._word_keys = {}, Counter(), {}
+        self._locations, self.uses, self._word_keys, self._bits = {}, Counter(), {}, {}
         return cf
 
 

@@ -62,6 +62,8 @@ class HeldWords:
         keys = self._word_keys
         for ins in instructions_of(self.rungs[k].elements):
             m = ins.mnemonic
+            if m == "MCR":
+                self.saw_mcr = True
             element = _ELEMENT_USES.get(m)
             for op in ins.operands:
                 for ref in ((op,) if op.__class__ is AddressRef else () if op.__class__ is Const else address_refs(op)):
