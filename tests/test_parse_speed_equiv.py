@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from softplc_lite.ladder import parser
+from softplc_lite.ladder import lalr_driver, parser
 from softplc_lite.ladder.ast import Pos
 from softplc_lite.ladder.errors import LadderError
 from softplc_lite.ladder.lalr_driver import FastLalr, NotFastPath
@@ -180,3 +180,40 @@ def grouped_or_none(line: str):
         return parser._group(drafts[0].tokens, BUILTIN, drafts[0].pos, {}) if drafts else None
     except (UnexpectedInput, LadderError):
         return None
+
+
+@pytest.mark.parametrize("text", ["XIC B3/: ;\n", "XIC B3/:\n;\n", "XIC B3/: B3/x\n", "SOR XIC B3/: ; EOR\n",
+                                  "XIC B3/: (\n", "XIC B3/0 B3/: ) OTE B3/1\n", "XIC B3/:", "XIC Timer/DN B3/: [\n"])
+def test_a_rule_action_s_error_just_before_a_syntax_error(lark_only, text):
+    # The fast loop reduces a mnemonic rung's list one token before lark
+    # does, so a bad address is refused before the syntax error after it is
+    # seen: lark, parsing again, says which one it meets first.
+    fast = outcome(text, "t.lad")
+    lark_only()
+    assert fast == outcome(text, "t.lad")
+
+
+def test_the_list_steps_come_from_the_tables():
+    steps = parser._fast_parser().list_steps
+    assert steps, "mn_tokens' list steps"
+    kinds = set().union(*steps.values())
+    assert kinds == {"NAME", "ADDRESS", "SYMBOL_MEMBER", "STRING", "BST", "NXB", "BND"}
+
+
+@pytest.mark.parametrize(("regexp", "chars"), [
+    (r"[ \t\f]+", " \t\f"), (r"(?i:bst)", "Bb"), (r"(?:\r?\n)+", "\r\n"), (r'"([^"\\\n]|\\.)*"', '"'),
+    (r"\/\/[^\n]*", "/"), (r"([0-9]+\.[0-9]*|\.[0-9]+)|[0-9]+[eE][0-9]+", ".0123456789"), (r"(?:<>|<=|=)", "<="),
+    (r"#?[A-C]{1,2}", "#ABC"), (r"(?>x)y", "x"), (r"(?=a)b", "b"),
+    (r"a?", None), (r".x", None), (r"[^a]", None), (r"\sx", None), (r"[\u0100-\u0400]", None), (r"(?i:\u00e9)", None)])
+def test_the_characters_a_terminal_can_start_with(regexp, chars):
+    # Too many is safe (a look-ahead kept that was not needed), too few not.
+    found = lalr_driver._first_chars(regexp, 0)
+    assert found == (None if chars is None else frozenset(chars))
+
+
+def test_the_blanks_need_no_look_ahead_in_this_grammar():
+    # No terminal of ladder.lark starts with a blank, so the skip of blanks
+    # before a token is a plain repetition (the look-ahead cost ~0.4 us a token).
+    parse_program("XIC B3/0 OTE B3/1\n")
+    for lexer in parser._fast_parser().lexers.values():
+        assert "(?!" not in lexer.skip.__self__.pattern

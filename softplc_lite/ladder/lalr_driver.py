@@ -34,6 +34,7 @@ import re
 from lark import Lark, Token
 from lark.lexer import UnlessCallback
 from lark.parsers.lalr_analysis import Shift
+from lark.utils import sre_constants, sre_parse
 
 _new_str = str.__new__
 
@@ -67,7 +68,11 @@ class _StateLexer:
         skips = []
         for i, t in enumerate(terminals):
             if t.name in basic.ignore_types:
-                before = "|".join(u.pattern.to_regexp() for u in terminals[:i])
+                # Only a terminal that can start where the ignored one does
+                # can match there first: the others need no look-ahead.
+                ignored = _first_chars(t.pattern.to_regexp(), flags)
+                before = "|".join(u.pattern.to_regexp() for u in terminals[:i]
+                                  if _may_overlap(ignored, _first_chars(u.pattern.to_regexp(), flags)))
                 skips.append((f"(?!{before})" if before else "") + f"(?>{t.pattern.to_regexp()})")
         skip = f"(?:{'|'.join(skips)})*+" if skips else ""
         self.match = re.compile(skip + "(?:" + alternation + ")", flags).match
@@ -107,7 +112,7 @@ class FastLalr:
     exactly what ``lark.parse`` gives for a text it accepts. Construction
     raises NotFastPath for a ``Lark`` set up otherwise."""
 
-    def __init__(self, lark: Lark) -> None:
+    def __init__(self, lark: Lark, token_actions: dict | None = None) -> None:
         frontend = lark.parser
         connector = frontend.lexer
         postlex = connector.postlexer
@@ -123,23 +128,31 @@ class FastLalr:
         self.end_states = table.end_states
         # state -> {symbol: (shift_to, None) or (None, (size, origin, callback))}
         self.actions: dict[int, dict[str, tuple]] = {}
+        reductions: dict = {}  # rule -> its one (size, origin, callback)
         for state, row in table.states.items():
             compiled = {}
             for symbol, (action, arg) in row.items():
                 if action is Shift:
                     compiled[str(symbol)] = (arg, None)
                 else:
-                    compiled[str(symbol)] = (None, (len(arg.expansion), str(arg.origin.name), callbacks[arg]))
+                    if arg not in reductions:
+                        reductions[arg] = (len(arg.expansion), str(arg.origin.name), callbacks[arg])
+                    compiled[str(symbol)] = (None, reductions[arg])
             self.actions[state] = compiled
+        self.list_steps = _list_steps(self.actions, reductions, token_actions or {},
+                                      set(self.span_changes) | set(self.dropped_inside))
 
     def parse(self, text: str, start: str):
         """Lark's contextual lexer, post-lexer and LALR parser as one loop."""
         actions = self.actions
+        list_steps = self.list_steps
         lexers = self.lexers
         span_changes = self.span_changes
         dropped_inside = self.dropped_inside
         spans = [False] * (1 + max((i for i, _ in span_changes.values()), default=0))
         state = self.start_states[start]
+        lex_state = state  # whose terminals lex the next token: lark lexes it before it reduces
+        expected = None  # after a list step: the actions of the state lark would be in
         state_stack = [state]
         value_stack: list = []
         push_state = state_stack.append
@@ -148,9 +161,8 @@ class FastLalr:
         end = len(text)
         line = 1
         line_start = 0  # where the current line starts
-        token = None
         while pos < end:
-            lexer = lexers[state]
+            lexer = lexers[lex_state]
             m = lexer.match(text, pos)
             if m is None:
                 blanks = lexer.skip(text, pos)
@@ -183,6 +195,16 @@ class FastLalr:
                 spans[change[0]] = change[1]
             elif kind in dropped_inside and True in spans:
                 continue
+            if expected is not None and kind not in expected:
+                raise NotFastPath(kind)  # where lark, one token later than this loop, finds the error
+            steps = list_steps.get(state)
+            if steps is not None:  # the next step of a list, most tokens of a mnemonic rung
+                step = steps.get(kind)
+                if step is not None:
+                    lex_state, token_action = step
+                    expected = actions[lex_state]
+                    value_stack[-1] = token_action(value_stack[-1], kind, value, token_line, column)
+                    continue
             token = _new_str(Token, value)
             token.type = kind
             token.start_pos = start_pos
@@ -192,7 +214,8 @@ class FastLalr:
             token.end_line = line
             token.end_column = pos - line_start + 1
             token.end_pos = pos
-            # the parser: reduce while the table says so, then shift
+            # the parser: reduce while the table says so, then shift, or
+            # take one step of a left-recursive list (see _list_steps)
             row = actions[state]
             while True:
                 action = row.get(kind)
@@ -212,17 +235,26 @@ class FastLalr:
                 state = actions[state_stack[-1]][origin][0]
                 push_state(state)
                 row = actions[state]
-            state = shift_to
+            steps = list_steps.get(state)
+            if steps is not None and kind in steps:  # the first step of a list
+                lex_state, token_action = steps[kind]
+                expected = actions[lex_state]
+                value_stack[-1] = token_action(value_stack[-1], kind, value, token_line, column)
+                continue
+            state = lex_state = shift_to
+            expected = None
             push_state(state)
             push_value(token)
-        return self._end(token, state_stack, value_stack, self.end_states[start])
+        if expected is not None and "$END" not in expected:
+            raise NotFastPath("$END")
+        return self._end(state_stack, value_stack, self.end_states[start])
 
-    def _end(self, last: Token | None, state_stack: list, value_stack: list, end_state: int):
-        """Lark's "$END": reduce until the start rule is complete."""
-        end = Token("$END", "", 0, 1, 1) if last is None else Token.new_borrow_pos("$END", "", last)
+    def _end(self, state_stack: list, value_stack: list, end_state: int):
+        """Lark's "$END": reduce until the start rule is complete (no rule
+        action sees the $END token itself)."""
         actions = self.actions
         while True:
-            action = actions[state_stack[-1]].get(end.type)
+            action = actions[state_stack[-1]].get("$END")
             if action is None or action[0] is not None:
                 raise NotFastPath("$END")
             size, origin, callback = action[1]
@@ -238,9 +270,126 @@ class FastLalr:
                 return value_stack[-1]
 
 
+def _list_steps(actions: dict[int, dict[str, tuple]], reductions: dict, token_actions: dict,
+                post_lexer_kinds: set[str]) -> dict:
+    """state -> {token kind: (state after the shift, token action)} for
+    each left-recursive list rule ``x: x? K`` given a token action (parser.py
+    gives mn_tokens'): in a state reached by ``x``, a token K shifts to a
+    state whose every action is to reduce ``x: x K``, which returns to the
+    state reached by ``x``. The loop does that shift and reduce as one step,
+    with no stack traffic and no Token: the token action gets (list so far,
+    kind, text, line, column) and does what the rule's callback does with
+    [list so far, Token]; its result replaces the list on the stack. This
+    is the classic "default reduction": the token after K, which lark reads
+    before it reduces, is checked against the shifted-to state's actions
+    before it is used. Kinds the post-lexer reads are left to the general
+    loop."""
+    reached_by: dict[int, str] = {}
+    for row in actions.values():
+        for symbol, (shift_to, _reduce) in row.items():
+            if shift_to is not None:
+                reached_by[shift_to] = symbol
+    nonterminals = {origin for _size, origin, _callback in reductions.values()}
+    found: dict[int, dict[str, tuple]] = {}
+    for state, row in actions.items():
+        for kind, (shift_to, _reduce) in row.items():
+            if shift_to is None or kind in nonterminals or kind in post_lexer_kinds:
+                continue
+            after = set(actions[shift_to].values())
+            if len(after) != 1:
+                continue
+            (to, reduce), = after
+            if to is None and reduce[0] == 2 and reduce[1] == reached_by.get(state) and \
+                    reduce[1] in token_actions and _left_recursive(reductions, reduce):
+                found.setdefault(state, {})[kind] = (shift_to, token_actions[reduce[1]])
+    return found
+
+
+def _left_recursive(reductions: dict, reduce: tuple) -> bool:
+    rule = next(r for r, compiled in reductions.items() if compiled is reduce)
+    return str(rule.expansion[0].name) == reduce[1]
+
+
 def _count_lines(text: str, begin: int, stop: int, line: int, line_start: int) -> tuple[int, int]:
     """The line and line start after text[begin:stop], as lark's LineCounter."""
     newlines = text.count("\n", begin, stop)
     if newlines:
         return line + newlines, text.rindex("\n", begin, stop) + 1
     return line, line_start
+
+
+# -- the characters a terminal can start with -------------------------------------
+# Read from the regex's parse by Python's own regex parser (the one lark's
+# get_regexp_width uses). None stands for "any character, or cannot tell":
+# the answer may be too large, never too small.
+
+_ZERO_WIDTH = (sre_constants.AT, sre_constants.ASSERT, sre_constants.ASSERT_NOT)
+_REPEATS = (sre_constants.MAX_REPEAT, sre_constants.MIN_REPEAT, sre_constants.POSSESSIVE_REPEAT)
+_MOST_CHARS = 512  # a larger class counts as "any character"
+
+
+def _first_chars(regexp: str, flags: int) -> frozenset[str] | None:
+    """The characters a match of ``regexp`` can start with (lark allows
+    no terminal to match the empty string)."""
+    chars, can_be_empty = _first(sre_parse.parse(regexp, flags), bool(flags & sre_constants.SRE_FLAG_IGNORECASE))
+    return None if chars is None or can_be_empty else frozenset(chars)
+
+
+def _may_overlap(a: frozenset[str] | None, b: frozenset[str] | None) -> bool:
+    return a is None or b is None or not a.isdisjoint(b)
+
+
+def _first(items, ignore_case: bool) -> tuple[set[str] | None, bool]:
+    """(first characters or None, can the sequence ``items`` match nothing)."""
+    found: set[str] = set()
+    for op, arg in items:
+        if op in _ZERO_WIDTH:
+            continue
+        if op is sre_constants.LITERAL:
+            chars, can_be_empty = {chr(arg)}, False
+        elif op is sre_constants.IN:
+            chars, can_be_empty = _class_chars(arg), False
+        elif op is sre_constants.SUBPATTERN:
+            _group, add_flags, del_flags, pattern = arg
+            case = sre_constants.SRE_FLAG_IGNORECASE
+            chars, can_be_empty = _first(pattern, (ignore_case or bool(add_flags & case)) and not del_flags & case)
+        elif op is sre_constants.ATOMIC_GROUP:
+            chars, can_be_empty = _first(arg, ignore_case)
+        elif op is sre_constants.BRANCH:
+            chars, can_be_empty = set(), False
+            for alternative in arg[1]:
+                more, empty = _first(alternative, ignore_case)
+                if more is None:
+                    return None, True
+                chars |= more
+                can_be_empty = can_be_empty or empty
+        elif op in _REPEATS:
+            least, _most, pattern = arg
+            chars, can_be_empty = _first(pattern, ignore_case)
+            can_be_empty = can_be_empty or least == 0
+        else:  # ANY, NOT_LITERAL, a group reference...
+            return None, True
+        if chars is None:
+            return None, True
+        if ignore_case and op in (sre_constants.LITERAL, sre_constants.IN):
+            if not all(c.isascii() for c in chars):
+                return None, True
+            chars = chars | {c.lower() for c in chars} | {c.upper() for c in chars}
+        found |= chars
+        if not can_be_empty:
+            return found, False
+    return found, True
+
+
+def _class_chars(items) -> set[str] | None:
+    """The characters of a class [...]; None for a negated one, a category
+    (\\s, \\w ...) or a large range."""
+    chars: set[str] = set()
+    for op, arg in items:
+        if op is sre_constants.LITERAL:
+            chars.add(chr(arg))
+        elif op is sre_constants.RANGE and arg[1] - arg[0] < _MOST_CHARS:
+            chars.update(chr(c) for c in range(arg[0], arg[1] + 1))
+        else:
+            return None
+    return chars

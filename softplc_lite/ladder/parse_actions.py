@@ -155,16 +155,19 @@ class _ToAst(Transformer):
 
     # operands ------------------------------------------------------------------
     def _address(self, tok: Token) -> AddressRef:
-        text = str(tok)  # a plain str key: a Token compares with lark's own __eq__
+        # a plain str key: a Token compares with lark's own __eq__
+        return self._address_at(str(tok), self._token_pos(tok))
+
+    def _address_at(self, text: str, pos: Pos) -> AddressRef:
         address = self.addresses.get(text)
         if address is not None:  # this text parsed before in this program: one shared Address
-            return AddressRef(address, self._token_pos(tok))
+            return AddressRef(address, pos)
         try:
             address = self.addresses[text] = parse_address(text)
-            return AddressRef(address, self._token_pos(tok))
+            return AddressRef(address, pos)
         except AddressError as e:
-            p = self._pos(tok)
-            return self._fail(LadderError(Pos(p.source, p.line, p.column + e.position), e.reason), Placeholder(0, p))
+            return self._fail(LadderError(Pos(pos.source, pos.line, pos.column + e.position), e.reason),
+                              Placeholder(0, pos))
 
     # The rules below are reduced once per token of a program: they take
     # lark's child list as it is (no v_args wrapper, one call less a token).
@@ -252,21 +255,29 @@ class _ToAst(Transformer):
         else:
             tokens, tok = children
         if isinstance(tok, Token):
-            kind = tok.type
-            source, line_offset, column_offset = self.context
-            pos = self._token_pos(tok) if line_offset or column_offset else Pos(source, tok.line, tok.column)
-            if kind == "ADDRESS":
-                address = self.addresses.get(tok.value)
-                tok = self._address(tok) if address is None else AddressRef(address, pos)
-            elif kind == "NAME":
-                tok = _Name(tok.value, pos)
-            elif kind == "SYMBOL_MEMBER":  # PollTimer/DN: never a mnemonic, so an operand at once
-                tok = SymbolRef(tok.value, pos)
-            elif kind == "STRING":
-                tok = Text(_unquote(tok.value), pos)
-            else:  # BST, NXB, BND
-                tok = _Marker(kind, pos)
-        tokens.append(tok)  # or a signed number, already a Const
+            return self.mn_token(tokens, tok.type, tok.value, tok.line, tok.column)
+        tokens.append(tok)  # a signed number, already a Const
+        return tokens
+
+    def mn_token(self, tokens: list, kind: str, text: str, line: int, column: int) -> list:
+        """``mn_tokens`` for a token, given as its fields: lalr_driver calls
+        it so for most tokens of a rung, without making a Token."""
+        source, line_offset, column_offset = self.context
+        if line_offset or column_offset:
+            pos = Pos(source, line + line_offset, column + column_offset if line == 1 else column)
+        else:
+            pos = Pos(source, line, column)
+        if kind == "ADDRESS":
+            address = self.addresses.get(text)
+            tokens.append(self._address_at(text, pos) if address is None else AddressRef(address, pos))
+        elif kind == "NAME":
+            tokens.append(_Name(text, pos))
+        elif kind == "SYMBOL_MEMBER":  # PollTimer/DN: never a mnemonic, so an operand at once
+            tokens.append(SymbolRef(text, pos))
+        elif kind == "STRING":
+            tokens.append(Text(_unquote(text), pos))
+        else:  # BST, NXB, BND
+            tokens.append(_Marker(kind, pos))
         return tokens
 
     def mnemonic_rung(self, items):

@@ -149,18 +149,21 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
 
 @lru_cache(maxsize=1)
 def _fast_parser() -> FastLalr:
-    return FastLalr(_ast_parser())
+    lark = _ast_parser()
+    return FastLalr(lark, token_actions={"mn_tokens": lark.options.transformer.mn_token})
 
 
 def _parse_fast_or_lark(parser: Lark, text: str, start: str, problems: list[LadderError] | None):
     """The same parse as ``parser.parse``, by lalr_driver's faster loop over
     the same tables; a text that loop cannot take (a syntax error) is parsed
     again by lark itself, for lark's error, after undoing what the first try
-    added to ``problems``."""
+    added to ``problems``. So is one where a rule action refuses something
+    (a bad address): the loop reduces a list one token earlier than lark,
+    so lark may find a syntax error first."""
     found = len(problems) if problems is not None else 0
     try:
         return _fast_parser().parse(text, start)
-    except NotFastPath:
+    except (NotFastPath, LadderError):
         if problems is not None:
             del problems[found:]
         return parser.parse(text, start=start)
