@@ -90,3 +90,50 @@ def test_a_rung_made_a_block_of_its_own_runs_the_same(monkeypatch):
         e.set_mode(Mode.RUN)
         e.run(40)
     assert whole.table == split.table and whole.table.read("C5:0.ACC") > 0
+
+
+def _rung_in_recorder():
+    """A TLM whose instruction SEEN records the rung-in it is given."""
+    from softplc_lite.ladder.instructions import InstructionSpec, K, OperandSpec
+    from softplc_lite.tlm import TLM
+
+    seen_spec = InstructionSpec("SEEN", "record the rung-in", (OperandSpec("dest", K.WORD),), True, 0, "REC")
+
+    class Recorder(TLM):
+        name = "REC"
+
+        def __init__(self):
+            self.rung_ins = []
+
+        def instructions(self):
+            return [seen_spec]
+
+        def create(self, instr, ctx):
+            def seen(c):
+                self.rung_ins.append(c)
+                return c
+            return seen
+
+    return Recorder()
+
+
+@pytest.mark.parametrize("executor", ["compiled", "reference"])
+def test_contacts_give_a_module_instruction_a_bool_rung_in(executor):
+    """Block code keeps a contact as ``word & mask`` (any value with the
+    rung's truth); where the rung condition leaves block code it is a bool,
+    True or False, as the reference interpreter gives it."""
+    from softplc_lite.ladder import Mode, run_text
+
+    rec = _rung_in_recorder()
+    program = "\n".join([
+        "XIC B3/4 SEEN N7:0",                       # bit 4 set: the word & mask is 16
+        "XIC B3/5 SEEN N7:1",                       # clear: 0
+        "BST XIC B3/4 NXB XIO B3/4 BND SEEN N7:2",  # a branch of truthy legs
+        "XIC B3/4 XIC B3/15 SEEN N7:3",             # bit 15: the word & mask is negative
+    ])
+    engine = run_text(program, scans=0, executor=executor, modules=[rec],
+                      values={"B3:0": -32768 | 16})
+    engine.set_mode(Mode.RUN)
+    engine.run(1)
+    assert rec.rung_ins == [True, False, True, True]
+    assert all(type(c) is bool for c in rec.rung_ins)

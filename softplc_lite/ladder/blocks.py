@@ -31,6 +31,12 @@ TND = -2
 # use per rung; smaller ones pay the call more often. CPython compiles one
 # huge function body several times slower than the same code in pieces.
 CHUNK_RUNGS = 1000
+
+# The rung condition ``c`` of block code is any value with the rung's truth
+# (a contact is ``word & mask``, not ``word & mask != 0``: a compare less
+# per contact to compile and to run). Where it leaves block code -- a kernel,
+# a bound or module instruction, the MCR zone -- it is made a bool.
+RUNG_BOOL = "not not c"
 # Word locals per block (about: a block ends after the rung that passes it).
 LOCALS_BUDGET = 300
 

@@ -30,7 +30,7 @@ from ..datatable import DataTable, ValueKind, bit_mask
 from ..datatable.filetypes import Storage
 from . import blocks
 from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, instructions_of, walk
-from .blocks import RET, TND, BlockCode, CompiledFile  # noqa: F401 (RET, TND: the block protocol, imported from here)
+from .blocks import RET, RUNG_BOOL, TND, BlockCode, CompiledFile  # noqa: F401 (RET, TND: the block protocol, imported from here)
 from .held_words import _BIT_OPS, _NO_BARRIER, HeldWords, _may_hold
 from .templates import _COMPARE, TableTemplates
 from .bound import BoundAccess
@@ -233,7 +233,7 @@ class _FileCompiler(HeldWords, TableTemplates):
                 held = self.bit(2, el.operands[0])
                 if held is None:
                     return None
-                return f"{held[0]} & {held[1]!r} != 0" if m == "XIC" else f"not {held[0]} & {held[1]!r}"
+                return f"{held[0]} & {held[1]!r}" if m == "XIC" else f"not {held[0]} & {held[1]!r}"
             if m in _COMPARE and all(isinstance(op, Const) or op.address.is_direct for op in el.operands):
                 # A compare of direct words reads and writes nothing else: a contact too.
                 for op in el.operands:
@@ -306,7 +306,7 @@ class _FileCompiler(HeldWords, TableTemplates):
         if bound is not None:
             # A bound instruction (ladder/instr/): one object per instruction.
             name = self.bind_once((id(ins), "bi"), "_bi", lambda: bound.bind(ins, BoundAccess(self.table, self.machine)))
-            self.emit(ind, f"c = {name}(c)")
+            self.emit(ind, f"c = {name}({RUNG_BOOL})")
             return
         key = (id(ins), "tli")
         if key not in self.named:
@@ -315,7 +315,7 @@ class _FileCompiler(HeldWords, TableTemplates):
                 raise NotImplementedError(f"no compiler template for {m}")  # validated programs never get here
             self.bind_once(key, "_tli", lambda: instance)
         # A module (TLM) instruction: its instance takes the rung-in and gives the rung-out.
-        self.emit(ind, f"c = {self.named[key]}(c)")
+        self.emit(ind, f"c = {self.named[key]}({RUNG_BOOL})")
 
     # -- blocks -----------------------------------------------------------------------------------
     def block(self, first: int, end: int, words=None) -> BlockCode:

@@ -15,6 +15,7 @@ import re
 from ..datatable import bit_mask
 from ..datatable.filetypes import Storage
 from .ast import AddressRef, BinOp, Const, Instruction, UnaryOp, address_refs, instructions_of
+from .blocks import RUNG_BOOL
 from .semantics import BASE_MS, CD, CU, DN, EN, OV, STAMP, STAMP_MODULO, TT, UN
 
 
@@ -279,7 +280,7 @@ class HeldWords:
         self.emit(ind, f"if ({wp} | {wa}) < 0:")  # either negative: the kernel raises the fault, on an exact table
         self.flush_lines(ind + 1)
         d, i, _ = self.location(ind + 1, ins.operands[0])
-        self.emit(ind + 1, f"{self.bind('_ton', self.machine.ton)}({d}, {i}, c, {base!r})")
+        self.emit(ind + 1, f"{self.bind('_ton', self.machine.ton)}({d}, {i}, {RUNG_BOOL}, {base!r})")
         self.emit(ind, "if c:")
         self.emit(ind + 1, f"if {wc} & {EN!r} and {wa} < {wp}:")
         self.emit(ind + 2, f"_r = (_now - ({wc} & {STAMP!r})) % {STAMP_MODULO!r}")  # ms since its last update

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from . import status as S
 from .ast import AddressRef
-from .blocks import RET, TND
+from .blocks import RET, RUNG_BOOL, TND
 from .held_words import _SIMPLE, _is_word, _word_valued
 from .semantics import BASE_MS, MajorFault, lim, source_units
 
@@ -62,7 +62,7 @@ class TableTemplates:
     def _timer(self, ind, ops, kernel: str):
         d, i, _ = self.location(ind, ops[0])
         fn = self.bind(f"_{kernel}", getattr(self.machine, kernel))
-        self.emit(ind, f"{fn}({d}, {i}, c, {BASE_MS[ops[1].value]!r})")
+        self.emit(ind, f"{fn}({d}, {i}, {RUNG_BOOL}, {BASE_MS[ops[1].value]!r})")
 
     def i_TON(self, ind, ops):
         self._timer(ind, ops, "ton")
@@ -76,7 +76,7 @@ class TableTemplates:
     def _counter(self, ind, ops, kernel: str):
         d, i, _ = self.location(ind, ops[0])
         fn = self.bind(f"_{kernel}", getattr(self.machine, kernel))
-        self.emit(ind, f"{fn}({d}, {i}, c)")
+        self.emit(ind, f"{fn}({d}, {i}, {RUNG_BOOL})")
 
     def i_CTU(self, ind, ops):
         self._counter(ind, ops, "ctu")
@@ -280,7 +280,7 @@ class TableTemplates:
     def i_MCR(self, ind, ops):
         # An MCR alone on its rung ends the zone; with conditions before it, it starts one.
         conditional = self.rung_elements[0] is not self.current
-        self.emit(ind, f"z = {'c' if conditional else 'True'}")
+        self.emit(ind, f"z = {RUNG_BOOL if conditional else 'True'}")
         self.emit(ind, "_zone[0] = z")
 
     def i_AFI(self, ind, ops):
