@@ -352,7 +352,6 @@ class _FileCompiler(HeldWords, TableTemplates):
         return BlockCode(self.line_rung[0], end, self.lines, self.line_instr, self.line_rung)
 
     def compile(self) -> CompiledFile:
-        cf = CompiledFile(self.number, len(self.rungs), self.has_mcr, self)
         # A block starts at every label (a JMP lands at a block's start) and
         # holds at most CHUNK_RUNGS rungs and about LOCALS_BUDGET word locals:
         # CPython's compile() slows down more than linearly with the number of
@@ -362,6 +361,7 @@ class _FileCompiler(HeldWords, TableTemplates):
         count = len(self.rungs)
         words = [self.rung_words(k) for k in range(count)]
         self.has_mcr = self.saw_mcr  # (the pass just made saw every instruction)
+        cf = CompiledFile(self.number, len(self.rungs), self.has_mcr, self)
         k = 0
         while k < count:
             first = k
