@@ -38,7 +38,7 @@ from .expr import namespace as expr_namespace
 from .expr import to_python
 from .instr import BOUND
 from .resolvers import resolver
-from .semantics import Machine
+from .semantics import DN, EN, STAMP, TT, Machine
 
 
 class EndScan(Exception):
@@ -344,7 +344,8 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.current = None
         self.flush_lines(2)
         if self.uses_now:  # the engine's clock of this scan, read once per block (TON)
-            self.lines.insert(1, "        _now = _m.now_ms")
+            self.lines.insert(1, f"        _now = _m.now_ms; _ton_done = (_now & {STAMP!r}) | {EN | DN!r}; "
+                                 f"_ton_timing = (_now & {STAMP!r}) | {EN | TT!r}")
             self.line_instr.insert(1, None)
             self.line_rung.insert(1, self.line_rung[0])
         if len(self.lines) == 1:

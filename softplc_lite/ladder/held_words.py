@@ -281,21 +281,25 @@ class HeldWords:
         self.flush_lines(ind + 1)
         d, i, _ = self.location(ind + 1, ins.operands[0])
         self.emit(ind + 1, f"{self.bind('_ton', self.machine.ton)}({d}, {i}, {RUNG_BOOL}, {base!r})")
-        self.emit(ind, "if c:")
-        self.emit(ind + 1, f"if {wc} & {EN!r} and {wa} < {wp}:")
-        self.emit(ind + 2, f"_r = (_now - ({wc} & {STAMP!r})) % {STAMP_MODULO!r}")  # ms since its last update
-        self.emit(ind + 2, f"_t = _r // {base!r}")
-        self.emit(ind + 2, f"_r -= _t * {base!r}")
-        self.emit(ind + 2, f"{wa} += _t")
-        self.emit(ind + 2, f"if {wa} >= {wp}: {wa} = {wp}; _r = 0")
-        self.emit(ind + 2, f"{wc} = ({wc} & {~STAMP!r}) | ((_now - _r) & {STAMP!r}) | {EN!r}")
-        self.emit(ind + 1, "else:")
-        self.emit(ind + 2, f"{wc} = ({wc} & {~STAMP!r}) | (_now & {STAMP!r}) | {EN!r}")
-        self.emit(ind + 1, f"if {wa} >= {wp}: {wc} = ((({wc} | {DN!r}) & {~STAMP!r}) | (_now & {STAMP!r})) & {~TT!r}")
-        self.emit(ind + 1, f"else: {wc} = ({wc} | {TT!r}) & {~DN!r}")
+        # EN, TT, DN and the stamp are every bit of the control word, so each
+        # outcome sets the whole word: done is EN|DN and the stamp of now
+        # (_ton_done, made once a block), enabled this scan EN|TT and now
+        # (_ton_timing), still timing EN|TT and the stamp its time counts from.
         assert EN | TT | DN | STAMP == -1
+        self.emit(ind, "if c:")
+        self.emit(ind + 1, f"if {wa} < {wp}:")  # not done (DN is ACC >= PRE, tested each scan)
+        self.emit(ind + 2, f"if {wc} & {EN!r}:")
+        self.emit(ind + 3, f"_r = (_now - ({wc} & {STAMP!r})) % {STAMP_MODULO!r}")  # ms since its last update
+        self.emit(ind + 3, f"_t = _r // {base!r}")
+        self.emit(ind + 3, f"{wa} += _t")
+        self.emit(ind + 3, f"if {wa} >= {wp}: {wa} = {wp}; {wc} = _ton_done")
+        self.emit(ind + 3, f"else: {wc} = ((_now - _r + _t * {base!r}) & {STAMP!r}) | {EN | TT!r}")
+        self.emit(ind + 2, "else:")
+        self.emit(ind + 3, f"{wc} = _ton_timing")  # the evaluation that enables it starts it
+        self.emit(ind + 1, "else:")
+        self.emit(ind + 2, f"{wc} = _ton_done")
         self.emit(ind, "else:")
-        self.emit(ind + 1, f"{wc} = 0")  # EN TT DN and the stamp are every bit of the word
+        self.emit(ind + 1, f"{wc} = 0")
         self.emit(ind + 1, f"{wa} = 0")
         self.dirty.update((wc, wa))
 
