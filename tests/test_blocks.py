@@ -137,3 +137,33 @@ def test_contacts_give_a_module_instruction_a_bool_rung_in(executor):
     engine.run(1)
     assert rec.rung_ins == [True, False, True, True]
     assert all(type(c) is bool for c in rec.rung_ins)
+
+
+@pytest.mark.parametrize("scan_ms", [3, 7, 10, 26])
+def test_a_held_ton_times_as_the_kernel_through_every_outcome(scan_ms):
+    """TON on held words sets its whole control word per outcome (done,
+    enabled now, still timing with the stamp its time counts from): scan
+    times that are not a multiple of the time base leave a remainder that
+    the stamp must carry; the rung goes false and true again, and a preset
+    is raised under a done timer. Both executors, every scan."""
+    from softplc_lite.ladder import Settings
+
+    text = ("XIO B3/0 TON T4:0 0.01 25 0\n"          # times out, then reset by B3/0
+            "XIC T4:0/DN OTL B3/0\n"
+            "XIC B3/0 XIO T4:1/DN TON T4:1 0.01 40 0\n"
+            "TON T4:2 1.0 1 0\n"                    # a 1 s base: ACC counts seconds
+            "XIC T4:2/DN MOV 3 T4:2.PRE\n"           # a preset raised under a done timer
+            "XIC T4:1/DN OTU B3/0\n")
+    engines = [Engine(load_text(text, "t.lad"), executor=ex, settings=Settings(scan_ms=scan_ms))
+               for ex in EXECUTORS]
+    for e in engines:
+        e.set_mode(Mode.RUN)
+    seen_done = set()
+    for _ in range(900 // scan_ms + 200):
+        for e in engines:
+            e.scan()
+        compiled, reference = engines
+        assert compiled.table.file(4).data[:9] == reference.table.file(4).data[:9]
+        assert compiled.table.read("B3:0") == reference.table.read("B3:0")
+        seen_done.update(k for k in range(3) if compiled.table.read(f"T4:{k}/DN"))
+    assert seen_done == {0, 1, 2}
