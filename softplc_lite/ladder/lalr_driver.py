@@ -33,6 +33,7 @@ import re
 
 from lark import Lark, Token
 from lark.lexer import UnlessCallback
+from lark.parse_tree_builder import ExpandSingleChild
 from lark.parsers.lalr_analysis import Shift
 from lark.utils import sre_constants, sre_parse
 
@@ -136,7 +137,10 @@ class FastLalr:
                     compiled[str(symbol)] = (arg, None)
                 else:
                     if arg not in reductions:
-                        reductions[arg] = (len(arg.expansion), str(arg.origin.name), callbacks[arg])
+                        callback = callbacks[arg]
+                        if len(arg.expansion) == 1 and type(callback) is ExpandSingleChild:
+                            callback = None  # a "?rule" of one symbol gives that symbol's value: nothing to do
+                        reductions[arg] = (len(arg.expansion), str(arg.origin.name), callback)
                     compiled[str(symbol)] = (None, reductions[arg])
             self.actions[state] = compiled
         self.list_steps = _list_steps(self.actions, reductions, token_actions or {},
@@ -189,6 +193,16 @@ class FastLalr:
                 if found is None:
                     found = known[value] = scanner.fullmatch(value) or kind
                 kind = found
+            steps = list_steps.get(state)
+            if steps is not None:  # the next step of a list, most tokens of a mnemonic rung
+                step = steps.get(kind)  # (never a kind the post-lexer reads)
+                if step is not None:
+                    if expected is not None and kind not in expected:
+                        raise NotFastPath(kind)
+                    lex_state, token_action = step
+                    expected = actions[lex_state]
+                    value_stack[-1] = token_action(value_stack[-1], kind, value, token_line, column)
+                    continue
             # the post-lexer
             change = span_changes.get(kind)
             if change is not None:
@@ -197,14 +211,6 @@ class FastLalr:
                 continue
             if expected is not None and kind not in expected:
                 raise NotFastPath(kind)  # where lark, one token later than this loop, finds the error
-            steps = list_steps.get(state)
-            if steps is not None:  # the next step of a list, most tokens of a mnemonic rung
-                step = steps.get(kind)
-                if step is not None:
-                    lex_state, token_action = step
-                    expected = actions[lex_state]
-                    value_stack[-1] = token_action(value_stack[-1], kind, value, token_line, column)
-                    continue
             token = _new_str(Token, value)
             token.type = kind
             token.start_pos = start_pos
@@ -225,6 +231,10 @@ class FastLalr:
                 if shift_to is not None:
                     break
                 size, origin, callback = reduce
+                if callback is None:  # the value stays; only the state changes
+                    state = state_stack[-1] = actions[state_stack[-2]][origin][0]
+                    row = actions[state]
+                    continue
                 if size:
                     children = value_stack[-size:]
                     del state_stack[-size:]
@@ -258,6 +268,11 @@ class FastLalr:
             if action is None or action[0] is not None:
                 raise NotFastPath("$END")
             size, origin, callback = action[1]
+            if callback is None:
+                state_stack[-1] = actions[state_stack[-2]][origin][0]
+                if state_stack[-1] == end_state:
+                    return value_stack[-1]
+                continue
             if size:
                 children = value_stack[-size:]
                 del state_stack[-size:]

@@ -35,6 +35,8 @@ from .ast import (
 from .errors import LadderError
 from .limits import MAX_CONSTANT, MAX_NUMBER_DIGITS
 
+_new_tuple = tuple.__new__
+
 # -- transformer --------------------------------------------------------------------
 
 # Markers for mnemonic-form branch keywords inside a flat token run.
@@ -178,9 +180,8 @@ class _ToAst(Transformer):
         tok = children[0]
         return SymbolRef(str(tok), self._token_pos(tok))
 
-    @v_args(inline=True)
-    def signed_number(self, tok):
-        return self._const(tok)
+    def signed_number(self, children):  # once a number: no v_args wrapper
+        return self._const(children[0])
 
     @v_args(inline=True)
     def negative_number(self, sign, tok):
@@ -264,9 +265,8 @@ class _ToAst(Transformer):
         it so for most tokens of a rung, without making a Token."""
         source, line_offset, column_offset = self.context
         if line_offset or column_offset:
-            pos = Pos(source, line + line_offset, column + column_offset if line == 1 else column)
-        else:
-            pos = Pos(source, line, column)
+            line, column = line + line_offset, column + column_offset if line == 1 else column
+        pos = _new_tuple(Pos, (source, line, column))  # Pos(...) without its __new__'s frame
         if kind == "ADDRESS":
             address = self.addresses.get(text)
             tokens.append(self._address_at(text, pos) if address is None else AddressRef(address, pos))
