@@ -167,3 +167,47 @@ def test_a_held_ton_times_as_the_kernel_through_every_outcome(scan_ms):
         assert compiled.table.read("B3:0") == reference.table.read("B3:0")
         seen_done.update(k for k in range(3) if compiled.table.read(f"T4:{k}/DN"))
     assert seen_done == {0, 1, 2}
+
+
+@pytest.mark.parametrize("reader", [
+    "XIC S:0/2 OTE B3/9",            # a contact
+    "MOV S:0 N7:9",                   # a word read inline
+    "COP #S:0 #N7:9 1",               # a block copy of S
+    "JSR 3",                          # code that is not block code (a barrier)
+    "ADD S:0 0 N7:9",                 # a store reading S:0 as its operand
+    "",                               # the end of the scan
+])
+def test_flags_a_held_store_leaves_pending_are_set_before_anything_reads_s0(reader):
+    """A word store on held words leaves S:0's flags pending (its value and
+    carry) until something reads S:0: each reader, after stores whose rungs
+    are true or false, sees the flags of the last store that ran."""
+    text = ("XIC B3/0 MOV 0 N7:1\n"          # runs: Z
+            "XIC B3/1 MOV -5 N7:2\n"         # rung false: flags stay Z
+            f"{reader}\n"
+            "XIC B3/0 ADD 32767 1 N7:3\n"    # overflow: the kernel sets V in the table
+            f"{reader}\n"
+            "XIC B3/0 ADD -1 -1 N7:4\n"      # carry and sign, in range
+            "XIC B3/0 MOV 1 N7:5\n"          # clears them: only the last store counts
+            f"{reader}\n"
+            "OTE B3/15\n"
+            "FILE 3\nRET\n")
+    if not reader:
+        text = text.replace("\n\n", "\n")
+    e = _both(text, scans=2, values={"B3:0": 1})
+    if not reader.startswith(("MOV", "ADD")):  # (a reader that stores sets the flags itself)
+        assert e.table.read("S:0") & 15 == 0  # MOV 1: no flag
+    assert e.table.read("N7:3") == 32767 and e.table.read("N7:4") == -2
+
+
+def test_flags_pending_survive_a_breakpoint_split():
+    """A rung isolated for a breakpoint is a block of its own: the flags
+    pending at the end of the block before it are written with it."""
+    text = "XIC B3/0 ADD -1 -1 N7:4\nXIC B3/0 MOV -3 N7:5\nXIC S:0/3 OTE B3/1\nXIC S:0/0 OTE B3/2\n"
+    for isolate in (False, True):
+        e = Engine(load_text(text, "t.lad"))
+        if isolate:
+            e.files[2][0].isolate(2)
+        e.table.write("B3/0", 1)
+        e.set_mode(Mode.RUN)
+        e.run(1)
+        assert (e.table.read("B3/1"), e.table.read("B3/2")) == (1, 0)  # sign from MOV -3, carry cleared

@@ -31,7 +31,7 @@ from ..datatable.filetypes import Storage
 from . import blocks
 from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, instructions_of, walk
 from .blocks import RET, RUNG_BOOL, TND, BlockCode, CompiledFile  # noqa: F401 (RET, TND: the block protocol, imported from here)
-from .held_words import _BIT_OPS, _NO_BARRIER, HeldWords, _may_hold
+from .held_words import _BIT_OPS, _FLAGS, _NO_BARRIER, HeldWords, _may_hold
 from .templates import _COMPARE, TableTemplates
 from .bound import BoundAccess
 from .expr import namespace as expr_namespace
@@ -132,6 +132,8 @@ class _FileCompiler(HeldWords, TableTemplates):
             f, index, bit = self.resolve(a)
             name = self.words.get((f.number, index))
             if name is not None:  # held in a local (loaded at rung level before this instruction)
+                if (f.number, index) == _FLAGS:
+                    self.flags_exact(ind)
                 return name if bit is None else f"(1 if {name} & {bit_mask(bit)!r} else 0)"
         d, i, m = self.location(ind, operand)
         if m is not None:
@@ -162,6 +164,8 @@ class _FileCompiler(HeldWords, TableTemplates):
             name = self.words.get(key)
             if name is None and self.uses.get(key, 0) >= 2:
                 name = self.word_at(ind, f, index)  # loaded now, at rung level
+            elif name is not None and key == _FLAGS:
+                self.flags_exact(ind)
             if name is not None:
                 return name, mask, True
         return in_place, mask, False
@@ -333,6 +337,7 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.words: dict[tuple[int, int], str] = {}  # (file, word) -> the local holding it
         self.local_names: set[str] = set()  # every word local of the block, held now or not
         self.dirty: set[str] = set()  # locals a rung may have changed since the last write-back
+        self.flags_pending = False  # a word store may have left S:0's flags pending (flags_exact)
         self.temp = 0
         self.rung_index = first
         self.rung_marked = None

@@ -38,7 +38,7 @@ class HeldWords:
             return None
         return name, (bit_mask(bit) if bit is not None else None)
 
-    def word_at(self, ind: int, f, index: int, force: bool = False) -> str | None:
+    def word_at(self, ind: int, f, index: int, force: bool = False, for_store: bool = False) -> str | None:
         """The local holding word ``index`` of file ``f`` (loaded now if not
         held), or None if no local may hold that file's words, or (unless
         ``force``) the block uses the word only once: a local would cost a
@@ -52,7 +52,13 @@ class HeldWords:
                 return None
             name = self.words[key] = f"w{f.number}_{index}"
             self.local_names.add(name)
-            self.emit(ind, f"{name} = {self.array_name(f)}[{index!r}]")
+            if key == _FLAGS:
+                self.emit(ind, f"{name} = {self.array_name(f)}[{index!r}]; _fz = None")  # no store pending yet
+                self.flags_pending = False
+            else:
+                self.emit(ind, f"{name} = {self.array_name(f)}[{index!r}]")
+        elif key == _FLAGS and not for_store:
+            self.flags_exact(ind)
         return name
 
     def rung_words(self, k: int) -> list[tuple[int, int]]:
@@ -88,8 +94,19 @@ class HeldWords:
         f, index, _ = self.resolve(a)
         return (f.number, index) if _may_hold(f, index) else None
 
+    def flags_exact(self, ind: int) -> None:
+        """S:0's local made exact before anything reads it: a word store
+        held in a block leaves its flags pending, as its value (_fz) and
+        carry (_fc), and they are set here (only the last store's count:
+        each sets all four of C V Z S)."""
+        if self.flags_pending and _FLAGS in self.words:
+            name = self.words[_FLAGS]
+            self.emit(ind, f"if _fz is not None: {name} = ({name} & -16) | _fc | "
+                           f"(4 if _fz == 0 else 8 if _fz < 0 else 0); _fz = None")  # Z S:0/2, S S:0/3
+
     def flush_lines(self, ind: int) -> None:
         """Write back every local a rung may have changed."""
+        self.flags_exact(ind)
         for (number, index), name in self.words.items():
             if name in self.dirty:
                 self.emit(ind, f"f{number}[{index!r}] = {name}")
@@ -142,7 +159,7 @@ class HeldWords:
                 # into its local if held, else into the table; S:0 likewise.
                 f, index, _ = self.resolve(dest.address)
                 self.inline_dest = self.words.get((f.number, index), "")
-                self.inline_flags = self.word_at(ind, self.status_file, 0) or ""
+                self.inline_flags = self.word_at(ind, self.status_file, 0, for_store=True) or ""
                 self.dispatch(ind, ins)
                 for name in (self.inline_dest, self.inline_flags):
                     if name:
@@ -153,6 +170,7 @@ class HeldWords:
             # Its kernel writes the destination and S:0 in the table: held, they
             # are written back first and forgotten after.
             f, index, _ = self.resolve(dest.address)
+            self.flags_exact(ind)
             for key in ((f.number, index), _FLAGS):
                 name = self.words.get(key)
                 if name is not None:
@@ -188,19 +206,27 @@ class HeldWords:
         else:
             v = "_v"
             self.emit(ind, f"_v = {value_code}")
-        flags = f"(4 if {v} == 0 else 8 if {v} < 0 else 0)"  # Z S:0/2, S S:0/3
-        if carry is not None:
-            flags = f"({carry}) | {flags}"
+        if self.inline_flags:
+            # S:0 held: the flags are left pending until something reads S:0
+            # (flags_exact); a later store replaces them.
+            set_flags = f"_fz = {v}; _fc = {carry or 0}"
+            self.flags_pending = True
+        else:
+            flags = f"(4 if {v} == 0 else 8 if {v} < 0 else 0)"  # Z S:0/2, S S:0/3
+            if carry is not None:
+                flags = f"({carry}) | {flags}"
+            set_flags = f"{s0} = ({s0} & -16) | {flags}"
         if in_range:
             self.emit(ind, f"{target} = {v}")
-            self.emit(ind, f"{s0} = ({s0} & -16) | {flags}")
+            self.emit(ind, set_flags)
             return
         self.emit(ind, "if -32768 <= _v <= 32767:")
         self.emit(ind + 1, f"{target} = _v")
-        self.emit(ind + 1, f"{s0} = ({s0} & -16) | {flags}")
+        self.emit(ind + 1, set_flags)
         self.emit(ind, "else:")
         self.emit(ind + 1, f"_m.rung = {self.rung_index!r}")  # the minor fault names this rung
         if self.inline_flags:  # the kernel sets S:0 in the table
+            self.flags_exact(ind + 1)
             self.emit(ind + 1, f"_s[0] = {s0}")
         self.emit(ind + 1, fallback.replace("_D_", f"{self.array_name(f)}, {index!r}"))
         if name:
@@ -336,6 +362,8 @@ class HeldWords:
             return
         held = [(key, name) for key, name in self.words.items()
                 if (key[0] == sf.number and si <= key[1] < si + n) or (key[0] == df.number and di <= key[1] < di + n)]
+        if any(key == _FLAGS for key, _ in held):
+            self.flags_exact(ind)
         for (number, index), name in held:
             if name in self.dirty:
                 self.emit(ind, f"f{number}[{index!r}] = {name}")
