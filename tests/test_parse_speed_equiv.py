@@ -137,7 +137,7 @@ def test_a_syntax_error_is_lark_s_with_every_problem_found_before_it_once():
 
 
 def test_a_mnemonic_rung_skips_limit_problem_only_when_nothing_can_be_over_a_limit():
-    # parser._group tells limit_problem's work is needed from the branch
+    # parser._finish tells limit_problem's work is needed from the branch
     # depth and the expressions it saw; at and past each limit it is asked.
     from softplc_lite.ladder.instructions import BUILTIN
     from softplc_lite.ladder.limits import (
@@ -147,8 +147,8 @@ def test_a_mnemonic_rung_skips_limit_problem_only_when_nothing_can_be_over_a_lim
     )
 
     def grouped(text):
-        tokens = parser._ast_parser().parse(text + "\n", start="start")[0].tokens
-        return parser._group(tokens, BUILTIN, Pos("t.lad", 1, 1), {})
+        run = parser._parse_tree(text + "\n", "t.lad", "start", instructions=BUILTIN)[0].run
+        return parser._finish(run, BUILTIN)
 
     def nested(depth):
         return "XIC B3/0 " + "BST XIC B3/1 NXB " * depth + "OTE B3/2 " + "BND " * depth
@@ -169,21 +169,22 @@ def test_a_mnemonic_rung_skips_limit_problem_only_when_nothing_can_be_over_a_lim
 
 
 def grouped_or_none(line: str):
-    """_group's answer for a one-line mnemonic rung; None for any other line
+    """_finish's answer for a one-line mnemonic rung; None for any other line
     (a line of a multi-line rung, a directive, one with a problem)."""
-    from lark.exceptions import UnexpectedInput
-
     from softplc_lite.ladder.instructions import BUILTIN
 
     try:
-        drafts = [i for i in parser._ast_parser().parse(line + "\n", start="start") if getattr(i, "tokens", None)]
-        return parser._group(drafts[0].tokens, BUILTIN, drafts[0].pos, {}) if drafts else None
-    except (UnexpectedInput, LadderError):
+        drafts = [i for i in parser._parse_tree(line + "\n", "t.lad", "start", instructions=BUILTIN)
+                  if getattr(i, "run", None)]
+        return parser._finish(drafts[0].run, BUILTIN) if drafts else None
+    except LadderError:
         return None
 
 
 @pytest.mark.parametrize("text", ["XIC B3/: ;\n", "XIC B3/:\n;\n", "XIC B3/: B3/x\n", "SOR XIC B3/: ; EOR\n",
-                                  "XIC B3/: (\n", "XIC B3/0 B3/: ) OTE B3/1\n", "XIC B3/:", "XIC Timer/DN B3/: [\n"])
+                                  "XIC B3/: (\n", "XIC B3/0 B3/: ) OTE B3/1\n", "XIC B3/:", "XIC Timer/DN B3/: [\n",
+                                  "MOV 1e999 ;\n", "MOV 1e999", "MOV 5 N7:0 (\n", "TON T4:0 0x10 -5 +3 1.5e3 .5\n",
+                                  "MOV 0x1FFFFFFFFF N7:0 ]\n", "MOV 5\n", "SOR MOV 5 EOR 6\n"])
 def test_a_rule_action_s_error_just_before_a_syntax_error(lark_only, text):
     # The fast loop reduces a mnemonic rung's list one token before lark
     # does, so a bad address is refused before the syntax error after it is
@@ -197,7 +198,9 @@ def test_the_list_steps_come_from_the_tables():
     steps = parser._fast_parser().list_steps
     assert steps, "mn_tokens' list steps"
     kinds = set().union(*steps.values())
-    assert kinds == {"NAME", "ADDRESS", "SYMBOL_MEMBER", "STRING", "BST", "NXB", "BND"}
+    assert kinds == {"NAME", "ADDRESS", "SYMBOL_MEMBER", "STRING", "BST", "NXB", "BND", "INT", "FLOAT", "HEX"}
+    for by_kind in steps.values():  # a number is reduced to signed_number on the way
+        assert all((step[2] is None) == (kind in ("INT", "FLOAT", "HEX")) for kind, step in by_kind.items())
 
 
 @pytest.mark.parametrize(("regexp", "chars"), [

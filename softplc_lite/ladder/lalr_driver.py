@@ -199,9 +199,12 @@ class FastLalr:
                 if step is not None:
                     if expected is not None and kind not in expected:
                         raise NotFastPath(kind)
-                    lex_state, token_action = step
-                    expected = actions[lex_state]
-                    value_stack[-1] = token_action(value_stack[-1], kind, value, token_line, column)
+                    lex_state, expected, token_action, units, list_callback = step
+                    if token_action is not None:
+                        value_stack[-1] = token_action(value_stack[-1], kind, value, token_line, column)
+                    else:
+                        token = Token(kind, value, start_pos, token_line, column, line, pos - line_start + 1, pos)
+                        value_stack[-1] = list_callback([value_stack[-1], _reduced(units, token)])
                     continue
             # the post-lexer
             change = span_changes.get(kind)
@@ -247,9 +250,11 @@ class FastLalr:
                 row = actions[state]
             steps = list_steps.get(state)
             if steps is not None and kind in steps:  # the first step of a list
-                lex_state, token_action = steps[kind]
-                expected = actions[lex_state]
-                value_stack[-1] = token_action(value_stack[-1], kind, value, token_line, column)
+                lex_state, expected, token_action, units, list_callback = steps[kind]
+                if token_action is not None:
+                    value_stack[-1] = token_action(value_stack[-1], kind, value, token_line, column)
+                else:
+                    value_stack[-1] = list_callback([value_stack[-1], _reduced(units, token)])
                 continue
             state = lex_state = shift_to
             expected = None
@@ -287,18 +292,26 @@ class FastLalr:
 
 def _list_steps(actions: dict[int, dict[str, tuple]], reductions: dict, token_actions: dict,
                 post_lexer_kinds: set[str]) -> dict:
-    """state -> {token kind: (state after the shift, token action)} for
-    each left-recursive list rule ``x: x? K`` given a token action (parser.py
-    gives mn_tokens'): in a state reached by ``x``, a token K shifts to a
-    state whose every action is to reduce ``x: x K``, which returns to the
-    state reached by ``x``. The loop does that shift and reduce as one step,
-    with no stack traffic and no Token: the token action gets (list so far,
-    kind, text, line, column) and does what the rule's callback does with
-    [list so far, Token]; its result replaces the list on the stack. This
-    is the classic "default reduction": the token after K, which lark reads
-    before it reduces, is checked against the shifted-to state's actions
-    before it is used. Kinds the post-lexer reads are left to the general
-    loop."""
+    """state -> {token kind: step} for each left-recursive list rule
+    ``x: x? y`` given a token action (parser.py gives mn_tokens'): in a
+    state reached by ``x``, a token K shifts to a state whose every action
+    is to reduce, and the reductions end with ``x: x y``, which returns to
+    the state reached by ``x``. The loop does that shift and those
+    reductions as one step, with no stack traffic. A step is
+
+    (state after the shift, the next token's allowed kinds, token action,
+    reductions, list callback).
+
+    For ``y`` the token itself the token action gets (list so far, kind,
+    text, line, column), no Token, and does what the rule's callback does
+    with [list so far, Token]; its result replaces the list on the stack.
+    Otherwise (a number: ``y`` is signed_number, reduced from INT) the
+    one-symbol reductions' callbacks (None: the value stays) and then the
+    list callback are called on a Token, as by lark. This is the classic
+    "default reduction": the token after K, which lark reads (in the state
+    after the shift) before it reduces, is checked against the kinds every
+    state on the way reduces on before it is used. Kinds the post-lexer
+    reads are left to the general loop."""
     reached_by: dict[int, str] = {}
     for row in actions.values():
         for symbol, (shift_to, _reduce) in row.items():
@@ -307,17 +320,46 @@ def _list_steps(actions: dict[int, dict[str, tuple]], reductions: dict, token_ac
     nonterminals = {origin for _size, origin, _callback in reductions.values()}
     found: dict[int, dict[str, tuple]] = {}
     for state, row in actions.items():
+        list_rule = reached_by.get(state)
+        if list_rule not in token_actions:
+            continue
         for kind, (shift_to, _reduce) in row.items():
             if shift_to is None or kind in nonterminals or kind in post_lexer_kinds:
                 continue
-            after = set(actions[shift_to].values())
-            if len(after) != 1:
-                continue
-            (to, reduce), = after
-            if to is None and reduce[0] == 2 and reduce[1] == reached_by.get(state) and \
-                    reduce[1] in token_actions and _left_recursive(reductions, reduce):
-                found.setdefault(state, {})[kind] = (shift_to, token_actions[reduce[1]])
+            units: list = []
+            allowed = set(actions[shift_to])
+            current = shift_to
+            while len(units) < 8:
+                after = set(actions[current].values())
+                if len(after) != 1:
+                    break
+                (to, reduce), = after
+                if to is not None:
+                    break
+                size, origin, callback = reduce
+                if size == 2 and origin == list_rule and _left_recursive(reductions, reduce):
+                    if units:
+                        step = (shift_to, frozenset(allowed), None, tuple(units), callback)
+                    else:
+                        step = (shift_to, actions[shift_to], token_actions[list_rule], None, None)
+                    found.setdefault(state, {})[kind] = step
+                    break
+                goto = actions[state].get(origin)
+                if size != 1 or goto is None or goto[0] is None:
+                    break
+                units.append(callback)
+                current = goto[0]
+                allowed &= set(actions[current])
     return found
+
+
+def _reduced(units: tuple, token: Token):
+    """The value of one-symbol reductions over a token, as lark's loop gives it."""
+    value = token
+    for callback in units:
+        if callback is not None:
+            value = callback([value])
+    return value
 
 
 def _left_recursive(reductions: dict, reduce: tuple) -> bool:

@@ -43,16 +43,68 @@ _new_tuple = tuple.__new__
 BST, NXB, BND = "BST", "NXB", "BND"
 
 
-@dataclass(slots=True)  # one a mnemonic or symbol name in a mnemonic rung
-class _Name:
-    text: str
-    pos: Pos
+class _MnemonicRun:
+    """A mnemonic rung's elements, grouped as its tokens are parsed (the
+    value of ``mn_tokens``): only the instruction table knows where one
+    instruction's operands end, so a name that is a mnemonic starts an
+    instruction and any other token is an operand of the current one.
 
+    The first problem (an unknown instruction, an operand before any
+    instruction, NXB or BND outside a branch) is kept, not raised: parser.py
+    raises it when it adds the rung, after the whole text is parsed, as a
+    syntax error found later comes first. Nothing after it is grouped (the
+    operands are still built, for the problems they have of their own).
+    ``texts``: the quoted operands, (instruction, operand index), which
+    parser.py parses as expressions where the instruction takes one."""
 
-@dataclass(slots=True)
-class _Marker:
-    kind: str
-    pos: Pos
+    __slots__ = ("branches", "current", "deepest", "pos", "problem", "root", "series", "texts")
+
+    def __init__(self, pos: Pos) -> None:
+        self.pos = pos  # the first token's
+        self.root: list[Element] = []
+        self.series = self.root  # where the next instruction or branch goes
+        self.branches: list[tuple[list[Element], Branch]] = []  # (series to return to, open branch)
+        self.current: Instruction | None = None
+        self.deepest = 0
+        self.texts: list[tuple[Instruction, int]] = []
+        self.problem: LadderError | None = None
+
+    def instruction(self, mnemonic: str, pos: Pos) -> None:
+        if self.problem is None:
+            self.current = Instruction(mnemonic, [], pos)
+            self.series.append(self.current)
+
+    def operand(self, operand) -> None:
+        if self.problem is not None:
+            return
+        current = self.current
+        if current is None:
+            self.problem = LadderError(operand.pos, "an operand with no instruction before it")
+            return
+        operands = current.operands
+        if type(operand) is Text:
+            self.texts.append((current, len(operands)))
+        operands.append(operand)
+
+    def marker(self, kind: str, pos: Pos) -> None:
+        if self.problem is not None:
+            return
+        self.current = None
+        branches = self.branches
+        if kind == BST:
+            branch = Branch([[]], pos)
+            self.series.append(branch)
+            branches.append((self.series, branch))
+            self.series = branch.legs[0]
+            self.deepest = max(self.deepest, len(branches))
+        elif not branches:
+            self.problem = LadderError(pos, f"{kind} without a BST to open the branch")
+        elif kind == NXB:
+            legs = branches[-1][1].legs
+            legs.append([])
+            self.series = legs[-1]
+        else:  # BND
+            self.series, _ = branches.pop()
 
 
 @dataclass
@@ -72,7 +124,7 @@ class _Header:
 class _RungDraft:
     pos: Pos
     elements: list[Element] | None = None  # neutral: already structured
-    tokens: list | None = None  # mnemonic: flat, grouped later
+    run: _MnemonicRun | None = None  # mnemonic: grouped, to be finished
     comment: str | None = None  # trailing // comment on the rung's line
 
 
@@ -119,6 +171,11 @@ class _ToAst(Transformer):
         # Address text -> Address within one parse: a program names the same
         # addresses many times (more distinct ones than parse_address's cache holds)
         self.addresses: dict[str, object] = {}
+        # The instruction set of the program being parsed (an InstructionSet:
+        # the built-in instructions and its app's modules'), and name ->
+        # mnemonic, or "" for a name that is none, within one parse.
+        self.instructions = None
+        self.mnemonics: dict[str, str] = {}
 
     def _fail(self, error: LadderError, placeholder):
         if self.problems is None:
@@ -171,8 +228,8 @@ class _ToAst(Transformer):
             return self._fail(LadderError(Pos(pos.source, pos.line, pos.column + e.position), e.reason),
                               Placeholder(0, pos))
 
-    # The rules below are reduced once per token of a program: they take
-    # lark's child list as it is (no v_args wrapper, one call less a token).
+    # The rules below take lark's child list as it is: a v_args wrapper
+    # costs three calls a reduction, and most are reduced once a token.
     def address(self, children):
         return self._address(children[0])
 
@@ -180,11 +237,11 @@ class _ToAst(Transformer):
         tok = children[0]
         return SymbolRef(str(tok), self._token_pos(tok))
 
-    def signed_number(self, children):  # once a number: no v_args wrapper
+    def signed_number(self, children):
         return self._const(children[0])
 
-    @v_args(inline=True)
-    def negative_number(self, sign, tok):
+    def negative_number(self, children):
+        sign, tok = children
         const = self._const(tok)
         # -0x10 is the number -16: only an unsigned hex constant is a bit pattern
         return Const(-const.value, self._pos(sign)) if str(sign) == "-" else Const(const.value, self._pos(sign), hex=const.hex)
@@ -192,8 +249,8 @@ class _ToAst(Transformer):
     def _const(self, tok: Token) -> Const:
         return Const(self._num(tok), self._pos(tok), hex=tok.type == "HEX")
 
-    @v_args(inline=True)
-    def call(self, name, arg):
+    def call(self, children):
+        name, arg = children
         arg = self._atomize(arg)
         func = str(name).upper()
         if func not in _CALLS:
@@ -201,8 +258,8 @@ class _ToAst(Transformer):
                                           f"functions are {' '.join(_CALLS)}"), Placeholder(0, self._pos(name)))
         return Call(func, arg, self._pos(name))
 
-    @v_args(inline=True)
-    def negate(self, sign, operand):
+    def negate(self, children):
+        sign, operand = children
         operand = self._atomize(operand)
         if str(sign) == "+":
             return operand
@@ -210,13 +267,13 @@ class _ToAst(Transformer):
             return Const(-operand.value, self._pos(sign))
         return UnaryOp("NEG", operand, self._pos(sign))
 
-    @v_args(inline=True)
-    def bit_not(self, keyword, operand):
+    def bit_not(self, children):
+        keyword, operand = children
         operand = self._atomize(operand)
         return UnaryOp("NOT", operand, self._pos(keyword))
 
-    @v_args(inline=True)
-    def binop(self, left, op, right):
+    def binop(self, children):
+        left, op, right = children
         operator = str(op).upper()
         if operator == "/":
             operator = "|"  # PLC-5 writes division as |
@@ -249,18 +306,19 @@ class _ToAst(Transformer):
 
     # mnemonic --------------------------------------------------------------------------
     def mn_tokens(self, children):
-        """The tokens of a mnemonic rung, one list grown left to right (one
-        call a token): [token] or [tokens so far, token]."""
+        """A mnemonic rung's tokens, grouped left to right (one call a
+        token): [token] or [run so far, token]."""
         if len(children) == 1:
-            tokens, tok = [], children[0]
+            tok = children[0]
+            run = _MnemonicRun(self._pos(tok))
         else:
-            tokens, tok = children
+            run, tok = children
         if isinstance(tok, Token):
-            return self.mn_token(tokens, tok.type, tok.value, tok.line, tok.column)
-        tokens.append(tok)  # a signed number, already a Const
-        return tokens
+            return self.mn_token(run, tok.type, tok.value, tok.line, tok.column)
+        run.operand(tok)  # a signed number, already a Const
+        return run
 
-    def mn_token(self, tokens: list, kind: str, text: str, line: int, column: int) -> list:
+    def mn_token(self, run: _MnemonicRun, kind: str, text: str, line: int, column: int) -> _MnemonicRun:
         """``mn_tokens`` for a token, given as its fields: lalr_driver calls
         it so for most tokens of a rung, without making a Token."""
         source, line_offset, column_offset = self.context
@@ -269,24 +327,35 @@ class _ToAst(Transformer):
         pos = _new_tuple(Pos, (source, line, column))  # Pos(...) without its __new__'s frame
         if kind == "ADDRESS":
             address = self.addresses.get(text)
-            tokens.append(self._address_at(text, pos) if address is None else AddressRef(address, pos))
+            run.operand(self._address_at(text, pos) if address is None else AddressRef(address, pos))
         elif kind == "NAME":
-            tokens.append(_Name(text, pos))
+            mnemonic = self.mnemonics.get(text)
+            if mnemonic is None:
+                mnemonic = self.mnemonics[text] = text.upper() if self.instructions.is_mnemonic(text) else ""
+            if mnemonic:
+                run.instruction(mnemonic, pos)
+            elif run.current is None and run.problem is None:
+                run.problem = LadderError(pos, f"unknown instruction {text!r}{self.instructions.hint(text)}")
+            else:
+                run.operand(SymbolRef(text, pos))
         elif kind == "SYMBOL_MEMBER":  # PollTimer/DN: never a mnemonic, so an operand at once
-            tokens.append(SymbolRef(text, pos))
+            run.operand(SymbolRef(text, pos))
         elif kind == "STRING":
-            tokens.append(Text(_unquote(text), pos))
+            run.operand(Text(_unquote(text), pos))
         else:  # BST, NXB, BND
-            tokens.append(_Marker(kind, pos))
-        return tokens
+            run.marker(kind, pos)
+        return run
 
     def mnemonic_rung(self, items):
-        # [mn_tokens, COMMENT?, _NL] or ["SOR", mn_tokens?, "EOR", COMMENT?, _NL]
+        # [run, COMMENT?, _NL] or ["SOR", run?, "EOR", COMMENT?, _NL]
         first = items[0]
-        pos = self._pos(first[0] if isinstance(first, list) else first)  # the first token, or SOR
+        if type(first) is _MnemonicRun:
+            run = first
+        else:  # SOR
+            run = items[1] if type(items[1]) is _MnemonicRun else _MnemonicRun(self._pos(first))
         comment = _tokens(items, "COMMENT")
-        tokens = next((i for i in items if isinstance(i, list)), [])
-        return _RungDraft(pos, tokens=tokens, comment=comment[0][2:].strip() if comment else None)
+        return _RungDraft(run.pos if run is first else self._pos(first), run=run,
+                          comment=comment[0][2:].strip() if comment else None)
 
     # directives and comments -------------------------------------------------------------
     @v_args(inline=True)

@@ -26,7 +26,6 @@ from lark.exceptions import UnexpectedInput, VisitError
 from ..gcpause import gc_paused
 from .ast import (
     MAIN_FILE,
-    Branch,
     DataDecl,
     Element,
     Instruction,
@@ -36,8 +35,6 @@ from .ast import (
     ProgramFile,
     Rung,
     SymbolDecl,
-    SymbolRef,
-    Text,
 )
 from .errors import LadderError
 from .lalr_driver import FastLalr, NotFastPath
@@ -48,12 +45,9 @@ from .limits import (
     limit_problem,
 )
 from .parse_actions import (
-    BST,
-    NXB,
     _Comment,
     _Header,
-    _Marker,
-    _Name,
+    _MnemonicRun,
     _RungDraft,
     _ToAst,
 )
@@ -124,14 +118,19 @@ def _lark(transformer) -> Lark:
 # -- errors ---------------------------------------------------------------------------
 
 def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column_offset: int = 0,
-                problems: list[LadderError] | None = None):
+                problems: list[LadderError] | None = None, instructions=None):
     parser = _ast_parser()
     builder = parser.options.transformer
-    saved = builder.context, builder.problems, builder.addresses  # an expression parse happens inside a program parse
+    # an expression parse happens inside a program parse
+    saved = builder.context, builder.problems, builder.addresses, builder.instructions, builder.mnemonics
     builder.context = (source, line_offset, column_offset)
     builder.problems = problems
     if start == "start":
+        if instructions is None:
+            from .instructions import BUILTIN as instructions
         builder.addresses = {}
+        builder.instructions = instructions
+        builder.mnemonics = {}
     try:
         result = _parse_fast_or_lark(parser, text, start, problems)
         if isinstance(result, Token):  # a bare number as a whole expression: in this parse's context
@@ -143,7 +142,7 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
             raise e.orig_exc from None
         raise
     finally:
-        builder.context, builder.problems, builder.addresses = saved
+        builder.context, builder.problems, builder.addresses, builder.instructions, builder.mnemonics = saved
     return result
 
 
@@ -208,12 +207,11 @@ def parse_program(
         from .instructions import BUILTIN as instructions
     if text and not text.endswith("\n"):
         text += "\n"
-    items = _parse_tree(text, source, "start", line_offset, problems=problems)
+    items = _parse_tree(text, source, "start", line_offset, problems=problems, instructions=instructions)
     program = program if program is not None else Program()
     current: ProgramFile | None = None
     comments: list[_Comment] = []
     declared = {d.name.upper(): d for d in program.symbols.values()}  # other files' symbols too
-    mnemonics: dict[str, bool] = {}  # name -> is it an instruction (the same few names, many times)
 
     def file_for_rungs(pos: Pos) -> ProgramFile:
         nonlocal current
@@ -243,7 +241,7 @@ def parse_program(
             if item.elements is not None:
                 elements, check_limits = item.elements, True
             else:
-                elements, check_limits = _group(item.tokens, instructions, item.pos, mnemonics)
+                elements, check_limits = _finish(item.run, instructions)
             problem = limit_problem(elements) if check_limits else None
             if problem is not None:
                 raise LadderError(problem[0].pos, problem[1])
@@ -325,70 +323,29 @@ def _comment_above(comments: list[_Comment], rung_line: int) -> str | None:
     return "\n".join(reversed(lines)) if lines else None
 
 
-def _group(tokens: list, instructions, rung_pos: Pos, mnemonics: dict[str, bool]) -> tuple[list[Element], bool]:
-    """Turn a flat mnemonic token run into instructions and branches; and
-    whether limit_problem must look at them (branches nested deeper than
-    its limit, or an expression: nothing else in a mnemonic rung can be over
-    a limit). ``mnemonics``: name -> is it an instruction, for this parse."""
-    root: list[Element] = []
-    stack: list[tuple[list[Element], Branch]] = []  # (series to return to, open branch)
-    series = root
-    current: Instruction | None = None
-    deepest = 0
+def _finish(run: _MnemonicRun, instructions) -> tuple[list[Element], bool]:
+    """A mnemonic rung's elements, grouped while it was parsed (see
+    _MnemonicRun), with its quoted expressions parsed; and whether
+    limit_problem must look at them (branches nested deeper than its
+    limit, or an expression: nothing else in a mnemonic rung can be over a
+    limit). Its first problem is raised here, in the order of its tokens."""
     expression = False
-    for tok in tokens:
-        kind = type(tok)
-        if kind is _Marker:
-            current = None
-            if tok.kind == BST:
-                branch = Branch([[]], tok.pos)
-                series.append(branch)
-                stack.append((series, branch))
-                series = branch.legs[0]
-                deepest = max(deepest, len(stack))
-            elif not stack:
-                raise LadderError(tok.pos, f"{tok.kind} without a BST to open the branch")
-            elif tok.kind == NXB:
-                branch = stack[-1][1]
-                branch.legs.append([])
-                series = branch.legs[-1]
-            else:  # BND
-                series, _ = stack.pop()
-            continue
-        if kind is _Name:
-            text = tok.text
-            known = mnemonics.get(text)
-            if known is None:
-                known = mnemonics[text] = instructions.is_mnemonic(text)
-            if known:
-                current = Instruction(text.upper(), [], tok.pos)
-                series.append(current)
-                continue
-            operand = SymbolRef(text, tok.pos)
-        else:
-            operand = tok
-        if isinstance(operand, Text) and current is not None and _takes_expression(current, instructions):
-            # CPT "N7:1 + 5": the quoted text is an expression; parse it now
+    for instruction, index in run.texts:
+        if _takes_expression(instruction, index, instructions):
+            # CPT "N7:1 + 5": the quoted text is an expression; parse it
             # so both rung syntaxes give the same tree.
-            operand = parse_expression(operand.value, operand.pos)
+            operands = instruction.operands
+            operands[index] = parse_expression(operands[index].value, operands[index].pos)
             expression = True
-        if current is None:
-            if kind is _Name:
-                raise LadderError(tok.pos, f"unknown instruction {tok.text!r}{instructions.hint(tok.text)}")
-            raise LadderError(_operand_pos(operand), "an operand with no instruction before it")
-        current.operands.append(operand)
-    if stack:
-        raise LadderError(stack[-1][1].pos, "BST without a matching BND (unclosed branch)")
-    return root, expression or deepest > MAX_BRANCH_DEPTH
+    if run.problem is not None:
+        raise run.problem
+    if run.branches:
+        raise LadderError(run.branches[-1][1].pos, "BST without a matching BND (unclosed branch)")
+    return run.root, expression or run.deepest > MAX_BRANCH_DEPTH
 
 
-def _takes_expression(instr: Instruction, instructions) -> bool:
+def _takes_expression(instr: Instruction, index: int, instructions) -> bool:
     from .instructions import K
 
     spec = instructions.lookup(instr.mnemonic)
-    index = len(instr.operands)
     return spec is not None and index < len(spec.operands) and spec.operands[index].kind is K.EXPRESSION
-
-
-def _operand_pos(operand) -> Pos:
-    return getattr(operand, "pos", None) or Pos("<program>", 0, 0)
