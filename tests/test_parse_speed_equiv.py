@@ -220,3 +220,15 @@ def test_the_blanks_need_no_look_ahead_in_this_grammar():
     parse_program("XIC B3/0 OTE B3/1\n")
     for lexer in parser._fast_parser().lexers.values():
         assert "(?!" not in lexer.skip.__self__.pattern
+
+
+def test_the_unit_chains_end_where_the_reductions_one_by_one_do():
+    fast = parser._fast_parser()
+    parse_expression("SQR(N7:0) ** 2 + -N7:1 * 3 < 4", Pos("e.lad", 1, 1))
+    assert fast.unit_chains
+    for (below, state, kind), end in fast.unit_chains.items():
+        action = fast.actions[state][kind]
+        while action[0] is None and action[1][2] is None:  # a one-symbol reduction lark's callback would undo
+            state = fast.actions[below][action[1][1]][0]
+            action = fast.actions[state].get(kind, (0, None))
+        assert state == end

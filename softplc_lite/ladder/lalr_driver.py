@@ -22,6 +22,14 @@ lexer and text: it depends on nothing else), and the ``Rule`` attribute
 look-ups of each reduction (precomputed into one table, keyed by plain
 str: lark names rules with Tokens, which compare through Token.__eq__).
 
+Read from the same tables (issue 17, cold load): the steps of a
+left-recursive list rule (``_list_steps``: most tokens of a mnemonic rung
+are one step, no stack traffic and, with a token action, no Token: about
+2 us a token instead of 4 on the 10,000-rung boolean program), and the
+one-symbol "?rule" reductions, which only change the state (lark's
+``ExpandSingleChild`` returns the child), chained per (state below, state,
+token kind) in ``unit_chains``.
+
 The post-lexer is read as a table (``span_changes``: the token kinds that
 open or close a span; ``dropped_inside``: the kinds dropped while a span is
 open), as parser.py's LadderPostLex declares it.
@@ -119,6 +127,7 @@ class FastLalr:
         postlex = connector.postlexer
         self.span_changes = dict(postlex.span_changes)
         self.dropped_inside = postlex.dropped_inside
+        self.span_count = 1 + max((i for i, _ in self.span_changes.values()), default=0)
         self.lexers = _Lexers(connector.lexer.lexers)
         parser = frontend.parser.parser
         table = parser.parse_table
@@ -143,6 +152,10 @@ class FastLalr:
                         reductions[arg] = (len(arg.expansion), str(arg.origin.name), callback)
                     compiled[str(symbol)] = (None, reductions[arg])
             self.actions[state] = compiled
+        # (state below, state, token kind) -> the state after the one-symbol
+        # reductions that follow, one after the other (an expression operand
+        # goes up about ten levels of precedence that way)
+        self.unit_chains: dict[tuple[int, int, str], int] = {}
         self.list_steps = _list_steps(self.actions, reductions, token_actions or {},
                                       set(self.span_changes) | set(self.dropped_inside))
 
@@ -150,10 +163,11 @@ class FastLalr:
         """Lark's contextual lexer, post-lexer and LALR parser as one loop."""
         actions = self.actions
         list_steps = self.list_steps
+        unit_chains = self.unit_chains
         lexers = self.lexers
         span_changes = self.span_changes
         dropped_inside = self.dropped_inside
-        spans = [False] * (1 + max((i for i, _ in span_changes.values()), default=0))
+        spans = [False] * self.span_count
         state = self.start_states[start]
         lex_state = state  # whose terminals lex the next token: lark lexes it before it reduces
         expected = None  # after a list step: the actions of the state lark would be in
@@ -203,7 +217,7 @@ class FastLalr:
                     if token_action is not None:
                         value_stack[-1] = token_action(value_stack[-1], kind, value, token_line, column)
                     else:
-                        token = Token(kind, value, start_pos, token_line, column, line, pos - line_start + 1, pos)
+                        token = _token(kind, value, start_pos, token_line, column, line, pos - line_start + 1, pos)
                         value_stack[-1] = list_callback([value_stack[-1], _reduced(units, token)])
                     continue
             # the post-lexer
@@ -214,15 +228,7 @@ class FastLalr:
                 continue
             if expected is not None and kind not in expected:
                 raise NotFastPath(kind)  # where lark, one token later than this loop, finds the error
-            token = _new_str(Token, value)
-            token.type = kind
-            token.start_pos = start_pos
-            token.value = value
-            token.line = token_line
-            token.column = column
-            token.end_line = line
-            token.end_column = pos - line_start + 1
-            token.end_pos = pos
+            token = _token(kind, value, start_pos, token_line, column, line, pos - line_start + 1, pos)
             # the parser: reduce while the table says so, then shift, or
             # take one step of a left-recursive list (see _list_steps)
             row = actions[state]
@@ -235,7 +241,11 @@ class FastLalr:
                     break
                 size, origin, callback = reduce
                 if callback is None:  # the value stays; only the state changes
-                    state = state_stack[-1] = actions[state_stack[-2]][origin][0]
+                    key = (state_stack[-2], state, kind)
+                    state = unit_chains.get(key)
+                    if state is None:
+                        state = unit_chains[key] = self._after_units(*key)
+                    state_stack[-1] = state
                     row = actions[state]
                     continue
                 if size:
@@ -263,6 +273,17 @@ class FastLalr:
         if expected is not None and "$END" not in expected:
             raise NotFastPath("$END")
         return self._end(state_stack, value_stack, self.end_states[start])
+
+    def _after_units(self, below: int, state: int, kind: str) -> int:
+        """The state after the one-symbol reductions in a row that ``kind``
+        calls for in ``state``, over ``below``: each replaces the top state
+        only, so nothing else decides where they end."""
+        actions = self.actions
+        while True:
+            action = actions[state].get(kind)
+            if action is None or action[0] is not None or action[1][2] is not None:
+                return state
+            state = actions[below][action[1][1]][0]
 
     def _end(self, state_stack: list, value_stack: list, end_state: int):
         """Lark's "$END": reduce until the start rule is complete (no rule
@@ -351,6 +372,21 @@ def _list_steps(actions: dict[int, dict[str, tuple]], reductions: dict, token_ac
                 current = goto[0]
                 allowed &= set(actions[current])
     return found
+
+
+def _token(kind: str, value: str, start_pos: int, line: int, column: int, end_line: int, end_column: int,
+           end_pos: int) -> Token:
+    """lark's Token, without its constructor's keyword handling."""
+    token = _new_str(Token, value)
+    token.type = kind
+    token.start_pos = start_pos
+    token.value = value
+    token.line = line
+    token.column = column
+    token.end_line = end_line
+    token.end_column = end_column
+    token.end_pos = end_pos
+    return token
 
 
 def _reduced(units: tuple, token: Token):

@@ -2,11 +2,13 @@
 build AST nodes as LALR reduces each rule (parser.py passes it to Lark, so
 no parse tree is built), and the drafts it hands to parser.py, which
 assembles them into a Program (mnemonic rungs are grouped into instructions
-there, with the instruction table).
+here as they are parsed, with the instruction set of the parse, and
+finished there).
 
 Positions come from tokens (see the "!" rules in the grammar). Moved out of
-parser.py for its size (issue 17); the rules reduced once a token
-(``mn_tokens``, ``address``, ``symbol``) take lark's child list as it is.
+parser.py for its size (issue 17); the rule actions take lark's child list
+as it is (no v_args wrapper), and ``mn_token`` is ``mn_tokens`` for a token
+given as its fields, which lalr_driver calls without making a Token.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ _new_tuple = tuple.__new__
 
 # -- transformer --------------------------------------------------------------------
 
-# Markers for mnemonic-form branch keywords inside a flat token run.
+# The mnemonic-form branch keywords (token kinds).
 BST, NXB, BND = "BST", "NXB", "BND"
 
 

@@ -2,9 +2,10 @@
 
 The grammar is ``ladder.lark`` (LALR, contextual lexer). A small post-lexer
 lets neutral-text rungs and SOR...EOR rungs span lines. Mnemonic rungs are
-parsed as flat token runs and grouped into instructions here, because only
-the instruction table knows where one instruction's operands end: a name
-that is a known mnemonic starts a new instruction, any other name is a
+parsed as flat token runs, grouped into instructions as they are parsed
+(``parse_actions._MnemonicRun``) and finished here (``_finish``), because
+only the instruction table knows where one instruction's operands end: a
+name that is a known mnemonic starts a new instruction, any other name is a
 symbol operand.
 
 The rule actions (the Transformer applied during the parse) are in
