@@ -139,6 +139,35 @@ def test_contacts_give_a_module_instruction_a_bool_rung_in(executor):
     assert all(type(c) is bool for c in rec.rung_ins)
 
 
+# TONs whose element only the TON itself uses: run in place, not held.
+_TONS_ALONE = ("XIO B3/1 TON T4:3 0.01 25 0\n"
+               "TON T4:4 1.0 1 0\n"
+               "XIC B3/2 TON T4:5 0.01 7 3\n"
+               "TON T4:6 0.01 0 0\n"
+               "CTU C5:0 40 0\n"                      # B3/1 goes true at the 40th scan, B3/2 at the 60th
+               "XIC C5:0/DN OTL B3/1\n"
+               "GEQ C5:0.ACC 60 OTL B3/2\n"
+               "XIC C5:0/DN MOV 3 T4:4.PRE\n")
+
+
+@pytest.mark.parametrize("scan_ms", [3, 7, 10, 26])
+def test_a_ton_alone_in_its_block_times_as_the_kernel(scan_ms):
+    """The in-place TON: done, enabled now, timing with and without a whole
+    tick, reset by a false rung, a preset raised under a done timer."""
+    from softplc_lite.ladder import Settings
+
+    engines = [Engine(load_text(_TONS_ALONE, "t.lad"), executor=ex, settings=Settings(scan_ms=scan_ms))
+               for ex in EXECUTORS]
+    assert "_tp = " in engines[0].files[2][0].source  # the in-place shape, not held locals
+    for e in engines:
+        e.set_mode(Mode.RUN)
+    for _ in range(120):
+        for e in engines:
+            e.scan()
+        compiled, reference = engines
+        assert compiled.table.file(4).data[9:21] == reference.table.file(4).data[9:21]
+
+
 @pytest.mark.parametrize("scan_ms", [3, 7, 10, 26])
 def test_a_held_ton_times_as_the_kernel_through_every_outcome(scan_ms):
     """TON on held words sets its whole control word per outcome (done,

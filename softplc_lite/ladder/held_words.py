@@ -300,9 +300,14 @@ class HeldWords:
         """Semantics.ton written out on the element's locals (the kernel is
         the reference: the differential test holds them equal). The time is
         the engine's clock of this scan, _m.now_ms."""
-        wc, wp, wa = self.element_words(ind, ins.operands[0])
         base = BASE_MS[ins.operands[1].value]
         self.uses_now = True
+        f, index, _ = self.resolve(ins.operands[0].address)
+        keys = [(f.number, index + k) for k in range(3)]
+        if not any(key in self.words or self.uses.get(key, 0) > 1 for key in keys):
+            self._ton_in_place(ind, ins, f, index, base)
+            return
+        wc, wp, wa = self.element_words(ind, ins.operands[0])
         self.emit(ind, f"if ({wp} | {wa}) < 0:")  # either negative: the kernel raises the fault, on an exact table
         self.flush_lines(ind + 1)
         d, i, _ = self.location(ind + 1, ins.operands[0])
@@ -328,6 +333,35 @@ class HeldWords:
         self.emit(ind + 1, f"{wc} = 0")
         self.emit(ind + 1, f"{wa} = 0")
         self.dirty.update((wc, wa))
+
+    def _ton_in_place(self, ind: int, ins: Instruction, f, index: int, base: int) -> None:
+        """A TON whose element no other instruction of the block uses: its
+        words read into temporaries and each written in place when it
+        changes (a done timer: two reads and one write, where locals held
+        for the block cost three reads and two write-backs)."""
+        d = self.array_name(f)
+        control, pre, acc = (f"{d}[{index + k!r}]" for k in range(3))
+        self.emit(ind, f"_tp = {pre}; _ta = {acc}")
+        self.emit(ind, "if (_tp | _ta) < 0:")  # either negative: the kernel raises the fault, on an exact table
+        self.flush_lines(ind + 1)
+        self.emit(ind + 1, f"{self.bind('_ton', self.machine.ton)}({d}, {index!r}, {RUNG_BOOL}, {base!r})")
+        self.emit(ind, "if c:")
+        self.emit(ind + 1, "if _ta < _tp:")
+        self.emit(ind + 2, f"_tw = {control}")
+        self.emit(ind + 2, f"if _tw & {EN!r}:")
+        self.emit(ind + 3, f"_r = (_now - (_tw & {STAMP!r})) % {STAMP_MODULO!r}")
+        self.emit(ind + 3, f"_t = _r // {base!r}")
+        self.emit(ind + 3, "if _t:")
+        self.emit(ind + 4, "_ta += _t")
+        self.emit(ind + 4, f"if _ta >= _tp: {acc} = _tp; {control} = _ton_done")
+        self.emit(ind + 4, f"else: {acc} = _ta; {control} = ((_now - _r + _t * {base!r}) & {STAMP!r}) | {EN | TT!r}")
+        # no whole tick yet: ACC and the stamp stay (now - elapsed is the stamp)
+        self.emit(ind + 3, f"else: {control} = (_tw & {STAMP!r}) | {EN | TT!r}")
+        self.emit(ind + 2, f"else: {control} = _ton_timing")
+        self.emit(ind + 1, f"else: {control} = _ton_done")
+        self.emit(ind, "else:")
+        self.emit(ind + 1, f"{control} = 0")
+        self.emit(ind + 1, f"if _ta: {acc} = 0")
 
     def _local_count(self, ind: int, ins: Instruction, up: bool) -> None:
         """Semantics.ctu / ctd written out on the element's words: the
@@ -413,9 +447,10 @@ _LOCAL_SAFE = {
 
 
 # How often a TON's or counter's code uses each word of its element
-# (control, PRE, ACC), for the block's count of uses: TON all three more
-# than once; a counter its control word.
-_ELEMENT_USES = {"TON": (0, 0, 1, 1, 2, 2), "CTU": (0, 0, 1, 2), "CTD": (0, 0, 1, 2)}
+# (control, PRE, ACC), for the block's count of uses: a counter its control
+# word more than once (held); a TON each once, so a TON whose element nothing
+# else in the block uses runs in place (_ton_in_place).
+_ELEMENT_USES = {"TON": (0, 1, 2), "CTU": (0, 0, 1, 2), "CTD": (0, 0, 1, 2)}
 
 _STORES = frozenset({"MOV", "CPT", "ADD", "SUB"})  # the instructions _word_store may accept
 
