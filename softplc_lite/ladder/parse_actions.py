@@ -59,7 +59,7 @@ class _MnemonicRun:
     ``texts``: the quoted operands, (instruction, operand index), which
     parser.py parses as expressions where the instruction takes one."""
 
-    __slots__ = ("branches", "current", "deepest", "pos", "problem", "root", "series", "texts")
+    __slots__ = ("branches", "current", "deepest", "operands", "pos", "problem", "root", "series", "texts")
 
     def __init__(self, pos: Pos) -> None:
         self.pos = pos  # the first token's
@@ -67,31 +67,35 @@ class _MnemonicRun:
         self.series = self.root  # where the next instruction or branch goes
         self.branches: list[tuple[list[Element], Branch]] = []  # (series to return to, open branch)
         self.current: Instruction | None = None
+        self.operands: list | None = None  # the current instruction's, while no problem is found
         self.deepest = 0
         self.texts: list[tuple[Instruction, int]] = []
         self.problem: LadderError | None = None
 
     def instruction(self, mnemonic: str, pos: Pos) -> None:
         if self.problem is None:
-            self.current = Instruction(mnemonic, [], pos)
+            self.operands = []
+            self.current = Instruction(mnemonic, self.operands, pos)  # which keeps that list
             self.series.append(self.current)
 
     def operand(self, operand) -> None:
-        if self.problem is not None:
+        operands = self.operands
+        if operands is None:
+            if self.problem is None:
+                self.fail(LadderError(operand.pos, "an operand with no instruction before it"))
             return
-        current = self.current
-        if current is None:
-            self.problem = LadderError(operand.pos, "an operand with no instruction before it")
-            return
-        operands = current.operands
         if type(operand) is Text:
-            self.texts.append((current, len(operands)))
+            self.texts.append((self.current, len(operands)))
         operands.append(operand)
+
+    def fail(self, problem: LadderError) -> None:
+        self.problem = problem
+        self.operands = None
 
     def marker(self, kind: str, pos: Pos) -> None:
         if self.problem is not None:
             return
-        self.current = None
+        self.current = self.operands = None
         branches = self.branches
         if kind == BST:
             branch = Branch([[]], pos)
@@ -100,7 +104,7 @@ class _MnemonicRun:
             self.series = branch.legs[0]
             self.deepest = max(self.deepest, len(branches))
         elif not branches:
-            self.problem = LadderError(pos, f"{kind} without a BST to open the branch")
+            self.fail(LadderError(pos, f"{kind} without a BST to open the branch"))
         elif kind == NXB:
             legs = branches[-1][1].legs
             legs.append([])
@@ -329,7 +333,12 @@ class _ToAst(Transformer):
         pos = _new_tuple(Pos, (source, line, column))  # Pos(...) without its __new__'s frame
         if kind == "ADDRESS":
             address = self.addresses.get(text)
-            run.operand(self._address_at(text, pos) if address is None else AddressRef(address, pos))
+            operand = self._address_at(text, pos) if address is None else AddressRef(address, pos)
+            operands = run.operands
+            if operands is not None:  # the common case, without a call
+                operands.append(operand)
+            else:
+                run.operand(operand)
         elif kind == "NAME":
             mnemonic = self.mnemonics.get(text)
             if mnemonic is None:
@@ -337,7 +346,7 @@ class _ToAst(Transformer):
             if mnemonic:
                 run.instruction(mnemonic, pos)
             elif run.current is None and run.problem is None:
-                run.problem = LadderError(pos, f"unknown instruction {text!r}{self.instructions.hint(text)}")
+                run.fail(LadderError(pos, f"unknown instruction {text!r}{self.instructions.hint(text)}"))
             else:
                 run.operand(SymbolRef(text, pos))
         elif kind == "SYMBOL_MEMBER":  # PollTimer/DN: never a mnemonic, so an operand at once
