@@ -240,3 +240,30 @@ def test_flags_pending_survive_a_breakpoint_split():
         e.set_mode(Mode.RUN)
         e.run(1)
         assert (e.table.read("B3/1"), e.table.read("B3/2")) == (1, 0)  # sign from MOV -3, carry cleared
+
+
+def test_counters_alone_and_held_count_as_the_kernel():
+    """A counter whose control word nothing else in its block uses works on
+    a temporary written back at the end of its rung; one read elsewhere is
+    held. Both count, wrap (OV, UN), reset and set DN as the kernel."""
+    text = ("XIC S:1/15 MOV 32765 C5:0.ACC\nXIC S:1/15 MOV -32766 C5:1.ACC\n"
+            "XIC B3/0 CTU C5:0 5 32765\n"       # alone: wraps to -32768, OV
+            "XIC B3/0 CTD C5:1 -1 -32766\n"     # alone: wraps to 32767, UN
+            "XIC B3/0 CTU C5:2 3 0\nXIC C5:2/DN OTE B3/5\n"  # held: read by the next rung
+            "XIC B3/0 CTU C5:4 3 0\n"          # alone: DN from ACC = PRE on
+            "XIC B3/0 CTU C5:3 2 0\n"
+            "XIC C5:3/DN RES C5:3\n"            # RES in the same block: held around a kernel
+            "XIC S:1/15 OTL B3/0\n")
+    engines = [Engine(load_text(text, "t.lad"), executor=ex) for ex in EXECUTORS]
+    assert "_tw = f5[0]" in engines[0].files[2][0].source and "w5_6 = f5[6]" in engines[0].files[2][0].source
+    for e in engines:
+        e.set_mode(Mode.RUN)
+    for scan in range(12):
+        for e in engines:
+            e.table.write("B3/0", scan % 2)  # a counting edge every other scan
+            e.scan()
+        compiled, reference = engines
+        assert compiled.table.file(5).data == reference.table.file(5).data
+        assert compiled.table.read("B3:0") == reference.table.read("B3:0")
+    assert compiled.table.read("C5:0/OV") == 1 and compiled.table.read("C5:1/UN") == 1
+    assert compiled.table.read("B3/5") == 1 and compiled.table.read("C5:4/DN") == 1

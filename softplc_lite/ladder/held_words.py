@@ -366,8 +366,16 @@ class HeldWords:
     def _local_count(self, ind: int, ins: Instruction, up: bool) -> None:
         """Semantics.ctu / ctd written out on the element's words: the
         control word in a local; PRE and ACC in place unless the block uses
-        them elsewhere (a counting edge, which writes ACC, is rare)."""
-        wc, wp, wa = self.element_words(ind, ins.operands[0], force=(True, False, False))
+        them elsewhere (a counting edge, which writes ACC, is rare). A control
+        word nothing else in the block uses is a temporary, written back at
+        the end of the rung: the same read and write, one local less held."""
+        f, index, _ = self.resolve(ins.operands[0].address)
+        key = (f.number, index)
+        alone = key not in self.words and self.uses.get(key, 0) <= 1
+        wc, wp, wa = self.element_words(ind, ins.operands[0], force=(not alone, False, False))
+        if alone:
+            control, wc = wc, "_tw"
+            self.emit(ind, f"_tw = {control}")
         edge, limit, wrapped, flag, other = (CU, 32767, -32768, OV, UN) if up else (CD, -32768, 32767, UN, OV)
         self.emit(ind, "if c:")
         self.emit(ind + 1, f"if not {wc} & {edge!r}:")
@@ -377,7 +385,10 @@ class HeldWords:
         self.emit(ind + 2, f"else: {wa} {'+' if up else '-'}= 1")
         self.emit(ind + 1, f"{wc} |= {edge!r}")
         self.emit(ind, f"else: {wc} &= {~edge!r}")
-        self.emit(ind, f"{wc} = ({wc} | {DN!r}) if {wa} >= {wp} else ({wc} & {~DN!r})")
+        if alone:
+            self.emit(ind, f"{control} = ({wc} | {DN!r}) if {wa} >= {wp} else ({wc} & {~DN!r})")
+        else:
+            self.emit(ind, f"{wc} = ({wc} | {DN!r}) if {wa} >= {wp} else ({wc} & {~DN!r})")
         self.held(wc, wa)
 
     def local_COP(self, ind: int, ins: Instruction) -> None:
@@ -447,10 +458,10 @@ _LOCAL_SAFE = {
 
 
 # How often a TON's or counter's code uses each word of its element
-# (control, PRE, ACC), for the block's count of uses: a counter its control
-# word more than once (held); a TON each once, so a TON whose element nothing
-# else in the block uses runs in place (_ton_in_place).
-_ELEMENT_USES = {"TON": (0, 1, 2), "CTU": (0, 0, 1, 2), "CTD": (0, 0, 1, 2)}
+# (control, PRE, ACC), for the block's count of uses: each once, so a TON
+# or counter whose element nothing else in the block uses works on
+# temporaries, not locals held for the block (_ton_in_place, _local_count).
+_ELEMENT_USES = {"TON": (0, 1, 2), "CTU": (0, 1, 2), "CTD": (0, 1, 2)}
 
 _STORES = frozenset({"MOV", "CPT", "ADD", "SUB"})  # the instructions _word_store may accept
 
