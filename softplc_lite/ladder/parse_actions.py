@@ -37,7 +37,7 @@ from .ast import (
 from .errors import LadderError
 from .limits import MAX_CONSTANT, MAX_NUMBER_DIGITS
 
-_new_tuple = tuple.__new__
+_new_tuple = tuple.__new__  # _new_tuple(Pos, (...)): a Pos without its __new__'s Python frame
 
 # -- transformer --------------------------------------------------------------------
 
@@ -71,12 +71,6 @@ class _MnemonicRun:
         self.deepest = 0
         self.texts: list[tuple[Instruction, int]] = []
         self.problem: LadderError | None = None
-
-    def instruction(self, mnemonic: str, pos: Pos) -> None:
-        if self.problem is None:
-            self.operands = []
-            self.current = Instruction(mnemonic, self.operands, pos)  # which keeps that list
-            self.series.append(self.current)
 
     def operand(self, operand) -> None:
         operands = self.operands
@@ -205,9 +199,9 @@ class _ToAst(Transformer):
     def _token_pos(self, tok: Token) -> Pos:
         source, line_offset, column_offset = self.context
         if not (line_offset or column_offset):  # a whole file
-            return Pos(source, tok.line, tok.column)
+            return _new_tuple(Pos, (source, tok.line, tok.column))
         line = tok.line
-        return Pos(source, line + line_offset, tok.column + column_offset if line == 1 else tok.column)
+        return _new_tuple(Pos, (source, line + line_offset, tok.column + column_offset if line == 1 else tok.column))
 
     def _small_int(self, tok: Token, what: str) -> int:
         """A file number or element count; one too long to be either is
@@ -253,7 +247,7 @@ class _ToAst(Transformer):
         return Const(-const.value, self._pos(sign)) if str(sign) == "-" else Const(const.value, self._pos(sign), hex=const.hex)
 
     def _const(self, tok: Token) -> Const:
-        return Const(self._num(tok), self._pos(tok), hex=tok.type == "HEX")
+        return Const(self._num(tok), self._token_pos(tok), hex=tok.type == "HEX")
 
     def call(self, children):
         name, arg = children
@@ -330,7 +324,7 @@ class _ToAst(Transformer):
         source, line_offset, column_offset = self.context
         if line_offset or column_offset:
             line, column = line + line_offset, column + column_offset if line == 1 else column
-        pos = _new_tuple(Pos, (source, line, column))  # Pos(...) without its __new__'s frame
+        pos = _new_tuple(Pos, (source, line, column))
         if kind == "ADDRESS":
             address = self.addresses.get(text)
             operand = self._address_at(text, pos) if address is None else AddressRef(address, pos)
@@ -344,7 +338,10 @@ class _ToAst(Transformer):
             if mnemonic is None:
                 mnemonic = self.mnemonics[text] = text.upper() if self.instructions.is_mnemonic(text) else ""
             if mnemonic:
-                run.instruction(mnemonic, pos)
+                if run.problem is None:  # a new instruction, which keeps the list it is given
+                    run.operands = operands = []
+                    run.current = instruction = Instruction(mnemonic, operands, pos)
+                    run.series.append(instruction)
             elif run.current is None and run.problem is None:
                 run.fail(LadderError(pos, f"unknown instruction {text!r}{self.instructions.hint(text)}"))
             else:
