@@ -29,6 +29,7 @@ ADD N7:0 1 N7:0
 MOV N7:0 N7:[N7:5]
 BSL B3:2 R6:0 B3/1 16
 CPT N7:3 "N7:0 * 2 - N7:1 | 3"
+XIC Start COP #N7:0 #N7:40 4
 XIC B3/5 MCR
 XIC B3/6 OTE B3/7
 MCR
@@ -70,15 +71,17 @@ def _round_trip(text: str, tmp_path: Path):
 
 def test_cached_code_runs_as_freshly_compiled_code(tmp_path):
     fresh, cached = _round_trip(VARIED, tmp_path)
+    assert all(callable(compiled._compiler) for compiled, _ in cached.files.values())  # from the cache, not compiled
     for scan in range(40):
         fresh.scan()
         cached.scan()
         assert cached.table == fresh.table, f"scan {scan}"
     assert fresh.table.read("N7:20") == fresh.table.read("N7:0") + 100  # the JSR ran
+    assert fresh.table.read("N7:40") == fresh.table.read("N7:0")  # the COP ran (its slices bound again)
     assert fresh.table.read("C5:0.ACC") > 0 and fresh.fault is None and cached.fault is None
     # Positions survive: the watch view and messages point at the same text.
     rung = cached.program.files[3].rungs[1].elements[0]
-    assert str(rung.pos) == "prog.lad:18:1"
+    assert str(rung.pos) == "prog.lad:19:1"
 
 
 def test_a_fault_in_cached_code_names_its_rung_and_instruction(tmp_path):
