@@ -358,6 +358,8 @@ class _ToAst(Transformer):
         # [run, COMMENT?, _NL] or ["SOR", run?, "EOR", COMMENT?, _NL]
         first = items[0]
         if type(first) is _MnemonicRun:
+            if len(items) == 2:  # no comment: most rungs
+                return _RungDraft(first.pos, run=first)
             run = first
         else:  # SOR
             run = items[1] if type(items[1]) is _MnemonicRun else _MnemonicRun(self._pos(first))
