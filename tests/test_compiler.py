@@ -12,7 +12,7 @@ from softplc_lite.ladder import Engine, load_text
 # functions, bound kernels, module (TLM) instruction instances and
 # expression helpers.
 ALLOWED = re.compile(
-    r"^(f\d+|w\d+_\d+|_sl\d+_\d+|z|_m|_block|_d\d+|_i\d+|_m\d+|b\d+|o\d+|r\d+|c|_env|_factory|_loc\d+|_tli\d+|_bi\d+|_jsr|_zone|_x_div|_x_mod|_x_pow|_int|"
+    r"^(f\d+|w\d+_\d+|z|_m|_block|_d\d+|_i\d+|_m\d+|b\d+|o\d+|r\d+|c|_env|_factory|_loc\d+|_tli\d+|_bi\d+|_jsr|_zone|_x_div|_x_mod|_x_pow|_int|"
     r"_fn_[A-Z]+|_[a-z]+(?:_[a-z]+)*|abs|bool)$"
 )
 

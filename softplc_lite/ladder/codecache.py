@@ -136,8 +136,6 @@ def export_file(compiled: CompiledFile, rungs, machine, table) -> tuple | None:
             recipe[name] = ("machine", value.__name__)
         elif functions.get(name) is value:
             recipe[name] = ("function",)
-        elif type(value) is slice:
-            recipe[name] = ("slice", value.start, value.stop)
         else:
             return None
     blocks = []
@@ -179,8 +177,6 @@ def import_file(data: tuple, program: Program, number: int, table, machine, jsr,
             env[name] = getattr(machine, args[0])
         elif kind == "function":
             env[name] = functions[name]
-        elif kind == "slice":
-            env[name] = slice(*args)
         elif kind == "calls":
             calls = [node(loc) for loc in args[0]]
             env[name] = calls
