@@ -255,7 +255,7 @@ def test_counters_alone_and_held_count_as_the_kernel():
             "XIC C5:3/DN RES C5:3\n"            # RES in the same block: held around a kernel
             "XIC S:1/15 OTL B3/0\n")
     engines = [Engine(load_text(text, "t.lad"), executor=ex) for ex in EXECUTORS]
-    assert "_tw = _tw0 = f5[0]" in engines[0].files[2][0].source and "w5_6 = f5[6]" in engines[0].files[2][0].source
+    assert "_tw = _tw_was = f5[0]" in engines[0].files[2][0].source and "w5_6 = f5[6]" in engines[0].files[2][0].source
     for e in engines:
         e.set_mode(Mode.RUN)
     for scan in range(12):

@@ -375,7 +375,7 @@ class HeldWords:
         wc, wp, wa = self.element_words(ind, ins.operands[0], force=(not alone, False, False))
         if alone:
             control, wc = wc, "_tw"
-            self.emit(ind, f"_tw = _tw0 = {control}")
+            self.emit(ind, f"_tw = _tw_was = {control}")
         edge, limit, wrapped, flag, other = (CU, 32767, -32768, OV, UN) if up else (CD, -32768, 32767, UN, OV)
         self.emit(ind, "if c:")
         self.emit(ind + 1, f"if not {wc} & {edge!r}:")
@@ -387,7 +387,7 @@ class HeldWords:
         self.emit(ind, f"else: {wc} &= {~edge!r}")
         if alone:
             self.emit(ind, f"{wc} = ({wc} | {DN!r}) if {wa} >= {wp} else ({wc} & {~DN!r})")
-            self.emit(ind, f"if _tw != _tw0: {control} = _tw")  # steady counters write nothing
+            self.emit(ind, f"if _tw != _tw_was: {control} = _tw")  # steady counters write nothing
         else:
             self.emit(ind, f"{wc} = ({wc} | {DN!r}) if {wa} >= {wp} else ({wc} & {~DN!r})")
         self.held(wc, wa)
