@@ -267,3 +267,19 @@ def test_counters_alone_and_held_count_as_the_kernel():
         assert compiled.table.read("B3:0") == reference.table.read("B3:0")
     assert compiled.table.read("C5:0/OV") == 1 and compiled.table.read("C5:1/UN") == 1
     assert compiled.table.read("B3/5") == 1 and compiled.table.read("C5:4/DN") == 1
+
+
+def test_a_rung_condition_used_once_is_folded_into_its_use():
+    """c = EXPR whose one use is the rung's "if c:" or "... if c else ...":
+    EXPR moves there (compiler.fold_condition); with two uses, or anything
+    but loads between, it stays. Both executors agree either way."""
+    text = ("XIC B3/0 OTU B3/0\n"                 # reads and writes the same bit: folded
+            "XIC B3/1 OTE B3/2\n"                 # folded into the conditional expression
+            "XIC B3/3 OTE B3/4 OTE B3/5\n"        # two uses: kept
+            "CTU C5:0 5 0\n"                      # no contact: "if True:" compiles to nothing
+            "XIC B3/6 TON T4:0 0.01 3 0\n")       # the TON's fault path uses c too: kept
+    e = _both(text, scans=4, values={"B3:0": 0b1001011})
+    source = e.files[2][0].source
+    assert "if w3_0 & 1:" in source or "if f3[0] & 1:" in source
+    assert source.count("\n        c = ") == 2 and "if True:" in source
+    assert e.table.read("B3/0") == 0 and e.table.read("B3/2") == 1 and e.table.read("B3/4") == 1

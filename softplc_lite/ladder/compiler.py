@@ -22,6 +22,7 @@ messages.
 
 from __future__ import annotations
 
+import re
 from collections import Counter
 from functools import cached_property
 
@@ -177,11 +178,44 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.current = None
         self.rung_in = "z" if self.has_mcr else "True"
         first = rung.elements[0] if rung.elements else None
+        start = len(self.lines)
         expr = self.contact_expression(first) if first is not None else None
         if expr is None:
             self.start_rung()
         self.first_contact = (first, expr)  # series takes it as computed, not twice
         self.series(2, rung.elements)
+        self.fold_condition(start)
+
+    def fold_condition(self, start: int) -> None:
+        """``c = EXPR`` whose one use, later in the rung, is ``if c:`` or
+        ``... if c else ...`` at rung level: EXPR goes there and the line
+        goes (a store and a load of c less a rung; ``if True:`` compiles
+        to nothing). Every rung sets c before it reads it, so no later
+        rung needs this one's."""
+        lines = self.lines
+        for k in range(start, len(lines)):
+            if lines[k].startswith(_RUNG_C):
+                break
+        else:
+            return
+        use = None
+        for j in range(k + 1, len(lines)):
+            found = _C_NAME.findall(lines[j])
+            if found:
+                if use is not None or len(found) > 1:
+                    return
+                use = j
+        if use is None or not all(_LOAD.match(lines[j]) for j in range(k + 1, use)):
+            return  # (only loads between: EXPR reads the same data later)
+        line = lines[use]
+        expr = lines[k][len(_RUNG_C):]
+        if line.startswith(_RUNG_IF):
+            lines[use] = f"{_RUNG_IF[:-2]}{expr}:{line[len(_RUNG_IF):]}"
+        elif line.startswith("        ") and line[8] != " " and " if c else " in line:
+            lines[use] = line.replace(" if c else ", f" if ({expr}) else ", 1)
+        else:
+            return
+        del lines[k], self.line_instr[k], self.line_rung[k]
 
     def start_rung(self) -> None:
         """Give ``c`` its rung-in (left pending while a rung's first contacts
@@ -383,6 +417,13 @@ class _FileCompiler(HeldWords, TableTemplates):
         self._locations, self.uses, self._word_keys, self._bits = {}, Counter(), {}, {}
         return cf
 
+
+# fold_condition: the rung-level assignment of c, its rung-level "if c:", and
+# c as a name (not part of one: _fc, _calls).
+_RUNG_C = "        c = "
+_RUNG_IF = "        if c:"
+_C_NAME = re.compile(r"(?<![\w.])c(?!\w)")
+_LOAD = re.compile(r"^        (?:\w+ = )+f\d+\[\d+\](?:; (?:\w+ = )+(?:f\d+\[\d+\]|None))*$")  # w3_0 = f3[0]
 
 # Outputs: they leave the rung condition as they found it.
 _PASS_THROUGH = frozenset({"OTE", "OTL", "OTU"})
