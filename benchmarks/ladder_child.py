@@ -80,6 +80,22 @@ def timed_scans(scan, count: int) -> list[int]:
     return samples
 
 
+def cpu_scans(scan, count: int) -> list[int]:
+    """``count`` consecutive scans, each in thread CPU time (ns): what the
+    scan itself costs, whatever else the machine runs."""
+    samples = []
+    gc.collect()
+    gc.disable()
+    try:
+        for _ in range(count):
+            t0 = time.thread_time_ns()
+            scan()
+            samples.append(time.thread_time_ns() - t0)
+    finally:
+        gc.enable()
+    return samples
+
+
 def straight_line_scan(program):
     """The straight-line baseline (straight_line.py) on its own copy of the
     initial table, with its own input hook: one call is one scan."""
@@ -109,6 +125,8 @@ def serve(text: str) -> None:
         command, _, arg = line.strip().partition(" ")
         if command == "scan":
             reply({"ns": timed_scans(engine.scan, int(arg)), "mode": engine.mode.name})
+        elif command == "cpuscan":
+            reply({"ns": cpu_scans(engine.scan, int(arg)), "mode": engine.mode.name})
         elif command == "baseline":
             if baseline_scan is None:
                 baseline_scan = straight_line_scan(program)
