@@ -66,31 +66,18 @@ def load(text: str):
     return program, engine, times
 
 
-def timed_scans(scan, count: int) -> list[int]:
+def timed_scans(scan, count: int, clock=time.perf_counter_ns) -> list[int]:
+    """``count`` consecutive scans, each timed (ns) by ``clock``: wall time,
+    or thread CPU time (time.thread_time_ns: what the scan itself costs,
+    whatever else the machine runs)."""
     samples = []
     gc.collect()
     gc.disable()
     try:
         for _ in range(count):
-            t0 = time.perf_counter_ns()
+            t0 = clock()
             scan()
-            samples.append(time.perf_counter_ns() - t0)
-    finally:
-        gc.enable()
-    return samples
-
-
-def cpu_scans(scan, count: int) -> list[int]:
-    """``count`` consecutive scans, each in thread CPU time (ns): what the
-    scan itself costs, whatever else the machine runs."""
-    samples = []
-    gc.collect()
-    gc.disable()
-    try:
-        for _ in range(count):
-            t0 = time.thread_time_ns()
-            scan()
-            samples.append(time.thread_time_ns() - t0)
+            samples.append(clock() - t0)
     finally:
         gc.enable()
     return samples
@@ -126,7 +113,7 @@ def serve(text: str) -> None:
         if command == "scan":
             reply({"ns": timed_scans(engine.scan, int(arg)), "mode": engine.mode.name})
         elif command == "cpuscan":
-            reply({"ns": cpu_scans(engine.scan, int(arg)), "mode": engine.mode.name})
+            reply({"ns": timed_scans(engine.scan, int(arg), time.thread_time_ns), "mode": engine.mode.name})
         elif command == "baseline":
             if baseline_scan is None:
                 baseline_scan = straight_line_scan(program)
