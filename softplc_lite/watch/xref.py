@@ -111,8 +111,10 @@ class Use:
     span: int = 1  # elements from the address on (a block of known length)
 
     def describe(self) -> str:
+        """One line: where (instruction and operand numbered from 1, as the
+        rung shows them left to right), what and how."""
         how = "indirect " + self.access.value if self.indirect else self.access.value
-        return (f"file {self.file} rung {self.rung}  {self.mnemonic} #{self.instruction} "
+        return (f"file {self.file} rung {self.rung}  instruction {self.instruction + 1} {self.mnemonic}  "
                 f"operand {self.operand + 1} {self.address}  {how}")
 
 
