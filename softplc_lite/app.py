@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from .datatable import DataTable, DataTableError, jsonio
-from .errors import LocatedError
+from .errors import FileAccessError, LocatedError
 from .display import Display, display_names, parse_display
 from .ladder.ast import Pos, Program, walk
 from .ladder.errors import LadderError
@@ -99,8 +99,8 @@ def parse_files(files: list[Path], base: Path, instructions: InstructionSet = BU
         except LocatedError as e:
             errors.append(LadderError(Pos(_display(f, base), e.line, e.column), e.message))
             continue
-        except OSError as e:
-            errors.append(LadderError(Pos(_display(f, base), 1, 1), f"cannot read: {e.strerror or e}"))
+        except FileAccessError as e:
+            errors.append(LadderError(Pos(_display(f, base), 1, 1), f"cannot read the file: {e.words}"))
             continue
         problems: list[LadderError] = []
         try:
@@ -125,10 +125,10 @@ def read_settings_file(path: Path) -> dict:
         return {}
     try:
         text = read_text(path)
-    except LocatedError as e:
+    except LocatedError as e:  # bad encoding
         raise AppError([e]) from None
-    except OSError as e:
-        raise AppError(f"{path}: cannot read: {e.strerror}") from None
+    except FileAccessError as e:  # "cannot read APP/softplc.toml: permission denied"
+        raise AppError(str(e)) from None
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

@@ -5,9 +5,16 @@
 Module configs (tlm.errors.ModuleError) and port traces
 (ports.errors.PortError) derive from it; the CLI prints any of them without
 a traceback.
+
+``file_error(e, path, action)`` turns an OSError met opening, reading or
+writing a user's file into a sentence ("cannot read app/softplc.toml:
+permission denied"), never Python's ``[Errno 13] Permission denied: '...'``.
 """
 
 from __future__ import annotations
+
+import errno
+import os
 
 
 class LocatedError(Exception):
@@ -27,3 +34,55 @@ class LocatedError(Exception):
             if self.column:
                 where += f":{self.column}"
         return f"{where}: {self.message}" if where else self.message
+
+
+# errno -> what a person is told; anything else: the OS's own words, in lower case.
+_WORDS = {
+    errno.ENOENT: "no such file or directory",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "permission denied",
+    errno.EISDIR: "it is a directory",
+    errno.ENOTDIR: "a part of the path is not a directory",
+    errno.ENOSPC: "no space left on the device",
+    errno.EROFS: "the file system is read-only",
+    errno.EEXIST: "it already exists",
+    errno.ENAMETOOLONG: "the name is too long",
+    errno.ELOOP: "too many symbolic links",
+    errno.EMFILE: "too many open files",
+    errno.EBUSY: "the file is busy",
+}
+
+
+def os_error_words(e: OSError) -> str:
+    """What went wrong, in words: 'permission denied', 'it is a directory'."""
+    if e.errno in _WORDS:
+        return _WORDS[e.errno]
+    text = e.strerror or str(e) or type(e).__name__
+    return text[:1].lower() + text[1:]
+
+
+class FileAccessError(OSError):
+    """An OSError on a user's file, said as a sentence (see file_error):
+    ``str(e)`` and ``e.report()`` are "cannot read PATH: permission
+    denied". Still an OSError with the original's errno, strerror and
+    filename, so a caller that handles OSErrors handles it."""
+
+    def __init__(self, message: str, path: str | None, error: OSError) -> None:
+        super().__init__(error.errno, error.strerror, path)
+        self.message = message
+        self.words = os_error_words(error)
+
+    def report(self) -> str:
+        return self.message
+
+    def __str__(self) -> str:  # not OSError's "[Errno 13] Permission denied: '...'"
+        return self.message
+
+
+def file_error(e: OSError, path: str | os.PathLike[str] | None = None, action: str = "read") -> FileAccessError:
+    """``e`` as 'cannot ACTION PATH: WORDS' (action: read, write, open,
+    create, save...); ``path`` defaults to the file the OSError names."""
+    name = os.fspath(path) if path is not None else (e.filename if e.filename is not None else "")
+    name = os.fsdecode(name) if isinstance(name, bytes) else str(name)
+    where = f" {name}" if name else ""
+    return FileAccessError(f"cannot {action}{where}: {os_error_words(e)}", name or None, e)

@@ -196,10 +196,10 @@ def load_text(table: DataTable, text: str, source: str = "<json>") -> None:
 def load_file(table: DataTable, path: str) -> None:
     try:
         text = read_text(path)
-    except LocatedError as e:
+    except LocatedError as e:  # bad encoding
         raise DataTableJSONError(e.report()) from None
-    except OSError as e:
-        raise DataTableJSONError(f"{path}: cannot read: {e.strerror}") from None
+    except OSError as e:  # errors.FileAccessError: "cannot read PATH: permission denied"
+        raise DataTableJSONError(str(e)) from None
     load_text(table, text, path)
 
 

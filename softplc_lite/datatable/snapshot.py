@@ -37,6 +37,7 @@ import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..errors import file_error
 from .errors import DataTableError, SnapshotError
 from .filetypes import FILE_TYPES, MAX_ELEMENTS
 from .table import DataTable
@@ -221,7 +222,7 @@ def load(path: str | os.PathLike[str]) -> DataTable:
     except FileNotFoundError:
         raise SnapshotError(f"{path}: no snapshot") from None
     except OSError as e:
-        raise SnapshotError(f"{path}: cannot read: {e.strerror}") from None
+        raise SnapshotError(file_error(e, path).report()) from None
     return decode(raw, str(path))
 
 

@@ -22,7 +22,9 @@ from dataclasses import dataclass
 from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
 
+from ..errors import LocatedError
 from ..ladder.instructions import InstructionSet
+from ..textfile import read_text
 from .api import TLM, find_file
 from .errors import ModuleError, ModuleErrors
 
@@ -75,10 +77,12 @@ def read_modules_lst(app_dir: Path) -> tuple[Path | None, list[Enabled]]:
     path = find_file(app_dir, MODULES_FILE)
     if path is None:
         return None, []
-    try:
-        text = path.read_text(encoding="latin-1")
-    except OSError as e:
-        raise ModuleError(f"cannot read: {e.strerror}", str(path)) from None
+    try:  # a BOM or UTF-16 from a Windows editor is read; DOS-era bytes as latin-1 (textfile.py)
+        text = read_text(path, fallback="latin-1")
+    except LocatedError as e:
+        raise ModuleError(e.message, e.path, e.line, e.column) from None
+    except OSError as e:  # errors.FileAccessError: "cannot read PATH: permission denied"
+        raise ModuleError(str(e)) from None
     out: list[Enabled] = []
     seen: dict[str, int] = {}
     for number, raw in enumerate(text.splitlines(), start=1):

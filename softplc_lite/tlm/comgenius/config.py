@@ -26,7 +26,9 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ...errors import LocatedError
 from ...ports import COM_NAME  # COM1..COM99: in [DRIVER] keys and [PORTS]
+from ...textfile import read_text
 from ..api import find_file
 from ..errors import ModuleError
 from .strings import MAX_LENGTH, MAX_STRINGS, EscapeError, StringTable, decode_escapes
@@ -198,8 +200,10 @@ def load_config(app_dir: Path) -> ComGeniusConfig:
     if path is None:
         raise ModuleError(f"COMGENIUS is enabled in MODULES.LST but {app_dir / CONFIG_FILE} does not exist "
                           "(it holds the [DRIVER], [PORTS] and [STRINGS] sections)")
-    try:
-        text = path.read_text(encoding="latin-1")
-    except OSError as e:
-        raise ModuleError(f"cannot read: {e.strerror}", str(path)) from None
+    try:  # a BOM or UTF-16 from a Windows editor is read; DOS-era bytes as latin-1 (textfile.py)
+        text = read_text(path, fallback="latin-1")
+    except LocatedError as e:
+        raise ModuleError(e.message, e.path, e.line, e.column) from None
+    except OSError as e:  # errors.FileAccessError: "cannot read PATH: permission denied"
+        raise ModuleError(str(e)) from None
     return parse_config(text, str(path))

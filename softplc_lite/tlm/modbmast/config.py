@@ -24,6 +24,7 @@ from pathlib import Path
 from ...datatable import DataTableError, parse_address
 from ...datatable.address import Address
 from ...datatable.filetypes import MAX_ELEMENTS, WORD_BITS
+from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
 from .requests import REQUEST_KINDS, RequestKind
@@ -554,9 +555,9 @@ def load_config(app_dir: Path) -> ModbmastConfig:
         raise ModuleError(f"MODBMAST is enabled in MODULES.LST but {app_dir / CONFIG_FILE} (or {ALIAS_FILE}) "
                           "does not exist: it holds the <ModbusSerial> configuration (docs/modbmast.md)")
     try:
-        data = path.read_bytes()
-    except OSError as e:
-        raise ModuleError(f"cannot read: {e.strerror}", str(path)) from None
+        data = read_bytes(path)  # xmlreader honours a BOM (UTF-8, UTF-16) and the declared encoding
+    except OSError as e:  # errors.FileAccessError: "cannot read PATH: permission denied"
+        raise ModuleError(str(e)) from None
     config = parse_config(data, str(path))
     config.warnings += warnings
     return config
