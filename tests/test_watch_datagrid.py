@@ -7,7 +7,7 @@ import pytest
 from rich.console import Console
 
 from softplc_lite.datatable import DataTable, DataTableError
-from softplc_lite.watch.datagrid import RADIXES, DataGrid, next_radix, word_in_radix
+from softplc_lite.watch.datagrid import RADIXES, DataGrid, grid_for, next_radix, word_in_radix
 
 
 @pytest.fixture
@@ -143,3 +143,14 @@ def test_bad_file_and_radix_say_what_was_expected(table):
         DataGrid(table, "7N")
     with pytest.raises(ValueError, match="expected one of decimal, hex, binary, ascii"):
         DataGrid(table, "N7", radix="octal")
+
+
+def test_grid_for_the_d_prompt(table):
+    grid = grid_for(table, " N7:20 ")
+    assert (grid.file.name, grid.first, grid.radix) == ("N7", 20, "decimal")
+    assert grid_for(table, "b3").radix == "binary"
+    assert grid_for(table, "O").file.name == "O0"
+    with pytest.raises(DataTableError, match=r"expected a file \(N7, T4, ST9\) or a file and an element"):
+        grid_for(table, "N7:x")
+    with pytest.raises(DataTableError, match="there is no data file N12"):
+        grid_for(table, "N12")

@@ -21,7 +21,7 @@ from rich.cells import cell_len
 from rich.console import Console, ConsoleOptions, RenderResult
 from rich.text import Text
 
-from ..datatable import DataTable
+from ..datatable import DataTable, DataTableError
 from ..datatable.filetypes import Storage
 from ..datatable.table import member_order, read_string
 
@@ -62,6 +62,17 @@ def word_in_radix(word: int, radix: str, bits: int = 16) -> str:
 
 def _cell_width(radix: str, bits: int) -> int:
     return {"hex": bits // 4, "binary": bits, "ascii": bits // 8}.get(radix, 6 if bits == 16 else 11)
+
+
+def grid_for(table: DataTable, text: str) -> "DataGrid":
+    """The grid the ``d`` prompt asks for: a file (``N7``, ``ST9``, ``O``)
+    or a file and the element to start at (``N7:20``). DataTableError
+    saying what was expected otherwise."""
+    name, colon, start = text.strip().partition(":")
+    if colon and not start.isdigit():
+        raise DataTableError(f"data file {text.strip()!r}: expected a file (N7, T4, ST9) or a file and an "
+                             "element to start at (N7:20)")
+    return DataGrid(table, name, int(start) if colon else 0)
 
 
 class DataGrid:
