@@ -15,7 +15,7 @@ from __future__ import annotations
 import enum
 import time
 import traceback
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable
 
 from ..datatable import DataTable, DataTableError, parse_address
@@ -169,18 +169,28 @@ def initial_values(program: Program, table: DataTable, problems: list | None = N
                     table.write_word(addr, v)
                 else:
                     table.write(addr, v)
+    for address, value, pos in instruction_writes(program):
+        with _located(pos, problems):
+            table.write(address, value)
+
+
+def instruction_writes(program: Program) -> list[tuple]:
+    """(address, value, pos) that a download writes for the instructions:
+    the preset and accumulator operands of TON/TOF/RTO/CTU/CTD into PRE and
+    ACC, and each bound instruction's ``initial`` (a control's LEN, POS)."""
+    out = []
     for pfile in program.files.values():
         for rung in pfile.rungs:
             for ins in instructions_of(rung.elements):
                 if ins.mnemonic in _PRESET and ins.operands[0].address.is_direct:
                     pre, acc = ins.operands[-2], ins.operands[-1]
-                    with _located(ins.pos, problems):
-                        table.write(ins.operands[0].address, {"PRE": pre.value, "ACC": acc.value})
+                    timer = ins.operands[0].address
+                    out.append((replace(timer, member="PRE"), pre.value, ins.pos))
+                    out.append((replace(timer, member="ACC"), acc.value, ins.pos))
                 bound = BOUND.get(ins.mnemonic)
                 if bound is not None and bound.initial is not None:
-                    with _located(ins.pos, problems):
-                        for address, value in bound.initial(ins):
-                            table.write(address, value)
+                    out += [(address, value, ins.pos) for address, value in bound.initial(ins)]
+    return out
 
 
 def layout_problems(program: Program, modules=()) -> tuple[DataTable, list[LadderError]]:
@@ -285,6 +295,8 @@ class Engine:
         self._depth = 0
         self._deadline = 0.0
         self._owner = {spec.mnemonic: m for m in self.modules for spec in m.instructions()}
+        self._instances: dict[int, object] = {}  # id(instruction) -> its module instance (online edit)
+        self._kept_instances: dict[int, object] = {}  # while replace_program builds: instances kept
         self.module_warnings: list[str] = []
         self.recorder = None  # the --record trace, shared by the modules' ports
         reference_module_blocks(program, self.table, self._owner)
@@ -349,9 +361,13 @@ class Engine:
         module = self._owner.get(ins.mnemonic)
         if module is None:
             return None
-        from ..tlm.api import InstructionContext
+        instance = self._kept_instances.get(id(ins))  # an online edit: the same instruction in an unchanged rung
+        if instance is None:
+            from ..tlm.api import InstructionContext
 
-        return module.create(ins, InstructionContext(self, ins))
+            instance = module.create(ins, InstructionContext(self, ins))
+        self._instances[id(ins)] = instance
+        return instance
 
     def close(self) -> None:
         """End of the run: modules release what they hold (ports, files)."""
@@ -360,6 +376,31 @@ class Engine:
         if self.recorder is not None:
             self.recorder.close()
             self.recorder = None
+
+    # -- online program edit ---------------------------------------------------------------
+    def replace_program(self, program: Program):
+        """Run ``program`` (validated) from the next scan on, the data table
+        kept: call between scans, from the scan thread. Returns the
+        ProgramChanges; raises EditRefused (nothing changed) if the table
+        cannot take the program. What is kept and what is written:
+        ladder/online.py, docs/engine.md "Online program edit"."""
+        from .online import replace_program
+
+        return replace_program(self, program)
+
+    def _rebuild(self, program: Program, kept_instances: dict) -> None:
+        """Build the code of ``program`` for the engine's executor; module
+        instructions in ``kept_instances`` (id -> instance) keep theirs. If
+        building fails, the old program and code stay and the error is raised."""
+        saved = self.program, self.files, self._instances
+        self.program, self._instances, self._kept_instances = program, {}, kept_instances
+        try:
+            self._build_files(program, compile_file if self.executor == "compiled" else interpret_file)
+        except BaseException:
+            self.program, self.files, self._instances = saved
+            raise
+        finally:
+            self._kept_instances = {}
 
     # -- modes --------------------------------------------------------------------------
     def set_mode(self, mode: Mode) -> None:

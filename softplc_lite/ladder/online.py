@@ -1,0 +1,327 @@
+"""Online program edit, the engine's side: what changed between two
+programs, and what an accepted edit writes into the live data table.
+
+``program_changes(old, new)`` compares the rungs of each program file by
+their canonical text (fmt.format_rung) with difflib.SequenceMatcher, so an
+inserted rung is one rung added, not every later rung changed; a rung that
+only moved is matched by its text and counted as moved. ``Engine.replace_
+program`` (engine.py) uses the result to carry breakpoints and module
+instruction instances over, and ``edit_writes`` for the preset rule
+(docs/engine.md, "Online program edit").
+"""
+
+from __future__ import annotations
+
+import difflib
+from dataclasses import dataclass, field
+
+from ..datatable import DataTable, parse_address
+from .ast import Pos, Program, walk
+from .errors import LadderError
+from .fmt import format_rung
+
+
+class EditRefused(Exception):
+    """An edit the live data table cannot take (a file it needs exists with
+    another type): nothing was changed. ``errors`` are located."""
+
+    def __init__(self, errors: list[LadderError]) -> None:
+        self.errors = errors
+        super().__init__("\n".join(e.report() for e in errors))
+
+
+@dataclass
+class FileChanges:
+    """One program file's rungs: numbers of the new program for added,
+    changed and moved rungs, of the old one for removed rungs."""
+
+    number: int
+    added: list[int] = field(default_factory=list)
+    removed: list[int] = field(default_factory=list)  # old rung numbers
+    changed: list[int] = field(default_factory=list)
+    moved: list[int] = field(default_factory=list)
+    kept: dict[int, int] = field(default_factory=dict)  # old rung -> new rung, same text (moved ones too)
+    status: str = "edited"  # "edited", "new" (the file is new), "deleted"
+
+    def __bool__(self) -> bool:
+        return bool(self.added or self.removed or self.changed or self.moved or self.status != "edited")
+
+    def summary(self) -> str:
+        if self.status == "new":
+            return f"file {self.number}: new, {_count(len(self.added), 'rung')}"
+        if self.status == "deleted":
+            return f"file {self.number}: deleted ({_count(len(self.removed), 'rung')})"
+        parts = []
+        for label, rungs in (("added", self.added), ("removed", self.removed),
+                             ("changed", self.changed), ("moved", self.moved)):
+            if rungs:
+                noun = ("rung " if len(rungs) == 1 else "rungs ") if not parts else ""
+                was = "was " if label == "removed" else ""
+                parts.append(f"{len(rungs)} {noun}{label} ({was}{_numbers(rungs)})")
+        return f"file {self.number}: " + ", ".join(parts)
+
+
+@dataclass
+class ProgramChanges:
+    """What an online edit changed, per program file (only files with a
+    change are listed), plus what the data table gained (``created``, filled
+    in by Engine.replace_program) and whether DATA/SYMBOL lines changed."""
+
+    files: dict[int, FileChanges] = field(default_factory=dict)
+    declarations_changed: bool = False
+    created: list[str] = field(default_factory=list)  # "N10:0-N10:19", "T4:3"
+    unchanged: frozenset[int] = frozenset()  # files in both programs with the same rungs
+
+    def __bool__(self) -> bool:
+        return bool(self.files or self.declarations_changed or self.created)
+
+    def new_rung(self, file: int, old_rung: int) -> int | None:
+        """Where old rung ``old_rung`` of ``file`` is in the new program when
+        its text is unchanged (a breakpoint there stays); else None."""
+        fc = self.files.get(file)
+        if fc is None:
+            return old_rung if file in self.unchanged else None
+        return fc.kept.get(old_rung)
+
+    def summary(self) -> str:
+        """One line for a person: "file 2: 1 rung added (12), 1 changed (4)"."""
+        parts = [fc.summary() for _, fc in sorted(self.files.items())]
+        if self.declarations_changed:
+            parts.append("DATA/SYMBOL lines changed")
+        if self.created:
+            parts.append("created " + ", ".join(self.created))
+        return "; ".join(parts) if parts else "no rung changed"
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
+def _numbers(rungs: list[int]) -> str:
+    shown = ", ".join(str(r) for r in rungs[:8])
+    return shown + (f", ... {len(rungs) - 8} more" if len(rungs) > 8 else "")
+
+
+def rung_texts(program: Program, number: int) -> list[str]:
+    return [format_rung(r) for r in program.files[number].rungs]
+
+
+def program_changes(old: Program, new: Program) -> ProgramChanges:
+    """The rungs added, removed, changed and moved in each program file."""
+    changes = ProgramChanges()
+    unchanged = set()
+    for number in sorted(set(old.files) | set(new.files)):
+        if number not in new.files:
+            changes.files[number] = FileChanges(number, removed=list(range(len(old.files[number].rungs))),
+                                                status="deleted")
+            continue
+        if number not in old.files:
+            changes.files[number] = FileChanges(number, added=list(range(len(new.files[number].rungs))),
+                                                status="new")
+            continue
+        fc = _file_changes(number, rung_texts(old, number), rung_texts(new, number))
+        if fc:
+            changes.files[number] = fc
+        else:
+            unchanged.add(number)
+    changes.unchanged = frozenset(unchanged)
+    changes.declarations_changed = (_declarations(old) != _declarations(new))
+    return changes
+
+
+def _declarations(program: Program) -> tuple:
+    data = tuple((d.file, d.size, tuple(d.values)) for d in program.data)
+    symbols = tuple(sorted((name, str(s.address)) for name, s in program.symbols.items()))
+    return data, symbols
+
+
+def _file_changes(number: int, old: list[str], new: list[str]) -> FileChanges:
+    fc = FileChanges(number)
+    matcher = difflib.SequenceMatcher(None, old, new, autojunk=False)
+    removed: list[int] = []
+    added: list[int] = []
+    for op, i1, i2, j1, j2 in matcher.get_opcodes():
+        if op == "equal":
+            fc.kept.update(zip(range(i1, i2), range(j1, j2)))
+        elif op == "replace":
+            # rung for rung, in place: changed; what one side has more is removed or added
+            n = min(i2 - i1, j2 - j1)
+            for k in range(n):
+                removed.append(i1 + k)  # paired below unless it only moved
+                added.append(j1 + k)
+            removed += range(i1 + n, i2)
+            added += range(j1 + n, j2)
+        elif op == "delete":
+            removed += range(i1, i2)
+        else:
+            added += range(j1, j2)
+    # a removed rung whose very text was added elsewhere only moved
+    by_text: dict[str, list[int]] = {}
+    for j in added:
+        by_text.setdefault(new[j], []).append(j)
+    still_removed = []
+    for i in removed:
+        places = by_text.get(old[i])
+        if places:
+            j = places.pop(0)
+            fc.kept[i] = j
+            fc.moved.append(j)
+        else:
+            still_removed.append(i)
+    moved = set(fc.moved)
+    still_added = [j for j in added if j not in moved]
+    # the rest, in order: a removed rung and an added one at the same place are one rung changed
+    pairs = _in_place(still_removed, still_added, matcher)
+    paired_old = {i for i, _ in pairs}
+    paired_new = {j for _, j in pairs}
+    fc.changed = sorted(j for _, j in pairs)
+    fc.removed = [i for i in still_removed if i not in paired_old]
+    fc.added = [j for j in still_added if j not in paired_new]
+    fc.moved.sort()
+    return fc
+
+
+def _in_place(removed: list[int], added: list[int], matcher) -> list[tuple[int, int]]:
+    """Pairs (old, new) of one replace block's rungs that are one rung
+    changed: in order, each new rung with the most similar old rung after
+    the last one paired, when at least half their text is the same."""
+    old, new = matcher.a, matcher.b
+    removed_set, added_set = set(removed), set(added)
+    pairs = []
+    for op, i1, i2, j1, j2 in matcher.get_opcodes():
+        if op != "replace":
+            continue
+        olds = [i for i in range(i1, i2) if i in removed_set]
+        after = 0  # index into olds: pairs keep the rungs' order
+        for j in (j for j in range(j1, j2) if j in added_set):
+            scored = [(difflib.SequenceMatcher(None, old[i], new[j]).ratio(), k) for k, i in enumerate(olds)
+                      if k >= after]
+            if scored:
+                ratio, k = max(scored, key=lambda rk: (rk[0], -rk[1]))
+                if ratio >= 0.5:
+                    pairs.append((olds[k], j))
+                    after = k + 1
+    return pairs
+
+
+def kept_instructions(old: Program, new: Program, changes: ProgramChanges):
+    """(old instruction, new instruction) of every rung whose text is
+    unchanged (moved ones too): the module instances they may share."""
+    for number, pfile in new.files.items():
+        if number not in old.files:
+            continue
+        old_rungs = old.files[number].rungs
+        if number in changes.files:
+            pairs = changes.files[number].kept.items()
+        elif number in changes.unchanged:
+            pairs = ((k, k) for k in range(len(old_rungs)))
+        else:
+            continue
+        for i, j in pairs:
+            yield from zip(walk(old_rungs[i].elements), walk(pfile.rungs[j].elements))
+
+
+_STATE_MEMBERS = frozenset({"ACC", "POS"})
+
+
+def edit_writes(old_writes: list, new_writes: list, is_new) -> list:
+    """What an accepted edit writes of the download values of instructions
+    (timer/counter PRE and ACC, a control's LEN and POS): ``old_writes`` and
+    ``new_writes`` are (address, value, pos) of each program, ``is_new(address)``
+    says whether the edit created the element. A new element gets every
+    value; an existing one its PRE/LEN when the instruction's operand
+    differs from the old program's (RSLogix 5 writes an instruction's
+    preset when the edit is accepted), its ACC/POS only when no instruction
+    of the old program set that word (the running state is kept)."""
+    before = {str(a): v for a, v, _ in old_writes}
+    out = []
+    for address, value, pos in new_writes:
+        key = str(address)
+        if is_new(address):
+            out.append((address, value, pos))
+        elif address.member in _STATE_MEMBERS:
+            if key not in before:
+                out.append((address, value, pos))
+        elif before.get(key, object()) != value:
+            out.append((address, value, pos))
+    return out
+
+
+def replace_program(engine, program: Program) -> ProgramChanges:
+    """Engine.replace_program: ``program`` (validated) runs from the next
+    scan on, the data table kept. The files and elements it names are
+    created; DATA values go into new elements only; instruction download
+    values as ``edit_writes`` says; the code is built anew for the engine's
+    executor; module instructions of unchanged rungs keep their instances.
+    The mode, S:1/15 and the rest of the table stay. Raises EditRefused,
+    with nothing changed, when the table cannot take the program."""
+    from .engine import _located, instruction_writes, reference_module_blocks, reference_program
+
+    old = engine.program
+    changes = program_changes(old, program)
+    # First on a table of the same layout: the live one is changed only when
+    # everything fits (a file the program needs may exist with another type).
+    trial = DataTable()
+    for f in engine.table.files():
+        trial.create_file(f.ftype.letter, f.number, f.size)
+    problems: list[LadderError] = []
+    reference_program(program, trial, problems)
+    reference_module_blocks(program, trial, engine._owner, problems)
+    if problems:
+        raise EditRefused(problems)
+    sizes = {f.number: f.size for f in engine.table.files()}
+
+    def is_new(address) -> bool:
+        return address.element is not None and address.element >= sizes.get(address.file, 0)
+
+    writes = [(address, value, decl.pos) for decl in program.data for address, value in _data_values(decl)
+              if is_new(address)]  # DATA values of new elements only: the others keep their live values
+    writes += edit_writes(instruction_writes(old), instruction_writes(program), is_new)
+    for address, value, pos in writes:
+        with _located(pos, problems):
+            _write(trial, address, value)
+    if problems:
+        raise EditRefused(problems)
+    # The edit goes in: nothing below can be refused.
+    reference_program(program, engine.table)
+    reference_module_blocks(program, engine.table, engine._owner)
+    for address, value, _ in writes:
+        _write(engine.table, address, value)
+    changes.created = _created(sizes, engine.table)
+    instances = engine._instances
+    kept = {id(new): instances[id(was)] for was, new in kept_instructions(old, program, changes)
+            if id(was) in instances}
+    try:
+        engine._rebuild(program, kept)
+    except Exception as exc:  # a bug in the compiler: the old code runs on (the table only grew)
+        problem = f"internal error building the new program: {type(exc).__name__}: {exc}"
+        raise EditRefused([LadderError(Pos("online edit", 0, 0), problem)]) from exc
+    return changes
+
+
+def _data_values(decl):
+    for k, value in enumerate(decl.values):
+        yield parse_address(f"{decl.file}:0").with_element(k), value  # not text: O0 and I1 count in octal
+
+
+def _write(table: DataTable, address, value) -> None:
+    """As a download writes (engine.initial_values): a DATA integer above
+    32767 for a word file is stored as its 16 bits (0xFFFF)."""
+    if isinstance(value, int) and address.type_letter not in ("F", "L") and value > 32767:
+        table.write_word(address, value)
+    else:
+        table.write(address, value)
+
+
+def _created(sizes: dict[int, int], table: DataTable) -> list[str]:
+    """What the table gained since ``sizes`` (file number -> elements)."""
+    out = []
+    for f in table.files():
+        before = sizes.get(f.number)
+        if before is None:
+            out.append(f"{f.name} ({f.size} elements)")
+        elif f.size > before:
+            first = parse_address(f"{f.name}:0").with_element(before)
+            last = first.with_element(f.size - 1)
+            out.append(f"{first}" if f.size - before == 1 else f"{first}-{last}")
+    return out

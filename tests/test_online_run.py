@@ -1,0 +1,84 @@
+"""`softplc run --online` end to end (issue 18): a realtime run whose
+program file is edited mid-run, first badly, then well. The flag is wired
+into the CLI by the lead (see /tmp/h18/online_wiring.md)."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+pytestmark = pytest.mark.skip(reason="wired by the lead")
+
+
+class Lines:
+    """A pipe's lines, collected by a thread, waited for with a deadline."""
+
+    def __init__(self, stream) -> None:
+        self.lines: list[str] = []
+        self._thread = threading.Thread(target=self._read, args=(stream,), daemon=True)
+        self._thread.start()
+
+    def _read(self, stream) -> None:
+        for line in stream:
+            self.lines.append(line.rstrip("\n"))
+
+    def wait_for(self, text: str, timeout_s: float) -> str | None:
+        deadline = time.monotonic() + timeout_s
+        while time.monotonic() < deadline:
+            for line in list(self.lines):
+                if text in line:
+                    return line
+            time.sleep(0.02)
+        return None
+
+
+def save(path: Path, text: str) -> None:
+    """Write and move the mtime on, as an editor's save a moment later would."""
+    path.write_text(text)
+    st = path.stat()
+    import os
+
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 10_000_000))
+
+
+def test_run_online_takes_a_good_edit_and_refuses_a_bad_one(tmp_path):
+    app = tmp_path / "app"
+    app.mkdir()
+    main = app / "main.lad"
+    main.write_text("ADD N7:0 1 N7:0\n")
+    snap = app / ".softplc" / "datatable.snap"
+    proc = subprocess.Popen([sys.executable, "-m", "softplc_lite", "run", str(app), "--realtime", "--scan-ms", "5",
+                             "--fresh", "--online", "--print", "N7:0", "--print", "N7:1"],
+                            cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    err = Lines(proc.stderr)
+    try:
+        deadline = time.monotonic() + 20
+        while not snap.exists() and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.02)  # scanning: its first periodic save is there
+        assert proc.poll() is None, "\n".join(err.lines)
+        save(main, "ADD N7:0 1 N7:0\nADD N7:1 1\n")  # bad: ADD needs a destination
+        rejected = err.wait_for("online edit rejected", 15)
+        assert rejected is not None, "\n".join(err.lines)
+        assert err.wait_for("main.lad:2:", 5) is not None, "\n".join(err.lines)
+        save(main, "ADD N7:0 1 N7:0\nADD N7:1 1 N7:1\n")
+        accepted = err.wait_for("online edit accepted", 15)
+        assert accepted is not None, "\n".join(err.lines)
+        assert "file 2: 1 rung added (1)" in accepted
+        time.sleep(0.3)  # scans of the new program
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=20)
+    finally:
+        proc.kill()
+        proc.wait(timeout=20)
+    assert proc.returncode == 0, "\n".join(err.lines)
+    values = dict(line.split(" = ") for line in out.splitlines())
+    assert int(values["N7:1"]) > 10  # the added rung ran, scan after scan
+    assert int(values["N7:0"]) > int(values["N7:1"])  # the first rung ran all along, before and after
