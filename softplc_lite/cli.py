@@ -1,14 +1,17 @@
-"""The ``softplc`` command.
+"""The ``softplc`` command (docs/cli.md).
 
 Exit codes: 0 ok; 1 a program, config or data error (reported with
 file:line:col, no traceback); 2 usage error; 3 the PLC faulted; 4 an
 internal error in softplc itself (a bug, reported in one line, never as a
-traceback); 130 interrupted.
+traceback); 5 ``--replay``: the program's output differed from the
+recording; 130 interrupted (outside a run's scan loop: Ctrl-C or SIGTERM
+while ``run`` or ``watch`` scans ends the run cleanly, exit 0).
 """
 
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 import time
 from pathlib import Path
@@ -31,6 +34,9 @@ from .runner import RunOptions, Runner
 from .errors import LocatedError
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT, EXIT_INTERNAL = 0, 1, 2, 3, 4
+EXIT_REPLAY = 5  # --replay: the program wrote bytes other than the recording's
+EXIT_INTERRUPTED = 130
+DOCS = "docs/cli.md"
 
 # --scan-ms (SCAN_MS_RANGE, the range of softplc.toml's scan_ms): simulated ms
 # per scan, or the --realtime period (0: free-running).
@@ -74,6 +80,10 @@ def _cmd_address(args: argparse.Namespace) -> int:
 
 
 def _cmd_datatable(args: argparse.Namespace) -> int:
+    if not (args.load or args.print or args.dump or args.save):  # nothing to do: say what it is for
+        args.parser.error("expected FILEs to load (datatable .json or snapshot files) and what to do with them "
+                          "(--print ADDR, --dump, --save SNAPSHOT), e.g. "
+                          "softplc datatable docs/examples/datatable.json --print N7:0")
     table = DataTable()
     for path in args.load:
         if path.endswith(".json"):
@@ -96,19 +106,36 @@ def _print_values(table: DataTable, addresses: list[str], symbols=None) -> None:
         print(f"{name} = {format_read(table, a)}")
 
 
+def run_realtime(args: argparse.Namespace) -> bool:
+    """The clock of ``softplc run``: --realtime or --simulated when given;
+    otherwise the wall clock for an unbounded run (no --scans, no --replay:
+    a PLC that runs until stopped) and simulated time for a bounded one."""
+    if args.realtime or args.simulated:
+        return bool(args.realtime)
+    return args.scans is None and args.replay is None
+
+
 def _cmd_run(args: argparse.Namespace) -> int:
     app = load_app(args.app, args.state)
     _print_warnings(app.warnings)
     options = RunOptions(
-        scan_ms=args.scan_ms, realtime=args.realtime, fresh=args.fresh,
+        scan_ms=args.scan_ms, realtime=run_realtime(args), fresh=args.fresh,
         load=tuple(args.load or ()), sets=tuple(args.set), executor=args.executor,
         ports=tuple(args.port), record=args.record, replay=args.replay,
     )
     runner = Runner(app, options)
-    try:
-        _run_with_status(runner, app, args.scans)
-    finally:
+    problems = address_problems("--print", runner.table, args.print, app.program.symbols)
+    if problems:  # before scan 0: nothing ran, nothing is saved
         runner.engine.close()
+        for problem in problems:
+            print(f"error: {problem}", file=sys.stderr)
+        return EXIT_ERROR
+    try:
+        _run_with_status(runner, app, args.scans, unbounded=args.scans is None and args.replay is None)
+    finally:
+        # a second SIGTERM must not cut the final save short (a service manager sends one, then waits)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        runner.close()
     engine = runner.engine
     storage_problems = runner.finish()  # the final save; a failure is reported, and the output still printed
     if args.dump:
@@ -122,20 +149,43 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if engine.mode is Mode.FAULTED:
         print(f"softplc: {app.name}: {engine.fault}", file=sys.stderr)
         return EXIT_FAULT
+    if runner.replay_differences:
+        count = runner.replay_differences
+        print(f"softplc: {app.name}: --replay: the program's output differed from the recording "
+              f"({count} difference{'s' if count != 1 else ''}, listed above)", file=sys.stderr)
+        return EXIT_REPLAY
     return EXIT_ERROR if storage_problems else EXIT_OK
 
 
-def _run_with_status(runner: Runner, app, scans: int | None) -> None:
-    """Run, with the app's [display] status line redrawn on standard error
-    while it is a terminal. rich's Live redraws from its own thread a few
-    times a second; the scan loop only refreshes the values, at most ten
-    times a second, so drawing never slows scanning."""
+def address_problems(option: str, table: DataTable, texts: list[str], symbols=None) -> list[str]:
+    """What is wrong with each address (or symbol) given to ``option``, read
+    from the table a run starts with: checked before scan 0."""
+    names = SymbolIndex(symbols)
+    problems = []
+    for text in texts:
+        try:
+            format_read(table, resolve_name(text, names))
+        except DataTableError as e:
+            message = str(e)  # most name the address already: not twice
+            named = message.startswith((text, repr(text)))
+            problems.append(f"{option} {message}" if named else f"{option} {text}: {message}")
+    return problems
+
+
+def _run_with_status(runner: Runner, app, scans: int | None, unbounded: bool) -> None:
+    """Run, with a status line redrawn on standard error while it is a
+    terminal: for an app with [display] status items, and for every app
+    while the run is unbounded (the scan, the scan rate, the sim/real time
+    ratio). rich's Live redraws from its own thread a few times a second;
+    the scan loop only refreshes the values, at most ten times a second, so
+    drawing never slows scanning."""
     items = app.display.status
     console = Console(stderr=True)
-    if not items or not console.is_terminal:
+    if not (items or unbounded) or not console.is_terminal:
         runner.run(scans)
         return
     line = StatusLine(app.name, items)
+    start = time.monotonic()
     last = 0.0
 
     def refresh(engine) -> None:
@@ -143,12 +193,13 @@ def _run_with_status(runner: Runner, app, scans: int | None) -> None:
         now = time.monotonic()
         if now - last >= 0.1:
             last = now
-            line.update(engine.table, engine.scans, engine.clock.now_ms, engine.clock.realtime)
+            line.update(engine.table, engine.scans, engine.clock.now_ms, engine.clock.realtime, now - start)
 
     with Live(line, console=console, refresh_per_second=5, transient=False):
         runner.run(scans, on_scan=refresh)
         engine = runner.engine
-        line.update(engine.table, engine.scans, engine.clock.now_ms, engine.clock.realtime)
+        line.update(engine.table, engine.scans, engine.clock.now_ms, engine.clock.realtime,
+                    time.monotonic() - start)
 
 
 def _cmd_watch(args: argparse.Namespace) -> int:
@@ -201,34 +252,65 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="softplc",
         description="A soft PLC: text ladder logic on an emulated PLC-5/SoftPLC data table.",
+        epilog=f"Each COMMAND has its own --help. Exit codes, time and signals: {DOCS}; "
+               "the engine and softplc run: docs/engine.md; the watch view: docs/watch.md.",
     )
-    p.add_argument("--version", action="version", version=f"softplc_lite {__version__}")
+    p.add_argument("--version", action="version", version=f"softplc_lite {__version__}",
+                   help="print the version and exit")
     sub = p.add_subparsers(dest="command", metavar="COMMAND")
 
-    r = sub.add_parser("run", help="run an app (directory or .lad file) in RUN mode")
+    r = sub.add_parser(
+        "run", help="run an app (directory or .lad file) in RUN mode",
+        description="Run an app in RUN mode until --scans N scans, the end of a --replay trace, Ctrl-C or "
+                    "SIGTERM (both end cleanly: final save, --print/--dump output, exit 0).",
+        epilog=f"Time: an unbounded run (no --scans, no --replay) follows the wall clock; a bounded one is on "
+               f"simulated time; --realtime or --simulated says which. Exit codes: 0 ok, 1 error, 2 usage, "
+               f"3 PLC fault, 4 internal error, 5 --replay output differed. See {DOCS} and docs/engine.md.")
     r.add_argument("app", metavar="APP", help="app directory or .lad file")
-    r.add_argument("--scans", type=int_in(SCANS_RANGE, "--scans"), metavar="N", help="stop after N scans (default: run until Ctrl-C)")
+    r.add_argument("--scans", type=int_in(SCANS_RANGE, "--scans"), metavar="N",
+                   help="stop after N scans (0 or more; default: until Ctrl-C or SIGTERM, or the end of the "
+                   "--replay trace)")
     r.add_argument("--scan-ms", type=int_in(SCAN_MS_RANGE, "--scan-ms"), metavar="MS",
-                   help="simulated ms per scan (default 10), or with --realtime the scan period "
-                   "(0 = free-running); 0..32767")
-    r.add_argument("--realtime", action="store_true", help="use the wall clock instead of simulated time")
+                   help="simulated ms per scan (default: the app's scan_ms, 10), or on the wall clock the scan "
+                   "period (0 = free-running); 0..32767")
+    clock = r.add_mutually_exclusive_group()
+    clock.add_argument("--realtime", action="store_true",
+                       help="use the wall clock (the default without --scans and --replay)")
+    clock.add_argument("--simulated", action="store_true",
+                       help="use simulated time, --scan-ms a scan (the default with --scans or --replay)")
     r.add_argument("--state", metavar="DIR", help="keep the retentive snapshot in DIR (default APP/.softplc)")
-    r.add_argument("--fresh", action="store_true", help="ignore the retentive snapshot")
-    r.add_argument("--load", action="append", metavar="FILE.json", help="load data table values at start")
-    r.add_argument("--dump", metavar="FILE.json", help="write the data table as JSON at the end")
-    r.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE", help="set a value at start")
-    r.add_argument("--print", action="append", default=[], metavar="ADDR", help="print a value at the end")
+    r.add_argument("--fresh", action="store_true",
+                   help="ignore the retentive snapshot at start (it is still saved while running)")
+    r.add_argument("--load", action="append", metavar="FILE.json",
+                   help="load data table values from FILE.json at start (repeatable)")
+    r.add_argument("--dump", metavar="FILE.json", help="write the data table as JSON to FILE.json at the end")
+    r.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE",
+                   help="set ADDR (address or symbol) to VALUE (JSON, or plain text) at start (repeatable)")
+    r.add_argument("--print", action="append", default=[], metavar="ADDR",
+                   help="print ADDR (address or symbol) at the end (repeatable; checked before scan 0)")
     r.add_argument("--executor", choices=("compiled", "reference"), default="compiled",
                    help="compiled fast path (default) or the reference interpreter")
     r.add_argument("--port", action="append", default=[], metavar="N=DEVICE",
-                   help="open logical port N on DEVICE (a device path or pyserial URL) instead of its [PORTS] field")
+                   help="open logical port N ([MODULE:]N) on DEVICE (a device path or pyserial URL) instead of "
+                   "its [PORTS] field (repeatable; docs/serial.md)")
     r.add_argument("--record", metavar="TRACE", help="record every port's traffic to the TRACE file")
-    r.add_argument("--replay", metavar="TRACE", help="play every port back from a recorded TRACE file")
+    r.add_argument("--replay", metavar="TRACE",
+                   help="play every port back from a recorded TRACE file; stops at its end ('# scans: N' "
+                   "comment, else the last recorded byte); exit 5 if the output differed")
     r.set_defaults(func=_cmd_run)
 
-    w = sub.add_parser("watch", help="step scans in a terminal view: rungs, power flow, values, ports")
+    from .watch.keys import keys_help
+
+    w = sub.add_parser(
+        "watch", help="step scans in a terminal view: rungs, power flow, values, ports",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description="The online view of a running PLC in the terminal (docs/watch.md), or with --snapshot "
+                    "one rendering of it to a file.",
+        epilog=f"keys in the view:\n{keys_help()}\n\nCtrl-C or SIGTERM quit as q does (exit 0). See "
+               f"docs/watch.md and {DOCS}.")
     w.add_argument("app", metavar="APP", help="app directory or .lad file")
-    w.add_argument("--watch", action="append", default=[], metavar="ADDR", help="add ADDR to the watch list")
+    w.add_argument("--watch", action="append", default=[], metavar="ADDR",
+                   help="add ADDR (address or symbol) to the watch list (repeatable; checked before scan 0)")
     w.add_argument("--watch-file", metavar="FILE", help="a watch file: one address or symbol a line")
     w.add_argument("--force", action="append", default=[], metavar="ADDR=0|1", help="force a bit on or off")
     w.add_argument("--break-when", action="append", default=[], metavar="EXPR",
@@ -237,22 +319,28 @@ def build_parser() -> argparse.ArgumentParser:
     w.add_argument("--scan-ms", type=int_in(SCAN_MS_RANGE, "--scan-ms"), metavar="MS",
                    help="simulated ms per scan (default from the app; 0..32767)")
     w.add_argument("--state", metavar="DIR", help="keep the retentive snapshot in DIR (default APP/.softplc)")
-    w.add_argument("--fresh", action="store_true", help="ignore the retentive snapshot")
-    w.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE", help="set a value at start")
+    w.add_argument("--fresh", action="store_true", help="ignore the retentive snapshot at start")
+    w.add_argument("--set", action="append", default=[], metavar="ADDR=VALUE",
+                   help="set ADDR to VALUE at start (as for run)")
     w.add_argument("--port", action="append", default=[], metavar="N=DEVICE", help="as for run")
     w.add_argument("--replay", metavar="TRACE", help="play every port back from a recorded TRACE file")
-    w.add_argument("--scans", type=int_in(SCANS_RANGE, "--scans"), default=0, metavar="N",
-                   help="with --snapshot: scans to run first (0 or more; default 0)")
+    w.add_argument("--scans", type=int_in(SCANS_RANGE, "--scans"), metavar="N",
+                   help="with --snapshot: scans to run first (0 or more; default 0); refused without it")
     w.add_argument("--snapshot", metavar="FILE", help="render the view after --scans N scans to FILE "
                    "(.svg: an SVG picture; otherwise text) and exit; needs no terminal")
+    w.add_argument("--save", action="store_true",
+                   help="with --snapshot: save the retentive data table at the end, as a run does (without it "
+                   "a snapshot leaves the app's state as it was; the interactive view always saves on quit)")
     w.add_argument("--width", type=int_in(SNAPSHOT_WIDTH, "--width"), default=100, metavar="COLS",
                    help="--snapshot width, 40..1000 (default 100)")
     w.add_argument("--height", type=int_in(SNAPSHOT_HEIGHT, "--height"), default=40, metavar="ROWS",
                    help="--snapshot height, 12..1000 (default 40)")
     w.set_defaults(func=_cmd_watch)
 
-    c = sub.add_parser("check", help="parse and validate an app; list every problem")
-    c.add_argument("app", metavar="APP")
+    c = sub.add_parser("check", help="parse and validate an app; list every problem",
+                       description="Parse and validate an app; list every problem (exit 1), then RSLogix-style "
+                                   "verify warnings (exit 0 with warnings only). See docs/language.md.")
+    c.add_argument("app", metavar="APP", help="app directory or .lad file")
     c.set_defaults(func=_cmd_check)
 
     f = sub.add_parser("fmt", help="print a program canonically")
@@ -260,25 +348,49 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--style", choices=STYLES, default="mnemonic")
     f.set_defaults(func=_cmd_fmt)
 
-    a = sub.add_parser("address", help="parse data table addresses and print their canonical form")
+    a = sub.add_parser("address", help="parse data table addresses and print their canonical form",
+                       description="Print each address's canonical form, value kind and whether it is direct "
+                                   "(docs/datatable.md).")
     a.add_argument("text", nargs="+", metavar="ADDR", help="address text such as N7:0/3 or I:012/17")
     a.set_defaults(func=_cmd_address)
 
-    d = sub.add_parser("datatable", help="load data table JSON or snapshots, print values, dump, save")
-    d.add_argument("load", nargs="*", metavar="FILE", help="datatable .json or a snapshot file, in order")
-    d.add_argument("--print", action="append", default=[], metavar="ADDR", help="print a value")
+    d = sub.add_parser("datatable", help="load data table JSON or snapshots, print values, dump, save",
+                       description="Load data table files in order, then print values, dump JSON or save a "
+                                   "snapshot (docs/datatable.md).",
+                       epilog="example: softplc datatable docs/examples/datatable.json --print ST9:0")
+    d.add_argument("load", nargs="*", metavar="FILE",
+                   help="datatable .json or a snapshot file, loaded in order (none: an empty table)")
+    d.add_argument("--print", action="append", default=[], metavar="ADDR", help="print a value (repeatable)")
     d.add_argument("--dump", action="store_true", help="write the table as JSON to stdout")
     d.add_argument("--save", metavar="SNAPSHOT", help="save the table as a retentive snapshot")
-    d.set_defaults(func=_cmd_datatable)
+    d.set_defaults(func=_cmd_datatable, parser=d)
     return p
+
+
+def _stop_as_interrupt(signum, frame) -> None:
+    """SIGTERM does what Ctrl-C does."""
+    raise KeyboardInterrupt
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
-        parser.print_help()
-        return EXIT_OK
+        parser.print_usage(sys.stderr)
+        print(f"softplc: error: a COMMAND is needed: run, watch, check, fmt, address or datatable; "
+              f"softplc --help says what each does ({DOCS})", file=sys.stderr)
+        return EXIT_USAGE
+    previous = None
+    if args.command in ("run", "watch"):  # they end cleanly on Ctrl-C: SIGTERM (kill, systemd) too
+        previous = signal.signal(signal.SIGTERM, _stop_as_interrupt)
+    try:
+        return _dispatch(args)
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _dispatch(args: argparse.Namespace) -> int:
     try:
         return args.func(args)
     except (DataTableError, AppError, LadderError, LocatedError) as e:
@@ -289,7 +401,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"error: {e}", file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
-        return 130
+        return EXIT_INTERRUPTED
     except (Exception, RecursionError, MemoryError) as e:  # a bug: one line, never a traceback
         text = str(e)
         text = text if len(text) <= 300 else text[:300] + "..."

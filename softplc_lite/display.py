@@ -13,7 +13,9 @@ take. ``status`` items are also printed in the summary, first.
 
 The status line is a rich renderable (:class:`StatusLine`); ``softplc run``
 redraws it a few times a second on standard error while standard error is
-a terminal, independently of the scan rate.
+a terminal, independently of the scan rate: for an app with ``status``
+items, and for every app while a run is unbounded (no ``--scans``), then
+with the scan count, the scan rate and the simulated/real time ratio only.
 """
 
 from __future__ import annotations
@@ -122,7 +124,14 @@ def parse_display(section: object, where: str, symbols=None) -> Display:
 
 
 class StatusLine:
-    """One line: the app, the scan count and time, then each status value."""
+    """One line: the app, the scan count and time, the scan rate and how
+    fast simulated time goes against the wall clock, then each status value.
+
+    ``update`` is given the wall-clock seconds since the run started
+    (``wall_s``); the rate and the ratio are those since the update before
+    (the last tenth of a second or so in ``softplc run``), so they follow a
+    change of speed. Without ``wall_s`` (or before two updates) they are
+    left out."""
 
     def __init__(self, name: str, items: list[Item]) -> None:
         self.name = name
@@ -131,16 +140,29 @@ class StatusLine:
         self.now_ms = 0
         self.realtime = False
         self.values: list[str] = ["-"] * len(items)
+        self.rate: float | None = None  # scans a second of wall-clock time
+        self.ratio: float | None = None  # PLC seconds per wall-clock second
+        self._last: tuple[float, int, int] | None = None  # (wall_s, scans, now_ms) of the update before
 
-    def update(self, table: DataTable, scans: int, now_ms: int, realtime: bool) -> None:
+    def update(self, table: DataTable, scans: int, now_ms: int, realtime: bool, wall_s: float | None = None) -> None:
         self.scans, self.now_ms, self.realtime = scans, now_ms, realtime
         self.values = [item.read(table) for item in self.items]
+        if wall_s is None:
+            return
+        last = self._last
+        if last is not None and wall_s > last[0]:
+            span = wall_s - last[0]
+            self.rate = (scans - last[1]) / span
+            self.ratio = (now_ms - last[2]) / 1000 / span
+        self._last = (wall_s, scans, now_ms)
 
     def text(self) -> Text:
         t = Text()
         t.append(self.name, style="bold")
         clock = "real" if self.realtime else "simulated"
         t.append(f"  scan {self.scans}  {self.now_ms / 1000:.2f} s {clock}", style="dim")
+        if self.rate is not None and self.ratio is not None:
+            t.append(f"  {self.rate:.0f} scans/s  x{self.ratio:.2f} real time", style="dim")
         for item, value in zip(self.items, self.values):
             t.append("  ")
             t.append(f"{item.label} ", style="cyan")

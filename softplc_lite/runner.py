@@ -6,6 +6,11 @@ datatable.json; then --load files and --set values. While running, the
 snapshot is saved between scans every [retentive] save_ms (retentive.py);
 storage trouble (a save, a --record trace) is a minor fault, not a stop.
 Stop: the final save (``finish``).
+
+Between two scans ``Runner.run`` calls each callable of ``between_scans``
+(with the runner): the one place where something may change the program or
+the table at a scan boundary (an online edit): after a scan that did not
+fault, before the retentive save that may follow it and the next scan.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from .ladder.engine import Engine, Mode, RealClock, SimulatedClock
 from .ladder.symbols import resolve_name
 from .ports import parse_port_overrides
 from .ports.recorder import MAX_PENDING
+from .ports.trace import covered_scans
 from .retentive import Retentive, StorageFaults
 
 
@@ -57,6 +63,7 @@ class RunOptions:
     ports: tuple[str, ...] = ()  # --port [MODULE:]N=DEVICE (port N on DEVICE or a URL)
     record: str | None = None  # --record TRACE: write every port's traffic
     replay: str | None = None  # --replay TRACE: play every port back from a recording
+    save_state: bool = True  # False: the retentive snapshot is read at start but never written
 
     def module_options(self) -> dict[str, object]:
         """What modules get at attach (see tlm.api.TLM.attach)."""
@@ -100,7 +107,13 @@ class Runner:
             addr, value = parse_assignment(text, app.program.symbols)
             self.table.write(addr, value)
         # Removes the temp files of a save a killed run left; saves from the first scan on.
-        self.retentive = Retentive(path, settings.save_ms, self.faults) if path is not None else None
+        self.retentive = Retentive(path, settings.save_ms, self.faults) \
+            if path is not None and options.save_state else None
+        # A --replay trace's "# scans: N" comment: the scans it covers (None: until its last event)
+        self.replay_scans = covered_scans(options.replay) if options.replay else None
+        self.replay_differences = 0  # output differences of every replay port (set by ``close``)
+        # callables run between two scans, each given this runner (see the module docstring)
+        self.between_scans: list[Callable[[Runner], None]] = []
 
     @property
     def realtime(self) -> bool:
@@ -145,10 +158,37 @@ class Runner:
                                f"; the run goes on, the trace waits in memory (up to "
                                f"{MAX_PENDING // (1024 * 1024)} MB) and is written when the file takes it")
 
+    def replay_ports(self) -> list:
+        """The open ``replay://`` serial ports of every module (they have ``mismatches``)."""
+        found = []
+        for module in self.engine.modules:
+            for port in module.serial_ports():
+                serial = getattr(port, "serial", None)
+                if serial is not None and hasattr(serial, "mismatches"):
+                    found.append(serial)
+        return found
+
+    def replay_done(self) -> bool:
+        """Every replay port has delivered its last recorded byte to the
+        program, and the program has written every recorded one (true at
+        once when no port plays anything back: there is nothing to wait for)."""
+        return all(p.finished and not p.in_waiting for p in self.replay_ports())
+
+    def close(self) -> None:
+        """Close the engine (the modules report each replay port first);
+        ``replay_differences`` counts the replay output differences."""
+        self.replay_differences = sum(len(p.mismatches) for p in self.replay_ports())
+        self.engine.close()
+
     def run(self, scans: int | None = None, on_scan: Callable[[Engine], None] | None = None) -> None:
-        """Run in RUN mode for ``scans`` scans, or until Ctrl-C (then return
-        normally: the caller saves and exits cleanly) or a major fault."""
+        """Run in RUN mode for ``scans`` scans, or until Ctrl-C or SIGTERM
+        (then return normally: the caller saves and exits cleanly) or a
+        major fault. With ``--replay`` and ``scans`` None: the scans the
+        trace says it covers, else until ``replay_done``."""
         engine = self.engine
+        until_replay_end = scans is None and self.options.replay is not None
+        if until_replay_end and self.replay_scans is not None:
+            scans, until_replay_end = self.replay_scans, False
         if engine.mode is not Mode.RUN:
             engine.set_mode(Mode.RUN)
         period = engine.settings.scan_ms / 1000 if self.realtime else 0.0
@@ -163,6 +203,10 @@ class Runner:
                 if on_scan is not None:
                     on_scan(engine)
                 if engine.mode is Mode.FAULTED:
+                    break
+                for hook in self.between_scans:
+                    hook(self)
+                if until_replay_end and self.replay_done():
                     break
                 now = time.monotonic()
                 if now >= save_at:  # between two scans: the snapshot is one whole scan's table

@@ -17,6 +17,11 @@ A trace is a UTF-8 text file (docs/simulated-wire.md has the full page)::
   module written ``MODULE:N`` (``MODBMAST:1``, N 0-35): ``port_label()``.
 - The first line is the header ``# softplc_lite port trace 1``. A reader
   tolerates a file without it, but refuses another version number.
+- A comment line ``# scans: N`` (anywhere, a remark may follow N; the
+  first counts) says how many scans of the program the trace covers:
+  ``softplc run --replay TRACE`` without ``--scans`` runs that many
+  (``covered_scans()``). Without it the replay stops once every recorded
+  byte has been played and written.
 
 Errors name the file, line and column: ``parse_trace`` raises a
 ``TraceError`` (a ``PortError``), whose ``report()`` reads
@@ -53,6 +58,7 @@ _TIME = re.compile(r"^[0-9]{1,15}(\.[0-9]{1,9})?$")
 _PORT = re.compile(r"^(?:([A-Za-z][A-Za-z0-9_]*):)?([0-9]{1,6})$")
 _HEX = re.compile(r"^[0-9A-Fa-f]{2}$")
 _FIELD = re.compile(r"\S+")
+_SCANS = re.compile(r"^\s*#\s*scans:\s*([0-9]{1,15})(?:\s.*)?$", re.M)  # a remark may follow N
 
 
 class TraceError(PortError):
@@ -149,6 +155,30 @@ def read_trace(path: str | os.PathLike) -> list[TraceEvent]:
     except OSError as e:
         raise TraceError(f"cannot read trace file: {e.strerror or e}", name) from e
     return parse_trace(text, name)
+
+
+def scans_in(text: str) -> int | None:
+    """The N of a trace text's first ``# scans: N`` comment, None without one.
+
+    >>> scans_in("# softplc_lite port trace 1\\n# scans: 1195\\n0.000 0 TX 01\\n")
+    1195
+    >>> scans_in("# scans: 40 (at 10 ms a scan)\\n")
+    40
+    >>> scans_in("0.000 0 TX 01  # scans: 5\\n") is None
+    True
+    """
+    m = _SCANS.search(text)
+    return int(m.group(1)) if m else None
+
+
+def covered_scans(path: str | os.PathLike) -> int | None:
+    """The scans the trace file at ``path`` says it covers (``# scans: N``),
+    None without that comment or when the file cannot be read (opening the
+    replay port then says why)."""
+    try:
+        return scans_in(read_text(os.fspath(path)))
+    except (OSError, LocatedError):
+        return None
 
 
 def format_event(t_ms: float, port: int | str, direction: str, data: bytes) -> str:

@@ -1,5 +1,13 @@
 """``softplc watch``: build the session from the command line, then either
-render one snapshot (no terminal needed) or run the interactive view."""
+render one snapshot (no terminal needed) or run the interactive view.
+
+Before scan 0 the --watch addresses are read from the table the session
+starts with: a bad one is an error (exit 1), nothing scanned or saved. A
+snapshot reads the app's retentive state but leaves it as it was unless
+``--save`` is given; ``--scans N`` is for a snapshot only (usage error
+otherwise: the interactive view starts at scan 0, and ``n``/``r`` scan).
+Ctrl-C and SIGTERM (raised as KeyboardInterrupt) quit as ``q`` does: the
+final save, exit 0."""
 
 from __future__ import annotations
 
@@ -9,7 +17,7 @@ import sys
 from rich.console import Console
 
 from ..app import load_app
-from ..cli import EXIT_USAGE, SNAPSHOT_HEIGHT, SNAPSHOT_WIDTH  # the ranges the argument parser checks too
+from ..cli import EXIT_ERROR, EXIT_USAGE, SNAPSHOT_HEIGHT, SNAPSHOT_WIDTH, address_problems  # the ranges the parser checks too
 from ..runner import RunOptions
 from .screen import WatchScreen, rung_view
 from .session import WatchOptions, WatchSession
@@ -19,12 +27,18 @@ from .watchlist import WATCH_MAX, read_watch_file
 
 def watch_command(args) -> int:
     snapshot = args.snapshot
+    scans = args.scans
+    if scans is not None and not snapshot:
+        print("softplc watch: error: --scans N needs --snapshot FILE (the view starts at scan 0; "
+              "press n to step or r to run)", file=sys.stderr)
+        return EXIT_USAGE
     if not snapshot and not (sys.stdin.isatty() and sys.stdout.isatty()):
         print("softplc watch: needs a terminal (standard input and output are not one here); "
               "render the view to a file instead: softplc watch APP --scans N --snapshot view.txt "
               "(or view.svg)", file=sys.stderr)
         return EXIT_USAGE
-    problem = size_problem(args.width, args.height) or (args.scans < 0 and "--scans: expected 0 or more")
+    scans = scans or 0
+    problem = size_problem(args.width, args.height) or (scans < 0 and "--scans: expected 0 or more")
     if problem:  # the parser checks these: for callers that build ``args`` themselves
         print(f"softplc watch: error: {problem}", file=sys.stderr)
         return EXIT_USAGE
@@ -32,13 +46,22 @@ def watch_command(args) -> int:
     watch = list(args.watch)
     if args.watch_file:
         watch += read_watch_file(args.watch_file, app.program.symbols, room=max(0, WATCH_MAX - len(watch)))
+    save = not snapshot or getattr(args, "save", False)
     run = RunOptions(scan_ms=args.scan_ms, realtime=args.realtime, fresh=args.fresh, sets=tuple(args.set),
-                     ports=tuple(args.port), replay=args.replay)
+                     ports=tuple(args.port), replay=args.replay, save_state=save)
     options = WatchOptions(run=run, watch=tuple(watch), forces=tuple(args.force), break_when=tuple(args.break_when))
     session = WatchSession(app, options)
+    problems = address_problems("--watch", session.engine.table, list(args.watch), app.program.symbols) + \
+        address_problems(f"--watch-file {args.watch_file}:", session.engine.table, watch[len(args.watch):],
+                         app.program.symbols)
+    if problems:  # before scan 0: nothing scanned, nothing saved
+        session.engine.close()
+        for problem in problems:
+            print(f"error: {problem}", file=sys.stderr)
+        return EXIT_ERROR
     try:
         if snapshot:
-            for _ in range(args.scans):
+            for _ in range(scans):
                 session.scan()
                 if session.last_hit is not None:
                     break
@@ -47,6 +70,8 @@ def watch_command(args) -> int:
         from .terminal import run_terminal
 
         return run_terminal(session, rung_view)
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM: quit as q does (the finally saves)
+        return 0
     finally:
         session.quit()
 
