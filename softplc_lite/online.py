@@ -167,7 +167,15 @@ class ProgramWatcher:
         edit in the engine. Returns the edit (its summary says what
         changed), or None when there is nothing new."""
         edit = self.poll()
-        if edit is None or not edit.accepted:
+        return self.install(engine, edit) if edit is not None else None
+
+    def install(self, engine, edit: OnlineEdit) -> OnlineEdit:
+        """Put an accepted edit from ``poll`` in the engine (from the scan
+        thread, between scans; later than the poll if the caller waits, e.g.
+        a watch view stepping back in its history): the engine's program is
+        replaced and the app's with it. A rejected edit is returned as is;
+        one the table cannot take becomes rejected (EditRefused's errors)."""
+        if not edit.accepted or edit.applied:
             return edit
         try:
             edit.changes = engine.replace_program(edit.program)

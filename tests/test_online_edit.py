@@ -311,3 +311,16 @@ def test_a_new_lad_file_in_the_app_directory_is_an_edit(app_dir):
     e.table.write("B3/7", 0)
     e.scan()
     assert e.table.read("B3/7") == 1
+
+
+def test_a_valid_program_the_live_table_cannot_take_is_rejected_by_the_watcher(app_dir):
+    (app_dir / "main.lad").write_text("MOV 5 N10:0\n")
+    app = load_app(app_dir, use_cache=False)
+    e = Engine(app.program)
+    e.set_mode(Mode.RUN)
+    watcher = ProgramWatcher(app, interval_s=0.05)
+    write(app_dir / "main.lad", "MOV 1.5 F10:0\n")  # valid alone; the running table has N10
+    edit = scan_until_edit(watcher, e)
+    assert edit is not None and not edit.accepted and not edit.applied
+    assert "main.lad:1:" in edit.errors[0] and "file number 10 is already N10" in edit.errors[0]
+    assert app.program is e.program and e.table.read("N10:0") == 5
