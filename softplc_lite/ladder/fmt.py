@@ -23,6 +23,7 @@ from .ast import (
     walk,
 )
 from .errors import LadderError
+from .fmt_comments import Comments, attach_comments
 
 STYLES = ("mnemonic", "neutral")
 
@@ -171,4 +172,102 @@ def format_program(program: Program, style: str = "mnemonic") -> str:
             out.append(f"FILE {number}" + (f" {pfile.name}" if pfile.name else ""))
         for rung in pfile.rungs:
             out.append(format_rung(rung, style))
+    return "\n".join(out) + "\n"
+
+
+# -- a whole source file, every comment kept (softplc fmt) ---------------------------
+
+INDENT = "    "  # the elements of a multi-line rung
+
+
+def _rung_lines(rung: Rung, style: str, comments: Comments) -> list[str]:
+    """A rung with its own comment lines above, its trailing comment, and
+    (when it had any) its inner comments between the same two top-level
+    elements as in the source, the rung then spanning lines."""
+    key = id(rung)
+    lines = list(comments.above.get(key, ()))
+    trailing = comments.trailing.get(key)
+    if key not in comments.above and trailing is None and rung.comment:  # a rung built without its text
+        lines = [f"// {line}".rstrip() for line in rung.comment.split("\n")]
+    inner = comments.inner.get(key)
+    end = f"  {trailing}" if trailing else ""
+    if not inner:
+        body = format_series(rung.elements, style)
+        if not body and style == "mnemonic":
+            body = "SOR EOR"
+        lines.append((body + ";" if style == "neutral" else body) + end)
+        return lines
+    groups: list[list[str]] = [[] for _ in range(len(rung.elements) + 1)]
+    for before, c in inner:
+        groups[min(before, len(rung.elements))].append(c)
+    if style == "neutral" and rung.elements:
+        # a neutral rung opens at its first "(" or "[": a comment before its first element would be outside it
+        groups[1][:0], groups[0] = groups[0], []
+    out = ["SOR"] if style == "mnemonic" else []
+    indent = INDENT if style == "mnemonic" else ""
+
+    def add_comments(group) -> None:
+        for c in group:
+            if not c.own_line and out:
+                out[-1] += f"  {c.text}"
+            else:
+                out.append(indent + c.text)
+
+    add_comments(groups[0])
+    for k, el in enumerate(rung.elements):
+        out.append(indent + format_series([el], style))
+        add_comments(groups[k + 1])
+    if style == "mnemonic":
+        out.append("EOR" + end)
+    elif groups[-1] or not rung.elements:
+        out.append(";" + end)  # after the last comments, so they stay inside the rung
+    else:
+        out[-1] += ";" + end
+    return lines + out
+
+
+def format_source(program: Program, text: str, style: str = "mnemonic") -> str:
+    """``program`` (parsed from ``text``, one file) canonically, as
+    format_program prints it, with every comment of ``text`` kept (see
+    fmt_comments.py)."""
+    if style not in STYLES:
+        raise ValueError(f"style must be one of {', '.join(STYLES)}")
+    comments = attach_comments(program, text)
+    out: list[str] = []
+
+    def blank() -> None:
+        if out and out[-1] != "":
+            out.append("")
+
+    def blocks(found) -> None:
+        for block in found:
+            if block.blank_before:
+                blank()
+            out.extend(block.lines)
+            if block.blank_after:
+                blank()
+
+    def statement(obj, line: str) -> None:
+        blocks(comments.leading.get(id(obj), ()))
+        trailing = comments.trailing.get(id(obj))
+        out.append(f"{line}  {trailing}" if trailing else line)
+
+    blocks(comments.header)
+    for decl in program.symbols.values():
+        statement(decl, f"SYMBOL {decl.name} {decl.address}")
+    for decl in program.data:
+        values = " ".join(_data_value(v) for v in decl.values)
+        statement(decl, f"DATA {decl.file} {decl.size}" + (f" = {values}" if decl.values else ""))
+    for number in sorted(program.files):
+        pfile = program.files[number]
+        if program.symbols or program.data or number != min(program.files):
+            blank()
+        if number != MAIN_FILE or pfile.name or not pfile.rungs:
+            statement(pfile, f"FILE {number}" + (f" {pfile.name}" if pfile.name else ""))
+        for rung in pfile.rungs:
+            blocks(comments.leading.get(id(rung), ()))
+            out.extend(_rung_lines(rung, style, comments))
+    blocks(comments.footer)
+    while out and out[-1] == "":
+        out.pop()
     return "\n".join(out) + "\n"

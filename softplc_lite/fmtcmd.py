@@ -1,0 +1,166 @@
+"""``softplc fmt``: print, check or rewrite .lad files canonically.
+
+``fmt_command`` is the whole command (cli.py only parses its arguments):
+every PATH (a .lad file, an app directory: each of its .lad files, or
+``-``: standard input) is parsed with the instructions of its app (built-in
+plus the modules MODULES.LST enables) and printed by
+``ladder.fmt.format_source``, which keeps every comment.
+
+* A file fmt cannot parse is refused: every problem, as file:line:col, on
+  standard error, "N problems found", exit 1; with ``--write`` nothing is
+  written, not even the files that were fine.
+* ``--check``: exit 1 naming each file whose text is not what fmt prints
+  ("would reformat PATH"), 0 when all are; nothing else is printed.
+* ``--write``: each file that changes is replaced atomically (a temporary
+  file in the same directory, then a rename; its permission bits kept).
+  fmt writes UTF-8 without a BOM and LF line ends, whatever it read.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, Sequence
+
+from .app import AppError, app_instructions, lad_files
+from .errors import file_error
+from .ladder.errors import LadderError
+from .ladder.fmt import STYLES, format_source, unprintable
+from .ladder.parser import parse_program, syntax_problems
+from .textfile import decode_text, read_bytes
+from .errors import LocatedError
+
+STDIN = "-"
+EXIT_OK, EXIT_ERROR = 0, 1
+
+
+@dataclass
+class Formatted:
+    name: str  # as given (a file of an app directory: its path), "<stdin>" for -
+    path: Path | None  # None for standard input
+    raw: bytes  # as read
+    after: str
+
+    @property
+    def changed(self) -> bool:
+        return self.raw != self.after.encode("utf-8")
+
+
+def _format_text(text: str, name: str, style: str, instructions) -> tuple[str | None, list]:
+    """What fmt prints for ``text``, or the problems that stop it."""
+    problems: list = []
+    try:
+        program = parse_program(text, name, instructions, problems=problems)
+    except LadderError as e:
+        return None, syntax_problems(text, name, instructions=instructions) or [e]
+    if problems:
+        return None, problems
+    found = unprintable(program, style, instructions)
+    if found:
+        return None, found
+    return format_source(program, text, style), []
+
+
+def _sources(paths: Sequence[str], stdin: IO[bytes]) -> tuple[list[tuple[str, Path | None, bytes, Path]], list]:
+    """(name, path, bytes, app directory) of every file to format, and the problems finding them."""
+    found, problems = [], []
+    for given in paths:
+        if given == STDIN:
+            found.append(("<stdin>", None, stdin.read(), Path.cwd()))
+            continue
+        path = Path(given)
+        if not path.exists():
+            problems.append(LocatedError(f"{given}: no such file or directory (expected a .lad file or an app "
+                                         "directory)"))
+            continue
+        files = lad_files(path)
+        if path.is_dir() and not files:
+            problems.append(LocatedError(f"{given}: the directory has no .lad program files"))
+        for f in files:
+            try:
+                found.append((str(f), f, read_bytes(f), path if path.is_dir() else path.parent))
+            except OSError as e:
+                problems.append(LocatedError(str(e)))
+    return found, problems
+
+
+def _write_atomically(path: Path, text: str) -> None:
+    """Replace ``path`` by ``text`` (UTF-8): a reader sees the old file or the new, never half of one."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".fmt", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        shutil.copymode(path, tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def fmt_command(paths: Sequence[str], style: str = "mnemonic", check: bool = False, write: bool = False,
+                stdin: IO[bytes] | None = None, stdout: IO[str] | None = None,
+                stderr: IO[str] | None = None) -> int:
+    """The ``softplc fmt`` command; its exit code."""
+    stdin = stdin if stdin is not None else sys.stdin.buffer
+    stdout = stdout if stdout is not None else sys.stdout
+    stderr = stderr if stderr is not None else sys.stderr
+    if style not in STYLES:
+        raise ValueError(f"style must be one of {', '.join(STYLES)}")
+    sources, problems = _sources(paths, stdin)
+    results: list[Formatted] = []
+    instruction_sets: dict[Path, object] = {}
+    for name, path, raw, app_dir in sources:
+        try:
+            text = decode_text(raw, name)
+            key = app_dir.resolve()
+            if key not in instruction_sets:
+                instruction_sets[key] = app_instructions(app_dir)
+        except LocatedError as e:
+            problems.append(e)
+            continue
+        except AppError as e:  # MODULES.LST names a module that is not installed
+            problems.append(LocatedError(str(e)))
+            continue
+        after, found = _format_text(text, name, style, instruction_sets[key])
+        if found:
+            problems += found
+            continue
+        results.append(Formatted(name, path, raw, after))
+    if problems:
+        for p in problems:
+            print(p.report(), file=stderr)
+        print(f"{len(problems)} problem{'s' if len(problems) != 1 else ''} found; nothing formatted", file=stderr)
+        return EXIT_ERROR
+    if check:
+        changed = [r for r in results if r.changed]
+        for r in changed:
+            print(f"would reformat {r.name}", file=stderr)
+        return EXIT_ERROR if changed else EXIT_OK
+    if write:
+        status = EXIT_OK
+        for r in results:
+            if r.path is None:  # standard input has nowhere to be written back: print it
+                stdout.write(r.after)
+            elif r.changed:
+                try:
+                    _write_atomically(r.path, r.after)
+                except OSError as e:
+                    print(file_error(e, r.path, "write").report(), file=stderr)
+                    status = EXIT_ERROR
+                    continue
+                print(f"reformatted {r.name}", file=stderr)
+        return status
+    for k, r in enumerate(results):
+        if len(results) > 1:
+            stdout.write(("\n" if k else "") + f"// ==> {r.name} <==\n")
+        stdout.write(r.after)
+    return EXIT_OK
