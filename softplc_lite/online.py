@@ -156,6 +156,8 @@ class ProgramWatcher:
     def poll(self) -> OnlineEdit | None:
         """A new version read since the last poll, accepted or not; else None."""
         self.check()
+        if self._ready is None:  # the common case, every scan: no lock
+            return None
         with self._lock:
             edit, self._ready = self._ready, None
         if edit is not None:
