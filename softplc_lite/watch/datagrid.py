@@ -1,11 +1,11 @@
-"""The data-file monitor: one data table file as a grid, as RSLogix 5's data
-monitor shows it.
+"""The data-file monitor: one data table file as a grid (the watch view's
+counterpart of RSLogix 5's data monitor).
 
 Word files (N B I O S D A, and L) show rows of words, each row labelled with
 its first element's address (``N7:0`` then ``N7:10``); the radix is decimal,
-hex, binary or ASCII (two characters a word, high byte first as PLC-5 shows
-them, ``.`` for a byte that does not print). A B file starts in binary, an A
-file in ASCII, a D file in hex (its BCD digits), the rest in decimal. F
+hex, binary or ASCII (two characters a word, the first in the high byte, as
+an A word holds them: docs/datatable.md gives the sources; ``.`` for a byte
+that does not print). A B file starts in binary, an A file in ASCII, a D file in hex (its BCD digits), the rest in decimal. F
 files show floats to 7 significant digits whatever the radix; T, C and R
 files one element a row (status bits, then PRE/ACC or LEN/POS in the
 radix); ST files one string a row (its length, then the text quoted).
