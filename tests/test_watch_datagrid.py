@@ -7,7 +7,13 @@ import pytest
 from rich.console import Console
 
 from softplc_lite.datatable import DataTable, DataTableError
-from softplc_lite.watch.datagrid import RADIXES, DataGrid, grid_for, next_radix, word_in_radix
+from softplc_lite.watch.datagrid import (
+    RADIXES,
+    DataGrid,
+    grid_for,
+    next_radix,
+    word_in_radix,
+)
 
 
 @pytest.fixture

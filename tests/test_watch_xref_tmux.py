@@ -12,7 +12,6 @@ import sys
 import time
 
 import pytest
-
 from test_watch_tmux import Tmux
 
 pytestmark = pytest.mark.skip(reason="wired by the lead")

@@ -64,7 +64,7 @@ def _cell_width(radix: str, bits: int) -> int:
     return {"hex": bits // 4, "binary": bits, "ascii": bits // 8}.get(radix, 6 if bits == 16 else 11)
 
 
-def grid_for(table: DataTable, text: str) -> "DataGrid":
+def grid_for(table: DataTable, text: str) -> DataGrid:
     """The grid the ``d`` prompt asks for: a file (``N7``, ``ST9``, ``O``)
     or a file and the element to start at (``N7:20``). DataTableError
     saying what was expected otherwise."""

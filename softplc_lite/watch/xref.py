@@ -20,9 +20,9 @@ it. See docs/watch.md, "Find and cross-reference".
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from enum import Enum
-import re
 
 from rich.console import Console, ConsoleOptions, RenderResult
 from rich.text import Text
@@ -126,7 +126,7 @@ class _Target:
         self.letter, self.file, self.element, self.word, self.bit = letter, file, element, word, bit
 
     @classmethod
-    def of(cls, a: Address) -> "_Target":
+    def of(cls, a: Address) -> _Target:
         return cls(a.type_letter, a.file, a.element, *_word_and_bit(a))
 
     def matches(self, use: Use) -> bool:
@@ -251,7 +251,7 @@ class XrefIndex:
         m = _FILE_NAME.fullmatch(text)
         if m and not any(name.upper() == text.upper() for name in symbols):
             letter = m.group(1).upper()
-            ftype = FILE_TYPES[letter] if letter in FILE_TYPES else None
+            ftype = FILE_TYPES.get(letter)
             number = int(m.group(2)) if m.group(2) else (ftype.fixed_number if ftype else None)
             if ftype is not None and number is not None:
                 return _Target(letter, number, None, None, None), f"file {letter}{number}"
