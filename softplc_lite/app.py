@@ -32,7 +32,7 @@ from .ladder.engine import layout_problems
 from .ports import claim_conflicts
 from .ports.urlhandler.protocol_sim import url_problem as sim_url_problem
 from .tlm.api import TLM, find_file
-from .tlm.errors import ModuleError
+from .tlm.errors import ModuleError, ModuleErrors
 from .tlm.registry import configure_modules, installed, instruction_set, load_module, load_modules
 from .textfile import read_text
 
@@ -309,15 +309,17 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
     try:
         modules, _ = load_modules(module_dir, configure=False)
         instructions = instruction_set(modules, hints=True)
-    except ModuleError as e:
-        raise AppError(e.report()) from None
+    except ModuleError as e:  # MODULES.LST: without the instruction set the program cannot be checked
+        problems = list(e.problems) if isinstance(e, ModuleErrors) else [e]
+        raise AppError(problems + _settings_problems(path / SETTINGS_FILE if is_dir else None)) from None
     # Every problem at once: the modules' config files, then the program's.
-    warnings, config_problems = configure_modules(modules, module_dir)
-    if not config_problems:
-        claims = [c for m in modules for c in m.port_claims()]
+    configured: list[TLM] = []
+    warnings, config_problems = configure_modules(modules, module_dir, configured)
+    claims = [c for m in configured for c in m.port_claims()]  # a module whose config is bad has none
+    if not config_problems:  # a conflict with a port of a bad config may be only a consequence
         config_problems = [ModuleError(c) for c in claim_conflicts(claims)]
-        config_problems += [ModuleError(f"{c.where}: {c.module} port {c.number}: {problem}") for c in claims
-                            if c.url.lower().startswith("sim://") and (problem := sim_url_problem(c.url))]
+    config_problems += [ModuleError(f"{c.where}: {c.module} port {c.number}: {problem}") for c in claims
+                        if c.url.lower().startswith("sim://") and (problem := sim_url_problem(c.url))]
     warnings += _unused_configs(module_dir, modules)
     state = Path(state_dir) if state_dir is not None else (path / STATE_DIR if is_dir else None)
     cache = CodeCache(state) if use_cache and state is not None and not config_problems else None
@@ -381,6 +383,17 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
     app.code, app.cache_key, app.program_warnings = code, key, program_warnings
     app.code_cache = cache
     return app
+
+
+def _settings_problems(path: Path | None) -> list:
+    """Every problem of softplc.toml on its own (when the program cannot be checked)."""
+    if path is None:
+        return []
+    try:
+        load_settings(path, read_settings_file(path))
+    except AppError as e:
+        return e.errors or [LocatedError(str(e))]
+    return []
 
 
 def _cache_parts(files: list[Path], path: Path, modules) -> list[tuple[str, bytes]]:

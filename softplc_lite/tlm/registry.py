@@ -73,10 +73,19 @@ class Enabled:
 
 
 def read_modules_lst(app_dir: Path) -> tuple[Path | None, list[Enabled]]:
-    """The modules an app enables, from its MODULES.LST (none if absent)."""
+    """The modules an app enables, from its MODULES.LST (none if absent);
+    ModuleError (or ModuleErrors) for its problems."""
+    path, enabled, problems = _read_modules_lst(app_dir)
+    if problems:
+        raise problems[0] if len(problems) == 1 else ModuleErrors(problems)
+    return path, enabled
+
+
+def _read_modules_lst(app_dir: Path) -> tuple[Path | None, list[Enabled], list[ModuleError]]:
+    """MODULES.LST's modules (those of its good lines) and every problem of its lines."""
     path = find_file(app_dir, MODULES_FILE)
     if path is None:
-        return None, []
+        return None, [], []
     try:  # a BOM or UTF-16 from a Windows editor is read; DOS-era bytes as latin-1 (textfile.py)
         text = read_text(path, fallback="latin-1")
     except LocatedError as e:
@@ -85,18 +94,23 @@ def read_modules_lst(app_dir: Path) -> tuple[Path | None, list[Enabled]]:
         raise ModuleError(str(e)) from None
     out: list[Enabled] = []
     seen: dict[str, int] = {}
+    problems: list[ModuleError] = []  # every one, not just the first (softplc check)
     for number, raw in enumerate(text.splitlines(), start=1):
         content = raw.split(";", 1)[0].strip()
         if not content:
             continue
         if len(content.split()) != 1:
-            raise ModuleError(f"expected one module name on the line, found {content!r}", str(path), number)
+            problems.append(ModuleError(f"expected one module name on the line, found {content!r}", str(path),
+                                        number))
+            continue
         name = content.upper()
         if name in seen:
-            raise ModuleError(f"module {name} is named twice (first on line {seen[name]})", str(path), number)
+            problems.append(ModuleError(f"module {name} is named twice (first on line {seen[name]})", str(path),
+                                        number))
+            continue
         seen[name] = number
         out.append(Enabled(name, number))
-    return path, out
+    return path, out, problems
 
 
 def load_modules(app_dir: Path | None, configure: bool = True) -> tuple[list[TLM], list[str]]:
@@ -104,16 +118,22 @@ def load_modules(app_dir: Path | None, configure: bool = True) -> tuple[list[TLM
     warnings their configs gave. ModuleError for any problem."""
     if app_dir is None:
         return [], []
-    path, enabled = read_modules_lst(app_dir)
+    path, enabled, problems = _read_modules_lst(app_dir)  # every problem of the file, not just the first
     available = installed() if enabled else {}
     modules: list[TLM] = []
     warnings: list[str] = []
     for entry in enabled:
         if entry.name not in available:
             names = ", ".join(available) or "none"
-            raise ModuleError(f"module {entry.name} is not installed (installed modules: {names})",
-                              str(path), entry.line)
-        modules.append(load_module(entry.name, available))
+            problems.append(ModuleError(f"module {entry.name} is not installed (installed modules: {names})",
+                                        str(path), entry.line))
+            continue
+        try:
+            modules.append(load_module(entry.name, available))
+        except ModuleError as e:
+            problems.append(e)
+    if problems:
+        raise problems[0] if len(problems) == 1 else ModuleErrors(problems)
     instruction_set(modules)  # two modules claiming one mnemonic: an error now, not at run time
     if configure:
         warnings, problems = configure_modules(modules, app_dir)
@@ -122,9 +142,12 @@ def load_modules(app_dir: Path | None, configure: bool = True) -> tuple[list[TLM
     return modules, warnings
 
 
-def configure_modules(modules: list[TLM], app_dir: Path) -> tuple[list[str], list[ModuleError]]:
+def configure_modules(modules: list[TLM], app_dir: Path,
+                      configured: list[TLM] | None = None) -> tuple[list[str], list[ModuleError]]:
     """Let each module read its config: the warnings, and every problem of
-    every module's file (one module's bad file does not hide another's)."""
+    every module's file (one module's bad file does not hide another's).
+    ``configured``, when given, receives the modules whose config was read
+    without a problem (their ports can still be checked)."""
     warnings: list[str] = []
     problems: list[ModuleError] = []
     for module in modules:
@@ -132,8 +155,12 @@ def configure_modules(modules: list[TLM], app_dir: Path) -> tuple[list[str], lis
             warnings += module.configure(app_dir)
         except ModuleErrors as e:
             problems += e.problems
+            continue
         except ModuleError as e:
             problems.append(e)
+            continue
+        if configured is not None:
+            configured.append(module)
     return warnings, problems
 
 

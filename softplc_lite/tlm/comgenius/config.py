@@ -27,10 +27,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...errors import LocatedError
-from ...ports import COM_NAME  # COM1..COM99: in [DRIVER] keys and [PORTS]
+from ...ports import COM_NAME
+from ...ports.urlhandler.protocol_sim import url_problem as sim_url_problem  # COM1..COM99: in [DRIVER] keys and [PORTS]
 from ...textfile import read_text
 from ..api import find_file
-from ..errors import ModuleError
+from ..errors import ModuleError, ModuleErrors
 from .strings import MAX_LENGTH, MAX_STRINGS, EscapeError, StringTable, decode_escapes
 
 CONFIG_FILE = "COMGENIUS.LST"
@@ -157,41 +158,57 @@ def _driver_line(content: str, line: int, path: str, config: "ComGeniusConfig") 
 
 
 def parse_config(text: str, path: str = CONFIG_FILE) -> ComGeniusConfig:
-    """Read COMGENIUS.LST text; ModuleError on the first problem."""
+    """Read COMGENIUS.LST text; every problem (a line with a problem is
+    skipped, and the lines after it are still read): one ModuleError, or
+    ModuleErrors listing them."""
     config = ComGeniusConfig(path=path)
-    section: str | None = None
+    problems: list[ModuleError] = []
+    state = {"section": None}
     for number, raw in enumerate(text.splitlines(), start=1):
-        header = _SECTION.match(raw)
-        if header:
-            name = header.group(1).upper()
-            if name not in SECTIONS:
-                raise ModuleError(f"unknown section [{header.group(1)}] (sections: "
-                                  f"{', '.join(f'[{s}]' for s in SECTIONS)})", path, number)
-            section = name
-            continue
-        if section == "STRINGS":
-            if not raw.strip():
-                continue
-            _string_line(raw, number, path, config.strings)
-            if raw.lstrip().startswith(";") and '"' not in raw:
-                config.warnings.append(f"{path}:{number}: ';' does not start a comment in [STRINGS]: this line "
-                                       f"is string {len(config.strings) - 1}, the empty string")
-            continue
-        content = raw.split(";", 1)[0].strip()
-        if not content:
-            continue
-        if section is None:
-            raise ModuleError(f"{content!r} is outside any section (start with [DRIVER], [PORTS] or [STRINGS])",
-                              path, number)
-        if section == "DRIVER":
-            _driver_line(content, number, path, config)
-        else:
-            port = _port_line(content, number, path)
-            if port.logical in config.ports:
-                raise ModuleError(f"[PORTS]: logical port {port.logical} is defined twice (first on line "
-                                  f"{config.ports[port.logical].line})", path, number)
-            config.ports[port.logical] = port
+        try:
+            _config_line(raw, number, path, config, state)
+        except ModuleError as e:
+            problems.append(e)
+    if problems:
+        raise problems[0] if len(problems) == 1 else ModuleErrors(problems)
     return config
+
+
+def _config_line(raw: str, number: int, path: str, config: ComGeniusConfig, state: dict) -> None:
+    """One line of COMGENIUS.LST into ``config``; ``state["section"]``: the section it is in."""
+    section = state["section"]
+    header = _SECTION.match(raw)
+    if header:
+        name = header.group(1).upper()
+        if name not in SECTIONS:
+            raise ModuleError(f"unknown section [{header.group(1)}] (sections: "
+                              f"{', '.join(f'[{s}]' for s in SECTIONS)})", path, number)
+        state["section"] = name
+        return
+    if section == "STRINGS":
+        if not raw.strip():
+            return
+        _string_line(raw, number, path, config.strings)
+        if raw.lstrip().startswith(";") and '"' not in raw:
+            config.warnings.append(f"{path}:{number}: ';' does not start a comment in [STRINGS]: this line "
+                                   f"is string {len(config.strings) - 1}, the empty string")
+        return
+    content = raw.split(";", 1)[0].strip()
+    if not content:
+        return
+    if section is None:
+        raise ModuleError(f"{content!r} is outside any section (start with [DRIVER], [PORTS] or [STRINGS])",
+                          path, number)
+    if section == "DRIVER":
+        _driver_line(content, number, path, config)
+    else:
+        port = _port_line(content, number, path)
+        if port.physical.lower().startswith("sim://") and (problem := sim_url_problem(port.physical)):
+            raise ModuleError(f"COMGENIUS port {port.logical}: {problem}", path, number)  # what run would refuse
+        if port.logical in config.ports:
+            raise ModuleError(f"[PORTS]: logical port {port.logical} is defined twice (first on line "
+                              f"{config.ports[port.logical].line})", path, number)
+        config.ports[port.logical] = port
 
 
 def load_config(app_dir: Path) -> ComGeniusConfig:

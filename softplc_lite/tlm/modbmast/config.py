@@ -25,6 +25,7 @@ from ...datatable import DataTableError, parse_address
 from ...datatable.address import Address
 from ...datatable.filetypes import MAX_ELEMENTS, WORD_BITS
 from ...textfile import read_bytes
+from ...ports.urlhandler.protocol_sim import url_problem as sim_url_problem
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
 from .requests import REQUEST_KINDS, RequestKind
@@ -533,6 +534,10 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ModbmastConfig:
             continue
         if num is not None:
             lines[num] = node.line
+        if port is not None and port.device and port.device.lower().startswith("sim://") \
+                and (problem := sim_url_problem(port.device)):
+            c.error(node, f"MODBMAST port {port.num}: {problem}", "device")  # what run would refuse
+            continue
         if port is not None:
             config.ports[port.num] = port
     if c.problems:
