@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import signal
 import sys
+import threading
 import time
 from pathlib import Path
 from typing import Sequence
@@ -130,11 +131,19 @@ def _cmd_run(args: argparse.Namespace) -> int:
         for problem in problems:
             print(f"error: {problem}", file=sys.stderr)
         return EXIT_ERROR
+    def stop(signum, frame) -> None:
+        """Ctrl-C or SIGTERM: the run ends after the scan under way, so the
+        final save holds a whole scan; a second one stops at once."""
+        if runner.stop_requested:
+            raise KeyboardInterrupt
+        runner.request_stop()
+
+    previous = _handle_signals({signal.SIGINT: stop, signal.SIGTERM: stop})
     try:
         _run_with_status(runner, app, args.scans, unbounded=args.scans is None and args.replay is None)
     finally:
-        # a second SIGTERM must not cut the final save short (a service manager sends one, then waits)
-        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        # a SIGTERM must not cut the final save short (a service manager sends one, then waits)
+        _handle_signals({signal.SIGTERM: signal.SIG_IGN, **{s: h for s, h in previous.items() if s == signal.SIGINT}})
         runner.close()
     engine = runner.engine
     storage_problems = runner.finish()  # the final save; a failure is reported, and the output still printed
@@ -257,7 +266,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--version", action="version", version=f"softplc_lite {__version__}",
                    help="print the version and exit")
-    sub = p.add_subparsers(dest="command", metavar="COMMAND")
+    sub = p.add_subparsers(dest="command", metavar="COMMAND", help="what to do (each has its own --help)")
 
     r = sub.add_parser(
         "run", help="run an app (directory or .lad file) in RUN mode",
@@ -367,6 +376,14 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _handle_signals(handlers: dict) -> dict:
+    """Install signal handlers; the previous ones. Python lets only the main
+    thread do it: elsewhere (main() called from a thread) nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    return {sig: signal.signal(sig, handler) for sig, handler in handlers.items()}
+
+
 def _stop_as_interrupt(signum, frame) -> None:
     """SIGTERM does what Ctrl-C does."""
     raise KeyboardInterrupt
@@ -380,14 +397,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"softplc: error: a COMMAND is needed: run, watch, check, fmt, address or datatable; "
               f"softplc --help says what each does ({DOCS})", file=sys.stderr)
         return EXIT_USAGE
-    previous = None
+    previous = {}
     if args.command in ("run", "watch"):  # they end cleanly on Ctrl-C: SIGTERM (kill, systemd) too
-        previous = signal.signal(signal.SIGTERM, _stop_as_interrupt)
+        previous = _handle_signals({signal.SIGTERM: _stop_as_interrupt})
     try:
         return _dispatch(args)
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        _handle_signals(previous)
 
 
 def _dispatch(args: argparse.Namespace) -> int:

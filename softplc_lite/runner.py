@@ -114,6 +114,7 @@ class Runner:
         self.replay_differences = 0  # output differences of every replay port (set by ``close``)
         # callables run between two scans, each given this runner (see the module docstring)
         self.between_scans: list[Callable[[Runner], None]] = []
+        self.stop_requested = False  # request_stop(): end ``run`` at the next scan boundary
 
     @property
     def realtime(self) -> bool:
@@ -174,6 +175,10 @@ class Runner:
         once when no port plays anything back: there is nothing to wait for)."""
         return all(p.finished and not p.in_waiting for p in self.replay_ports())
 
+    def request_stop(self) -> None:
+        """End ``run`` after the scan under way (safe from a signal handler)."""
+        self.stop_requested = True
+
     def close(self) -> None:
         """Close the engine (the modules report each replay port first);
         ``replay_differences`` counts the replay output differences."""
@@ -181,9 +186,10 @@ class Runner:
         self.engine.close()
 
     def run(self, scans: int | None = None, on_scan: Callable[[Engine], None] | None = None) -> None:
-        """Run in RUN mode for ``scans`` scans, or until Ctrl-C or SIGTERM
-        (then return normally: the caller saves and exits cleanly) or a
-        major fault. With ``--replay`` and ``scans`` None: the scans the
+        """Run in RUN mode for ``scans`` scans, or until ``request_stop``
+        (at a scan boundary), Ctrl-C (KeyboardInterrupt, wherever it comes:
+        return normally, the caller saves and exits cleanly) or a major
+        fault. With ``--replay`` and ``scans`` None: the scans the
         trace says it covers, else until ``replay_done``."""
         engine = self.engine
         until_replay_end = scans is None and self.options.replay is not None
@@ -206,7 +212,7 @@ class Runner:
                     break
                 for hook in self.between_scans:
                     hook(self)
-                if until_replay_end and self.replay_done():
+                if self.stop_requested or (until_replay_end and self.replay_done()):
                     break
                 now = time.monotonic()
                 if now >= save_at:  # between two scans: the snapshot is one whole scan's table

@@ -1,16 +1,17 @@
-"""The keys of the interactive watch view, as one table.
+"""The keys of the interactive watch view, for ``softplc watch --help``.
 
-``softplc watch --help`` lists them from here. The table is meant to be
-the one place a key is described: the view's key handling
-(terminal.py's ``Controller``) and any help overlay should read it rather
-than keep a list of their own (tests/test_cli_help.py fails when a key the
-Controller handles is missing here, or one described here is not handled).
+The one table of keys is terminal.py's ``KEYS`` (label, what it does),
+made from the ``BINDINGS`` the Controller dispatches from. A terminal.py
+without that table (before it was added) still has its keys listed:
+``TODAY`` holds the keys its Controller handled then, and can go once
+terminal.py's table is in (tests/test_cli_usage.py checks whichever is used
+against the Controller).
 """
 
 from __future__ import annotations
 
-# (the key names a person presses, the Controller's key values, what it does)
-KEYS: tuple[tuple[str, tuple[str, ...], str], ...] = (
+# (label, the Controller's key values, what it does): the keys before terminal.py had its table
+TODAY: tuple[tuple[str, tuple[str, ...], str], ...] = (
     ("n, space", ("n", " "), "one scan forward (from history when stepped back)"),
     ("r", ("r",), "run: scan continuously"),
     ("p", ("p",), "pause"),
@@ -28,7 +29,16 @@ KEYS: tuple[tuple[str, tuple[str, ...], str], ...] = (
 )
 
 
+def key_rows() -> tuple[tuple[str, str], ...]:
+    """(label, what it does) of every key of the view."""
+    from . import terminal
+
+    table = getattr(terminal, "KEYS", None)
+    return tuple(table) if table else tuple((label, meaning) for label, _, meaning in TODAY)
+
+
 def keys_help() -> str:
-    """The key table as text for ``--help``: one key a line."""
-    width = max(len(names) for names, _, _ in KEYS)
-    return "\n".join(f"  {names.ljust(width)}  {meaning}" for names, _, meaning in KEYS)
+    """The keys as text for ``--help``: one key a line."""
+    rows = key_rows()
+    width = max(len(label) for label, _ in rows)
+    return "\n".join(f"  {label.ljust(width)}  {meaning}" for label, meaning in rows)

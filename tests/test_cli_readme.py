@@ -1,0 +1,55 @@
+"""issue 18, section 2: every line of the README's "Try it" block works in
+the order written, each in the state the lines before it left (a temp copy
+of programs/, so the tree's own state is not touched). A ``softplc watch``
+line runs in a real terminal (tmux), is quit with q once its view is up;
+every other line is bounded (--scans, a --replay trace, or check/fmt) and
+has a timeout."""
+
+from __future__ import annotations
+
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+from cli_tmux import SOFTPLC, terminal  # noqa: F401  (a fixture)
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def try_it_lines() -> list[str]:
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = text.split("\n## Try it\n", 1)[1].split("\n## ", 1)[0]
+    block = re.search(r"```bash\n(.*?)```", section, re.S).group(1)
+    return [line for line in block.splitlines() if line.strip()]
+
+
+def test_the_try_it_block_is_what_this_test_runs():
+    lines = try_it_lines()
+    assert len(lines) >= 10 and all(line.startswith("softplc ") for line in lines)
+    for line in lines:
+        argv = shlex.split(line, comments=True)
+        bounded = argv[1] in ("check", "fmt", "watch") or "--scans" in argv or "--replay" in argv
+        assert bounded, f"a README line that would run until stopped: {line}"
+
+
+def test_every_try_it_line_works_in_order(tmp_path, terminal):
+    shutil.copytree(ROOT / "programs", tmp_path / "programs", ignore=shutil.ignore_patterns(".softplc"))
+    for k, line in enumerate(try_it_lines()):
+        argv = shlex.split(line, comments=True)
+        if argv[1] == "watch":
+            terminal.session = f"w{k}"
+            terminal.start(f"{SOFTPLC} {shlex.join(argv[1:])}", cwd=tmp_path)
+            terminal.wait_for(r"PAUSED")
+            if "C5:1.ACC" in argv:  # after the Start=150 line: --fresh makes the polls good again
+                terminal.keys("r")
+                terminal.wait_for(r"C5:1\.ACC\W+[1-9]")  # good replies counted
+            terminal.keys("q")
+            assert terminal.exit_status() == 0, (line, terminal.screen())
+            continue
+        p = subprocess.run([sys.executable, "-m", "softplc_lite", *argv[1:]], cwd=tmp_path, capture_output=True,
+                           text=True, timeout=120)
+        assert p.returncode == 0, (line, p.stderr)
+        assert "Traceback" not in p.stderr, line

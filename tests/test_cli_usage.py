@@ -1,0 +1,179 @@
+"""issue 18, section 2: usage errors name only the rule broken (exit 2),
+addresses are checked before scan 0 (exit 1, nothing run or saved), the
+help texts, --version, softplc alone, softplc datatable alone, and the
+CLI-level watch fixes (--snapshot leaves the retentive state alone unless
+--save; --scans needs --snapshot). Real subprocesses and real files."""
+
+from __future__ import annotations
+
+import ast
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from softplc_lite import __version__
+from softplc_lite.cli import build_parser
+from softplc_lite.watch import terminal
+from softplc_lite.watch.keys import TODAY, key_rows
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def softplc(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=cwd, capture_output=True, text=True,
+                          timeout=60)
+
+
+def motor(tmp_path: Path) -> Path:
+    app = tmp_path / "motor"
+    shutil.copytree(ROOT / "programs" / "motor", app, ignore=shutil.ignore_patterns(".softplc"))
+    return app
+
+
+# -- usage errors: exit 2, the one rule broken --------------------------------------------------
+
+@pytest.mark.parametrize("args,message", [
+    (("run", "programs/motor", "--scans", "-5"), "softplc run: error: argument --scans: expected an integer 0 or more, not '-5'"),
+    (("run", "programs/motor", "--scans=-5"), "softplc run: error: argument --scans: expected an integer 0 or more, not '-5'"),
+    (("watch", "programs/motor", "--width", "20", "--snapshot", "x.txt"),
+     "softplc watch: error: argument --width: expected an integer from 40 to 1000, not '20'"),
+    (("run", "programs/motor", "--realtime", "--simulated"),
+     "softplc run: error: argument --simulated: not allowed with argument --realtime"),
+])
+def test_usage_errors_name_only_the_rule_broken(args, message):
+    p = softplc(*args)
+    assert p.returncode == 2
+    assert p.stderr.splitlines()[-1] == message  # one rule, on the last line under the usage
+    assert "Traceback" not in p.stderr and p.stdout == ""
+
+
+def test_softplc_alone_prints_usage_and_exits_2():
+    p = softplc()
+    assert p.returncode == 2 and p.stdout == ""
+    assert p.stderr.startswith("usage: softplc ")
+    assert "a COMMAND is needed: run, watch, check, fmt, address or datatable" in p.stderr
+
+
+def test_version():
+    p = softplc("--version")
+    assert (p.returncode, p.stdout) == (0, f"softplc_lite {__version__}\n")
+
+
+def test_datatable_alone_explains_itself():
+    p = softplc("datatable")
+    assert p.returncode == 2
+    assert p.stderr.startswith("usage: softplc datatable")
+    assert "expected FILEs to load" in p.stderr and "softplc datatable docs/examples/datatable.json" in p.stderr
+
+
+# -- checked before scan 0 ------------------------------------------------------------------------
+
+def test_a_bad_print_address_stops_before_scan_0(tmp_path):
+    app = motor(tmp_path)
+    p = softplc("run", str(app), "--scans", "5", "--print", "Motor", "--print", "N7:999", "--print", "Nope")
+    assert p.returncode == 1 and p.stdout == ""
+    assert p.stderr.splitlines() == [
+        "error: --print N7:999: element 999 is past the end of N7 (1 element)",
+        "error: --print 'Nope': Nope is neither an address nor a program symbol",
+    ]
+    assert not (app / ".softplc" / "datatable.snap").exists()  # no scan ran, nothing was saved
+
+
+def test_a_bad_watch_address_stops_before_scan_0(tmp_path):
+    app = motor(tmp_path)
+    out = tmp_path / "view.txt"
+    p = softplc("watch", str(app), "--watch", "N99:0", "--scans", "3", "--snapshot", str(out), "--save")
+    assert p.returncode == 1
+    assert p.stderr == "error: --watch N99:0: there is no data file N99\n"
+    assert not out.exists() and not (app / ".softplc" / "datatable.snap").exists()
+
+
+def test_a_bad_display_address_stops_before_scan_0_with_its_line(tmp_path):
+    app = motor(tmp_path)
+    (app / "softplc.toml").write_text('# shown by softplc run\n[display]\nsummary = { far = "N7:50" }\n')
+    p = softplc("run", str(app), "--scans", "5")
+    assert p.returncode == 1 and p.stdout == ""
+    assert re.search(r"softplc.toml:3: \[display\] summary 'far': .*past the end of N7", p.stderr), p.stderr
+    assert not (app / ".softplc" / "datatable.snap").exists()
+
+
+# -- watch at the CLI level -------------------------------------------------------------------------
+
+def test_watch_snapshot_leaves_the_retentive_state_unless_save(tmp_path):
+    app = motor(tmp_path)
+    snap = app / ".softplc" / "datatable.snap"
+    assert softplc("run", str(app), "--scans", "1", "--set", "N7:0=5").returncode == 0
+    before = snap.read_bytes()
+    view = tmp_path / "view.txt"
+    p = softplc("watch", str(app), "--scans", "3", "--set", "N7:0=77", "--snapshot", str(view))
+    assert p.returncode == 0 and view.exists(), p.stderr
+    assert snap.read_bytes() == before  # read at start, not written
+    p = softplc("watch", str(app), "--scans", "3", "--set", "N7:0=77", "--snapshot", str(view), "--save")
+    assert p.returncode == 0, p.stderr
+    assert softplc("run", str(app), "--scans", "0", "--print", "N7:0").stdout == "N7:0 = 77\n"
+
+
+def test_watch_scans_without_snapshot_is_refused():
+    p = softplc("watch", "programs/motor", "--scans", "10")
+    assert p.returncode == 2
+    assert p.stderr == ("softplc watch: error: --scans N needs --snapshot FILE (the view starts at scan 0; "
+                        "press n to step or r to run)\n")
+
+
+# -- help ---------------------------------------------------------------------------------------------
+
+def _subparsers():
+    parser = build_parser()
+    action = next(a for a in parser._actions if a.dest == "command")
+    return parser, action.choices
+
+
+def test_every_argument_has_help_and_every_help_points_to_docs():
+    parser, commands = _subparsers()
+    for name, sub in [("softplc", parser), *commands.items()]:
+        if name == "fmt":
+            continue  # fmt's options are the files helper's (issue 18): its --style still has none
+        for action in sub._actions:
+            assert action.help, f"{name} {action.option_strings or action.dest} has no help text"
+    for name in ("run", "watch", "check", "address", "datatable"):
+        p = softplc(name, "--help")
+        assert p.returncode == 0 and re.search(r"docs/\w+\.md", p.stdout), (name, p.stdout)
+    assert "docs/cli.md" in softplc("--help").stdout
+
+
+def test_watch_help_lists_every_key_of_the_table():
+    text = softplc("watch", "--help").stdout
+    assert "keys in the view:" in text
+    rows = key_rows()
+    assert len(rows) >= len(TODAY)
+    for label, meaning in rows:
+        assert re.search(rf"^  {re.escape(label)} +{re.escape(meaning)}$", text, re.M), label
+
+
+def _controller_keys() -> set[str]:
+    """The keys terminal.py's Controller.key compares ``k`` with (read from its source)."""
+    source = (ROOT / "softplc_lite" / "watch" / "terminal.py").read_text(encoding="utf-8")
+    tree = ast.parse(source)
+    cls = next(n for n in tree.body if isinstance(n, ast.ClassDef) and n.name == "Controller")
+    method = next(n for n in cls.body if isinstance(n, ast.FunctionDef) and n.name == "key")
+    keys: set[str] = set()
+    for node in ast.walk(method):
+        if isinstance(node, ast.Compare) and isinstance(node.left, ast.Name) and node.left.id == "k":
+            for right in node.comparators:
+                for const in ast.walk(right):
+                    if isinstance(const, ast.Constant) and isinstance(const.value, str):
+                        keys.add(const.value)
+    return keys
+
+
+def test_the_help_lists_the_keys_the_controller_handles():
+    if hasattr(terminal, "BINDINGS"):  # the Controller dispatches from the table the help shows
+        assert key_rows() == tuple((b.label, b.help) for b in terminal.BINDINGS)
+        return
+    described = {k for _, values, _ in TODAY for k in values}  # else: the keys of Controller.key's own tests
+    handled = _controller_keys()
+    assert described == handled, (described - handled, handled - described)
