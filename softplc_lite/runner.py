@@ -23,8 +23,7 @@ from pathlib import Path
 from typing import Callable
 
 from .app import App, save_code_cache
-from .datatable import DataTable, DataTableError
-from .datatable import jsonio, snapshot
+from .datatable import DataTable, DataTableError, jsonio, snapshot
 from .ladder import status as S
 from .ladder.engine import Engine, Mode, RealClock, SimulatedClock
 from .ladder.symbols import resolve_name

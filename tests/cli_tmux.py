@@ -27,7 +27,7 @@ class Terminal:
 
     def tmux(self, *args: str) -> str:
         return subprocess.run(["tmux", "-L", self.socket, *args], capture_output=True, text=True,
-                              timeout=10).stdout
+                              timeout=10, check=False).stdout
 
     def start(self, command: str, cwd: Path = ROOT, width: int = 120, height: int = 30) -> None:
         """Run ``command`` (a shell line); when it ends the pane shows
@@ -64,7 +64,7 @@ class Terminal:
         deadline = time.monotonic() + seconds
         while time.monotonic() < deadline:
             out = subprocess.run(["ps", "-o", "pid=,args=", "--ppid", str(shell)], capture_output=True,
-                                 text=True, timeout=10).stdout
+                                 text=True, timeout=10, check=False).stdout
             for row in out.splitlines():
                 pid, _, args = row.strip().partition(" ")
                 if "softplc_lite" in args:
@@ -73,13 +73,14 @@ class Terminal:
         raise AssertionError("the softplc process did not start")
 
     def kill(self) -> None:
-        subprocess.run(["tmux", "-L", self.socket, "kill-server"], capture_output=True, timeout=10)
+        subprocess.run(["tmux", "-L", self.socket, "kill-server"], capture_output=True, timeout=10, check=False)
         # tmux leaves the socket file behind
         Path(os.environ.get("TMUX_TMPDIR", "/tmp"), f"tmux-{os.getuid()}", self.socket).unlink(missing_ok=True)
 
 
-@pytest.fixture
-def terminal(request):
+def open_terminal(request):
+    """For a fixture: a Terminal named after the test, killed after it
+    (``@pytest.fixture(name="terminal")`` around ``yield from open_terminal(request)``)."""
     if shutil.which("tmux") is None:
         pytest.skip("tmux is not installed (apt-get install -y tmux)")
     t = Terminal(re.sub(r"\W", "", request.node.name)[-40:])

@@ -15,16 +15,20 @@ import time
 from pathlib import Path
 
 import pytest
-
-from cli_tmux import SOFTPLC, terminal  # noqa: F401  (a fixture)
+from cli_tmux import SOFTPLC, open_terminal
 
 ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(name="terminal")
+def fixture_terminal(request):
+    yield from open_terminal(request)
 BLINKER = ROOT / "programs" / "blinker" / "main.lad"  # C5:0.ACC counts blinks: one a second of PLC time
 
 
 def softplc(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=ROOT, capture_output=True,
-                          text=True, timeout=timeout)
+                          text=True, timeout=timeout, check=False)
 
 
 def run_then_sigterm(args: list[str], state: Path, seconds: float) -> subprocess.CompletedProcess:

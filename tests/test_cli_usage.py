@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 def softplc(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=60)
+                          timeout=60, check=False)
 
 
 def motor(tmp_path: Path) -> Path:
@@ -151,7 +151,7 @@ def test_watch_help_lists_every_key_of_the_table():
     rows = key_rows()
     assert len(rows) >= len(TODAY)
     for label, meaning in rows:
-        assert re.search(rf"^  {re.escape(label)} +{re.escape(meaning)}$", text, re.M), label
+        assert re.search(rf"^  {re.escape(label)} +{re.escape(meaning)}$", text, re.MULTILINE), label
 
 
 def _controller_keys() -> set[str]:

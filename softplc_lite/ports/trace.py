@@ -58,7 +58,7 @@ _TIME = re.compile(r"^[0-9]{1,15}(\.[0-9]{1,9})?$")
 _PORT = re.compile(r"^(?:([A-Za-z][A-Za-z0-9_]*):)?([0-9]{1,6})$")
 _HEX = re.compile(r"^[0-9A-Fa-f]{2}$")
 _FIELD = re.compile(r"\S+")
-_SCANS = re.compile(r"^\s*#\s*scans:\s*([0-9]{1,15})(?:\s.*)?$", re.M)  # a remark may follow N
+_SCANS = re.compile(r"^\s*#\s*scans:\s*([0-9]{1,15})(?:\s.*)?$", re.MULTILINE)  # a remark may follow N
 
 
 class TraceError(PortError):

@@ -17,12 +17,17 @@ import sys
 from rich.console import Console
 
 from ..app import load_app
-from ..cli import EXIT_ERROR, EXIT_USAGE, SNAPSHOT_HEIGHT, SNAPSHOT_WIDTH, address_problems  # the ranges the parser checks too
+from ..cli import (
+    EXIT_ERROR,
+    EXIT_USAGE,
+    SNAPSHOT_HEIGHT,  # the ranges the argument parser checks too
+    SNAPSHOT_WIDTH,
+    address_problems,
+)
 from ..runner import RunOptions
 from .screen import WatchScreen, rung_view
 from .session import WatchOptions, WatchSession
 from .watchlist import WATCH_MAX, read_watch_file
-
 
 
 def watch_command(args) -> int:
