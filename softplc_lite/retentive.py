@@ -23,6 +23,7 @@ scanning. docs/engine.md has the whole story.
 from __future__ import annotations
 
 import collections
+import os
 import queue
 import sys
 import threading
@@ -31,7 +32,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from .datatable import DataTable, snapshot
+from .datatable import DataTable, DataTableError, snapshot
+from .datatable.errors import SnapshotError
 from .ladder import status as S
 
 DURABLE_EVERY_S = 5.0  # one periodic save in this many seconds is fsynced (and becomes NAME.prev)
@@ -44,6 +46,30 @@ PERIOD_SHARE = 0.8
 LAG_SHARE = 0.2
 WRITER_JOIN_S = 30.0  # at stop, how long to wait for a save still being written
 HANDOVER_S = 0.0002  # the interpreter's thread switch interval while a save is being written
+
+
+def restore_snapshot(table: DataTable, path: Path) -> snapshot.Restored:
+    """Restore the app's retentive snapshot at ``path`` into ``table`` (the
+    program's table), falling back to ``NAME.prev`` as snapshot.restore
+    does. A snapshot that does not fit the program (a file number the
+    program now uses with another type) raises a SnapshotError that says
+    it is the retentive snapshot, where it is, and that ``--fresh`` starts
+    without it; the table is not changed then."""
+    try:
+        restored = snapshot.restore(path)
+    except SnapshotError as e:
+        raise SnapshotError(f"{e}: the retentive snapshot kept between runs in {path.parent}{os.sep} cannot be "
+                            f"read; run with --fresh to start from the program's initial data (the first save "
+                            "replaces it)") from None
+    if restored.table is not None:
+        try:
+            table.assign(restored.table)
+        except DataTableError as e:
+            reason = str(e).replace(" here", " in the program")
+            raise SnapshotError(f"{restored.source}: the retentive snapshot kept between runs in {path.parent}"
+                                f"{os.sep} does not fit the program ({reason}); run with --fresh to start from "
+                                "the program's initial data (the first save replaces it)") from None
+    return restored
 
 
 def describe_os_error(e: BaseException) -> str:
