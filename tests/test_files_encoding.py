@@ -101,11 +101,23 @@ def test_load_json_watch_file_and_trace_read_with_a_bom(tmp_path, encoding):
     jsonio.load_file(table, str(path))  # --load and datatable.json
     from softplc_lite.datatable import parse_address
     assert table.read(parse_address("N7:2")) == 3
-    # watch files and port traces read through textfile too: the same text comes back
-    watch = "N7:0\nStart  // the start button\n"
-    (tmp_path / "w.txt").write_bytes(ENCODINGS[encoding](watch))
-    assert read_text(tmp_path / "w.txt") == watch
-    assert decode_text(ENCODINGS[encoding](watch), "w.txt") == watch
+    # a watch file, with its located error still at the right column
+    from softplc_lite.watch.watchlist import read_watch_file
+    (tmp_path / "w.txt").write_bytes(ENCODINGS[encoding]("N7:0\nT4:0.ACC  # the timer\n"))
+    assert read_watch_file(tmp_path / "w.txt") == ["N7:0", "T4:0.ACC"]
+    (tmp_path / "bad.txt").write_bytes(ENCODINGS[encoding]("  N7:x\n"))
+    with pytest.raises(LocatedError) as e:
+        read_watch_file(tmp_path / "bad.txt")
+    plain = tmp_path / "plain.txt"
+    plain.write_text("  N7:x\n", encoding="utf-8")
+    with pytest.raises(LocatedError) as p:
+        read_watch_file(plain)
+    assert (e.value.line, e.value.column) == (p.value.line, p.value.column) == (1, 6)
+    # the shipped port trace (--replay)
+    from softplc_lite.ports.trace import read_trace
+    shipped = ROOT / "programs" / "modbus_master" / "pymodbus-session.trace"
+    (tmp_path / "t.trace").write_bytes(ENCODINGS[encoding](shipped.read_text(encoding="utf-8")))
+    assert read_trace(tmp_path / "t.trace") == read_trace(shipped)
 
 
 def test_bad_bytes_are_located_whatever_the_bom():
