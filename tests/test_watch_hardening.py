@@ -362,8 +362,8 @@ def test_watch_file_problems_are_located(tmp_path):
     where = tmp_path / "list.watch"
     binary = run(b"N7:0\nC5:0.ACC  # counts\n\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR")
     assert binary.returncode == 1 and "Traceback" not in binary.stderr
-    assert binary.stderr.strip() == (f"error: {where}:3:1: byte 0x89 is not UTF-8 text (the file must be saved "
-                                     "as UTF-8)")
+    assert binary.stderr.strip() == (f"error: {where}:3:1: byte 0x89 is not UTF-8 text (save the file as UTF-8, "
+                                     "or as UTF-16 with a byte-order mark)")
     bad = run(b"# watch\nN7:0\n    N7:x  # a typo\n")
     assert bad.returncode == 1
     assert bad.stderr.startswith(f"error: {where}:3:8: bad address 'N7:x'")

@@ -3,66 +3,10 @@ steps and quits, ``capture-pane`` reads the screen."""
 
 from __future__ import annotations
 
-import os
-import shutil
-import subprocess
 import sys
 import time
-from pathlib import Path
 
-import pytest
-
-ROOT = Path(__file__).resolve().parent.parent
-
-
-class Tmux:
-    """One tmux server of our own (-L socket), killed at the end."""
-
-    def __init__(self, name: str) -> None:
-        self.socket = f"softplc-test-{os.getpid()}-{name}"
-        self.session = name
-
-    def run(self, *args: str) -> str:
-        out = subprocess.run(["tmux", "-L", self.socket, *args], capture_output=True, text=True, timeout=10)
-        return out.stdout
-
-    def start(self, command: str, width: int = 100, height: int = 30) -> None:
-        env = f"cd {ROOT} && PYTHONPATH={ROOT} TERM=xterm-256color {command}"
-        subprocess.run(["tmux", "-L", self.socket, "new-session", "-d", "-s", self.session, "-x", str(width),
-                        "-y", str(height), env], check=True, timeout=10)
-
-    def screen(self) -> str:
-        return self.run("capture-pane", "-p", "-t", self.session)
-
-    def keys(self, *keys: str) -> None:
-        for k in keys:
-            self.run("send-keys", "-t", self.session, k)
-
-    def wait_for(self, text: str, seconds: float = 15.0) -> str:
-        deadline = time.monotonic() + seconds
-        screen = ""
-        while time.monotonic() < deadline:
-            screen = self.screen()
-            if text in screen:
-                return screen
-            time.sleep(0.1)
-        raise AssertionError(f"{text!r} not on screen after {seconds} s:\n{screen}")
-
-    def alive(self) -> bool:
-        return subprocess.run(["tmux", "-L", self.socket, "has-session", "-t", self.session],
-                              capture_output=True, timeout=10).returncode == 0
-
-    def kill(self) -> None:
-        subprocess.run(["tmux", "-L", self.socket, "kill-server"], capture_output=True, timeout=10)
-
-
-@pytest.fixture
-def tmux(request):
-    if shutil.which("tmux") is None:
-        pytest.skip("tmux is not installed (apt-get install -y tmux)")
-    t = Tmux(request.node.name[:20].replace("[", "_").replace("]", "_"))
-    yield t
-    t.kill()
+from tmux_helpers import Tmux, tmux  # noqa: F401  (the fixture; Tmux for the modules that import it from here)
 
 
 def test_step_run_and_quit_in_a_real_terminal(tmux, tmp_path):

@@ -1,4 +1,10 @@
-"""Values as an engineer reads them on a terminal (CLI --print, watch view)."""
+"""Values as an engineer reads them on a terminal (CLI --print, the watch
+view's rungs and watch list, status lines). JSON output (``--dump``,
+datatable.json) does not come through here and keeps floats exact.
+
+Floats show 7 significant digits (``FLOAT_DIGITS``): an F element is an
+IEEE single, good to about 7 digits, so ``3.14`` and not the double it
+widens to, ``3.140000104904175`` (softplc choice, docs/watch.md)."""
 
 from __future__ import annotations
 
@@ -10,14 +16,26 @@ from .filetypes import FileType
 from .table import word_text
 
 
+FLOAT_DIGITS = 7
+
+
+def format_float(value: float) -> str:
+    """``3.14``, ``150.0``, ``1.5e+07``, ``inf``: ``FLOAT_DIGITS`` significant
+    digits; a whole number keeps its ``.0`` so a float never reads as a word."""
+    text = f"{value:.{FLOAT_DIGITS}g}"
+    return text + ".0" if text.lstrip("-").isdigit() else text
+
+
 def format_value(value: Any) -> str:
-    """``42``, ``3.140000104904175``, ``"HELLO"`` (JSON-quoted, so control
+    """``42``, ``3.14``, ``"HELLO"`` (JSON-quoted, so control
     characters and lone surrogates show as escapes), or ``EN=1 DN=0 PRE=5``
     for a timer, counter or control element."""
     if isinstance(value, dict):
         return " ".join(f"{k}={v}" for k, v in value.items())
     if isinstance(value, str):
         return json.dumps(value)
+    if isinstance(value, float):
+        return format_float(value)
     return repr(value)
 
 

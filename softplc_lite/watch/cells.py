@@ -13,7 +13,7 @@ from rich.cells import cell_len
 from rich.style import Style
 
 from ..datatable import Address, DataTable, ValueKind
-from ..datatable.display import word_shown
+from ..datatable.display import format_float, word_shown
 from ..ladder.ast import (
     AddressRef,
     Branch,
@@ -228,7 +228,7 @@ def _value_text(value) -> str:
     if isinstance(value, bool):
         return str(int(value))
     if isinstance(value, float):
-        return f"{value:.7g}"
+        return format_float(value)
     if isinstance(value, str):
         text = json.dumps(value)
         return text if len(text) <= STRING_MAX else text[:STRING_MAX - 4] + '..."'

@@ -85,6 +85,26 @@ class History:
             if oldest.raw is not frames[0].raw:  # not shared with the next frame
                 self.kept_bytes -= len(oldest.raw)
 
+    def amend(self) -> None:
+        """Make the newest frame the table as it is now: an edit made
+        between two scans (a set value, a toggled bit, a mode change)
+        belongs to the scan before it, so stepping back past it and forward
+        again shows it rather than undoing it. Nothing to amend before the
+        first scan is recorded."""
+        frames = self.frames
+        if not frames:
+            return
+        if len(self.table._files) != self._count:
+            self._take_layout()
+        raw = b"".join(self._arrays)
+        if len(raw) != self._bytes:
+            self._take_layout()
+        old = frames[-1]
+        if len(frames) < 2 or frames[-2].raw is not old.raw:  # its bytes were counted for it alone
+            self.kept_bytes -= len(old.raw)
+        self.kept_bytes += len(raw)
+        frames[-1] = old._replace(layout=self._layout, raw=raw)
+
     def _take_layout(self) -> None:
         files = self.table.files()
         self._count = len(files)

@@ -130,12 +130,13 @@ class RungView:
     ``instructions`` the app's instruction set (``app.instructions``), for
     module instructions' operand names; ``max_lines``: draw only the top
     of the rung, that many lines (a long rung is then laid out only as far
-    as it is drawn)."""
+    as it is drawn); ``comments``: "full", "first line" (of the comment,
+    ``...`` marking the rest) or "hidden"."""
 
     def __init__(self, rung: Rung, number: int, table: DataTable, power: Power | None = None,
                  symbols: Mapping[str, object] | None = None, selected: bool = False, breakpoint: bool = False,
                  forced=frozenset(), tli_status: bool = True, instructions: InstructionSet | None = None,
-                 max_lines: int | None = None) -> None:
+                 max_lines: int | None = None, comments: str = "full") -> None:
         self.rung = rung
         self.number = number
         self.table = table
@@ -147,6 +148,17 @@ class RungView:
         self.tli_status = tli_status
         self.instructions = instructions or BUILTIN
         self.max_lines = max_lines
+        self.comments = comments
+
+    def _first_comment_line(self, console: Console, width: int) -> list[Segment] | None:
+        """The comment's first line, cut to one screen line; `` ...`` when
+        there is more of it."""
+        lines = [line.strip() for line in (self.rung.comment or "").split("\n") if line.strip()]
+        if not lines:
+            return None
+        text = Text(lines[0] + (" ..." if len(lines) > 1 else ""), style=COMMENT, no_wrap=True, overflow="ellipsis")
+        text.truncate(max(10, width - COMMENT_INDENT), overflow="ellipsis")
+        return [Segment(" " * COMMENT_INDENT), *text.render(console)]
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         lines = self._lines(console, max(options.max_width, 20))
@@ -163,7 +175,13 @@ class RungView:
                Segment("*" if self.breakpoint else " ", BREAKPOINT),
                Segment(f" Rung {self.number}", SELECTED if self.selected else HEADER)]
         used = 1
-        for paragraph in _paragraphs(self.rung.comment or ""):
+        if self.comments == "first line":
+            first = self._first_comment_line(console, width)
+            if first is not None and (self.max_lines is None or used < self.max_lines):
+                yield first
+                used += 1
+        full = self.rung.comment if self.comments == "full" else None
+        for paragraph in _paragraphs(full or ""):
             if self.max_lines is not None:  # wrap no more of a long comment than is drawn
                 if used >= self.max_lines:
                     return
@@ -196,7 +214,7 @@ class ProgramFileView:
                  first: int = 0, selected: int | None = None, breakpoints=frozenset(), forced=frozenset(),
                  height: int | None = None, tli_status: bool = True,
                  instructions: InstructionSet | None = None,
-                 power_of: Callable[[Rung, DataTable], Power] = rung_power) -> None:
+                 power_of: Callable[[Rung, DataTable], Power] = rung_power, comments: str = "full") -> None:
         self.pfile = pfile
         self.table = table
         self.names = symbols if isinstance(symbols, _SymbolNames) else _SymbolNames(symbols)
@@ -208,6 +226,7 @@ class ProgramFileView:
         self.tli_status = tli_status
         self.instructions = instructions
         self.power_of = power_of
+        self.comments = comments
         self.drawn = 0
         self.last_drawn: int | None = None
 
@@ -216,7 +235,8 @@ class ProgramFileView:
         marked = number in self.breakpoints or (self.pfile.number, number) in self.breakpoints
         return RungView(rung, number, self.table, power=self.power_of(rung, self.table), symbols=self.names,
                         selected=number == self.selected, breakpoint=marked, forced=self.forced,
-                        tli_status=self.tli_status, instructions=self.instructions, max_lines=max_lines)
+                        tli_status=self.tli_status, instructions=self.instructions, max_lines=max_lines,
+                        comments=self.comments)
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         self.drawn, self.last_drawn = 0, None

@@ -19,13 +19,30 @@ from .session import WatchSession
 WIDE = 120  # from this width the side panels go beside the rungs
 FORCES_SHOWN = 64  # forces listed by name; the rest are counted
 SIDE_WIDTH = 46
-KEYS = ("space/n step  r run  p pause  +/- speed  ↑↓/jk rung  f file  g go to rung  b breakpoint  "
-        "⌫ back  F force  U unforce  M mode  q quit")
-# The keys line at narrower widths: the longest that fits (q quit always shown from 80 columns).
-KEY_LINES = (KEYS, "n step  r run  p pause  +/- speed  ↑↓ rung  f file  g go to  b break  ⌫ back  F/U force  M mode  "
-                   "q quit",
-             "n step  r run  p pause  +/- speed  ↑↓ rung  b break  ⌫ back  F/U force  q quit",
-             "n step  r run  p pause  ⌫ back  q quit")
+# The keys line at the foot, the longest that fits (from 80 columns "? help" and "q quit" always show);
+# "?" lists every key (terminal.py's table).
+KEY_LINES = ("space/n step  r run  p pause  +/- speed  ↑↓ rung  f file  g go to  b break  ⌫ back  F/U force  "
+             "= set  t toggle  M mode  C clear fault  ? help  q quit",
+             "n step  r run  p pause  ↑↓ rung  b break  ⌫ back  F/U force  = set  t toggle  M mode  ? help  q quit",
+             "n step  r run  p pause  ⌫ back  = set  t toggle  ? help  q quit",
+             "n step  r run  p pause  ? help  q quit")
+
+
+class HelpOverlay:
+    """Every key and what it does (the ``?`` key; any key closes it):
+    ``keys`` is terminal.py's table of (key label, help text)."""
+
+    def __init__(self, keys) -> None:
+        self.keys = keys
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        yield Text(" keys (any key closes this)", style="bold underline")
+        width = max(cell_len(label) for label, _ in self.keys)
+        for label, text in self.keys:
+            line = Text(no_wrap=True, overflow="ellipsis")
+            line.append(f"  {label.ljust(width)}  ", style="bold")
+            line.append(text)
+            yield line
 
 
 class StatusBar:
@@ -47,6 +64,9 @@ class StatusBar:
         line.append(f" {s.app.name} ", style="bold reverse")
         mode_style = {"RUN": "green", "FAULTED": "bold red"}.get(e.mode.name, "yellow")
         line.append(f" {e.mode.name} ", style=mode_style)
+        fault = e.fault if e.mode is Mode.FAULTED else None
+        if fault is not None:  # where, first: the rest of the line may be cut
+            line.append(f" {_fault_place(fault)} ", style="bold red")
         if s.history.live:
             line.append(f" scan {e.scans}")
         else:
@@ -61,8 +81,9 @@ class StatusBar:
         else:
             line.append(f"  scan time {e.s[S.LAST_SCAN_MS]} ms, max {e.s[S.MAX_SCAN_MS]}", style="dim")
         second = Text(no_wrap=True, overflow="ellipsis")
-        if e.mode is Mode.FAULTED and e.fault is not None:
-            second.append(f" {e.fault}", style="bold red")
+        if fault is not None:  # the whole fault, or what the last command said (the first line says where)
+            said = s.message and s.message != str(fault)
+            second.append(f" {s.message if said else fault}", style="cyan" if said else "bold red")
         else:
             minor = e.s[S.MINOR_FAULT_BITS]
             overflow = e.s[S.PLC5_MINOR_FAULT_BITS] >> S.MINOR_OVERFLOW_BIT & 1  # PLC-5's overflow bit S:10/14
@@ -70,10 +91,20 @@ class StatusBar:
                 shown = ["S:10/14 overflow"] if overflow else []
                 shown += [f"S:17={minor & 0xFFFF:#06x}"] if minor else []
                 second.append(f" minor faults {' '.join(shown)} code {e.s[S.MINOR_FAULT_CODE]}", style="yellow")
-        if s.message:
-            second.append(f" {s.message}", style="cyan")
+            if s.message:
+                second.append(f" {s.message}", style="cyan")
         yield line
         yield second
+
+
+def _fault_place(fault) -> str:
+    """``fault 20: file 2 rung 2 MOV``: which fault, and where."""
+    where = f"fault {fault.code}"
+    if fault.file is not None:
+        where += f": file {fault.file} rung {fault.rung}"
+        if fault.instruction:
+            where += f" {fault.instruction.split()[0]}"
+    return where
 
 
 class ForcesView:
@@ -103,14 +134,33 @@ class RungsPanel:
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         s = self.session
         height = options.height or console.height
-        where = f" program file {s.file}  rung {s.selected} of {len(s.rungs)}" if s.file is not None else \
-            " no program file"
-        yield Text(where, style="bold underline")
+        yield self.header()
         view = self.view_factory(s, height - 1)
         yield view
         last = getattr(view, "last_drawn", None)
         if last is not None and s.selected > last and s.top < s.selected:
             s.top += max(1, s.selected - last)  # keep the selection in view next time
+
+
+    def header(self) -> Text:
+        """``program file 2 MAIN  rung 3 of 12  files: 2 MAIN  3 FILL``: the
+        shown file (number and name), the selected rung, every file."""
+        s = self.session
+        line = Text(no_wrap=True, overflow="ellipsis")
+        if s.file is None:
+            line.append(" no program file", style="bold underline")
+            return line
+        files = s.app.program.files
+        line.append(f" program file {_file_label(files[s.file])}", style="bold underline")
+        line.append(f"  rung {s.selected} of {len(s.rungs)}", style="bold")
+        line.append(f"  comments {s.comments}" if s.comments != "full" else "", style="dim")
+        if len(files) > 1:
+            line.append("  files: " + "  ".join(_file_label(files[n]) for n in s.files), style="dim")
+        return line
+
+
+def _file_label(pfile) -> str:
+    return f"{pfile.number} {pfile.name}" if pfile.name else str(pfile.number)
 
 
 class WatchScreen:
@@ -122,6 +172,7 @@ class WatchScreen:
         self.ports = PortsView(session.engine)
         self.forces = ForcesView(session)
         self.prompt = prompt
+        self.help = None  # the key table while the help overlay is shown
 
     def side(self) -> Group:
         parts = [self.session.watch, self.forces]
@@ -140,6 +191,10 @@ class WatchScreen:
             bottom = Text(f" {keys}", style="dim", no_wrap=True, overflow="ellipsis")
         root.split_column(Layout(self.status, size=2), Layout(name="body"), Layout(bottom, size=1))
         body = root["body"]
+        if self.help:
+            body.update(HelpOverlay(self.help))
+            yield from root.__rich_console__(console, options.update(height=height))
+            return
         side = self.side()
         if width >= WIDE:
             body.split_row(Layout(self.rungs), Layout(Padding(side, (0, 0, 0, 1)), size=SIDE_WIDTH))
@@ -159,4 +214,5 @@ def rung_view(session: WatchSession, height: int):
     pfile = s.app.program.files[s.file] if s.file is not None else ProgramFile(2, None, [])  # none: "(no rungs)"
     return ProgramFileView(pfile, s.engine.table, symbols=s.app.program.symbols,
                            first=s.top, selected=s.selected, breakpoints=frozenset(s.breaks.rungs),
-                           forced=frozenset(s.forces.forces), height=height, instructions=s.app.instructions)
+                           forced=frozenset(s.forces.forces), height=height, instructions=s.app.instructions,
+                           comments=s.comments)

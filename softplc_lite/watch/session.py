@@ -5,10 +5,14 @@ here (terminal.py reads keys, screen.py draws).
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass, field
 
 from ..app import App
+from ..datatable import DataTableError, ValueKind
+from ..datatable.display import format_read
+from ..ladder.ast import AddressRef, walk
 from ..ladder.engine import Mode, ModeError
 from ..ladder.symbols import is_symbol_text, resolve_name
 from ..runner import RunOptions, Runner
@@ -19,6 +23,8 @@ from .watchlist import WatchList
 
 # Run speeds ("+" and "-"): scans per second of wall time; 0 = as fast as it goes.
 SPEEDS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 0)
+# How rung comments are drawn ("c" cycles): all of it, its first line, none.
+COMMENTS = ("full", "first line", "hidden")
 
 
 @dataclass
@@ -61,6 +67,7 @@ class WatchSession:
         self.selected = 0  # selected rung of the shown file
         self.top = 0  # first rung shown
         self.message = ""
+        self.comments = COMMENTS[0]
         self.last_hit: Hit | None = None
         self.watch.sample(engine.table)
 
@@ -80,7 +87,7 @@ class WatchSession:
         hit = self.breaks.after_scan()
         if engine.mode is Mode.FAULTED:
             self.running = False
-            self.message = str(engine.fault)
+            self._show_fault()
         if hit is not None:
             self.running = False
             self.last_hit = hit
@@ -179,6 +186,31 @@ class WatchSession:
         self.selected = max(0, min(len(self.rungs) - 1, rung))
         self.top = self.selected
 
+    def goto_text(self, text: str) -> None:
+        """The ``g`` prompt: a rung number of the shown file."""
+        count = len(self.rungs)
+        if not count:
+            self.message = "no rung to go to"
+            return
+        try:
+            rung = int(text.strip())
+        except ValueError:
+            self.message = f"go to rung {text.strip()!r}: expected a rung number, 0 to {count - 1}"
+            return
+        self.goto(rung)
+        self.message = "" if rung == self.selected else \
+            f"go to rung: file {self.file} has rungs 0 to {count - 1}; at rung {self.selected}"
+
+    def first_rung(self) -> None:
+        self.goto(0)
+
+    def last_rung(self) -> None:
+        self.goto(len(self.rungs) - 1)
+
+    def cycle_comments(self) -> None:
+        self.comments = COMMENTS[(COMMENTS.index(self.comments) + 1) % len(COMMENTS)]
+        self.message = f"rung comments: {self.comments}"
+
     def next_file(self) -> None:
         if not self.files:
             self.message = "no program file"
@@ -195,8 +227,82 @@ class WatchSession:
         self.message = f"breakpoint {'set' if on else 'cleared'}: file {self.file} rung {self.selected}"
 
     def force(self, text: str) -> None:
+        self._go_live()
         self.forces.set(parse_force(text, self.app.program.symbols))
+        self._edited()
         self.message = f"forced {text}"
+
+    # -- online data edits ---------------------------------------------------------------------
+    # The view only changes the table between two scans (the session scans
+    # in whole scans), so an edit is at a scan boundary when it is made: it
+    # shows at once, the next scan reads it, and the newest history frame
+    # takes it in (History.amend) so stepping back and forward keeps it.
+    def set_value(self, text: str) -> None:
+        """``ADDR = VALUE`` (ADDR an address or symbol, members too:
+        ``T4:0.PRE = 50``): VALUE is a number, a quoted string, ``{"PRE": 10}``
+        for a whole element, or plain text for an ST element. A bad entry
+        changes nothing and says why on the message line."""
+        name, eq, raw = text.partition("=")
+        name, raw = name.strip(), raw.strip()
+        if not eq or not name or not raw:
+            self.message = f"set {text.strip()!r}: expected ADDR = VALUE, e.g. N7:0 = 150 or ST9:0 = \"text\""
+            return
+        try:
+            address = resolve_name(name, self.app.program.symbols)
+            try:
+                value = json.loads(raw)
+            except ValueError:
+                value = raw  # plain text: only an ST element takes it (write() says so otherwise)
+            self._go_live()
+            self.engine.table.write(address, value)
+        except (DataTableError, ValueError, TypeError, OverflowError) as e:
+            self.message = f"set {name}: {e}"
+            return
+        self._edited()
+        self.message = f"set {name} = {format_read(self.engine.table, address)}{self._forced_note(address)}"
+
+    def toggle(self, text: str) -> None:
+        """Invert a bit (RSLogix's Ctrl-T): ``B3/5``, ``O:0/0``, a symbol."""
+        name = text.strip()
+        try:
+            address = resolve_name(name, self.app.program.symbols)
+            if address.kind is not ValueKind.BIT:
+                self.message = f"toggle {name}: expected a bit address (B3/5, O:0/0, N7:0/3, T4:0.EN)"
+                return
+            self._go_live()
+            table = self.engine.table
+            table.write(address, 1 - table.read(address))
+        except (DataTableError, ValueError) as e:
+            self.message = f"toggle {name}: {e}"
+            return
+        self._edited()
+        self.message = f"toggled {name}: now {self.engine.table.read(address)}{self._forced_note(address)}"
+
+    def selected_bit(self) -> str:
+        """The first bit operand of the selected rung (what ``t`` offers to
+        toggle), or "" when it has none."""
+        rungs = self.rungs
+        if not rungs:
+            return ""
+        for ins in walk(rungs[self.selected].elements):
+            for operand in getattr(ins, "operands", ()):
+                if isinstance(operand, AddressRef) and operand.address.kind is ValueKind.BIT:
+                    return str(operand.address)
+        return ""
+
+    def _forced_note(self, address) -> str:
+        forced = str(address) in self.forces.forces
+        return " (forced: the force holds it at the next scan)" if forced else ""
+
+    def _go_live(self) -> None:
+        """Edits apply to the newest scan's table, not to one shown from history."""
+        if not self.history.live:
+            self.history.latest()
+            self.watch.sample(self.engine.table, trend=False)
+
+    def _edited(self) -> None:
+        self.history.amend()
+        self.watch.sample(self.engine.table, trend=False)  # shown at once, not after the next scan
 
     def set_mode(self, text: str) -> None:
         """PROGRAM, RUN or TEST (any case, or P/R/T). PROGRAM while in
@@ -211,21 +317,46 @@ class WatchSession:
         engine = self.engine
         again = engine.mode is mode
         try:
+            self._go_live()
             engine.set_mode(mode)
         except ModeError as e:
             self.message = str(e)
             return
+        self._edited()  # the mode word S:1 is in the table
         if engine.mode is Mode.FAULTED:
             self.running = False
-            self.message = str(engine.fault)
+            self._show_fault()
         elif again and mode is Mode.PROGRAM:
             self.message = "PROGRAM again: the modules reloaded their configuration"
         else:
             self.message = f"mode {mode.name}"
 
+    def clear_fault(self) -> None:
+        """Clear a major fault: to PROGRAM (RSLogix's "clear faults"); RUN
+        again with ``M run`` or ``r`` after it."""
+        engine = self.engine
+        if engine.mode is not Mode.FAULTED:
+            self.message = "no major fault to clear"
+            return
+        fault = engine.fault
+        self.running = False
+        self._go_live()
+        engine.set_mode(Mode.PROGRAM)
+        self._edited()
+        self.message = f"fault cleared ({fault.code if fault else '?'}): PROGRAM mode; M run to run again"
+
+    def _show_fault(self) -> None:
+        """The fault on the message line, its rung selected (and its file shown)."""
+        fault = self.engine.fault
+        self.message = str(fault)
+        if fault is not None and fault.file in self.files and fault.rung is not None:
+            self.file = fault.file
+            self.goto(fault.rung)
+
     def unforce(self, text: str) -> None:
         symbols = self.app.program.symbols
         found = self.forces.remove(resolve_name(text, symbols) if is_symbol_text(text.strip()) else text)
+        self.watch.sample(self.engine.table, trend=False)
         self.message = f"force removed: {text}" if found else f"{text} is not forced"
 
     # -- the end ---------------------------------------------------------------------------------

@@ -14,6 +14,7 @@ import sys
 import termios
 import time
 import tty
+from typing import NamedTuple
 
 from rich.console import Console
 from rich.live import Live
@@ -25,10 +26,58 @@ from .session import WatchSession
 REDRAW_HZ = 10  # at most
 DRAW_SHARE = 0.04  # of the wall time spent drawing while running, at most
 SLICE_S = 0.02  # scanning time between two looks at the keyboard
-PROMPT_MAX = 200  # characters a prompt (g, F, U, M) takes
+PROMPT_MAX = 200  # characters a prompt (g, F, U, M, =, t) takes
 
 _ESCAPES = {"\x1b[A": "up", "\x1b[B": "down", "\x1bOA": "up", "\x1bOB": "down",
-            "\x1b[5~": "pgup", "\x1b[6~": "pgdown"}
+            "\x1b[5~": "pgup", "\x1b[6~": "pgdown",
+            # Home and End as xterm, tmux and the Linux console send them
+            "\x1b[H": "home", "\x1b[F": "end", "\x1bOH": "home", "\x1bOF": "end",
+            "\x1b[1~": "home", "\x1b[4~": "end", "\x1b[7~": "home", "\x1b[8~": "end"}
+CTRL_T = "\x14"
+
+
+class Binding(NamedTuple):
+    """A key: its label (as the help shows it), the key values RawKeys
+    gives for it, the Controller's action, and what it does."""
+
+    label: str
+    keys: tuple[str, ...]
+    action: str
+    help: str
+
+
+# Every key of the view, the one list: the Controller dispatches from it,
+# the help overlay ("?") and ``softplc watch --help`` (KEYS) show it.
+# "/", "x", "X", "d" and "R" are kept free for find / cross-reference and
+# the data-file grid.
+BINDINGS: tuple[Binding, ...] = (
+    Binding("n, space", ("n", " "), "step", "one scan forward (from history when stepped back)"),
+    Binding("r", ("r",), "run", "run: scan continuously"),
+    Binding("p", ("p",), "pause", "pause"),
+    Binding("+ / -", ("+", "-"), "speed", "run faster / slower"),
+    Binding("up/down, k/j", ("up", "k", "down", "j"), "move", "select the rung above / below"),
+    Binding("PgUp/PgDn", ("pgup", "pgdown"), "move", "ten rungs up / down"),
+    Binding("Home/End", ("home", "end"), "ends", "first / last rung of the file"),
+    Binding("g", ("g",), "goto", "go to a rung (asks for its number)"),
+    Binding("f", ("f",), "next_file", "show the next program file"),
+    Binding("c", ("c",), "comments", "rung comments: full, first line, hidden (cycles)"),
+    Binding("b", ("b",), "breakpoint", "toggle a breakpoint on the selected rung"),
+    Binding("Backspace", ("\x7f", "\x08"), "back", "one scan back in the history"),
+    Binding("=", ("=",), "set", "set a value: ADDR = VALUE (N7:0 = 150, T4:0.PRE = 50, ST9:0 = \"text\")"),
+    Binding("t, Ctrl-T", ("t", CTRL_T), "toggle", "toggle a bit (offers the selected rung's first bit)"),
+    Binding("F", ("F",), "force", "force a bit: ADDR=1 or ADDR=0"),
+    Binding("U", ("U",), "unforce", "remove the force on ADDR"),
+    Binding("M", ("M",), "mode", "change mode: program, run or test"),
+    Binding("C", ("C",), "clear_fault", "clear the major fault (to PROGRAM; then M run)"),
+    Binding("?", ("?",), "help", "this list of keys (any key closes it)"),
+    Binding("q", ("q",), "quit", "quit (saves the retentive data table)"),
+)
+# (key label, help text) of every key: for ``softplc watch --help``.
+KEYS: tuple[tuple[str, str], ...] = tuple((b.label, b.help) for b in BINDINGS)
+_ACTIONS = {k: b.action for b in BINDINGS for k in b.keys}
+# The prompts: kind -> the text before what is typed.
+PROMPTS = {"g": "go to rung: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: ",
+           "M": "mode (program, run, test): ", "=": "set ADDR = VALUE: ", "t": "toggle bit: "}
 
 
 class RawKeys:
@@ -79,54 +128,82 @@ class Controller:
         self.prompt_kind = ""
         self.buffer = ""
         self.done = False
+        self.help = False  # the help overlay is shown
 
     def key(self, k: str) -> None:
-        s = self.session
+        if self.help:  # any key closes the help
+            self.help = False
+            return
         if self.prompt_kind:
             self._prompt_key(k)
             return
-        if k in (" ", "n"):
-            s.scan()
-        elif k == "r":
-            s.start()
-        elif k == "p":
-            s.pause()
-        elif k == "+":
-            s.faster()
-        elif k == "-":
-            s.slower()
-        elif k in ("down", "j"):
-            s.move(1)
-        elif k in ("up", "k"):
-            s.move(-1)
-        elif k == "pgdown":
-            s.move(10)
-        elif k == "pgup":
-            s.move(-10)
-        elif k == "f":
-            s.next_file()
-        elif k == "b":
-            s.toggle_breakpoint()
-        elif k in ("\x7f", "\x08"):
-            s.back()
-        elif k == "g":
-            self._ask("g", "go to rung: ")
-        elif k == "F":
-            self._ask("F", "force ADDR=1 or ADDR=0: ")
-        elif k == "U":
-            self._ask("U", "remove the force on ADDR: ")
-        elif k == "M":
-            self._ask("M", "mode (program, run, test): ")
-        elif k == "q":
-            self.done = True
+        action = _ACTIONS.get(k)
+        if action is not None:
+            getattr(self, f"_do_{action}")(k)
 
-    def _ask(self, kind: str, text: str) -> None:
-        self.prompt_kind, self.buffer = kind, ""
-        self.prompt = text
+    # one method per action of BINDINGS (a test checks none is missing)
+    def _do_step(self, k: str) -> None:
+        self.session.scan()
+
+    def _do_run(self, k: str) -> None:
+        self.session.start()
+
+    def _do_pause(self, k: str) -> None:
+        self.session.pause()
+
+    def _do_speed(self, k: str) -> None:
+        self.session.faster() if k == "+" else self.session.slower()
+
+    def _do_move(self, k: str) -> None:
+        self.session.move({"down": 1, "j": 1, "up": -1, "k": -1, "pgdown": 10, "pgup": -10}[k])
+
+    def _do_ends(self, k: str) -> None:
+        self.session.first_rung() if k == "home" else self.session.last_rung()
+
+    def _do_goto(self, k: str) -> None:
+        self._ask("g")
+
+    def _do_next_file(self, k: str) -> None:
+        self.session.next_file()
+
+    def _do_comments(self, k: str) -> None:
+        self.session.cycle_comments()
+
+    def _do_breakpoint(self, k: str) -> None:
+        self.session.toggle_breakpoint()
+
+    def _do_back(self, k: str) -> None:
+        self.session.back()
+
+    def _do_set(self, k: str) -> None:
+        self._ask("=")
+
+    def _do_toggle(self, k: str) -> None:
+        self._ask("t", self.session.selected_bit())
+
+    def _do_force(self, k: str) -> None:
+        self._ask("F")
+
+    def _do_unforce(self, k: str) -> None:
+        self._ask("U")
+
+    def _do_mode(self, k: str) -> None:
+        self._ask("M")
+
+    def _do_clear_fault(self, k: str) -> None:
+        self.session.clear_fault()
+
+    def _do_help(self, k: str) -> None:
+        self.help = True
+
+    def _do_quit(self, k: str) -> None:
+        self.done = True
+
+    def _ask(self, kind: str, offered: str = "") -> None:
+        self.prompt_kind, self.buffer = kind, offered
+        self.prompt = PROMPTS[kind] + offered
 
     def _prompt_key(self, k: str) -> None:
-        label = {"g": "go to rung: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: ",
-                 "M": "mode (program, run, test): "}
         if k == "esc":
             self.prompt_kind, self.prompt = "", None
             return
@@ -140,19 +217,23 @@ class Controller:
             self.buffer = self.buffer[:-1]
         elif len(k) == 1 and k.isprintable() and len(self.buffer) < PROMPT_MAX:
             self.buffer += k
-        self.prompt = label[self.prompt_kind] + self.buffer
+        self.prompt = PROMPTS[self.prompt_kind] + self.buffer
 
     def _submit(self, kind: str, text: str) -> None:
         s = self.session
         try:
             if kind == "g":
-                s.goto(int(text))
+                s.goto_text(text)
             elif kind == "F":
                 s.force(text)
             elif kind == "U":
                 s.unforce(text)
             elif kind == "M":
                 s.set_mode(text)
+            elif kind == "=":
+                s.set_value(text)
+            elif kind == "t":
+                s.toggle(text)
         except (ValueError, DataTableError) as e:
             s.message = f"{text}: {e}"
 
@@ -183,6 +264,7 @@ class ViewLoop:
         now = time.monotonic()
         if k is not None or (self.dirty and now - self.last_draw >= self.interval):
             self.screen.prompt = self.control.prompt
+            self.screen.help = KEYS if self.control.help else None
             self.draw(self.screen)
             drawn = time.monotonic()
             # Drawing takes at most DRAW_SHARE of the time while running: a

@@ -6,8 +6,8 @@ from __future__ import annotations
 from collections import deque
 from pathlib import Path
 
+from rich.cells import cell_len, set_cell_size
 from rich.console import Console, ConsoleOptions, RenderResult
-from rich.table import Table
 from rich.text import Text
 
 from ..datatable import DataTable, DataTableError, ValueKind
@@ -19,6 +19,7 @@ from ..textfile import decode_text
 
 BARS = "▁▂▃▄▅▆▇█"
 TREND = 24  # samples kept per address
+NAME_MIN = 8  # cells of a name kept however long a value (a read error's text) is
 WATCH_MAX = 256  # addresses in the watch list, --watch and --watch-file together
 WATCH_FILE_BYTES = 1 << 20  # the largest watch file read (1 MiB)
 
@@ -90,18 +91,40 @@ class WatchList:
             item.sample(table, trend)
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
-        table = Table(title="watch", title_justify="left", expand=True, show_edge=False, pad_edge=False)
-        table.add_column("address", no_wrap=True)
-        table.add_column("value", no_wrap=True)
-        table.add_column("trend", no_wrap=True)
+        # Columns sized here, not by rich's Table (which shrinks every column
+        # alike): the values first, whole; then the names, shortened with an
+        # ellipsis only when a value would not fit beside them; the trend
+        # gets what is left.
+        width = options.max_width
+        yield Text("watch", style="bold")
         if not self.items:
-            table.add_row(Text("(none: --watch ADDR)", style="dim"), "", "")
-        for item in self.items:
-            shown = format_value(item.value) if not isinstance(item.value, str) or not item.value.startswith("?") \
-                else item.value
-            table.add_row(item.text, Text(shown, style="bold yellow" if item.changed else ""),
-                          Text(sparkline(list(item.trend)), style="cyan"))
-        yield table
+            yield Text("(none: --watch ADDR)", style="dim")
+            return
+        rows = [(item.text, _shown(item.value), item) for item in self.items]
+        names_w = max(cell_len(n) for n, _, _ in rows)
+        value_w = min(max(cell_len(v) for _, v, _ in rows), max(width - min(names_w, NAME_MIN) - 1, 1))
+        name_w = min(names_w, max(width - value_w - 1, 1))
+        trend_w = min(TREND, width - name_w - value_w - 2)
+        for name, value, item in rows:
+            line = Text(no_wrap=True, overflow="ellipsis")
+            line.append(_fit(name, name_w).ljust(name_w) + " ")
+            line.append(_fit(value, value_w).rjust(value_w), style="bold yellow" if item.changed else "")
+            if trend_w > 0:
+                line.append(" " + sparkline(list(item.trend))[-trend_w:], style="cyan")
+            yield line
+
+
+def _shown(value) -> str:
+    if isinstance(value, str) and value.startswith("?"):  # why it cannot be read
+        return value
+    return format_value(value)
+
+
+def _fit(text: str, width: int) -> str:
+    """``text``, or its start and an ellipsis in ``width`` cells."""
+    if cell_len(text) <= width:
+        return text
+    return set_cell_size(text, max(width - 1, 0)) + "…"
 
 
 def read_watch_file(path: str | Path, symbols=None, room: int = WATCH_MAX) -> list[str]:
