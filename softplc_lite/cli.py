@@ -131,19 +131,9 @@ def _cmd_run(args: argparse.Namespace) -> int:
         for problem in problems:
             print(f"error: {problem}", file=sys.stderr)
         return EXIT_ERROR
-    def stop(signum, frame) -> None:
-        """Ctrl-C or SIGTERM: the run ends after the scan under way, so the
-        final save holds a whole scan; a second one stops at once."""
-        if runner.stop_requested:
-            raise KeyboardInterrupt
-        runner.request_stop()
-
-    previous = _handle_signals({signal.SIGINT: stop, signal.SIGTERM: stop})
     try:
-        _run_with_status(runner, app, args.scans, unbounded=args.scans is None and args.replay is None)
+        _scan_until_the_end(runner, app, args)
     finally:
-        # a SIGTERM must not cut the final save short (a service manager sends one, then waits)
-        _handle_signals({signal.SIGTERM: signal.SIG_IGN, **{s: h for s, h in previous.items() if s == signal.SIGINT}})
         runner.close()
     engine = runner.engine
     storage_problems = runner.finish()  # the final save; a failure is reported, and the output still printed
@@ -164,6 +154,26 @@ def _cmd_run(args: argparse.Namespace) -> int:
               f"({count} difference{'s' if count != 1 else ''}, listed above)", file=sys.stderr)
         return EXIT_REPLAY
     return EXIT_ERROR if storage_problems else EXIT_OK
+
+
+def _scan_until_the_end(runner: Runner, app, args: argparse.Namespace) -> None:
+    """Scan until --scans, the end of a --replay trace, a major fault, or
+    Ctrl-C/SIGTERM: either signal ends the run after the scan under way, so
+    the final save holds a whole scan (a second one stops at once). Then
+    SIGTERM is ignored: a service manager that sends it again must not cut
+    the final save short."""
+    def stop(signum, frame) -> None:
+        if runner.stop_requested:
+            raise KeyboardInterrupt
+        runner.request_stop()
+
+    previous = _handle_signals({signal.SIGINT: stop, signal.SIGTERM: stop})
+    try:
+        _run_with_status(runner, app, args.scans, unbounded=args.scans is None and args.replay is None)
+    finally:
+        _handle_signals({signal.SIGTERM: signal.SIG_IGN})
+        if signal.SIGINT in previous:
+            _handle_signals({signal.SIGINT: previous[signal.SIGINT]})
 
 
 def address_problems(option: str, table: DataTable, texts: list[str], symbols=None) -> list[str]:
