@@ -21,8 +21,10 @@ FORCES_SHOWN = 64  # forces listed by name; the rest are counted
 SIDE_WIDTH = 46
 # The keys line at the foot, the longest that fits (from 80 columns "? help" and "q quit" always show);
 # "?" lists every key (terminal.py's table).
-KEY_LINES = ("space/n step  r run  p pause  +/- speed  ↑↓ rung  f file  g go to  b break  ⌫ back  F/U force  "
-             "= set  t toggle  M mode  C clear fault  ? help  q quit",
+KEY_LINES = ("n step  r run  p pause  +/- speed  ↑↓ rung  g go to  f file  b break  ⌫ back  F/U force  = set  "
+             "t toggle  M mode  C clear fault  ? help  q quit",
+             "n step  r run  p pause  ↑↓ rung  b break  ⌫ back  F/U force  = set  t toggle  M mode  C clear fault  "
+             "? help  q quit",
              "n step  r run  p pause  ↑↓ rung  b break  ⌫ back  F/U force  = set  t toggle  M mode  ? help  q quit",
              "n step  r run  p pause  ⌫ back  = set  t toggle  ? help  q quit",
              "n step  r run  p pause  ? help  q quit")
