@@ -178,3 +178,50 @@ def test_dash_reads_standard_input():
     assert code == 1 and err.startswith("<stdin>:1:")
     code, out, err = run_fmt("-", stdin=b"xic b3/0 ote o:0/0\n", check=True)
     assert code == 1 and err == "would reformat <stdin>\n"
+
+
+def _sprinkle(src: str, style: str, rng) -> str:
+    """``src`` (fmt's output) with comments put in every kind of place:
+    end of line, own line above, free blocks between blank lines, inside a
+    rung wrapped in SOR ... EOR, inside a neutral rung split over lines."""
+    out, n = [], 0
+    for line in src.splitlines():
+        r, n = rng.random(), n + 1
+        plain = line and not line.startswith(("//", "SYMBOL", "DATA", "FILE", "SOR")) and "//" not in line
+        if r < 0.12 and style == "mnemonic" and plain and '"' not in line:
+            toks = line.split()
+            k = rng.randrange(0, len(toks) + 1)
+            out += ["SOR " + " ".join(toks[:k]) + f" // in {n}", f"  // own in {n}", "  " + " ".join(toks[k:]), "EOR"]
+        elif r < 0.12 and style == "neutral" and plain and ");" in line:
+            k = line.index(")") + 1
+            out += [line[:k] + f" // inside {n}", f"// own inside {n}", line[k:]]
+        elif r < 0.2 and plain:
+            out.append(line + f" // at the end {n}")
+        elif r < 0.3:
+            out += [f"// above {n}", line]
+        elif r < 0.35:
+            out += ["", f"// free {n}", "", line]
+        else:
+            out.append(line)
+    return "\n".join(out) + "\n"
+
+
+@pytest.mark.parametrize("style", ["mnemonic", "neutral"])
+@pytest.mark.parametrize("path", PROGRAMS, ids=lambda p: f"{p.parent.name}/{p.name}")
+def test_comments_anywhere_in_shipped_programs_are_kept(path, style):
+    import random
+
+    rng = random.Random(f"{path.name}-{style}")
+    instructions = app_instructions(path.parent)
+    program = parse_program(path.read_text(encoding="utf-8"), str(path), instructions)
+    if unprintable(program, style, instructions):
+        pytest.skip("string operands: neutral text cannot write them")
+    src = format_source(program, path.read_text(encoding="utf-8"), style)
+    for _ in range(8):
+        text = _sprinkle(src, style, rng)
+        parsed = parse_program(text, str(path), instructions)
+        once = format_source(parsed, text, style)
+        assert comment_texts(once) == comment_texts(text)
+        again = parse_program(once, str(path), instructions)
+        assert again == parsed
+        assert format_source(again, once, style) == once
