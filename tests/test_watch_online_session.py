@@ -194,6 +194,7 @@ def test_modes_from_every_state_and_a_fault_cleared_without_quitting(session):
     press(c, "M", "run")
     assert "clear the fault first" in s.message and e.mode is Mode.FAULTED
     press(c, "r")
+    assert not s.running and s.message == "FAULTED: C clears the fault (to PROGRAM), then M run"
     assert s.run_for(0.05) == 0  # a faulted PLC does not scan
     press(c, "C")
     assert e.mode is Mode.PROGRAM and e.fault is None and s.message.startswith("fault cleared")

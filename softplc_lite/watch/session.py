@@ -129,6 +129,9 @@ class WatchSession:
         return done
 
     def start(self) -> None:
+        if self.engine.mode is Mode.FAULTED:
+            self.message = "FAULTED: C clears the fault (to PROGRAM), then M run"
+            return
         if not self.history.live:
             self.history.latest()
         self.running = True

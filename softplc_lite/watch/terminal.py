@@ -69,7 +69,7 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("U", ("U",), "unforce", "remove the force on ADDR"),
     Binding("M", ("M",), "mode", "change mode: program, run or test"),
     Binding("C", ("C",), "clear_fault", "clear the major fault (to PROGRAM; then M run)"),
-    Binding("?", ("?",), "help", "this list of keys (any key closes it)"),
+    Binding("?", ("?",), "help", "show every key and what it does (any key closes the list)"),
     Binding("q", ("q",), "quit", "quit (saves the retentive data table)"),
 )
 # (key label, help text) of every key: for ``softplc watch --help``.
