@@ -303,3 +303,12 @@ def test_the_watch_list_keeps_values_whole_and_shortens_only_names_that_do_not_f
     assert lines[1].split()[1] == "-1234.568"  # the value whole
     assert lines[2].split() == ["F8:1", "0.0"]
     assert all(len(line) <= 46 for line in lines)
+
+
+def test_help_goes_to_two_columns_when_one_does_not_fit(session):
+    s = session()
+    shown = draw(s, width=100, height=14, help_keys=KEYS)
+    lines = shown.splitlines()
+    assert "keys (any key closes this)" in shown
+    assert any("n, space" in line and "toggle a breakpoint" in line for line in lines)  # side by side
+    assert "q " in shown and len(lines) == 14

@@ -32,18 +32,27 @@ KEY_LINES = ("n step  r run  p pause  +/- speed  ↑↓ rung  g go to  f file  b
 
 class HelpOverlay:
     """Every key and what it does (the ``?`` key; any key closes it):
-    ``keys`` is terminal.py's table of (key label, help text)."""
+    ``keys`` is terminal.py's table of (key label, help text). In two
+    columns when one does not fit the height."""
 
     def __init__(self, keys) -> None:
         self.keys = keys
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         yield Text(" keys (any key closes this)", style="bold underline")
-        width = max(cell_len(label) for label, _ in self.keys)
-        for label, text in self.keys:
+        height = (options.height or console.height) - 1
+        columns = 2 if len(self.keys) > height else 1
+        rows = -(-len(self.keys) // columns)
+        width = options.max_width // columns
+        label_w = max(cell_len(label) for label, _ in self.keys)
+        for row in range(rows):
             line = Text(no_wrap=True, overflow="ellipsis")
-            line.append(f"  {label.ljust(width)}  ", style="bold")
-            line.append(text)
+            for label, text in self.keys[row::rows]:
+                entry = Text(no_wrap=True, overflow="ellipsis")
+                entry.append(f"  {label.ljust(label_w)}  ", style="bold")
+                entry.append(text)
+                entry.truncate(width, overflow="ellipsis", pad=True)
+                line.append_text(entry)
             yield line
 
 
