@@ -27,12 +27,11 @@ from pathlib import Path
 from typing import IO, Sequence
 
 from .app import AppError, app_instructions, lad_files
-from .errors import file_error
+from .errors import LocatedError, file_error
 from .ladder.errors import LadderError
 from .ladder.fmt import STYLES, format_source, unprintable
 from .ladder.parser import parse_program, syntax_problems
 from .textfile import decode_text, read_bytes
-from .errors import LocatedError
 
 STDIN = "-"
 EXIT_OK, EXIT_ERROR = 0, 1
