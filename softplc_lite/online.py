@@ -6,8 +6,9 @@ each file, at most once per ``interval_s`` of wall time. A change is taken
 once the files have stayed the same for one more check (an editor still
 saving is not read half-written); then the app is loaded again the way
 ``softplc run`` loads it (app.load_app, without the code cache: parse,
-validate, the table check, the modules' instruction set) in a background
-thread while the old program keeps running. If the files changed while they
+validate, the table check, the modules' instruction set) and compiled
+(ladder/online.precompile) in a background thread while the old program
+keeps running. If the files changed while they
 were read, the result is dropped and they are read again.
 
 ``poll()`` returns None, or an ``OnlineEdit``: ``accepted`` with the new
@@ -29,7 +30,7 @@ from pathlib import Path
 
 from .app import App, AppError, lad_files, load_app
 from .ladder.ast import Program
-from .ladder.online import EditRefused, ProgramChanges, program_changes
+from .ladder.online import EditRefused, ProgramChanges, precompile, program_changes
 
 CHECK_INTERVAL_S = 0.2  # the least wall time between two looks at the files
 
@@ -44,6 +45,7 @@ class OnlineEdit:
     changes: ProgramChanges | None = None
     errors: list[str] = field(default_factory=list)
     applied: bool = False  # replace_program took it
+    code: dict | None = field(default=None, repr=False)  # precompiled in the worker (ladder/online.precompile)
 
     @property
     def accepted(self) -> bool:
@@ -150,8 +152,12 @@ class ProgramWatcher:
         except AppError as e:
             errors = [x.report() for x in e.errors] if e.errors else [str(e)]
             return OnlineEdit(errors=errors)
+        try:  # compiled here, in the background: the scan boundary only binds it
+            code = precompile(new.program, self.app.settings)
+        except Exception:  # the scan thread compiles it then, and reports what goes wrong
+            code = None
         return OnlineEdit(program=new.program, source_program=new.source_program,
-                          changes=program_changes(self.app.program, new.program))
+                          changes=program_changes(self.app.program, new.program), code=code)
 
     def poll(self) -> OnlineEdit | None:
         """A new version read since the last poll, accepted or not; else None."""
@@ -180,7 +186,7 @@ class ProgramWatcher:
         if not edit.accepted or edit.applied:
             return edit
         try:
-            edit.changes = engine.replace_program(edit.program)
+            edit.changes = engine.replace_program(edit.program, edit.code)
         except EditRefused as e:
             edit.errors = [x.report() for x in e.errors]
             return edit

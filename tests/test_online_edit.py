@@ -12,16 +12,34 @@ from softplc_lite.app import load_app
 from softplc_lite.ladder import Engine, Mode, load_text
 from softplc_lite.ladder import status as S
 from softplc_lite.ladder.instructions import InstructionSpec, K, OperandSpec
-from softplc_lite.ladder.online import EditRefused, program_changes
+from softplc_lite.ladder.online import EditRefused, precompile, program_changes
 from softplc_lite.online import ProgramWatcher
 from softplc_lite.tlm import TLM
 from softplc_lite.tlm.registry import instruction_set
 
 EXECUTORS = ["compiled", "reference"]
+# "precompiled": the compiled executor given the code compiled beforehand, as the watcher's thread does
+HOW = [*EXECUTORS, "precompiled"]
+PRECOMPILED: set[int] = set()  # ids of the engines built "precompiled"
 
 
-def running(text: str, executor: str, scans: int = 0, **values) -> Engine:
-    e = Engine(load_text(text), executor=executor)
+def replace(e: Engine, program):
+    """Engine.replace_program, with the code precompiled for a "precompiled" engine."""
+    if id(e) not in PRECOMPILED:
+        return e.replace_program(program)
+    code = precompile(program, e.settings)
+    assert code is not None
+    old_files = e.files
+    changes = e.replace_program(program, code)
+    if e.files is not old_files:  # taken: bound from the code (a compiler is made only when needed), not compiled
+        assert all(callable(compiled._compiler) for compiled, _ in e.files.values())
+    return changes
+
+
+def running(text: str, how: str, scans: int = 0, **values) -> Engine:
+    e = Engine(load_text(text), executor="reference" if how == "reference" else "compiled")
+    if how == "precompiled":
+        PRECOMPILED.add(id(e))
     for address, value in values.items():
         e.table.write(address, value)
     e.set_mode(Mode.RUN)
@@ -70,14 +88,14 @@ def test_same_program_is_no_change_and_files_added_or_deleted_are_said():
 # -- Engine.replace_program -------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("executor", EXECUTORS)
+@pytest.mark.parametrize("executor", HOW)
 def test_rungs_added_removed_changed_keep_the_table_and_timers_and_counters_run_on(executor):
     e = running(BASE, executor, scans=5, **{"B3:0/0": 1})
     e.table.write("B3/1", 1)
     e.scan()
     assert e.table.read("T4:0.ACC") == 5 and e.table.read("C5:0.ACC") == 1 and e.table.read("N7:0") == 6
     new = "XIC B3/0 TON T4:0 0.01 100 0\nXIC B3/1 CTU C5:0 100 0\nSUB N7:1 1 N7:1\n"
-    changes = e.replace_program(load_text(new))
+    changes = replace(e, load_text(new))
     assert changes.summary() == "file 2: 1 rung changed (2); created N7:1"
     assert e.table.read("T4:0.ACC") == 5 and e.table.read("N7:0") == 6  # kept, not scanned meanwhile
     e.table.write("B3/1", 0)
@@ -90,24 +108,24 @@ def test_rungs_added_removed_changed_keep_the_table_and_timers_and_counters_run_
     assert e.mode is Mode.RUN
 
 
-@pytest.mark.parametrize("executor", EXECUTORS)
+@pytest.mark.parametrize("executor", HOW)
 def test_new_files_and_elements_are_created_with_their_data_values(executor):
     e = running("ADD N7:0 1 N7:0\nDATA N10 2 = 7 8\n", executor, scans=2)
     e.table.write("N10:0", 70)
     new = "ADD N7:0 1 N7:0\nMOV N11:3 N7:20\nMOV F12:1 F12:0\nDATA N10 4 = 1 2 3 4\nDATA N11 4 = 5 6 7 9\n"
-    changes = e.replace_program(load_text(new))
+    changes = replace(e, load_text(new))
     assert "created N7:1-N7:20, N10:2-N10:3, N11 (4 elements), F12 (2 elements)" in changes.summary()
     assert [e.table.read(f"N10:{k}") for k in range(4)] == [70, 8, 3, 4]  # live values kept, new get DATA
     e.scan()
     assert e.table.read("N7:20") == 9 and e.table.read("N7:0") == 3
 
 
-@pytest.mark.parametrize("executor", EXECUTORS)
+@pytest.mark.parametrize("executor", HOW)
 def test_a_changed_preset_writes_pre_and_keeps_acc(executor):
     e = running(BASE, executor, scans=10, **{"B3:0/0": 1})
     e.table.write("T4:0.PRE", 500)  # an online data change, later overwritten by the edit's new preset
     e.table.write("C5:0.PRE", 77)  # a preset the edit does not touch: kept
-    e.replace_program(load_text(BASE.replace("100 0\nXIC B3/1", "20 0\nXIC B3/1")))
+    replace(e, load_text(BASE.replace("100 0\nXIC B3/1", "20 0\nXIC B3/1")))
     assert e.table.read("T4:0.PRE") == 20 and e.table.read("T4:0.ACC") == 9
     assert e.table.read("C5:0.PRE") == 77
     e.run(10)
@@ -116,23 +134,23 @@ def test_a_changed_preset_writes_pre_and_keeps_acc(executor):
     assert e.table.read("T4:0/DN") == 1  # 20 reached with the new preset
 
 
-@pytest.mark.parametrize("executor", EXECUTORS)
+@pytest.mark.parametrize("executor", HOW)
 def test_a_timer_new_to_the_program_gets_pre_and_acc_a_kept_one_keeps_its_acc(executor):
     e = running("XIC B3/0 TON T4:1 0.01 100 5\n", executor, scans=1)  # rung false: ACC reset to 0
-    e.replace_program(load_text("XIC B3/0 TON T4:1 0.01 100 5\nXIC B3/0 TON T4:0 0.01 30 4\n"
+    replace(e, load_text("XIC B3/0 TON T4:1 0.01 100 5\nXIC B3/0 TON T4:0 0.01 30 4\n"
                                 "XIC B3/0 TON T4:2 0.01 40 3\n"))
     assert [e.table.read(f"T4:{k}.PRE") for k in range(3)] == [30, 100, 40]
     # T4:0 existed (T4:1 made the file) but no instruction used it: as a download
     assert [e.table.read(f"T4:{k}.ACC") for k in range(3)] == [4, 0, 3]
 
 
-@pytest.mark.parametrize("executor", EXECUTORS)
+@pytest.mark.parametrize("executor", HOW)
 def test_an_edit_the_table_cannot_take_is_refused_and_nothing_changes(executor):
     e = running("ADD N7:0 1 N7:0\nMOV 5 N10:0\n", executor, scans=3)
     before = [(f.name, f.size) for f in e.table.files()]
     program = e.program
     with pytest.raises(EditRefused) as refused:
-        e.replace_program(load_text("ADD N7:0 1 N7:0\nMOV 1.5 F10:0\nMOV 1 N12:40\n", source="main.lad"))
+        replace(e, load_text("ADD N7:0 1 N7:0\nMOV 1.5 F10:0\nMOV 1 N12:40\n", source="main.lad"))
     assert "main.lad:2:" in str(refused.value) and "N10" in str(refused.value)
     assert [(f.name, f.size) for f in e.table.files()] == before  # N12 not created
     assert e.program is program
@@ -140,14 +158,14 @@ def test_an_edit_the_table_cannot_take_is_refused_and_nothing_changes(executor):
     assert e.table.read("N7:0") == 4 and e.table.read("N10:0") == 5  # the old program runs on
 
 
-@pytest.mark.parametrize("executor", EXECUTORS)
+@pytest.mark.parametrize("executor", HOW)
 def test_one_shots_and_fifo_and_shift_controls_are_kept(executor):
     text = ("XIC B3/0 ONS B3/1 ADD N7:0 1 N7:0\n"
             "XIC B3/2 FFL N7:1 #N7:10 R6:0 4 0\n"
             "XIC B3/3 BSL #B3:10 R6:1 B3/4 8\n")
     e = running(text, executor, scans=2, **{"B3:0/0": 1, "N7:1": 42, "B3:0/2": 1, "B3:0/3": 1, "B3:0/4": 1})
     assert e.table.read("N7:0") == 1 and e.table.read("R6:0.POS") == 1 and e.table.read("B3:10/0") == 1
-    e.replace_program(load_text("OTE B3/15\n" + text.replace("R6:1 B3/4 8", "R6:1 B3/4 12")))
+    replace(e, load_text("OTE B3/15\n" + text.replace("R6:1 B3/4 8", "R6:1 B3/4 12")))
     e.run(2)
     assert e.table.read("N7:0") == 1  # the storage bit is kept: a rung still true does not fire again
     assert e.table.read("R6:0.POS") == 1  # EN kept: no new FFL load without a transition
@@ -161,11 +179,11 @@ def test_one_shots_and_fifo_and_shift_controls_are_kept(executor):
     assert e.table.read("R6:0.POS") == 2 and e.table.read("B3:10/1") == 1
 
 
-@pytest.mark.parametrize("executor", EXECUTORS)
+@pytest.mark.parametrize("executor", HOW)
 def test_first_pass_is_not_set_again_and_the_mode_stays(executor):
     e = running("XIC S:1/15 ADD N7:0 1 N7:0\n", executor, scans=3)
     e.set_mode(Mode.TEST)
-    e.replace_program(load_text("XIC S:1/15 ADD N7:0 1 N7:0\nXIC S:1/15 ADD N7:1 1 N7:1\n"))
+    replace(e, load_text("XIC S:1/15 ADD N7:0 1 N7:0\nXIC S:1/15 ADD N7:1 1 N7:1\n"))
     e.run(2)
     assert e.mode is Mode.TEST and e.table.read("N7:0") == 1 and e.table.read("N7:1") == 0
     assert not e.table.read("S:1/15") and e.table.read(f"S:{S.MODE_WORD}") == Mode.TEST.value
@@ -195,15 +213,18 @@ class Keep(TLM):
         return count
 
 
-@pytest.mark.parametrize("executor", EXECUTORS)
+@pytest.mark.parametrize("executor", HOW)
 def test_module_instructions_of_unchanged_rungs_keep_their_instances(executor):
     module = Keep()
     instructions = instruction_set([module])
-    e = Engine(load_text("COUNTUP N7:0\nCOUNTUP N7:1\n", instructions=instructions), executor=executor,
-               modules=[module])
+    e = Engine(load_text("COUNTUP N7:0\nCOUNTUP N7:1\n", instructions=instructions),
+               executor="reference" if executor == "reference" else "compiled", modules=[module])
     e.set_mode(Mode.RUN)
     e.run(3)
-    e.replace_program(load_text("OTE B3/0\nCOUNTUP N7:0\nXIC B3/0 COUNTUP N7:1\n", instructions=instructions))
+    new = load_text("OTE B3/0\nCOUNTUP N7:0\nXIC B3/0 COUNTUP N7:1\n", instructions=instructions)
+    code = precompile(new, e.settings) if executor == "precompiled" else None
+    assert (code is not None) == (executor == "precompiled")
+    e.replace_program(new, code)
     e.run(2)
     assert e.table.read("N7:0") == 5  # moved down a rung, same text: the same instance
     assert e.table.read("N7:1") == 2  # its rung changed: a new instance

@@ -378,24 +378,28 @@ class Engine:
             self.recorder = None
 
     # -- online program edit ---------------------------------------------------------------
-    def replace_program(self, program: Program):
+    def replace_program(self, program: Program, code: dict | None = None):
         """Run ``program`` (validated) from the next scan on, the data table
-        kept: call between scans, from the scan thread. Returns the
-        ProgramChanges; raises EditRefused (nothing changed) if the table
+        kept: call between scans, from the scan thread (``code``: its code
+        from ladder/online.precompile, bound instead of compiled). Returns
+        the ProgramChanges; raises EditRefused (nothing changed) if the table
         cannot take the program. What is kept and what is written:
         ladder/online.py, docs/engine.md "Online program edit"."""
         from .online import replace_program
 
-        return replace_program(self, program)
+        return replace_program(self, program, code)
 
-    def _rebuild(self, program: Program, kept_instances: dict) -> None:
-        """Build the code of ``program`` for the engine's executor; module
-        instructions in ``kept_instances`` (id -> instance) keep theirs. If
-        building fails, the old program and code stay and the error is raised."""
+    def _rebuild(self, program: Program, kept_instances: dict, build=None) -> None:
+        """Build the code of ``program`` (with ``build``, else for the
+        engine's executor); module instructions in ``kept_instances`` (id ->
+        instance) keep theirs. If building fails, the old program and code
+        stay and the error is raised."""
         saved = self.program, self.files, self._instances
         self.program, self._instances, self._kept_instances = program, {}, kept_instances
+        if build is None:
+            build = compile_file if self.executor == "compiled" else interpret_file
         try:
-            self._build_files(program, compile_file if self.executor == "compiled" else interpret_file)
+            self._build_files(program, build)
         except BaseException:
             self.program, self.files, self._instances = saved
             raise

@@ -143,14 +143,9 @@ def _file_changes(number: int, old: list[str], new: list[str]) -> FileChanges:
     for op, i1, i2, j1, j2 in matcher.get_opcodes():
         if op == "equal":
             fc.kept.update(zip(range(i1, i2), range(j1, j2)))
-        elif op == "replace":
-            # rung for rung, in place: changed; what one side has more is removed or added
-            n = min(i2 - i1, j2 - j1)
-            for k in range(n):
-                removed.append(i1 + k)  # paired below unless it only moved
-                added.append(j1 + k)
-            removed += range(i1 + n, i2)
-            added += range(j1 + n, j2)
+        elif op == "replace":  # paired below: moved, or changed in place, or removed and added
+            removed += range(i1, i2)
+            added += range(j1, j2)
         elif op == "delete":
             removed += range(i1, i2)
         else:
@@ -181,6 +176,9 @@ def _file_changes(number: int, old: list[str], new: list[str]) -> FileChanges:
     return fc
 
 
+_MAX_COMPARED = 2500  # rung pairs of one replaced block compared by text similarity, at most
+
+
 def _in_place(removed: list[int], added: list[int], matcher) -> list[tuple[int, int]]:
     """Pairs (old, new) of one replace block's rungs that are one rung
     changed: in order, each new rung with the most similar old rung after
@@ -192,8 +190,12 @@ def _in_place(removed: list[int], added: list[int], matcher) -> list[tuple[int, 
         if op != "replace":
             continue
         olds = [i for i in range(i1, i2) if i in removed_set]
+        news = [j for j in range(j1, j2) if j in added_set]
+        if len(olds) * len(news) > _MAX_COMPARED:  # a block rewritten wholesale: rung for rung, cheaply
+            pairs += zip(olds, news)
+            continue
         after = 0  # index into olds: pairs keep the rungs' order
-        for j in (j for j in range(j1, j2) if j in added_set):
+        for j in news:
             scored = [(difflib.SequenceMatcher(None, old[i], new[j]).ratio(), k) for k, i in enumerate(olds)
                       if k >= after]
             if scored:
@@ -247,14 +249,49 @@ def edit_writes(old_writes: list, new_writes: list, is_new) -> list:
     return out
 
 
-def replace_program(engine, program: Program) -> ProgramChanges:
+def precompile(program: Program, settings) -> dict | None:
+    """The compiled code of ``program`` in the code cache's form
+    (codecache.export_file), compiled against a scratch table: what a
+    background thread can do while the old program runs, so that the scan
+    thread only binds it (codecache.import_file) at the scan boundary
+    instead of compiling. None when some file cannot take that form (the
+    scan thread then compiles)."""
+    from .codecache import export_file
+    from .compiler import compile_file
+    from .engine import reference_program
+    from .semantics import Machine
+
+    table = DataTable()
+    reference_program(program, table)
+    machine = Machine(table, settings)
+    files = {}
+    for number in sorted(program.files):
+        compiled = compile_file(program, number, table, machine, _no_call, [True], _stand_in)
+        data = export_file(compiled, program.files[number].rungs, machine, table)
+        if data is None:
+            return None
+        files[number] = data
+    return {"files": files}
+
+
+def _no_call(*args) -> None:  # precompile's JSR and module instances: never run, only named
+    raise AssertionError("precompiled code is bound again before it runs")
+
+
+def _stand_in(ins):
+    return _no_call
+
+
+def replace_program(engine, program: Program, code: dict | None = None) -> ProgramChanges:
     """Engine.replace_program: ``program`` (validated) runs from the next
     scan on, the data table kept. The files and elements it names are
     created; DATA values go into new elements only; instruction download
     values as ``edit_writes`` says; the code is built anew for the engine's
     executor; module instructions of unchanged rungs keep their instances.
-    The mode, S:1/15 and the rest of the table stay. Raises EditRefused,
-    with nothing changed, when the table cannot take the program."""
+    The mode, S:1/15 and the rest of the table stay. ``code``: the
+    program's code from ``precompile`` (bound here instead of compiled).
+    Raises EditRefused, with nothing changed, when the table cannot take
+    the program."""
     from .engine import _located, instruction_writes, reference_module_blocks, reference_program
 
     old = engine.program
@@ -292,7 +329,13 @@ def replace_program(engine, program: Program) -> ProgramChanges:
     kept = {id(new): instances[id(was)] for was, new in kept_instructions(old, program, changes)
             if id(was) in instances}
     try:
-        engine._rebuild(program, kept)
+        if code is not None and engine.executor == "compiled":
+            try:  # bound to the live table, as the code cache's code is
+                engine._rebuild(program, kept, engine._cached_build(code))
+            except Exception:  # code that does not fit after all: compile, as without it
+                engine._rebuild(program, kept)
+        else:
+            engine._rebuild(program, kept)
     except Exception as exc:  # a bug in the compiler: the old code runs on (the table only grew)
         problem = f"internal error building the new program: {type(exc).__name__}: {exc}"
         raise EditRefused([LadderError(Pos("online edit", 0, 0), problem)]) from exc
