@@ -4,6 +4,7 @@ into the CLI by the lead (see /tmp/h18/online_wiring.md)."""
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -44,8 +45,6 @@ def save(path: Path, text: str) -> None:
     """Write and move the mtime on, as an editor's save a moment later would."""
     path.write_text(text)
     st = path.stat()
-    import os
-
     os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 10_000_000))
 
 
@@ -53,7 +52,7 @@ def test_run_online_takes_a_good_edit_and_refuses_a_bad_one(tmp_path):
     app = tmp_path / "app"
     app.mkdir()
     main = app / "main.lad"
-    main.write_text("ADD N7:0 1 N7:0\n")
+    main.write_text("DATA N7 2\nADD N7:0 1 N7:0\n")  # N7:1 exists: --print checks it before scan 0
     snap = app / ".softplc" / "datatable.snap"
     proc = subprocess.Popen([sys.executable, "-m", "softplc_lite", "run", str(app), "--realtime", "--scan-ms", "5",
                              "--fresh", "--online", "--print", "N7:0", "--print", "N7:1"],
@@ -64,11 +63,11 @@ def test_run_online_takes_a_good_edit_and_refuses_a_bad_one(tmp_path):
         while not snap.exists() and time.monotonic() < deadline and proc.poll() is None:
             time.sleep(0.02)  # scanning: its first periodic save is there
         assert proc.poll() is None, "\n".join(err.lines)
-        save(main, "ADD N7:0 1 N7:0\nADD N7:1 1\n")  # bad: ADD needs a destination
+        save(main, "DATA N7 2\nADD N7:0 1 N7:0\nADD N7:1 1\n")  # bad: ADD needs a destination
         rejected = err.wait_for("online edit rejected", 15)
         assert rejected is not None, "\n".join(err.lines)
-        assert err.wait_for("main.lad:2:", 5) is not None, "\n".join(err.lines)
-        save(main, "ADD N7:0 1 N7:0\nADD N7:1 1 N7:1\n")
+        assert err.wait_for("main.lad:3:1: ADD takes 3 operands", 5) is not None, "\n".join(err.lines)
+        save(main, "DATA N7 2\nADD N7:0 1 N7:0\nADD N7:1 1 N7:1\n")
         accepted = err.wait_for("online edit accepted", 15)
         assert accepted is not None, "\n".join(err.lines)
         assert "file 2: 1 rung added (1)" in accepted
