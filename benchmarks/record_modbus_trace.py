@@ -221,6 +221,9 @@ def annotate(path: str | Path, recorded: dict, replay_scans: int) -> None:
         f"# recorded run: {counts} last_exception={recorded['last_exception']}",
         ("# replay: softplc run programs/modbus_master --fresh --replay programs/modbus_master/pymodbus-session.trace"
          f" --scans {replay_scans}"),
+        # read by ports/trace.py: a --replay without --scans stops there
+        f"# scans: {replay_scans} (the replay's: at the app's 1 ms a scan, the last reply is counted in scan "
+        f"{replay_scans})",
     ]
     header = 1 if lines and lines[0].startswith("# softplc_lite port trace") else 0
     lines[header:header] = [n + "\n" for n in notes]

@@ -22,17 +22,18 @@ from rich.console import Console
 from rich.live import Live
 
 from . import __version__
-from .app import SCAN_MS_RANGE, AppError, app_instructions, lad_files, load_app, parse_files
+from .app import SCAN_MS_RANGE, AppError, load_app
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
 from .datatable.display import format_read
 from .display import StatusLine
 from .ladder.engine import Mode
 from .ladder.errors import LadderError
-from .ladder.fmt import STYLES, format_program, unprintable
+from .fmtcmd import fmt_command
+from .ladder.fmt import STYLES
 from .ladder.symbols import SymbolIndex, is_symbol_text, resolve_name
 from .runner import RunOptions, Runner
-from .errors import LocatedError
+from .errors import FileAccessError, LocatedError, file_error
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT, EXIT_INTERNAL = 0, 1, 2, 3, 4
 EXIT_REPLAY = 5  # --replay: the program wrote bytes other than the recording's
@@ -95,7 +96,11 @@ def _cmd_datatable(args: argparse.Namespace) -> int:
     if args.dump:
         sys.stdout.write(jsonio.dumps(table))
     if args.save:
-        snapshot.save(table, args.save)
+        try:
+            snapshot.save(table, args.save)
+        except OSError as e:
+            print(f"error: --save: {file_error(e, args.save, 'write')}", file=sys.stderr)
+            return EXIT_ERROR
     return EXIT_OK
 
 
@@ -131,6 +136,17 @@ def _cmd_run(args: argparse.Namespace) -> int:
         for problem in problems:
             print(f"error: {problem}", file=sys.stderr)
         return EXIT_ERROR
+    if args.online:
+        from .online import ProgramWatcher
+
+        watcher = ProgramWatcher(app)
+
+        def online_edit(runner: Runner) -> None:
+            edit = watcher.apply(runner.engine)
+            if edit is not None:  # stderr: above the status line when rich's Live draws one
+                print(edit.summary() if edit.accepted else edit.report(), file=sys.stderr)
+
+        runner.between_scans.append(online_edit)
     try:
         _scan_until_the_end(runner, app, args)
     finally:
@@ -138,7 +154,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
     engine = runner.engine
     storage_problems = runner.finish()  # the final save; a failure is reported, and the output still printed
     if args.dump:
-        Path(args.dump).write_text(jsonio.dumps(runner.table), encoding="utf-8")
+        try:
+            Path(args.dump).write_text(jsonio.dumps(runner.table), encoding="utf-8")
+        except OSError as e:
+            print(f"error: --dump: {file_error(e, args.dump, 'write')}", file=sys.stderr)
+            storage_problems = storage_problems or [str(e)]
     if app.display:
         clock = "real" if engine.clock.realtime else "simulated"
         print(f"{app.name}: {engine.scans} scans, {engine.clock.now_ms / 1000:.2f} s {clock} time")
@@ -251,20 +271,7 @@ def _print_warnings(warnings: list[str]) -> None:
 
 
 def _cmd_fmt(args: argparse.Namespace) -> int:
-    path = Path(args.path)
-    if not path.exists():
-        raise AppError(f"{path}: no such file or directory")
-    files = lad_files(path)
-    instructions = app_instructions(path)
-    for k, f in enumerate(files):
-        program, errors = parse_files([f], path, instructions)
-        errors = errors or unprintable(program, args.style, instructions)
-        if errors:
-            raise AppError(errors)
-        if len(files) > 1:
-            print(("\n" if k else "") + f"// ==> {f.name} <==")
-        sys.stdout.write(format_program(program, args.style))
-    return EXIT_OK
+    return fmt_command(args.paths, args.style, check=args.check, write=args.write)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -307,6 +314,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="set ADDR (address or symbol) to VALUE (JSON, or plain text) at start (repeatable)")
     r.add_argument("--print", action="append", default=[], metavar="ADDR",
                    help="print ADDR (address or symbol) at the end (repeatable; checked before scan 0)")
+    r.add_argument("--online", action="store_true",
+                   help="online program edit: watch the app's .lad files; a saved valid version replaces the "
+                        "running program between two scans, the data table kept; errors are printed and "
+                        "nothing changes (docs/engine.md, Online program edit)")
     r.add_argument("--executor", choices=("compiled", "reference"), default="compiled",
                    help="compiled fast path (default) or the reference interpreter")
     r.add_argument("--port", action="append", default=[], metavar="N=DEVICE",
@@ -362,9 +373,19 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("app", metavar="APP", help="app directory or .lad file")
     c.set_defaults(func=_cmd_check)
 
-    f = sub.add_parser("fmt", help="print a program canonically")
-    f.add_argument("path", metavar="PATH", help=".lad file or app directory")
-    f.add_argument("--style", choices=STYLES, default="mnemonic")
+    f = sub.add_parser("fmt", help="print, check or rewrite .lad programs canonically, keeping every comment",
+                       description="Print each .lad file (an app directory: each of its .lad files; -: standard "
+                                   "input) canonically, keeping every comment; what does not parse is refused "
+                                   "(exit 1, every problem listed). See docs/language.md.")
+    f.add_argument("paths", nargs="+", metavar="PATH", help=".lad file, app directory, or - for standard input")
+    f.add_argument("--style", choices=STYLES, default="mnemonic",
+                   help="mnemonic (XIC B3/0 OTE O:0/0; the default) or neutral text (XIC(B3/0)OTE(O:0/0);)")
+    mode = f.add_mutually_exclusive_group()
+    mode.add_argument("--check", action="store_true",
+                      help="print nothing; exit 1 naming each file that is not formatted (a CI gate)")
+    mode.add_argument("--write", action="store_true",
+                      help="rewrite each file that changes in place, atomically; nothing is written if a file "
+                           "is refused")
     f.set_defaults(func=_cmd_fmt)
 
     a = sub.add_parser("address", help="parse data table addresses and print their canonical form",
@@ -424,7 +445,7 @@ def _dispatch(args: argparse.Namespace) -> int:
         print(f"error: {text}" if not isinstance(e, AppError) else text, file=sys.stderr)
         return EXIT_ERROR
     except OSError as e:
-        print(f"error: {e}", file=sys.stderr)
+        print(f"error: {e if isinstance(e, FileAccessError) else file_error(e, action='open')}", file=sys.stderr)
         return EXIT_ERROR
     except KeyboardInterrupt:
         return EXIT_INTERRUPTED

@@ -23,14 +23,14 @@ from pathlib import Path
 from typing import Callable
 
 from .app import App, save_code_cache
-from .datatable import DataTable, DataTableError, jsonio, snapshot
+from .datatable import DataTable, DataTableError, jsonio
 from .ladder import status as S
 from .ladder.engine import Engine, Mode, RealClock, SimulatedClock
 from .ladder.symbols import resolve_name
 from .ports import parse_port_overrides
 from .ports.recorder import MAX_PENDING
 from .ports.trace import covered_scans
-from .retentive import Retentive, StorageFaults
+from .retentive import Retentive, StorageFaults, restore_snapshot
 
 
 def parse_assignment(text: str, symbols=None) -> tuple[object, object]:
@@ -92,11 +92,10 @@ class Runner:
         self.restored_from: Path | None = None
         path = app.snapshot_path
         if path is not None and not options.fresh:
-            restored = snapshot.restore(path)
+            restored = restore_snapshot(self.table, path)  # a snapshot that does not fit says so, suggests --fresh
             for problem in restored.problems:
                 self.log(f"warning: {problem}")
             if restored.table is not None:
-                self.table.assign(restored.table)
                 self.restored_from = restored.source
         if self.restored_from is None and app.datatable_json is not None:
             jsonio.load_file(self.table, str(app.datatable_json))

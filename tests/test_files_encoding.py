@@ -17,7 +17,7 @@ import pytest
 from softplc_lite.app import AppError, load_app
 from softplc_lite.datatable import DataTable, jsonio
 from softplc_lite.errors import LocatedError
-from softplc_lite.textfile import decode_text, read_text
+from softplc_lite.textfile import decode_text
 
 ROOT = Path(__file__).resolve().parent.parent
 ENCODINGS = {
