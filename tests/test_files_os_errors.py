@@ -115,3 +115,14 @@ def test_a_snapshot_that_cannot_be_read_suggests_fresh(tmp_path):
         restore_snapshot(DataTable(), path)
     assert f"the retentive snapshot kept between runs in {path.parent}{os.sep} cannot be read" in str(e.value)
     assert "run with --fresh" in str(e.value)
+
+
+def test_dump_into_a_directory_is_said_in_words_and_exits_1(tmp_path):
+    """--dump to a path that is a directory: the run still ends cleanly, the
+    error is a sentence, and the exit status says something failed."""
+    out = subprocess.run([sys.executable, "-m", "softplc_lite", "run", "programs/motor", "--fresh", "--scans", "2",
+                          "--state", str(tmp_path / "state"), "--dump", str(tmp_path)],
+                         capture_output=True, text=True, timeout=60, cwd=Path(__file__).resolve().parent.parent)
+    assert out.returncode == 1
+    assert f"error: --dump: cannot write {tmp_path}: it is a directory" in out.stderr
+    assert "Errno" not in out.stderr and "Traceback" not in out.stderr
