@@ -91,8 +91,8 @@ def test_b_file_starts_in_binary_bit_15_on_the_left(table):
 def test_float_file_seven_significant_digits(table):
     assert drawn(DataGrid(table, "F8", radix="hex")) == [  # a radix does not apply to floats
         " F8  float, 7 elements  floats, 7 digits  F8:0..6",
-        "F8:0              0      3.141593        -1e-09             0             0",
-        "F8:5              0             0",
+        "F8:0            0.0      3.141593        -1e-09           0.0           0.0",
+        "F8:5            0.0           0.0",
     ]
 
 

@@ -279,7 +279,9 @@ def test_every_binding_has_an_action_and_no_key_is_bound_twice():
     keys = [k for b in BINDINGS for k in b.keys]
     assert len(keys) == len(set(keys))
     assert all(hasattr(Controller, f"_do_{b.action}") for b in BINDINGS)
-    assert not {"/", "x", "X", "d", "R"} & set(keys)  # kept for find and the data grid
+    actions = {k: b.action for b in BINDINGS for k in b.keys}
+    assert [actions[k] for k in ("/", "x", "X", "d", "R", "esc", "E")] == \
+        ["find", "use", "use", "data_file", "radix", "close", "edit_errors"]
 
 
 # -- value formats ---------------------------------------------------------------------------------
@@ -310,5 +312,8 @@ def test_help_goes_to_two_columns_when_one_does_not_fit(session):
     shown = draw(s, width=100, height=14, help_keys=KEYS)
     lines = shown.splitlines()
     assert "keys (any key closes this)" in shown
-    assert any("n, space" in line and "toggle a breakpoint" in line for line in lines)  # side by side
-    assert "q " in shown and len(lines) == 14
+    assert any("n, space" in line and "rung comments" in line for line in lines)  # side by side: 3 columns
+    assert all(label in shown for label, _ in KEYS) and len(lines) == 14
+    shown = draw(s, width=80, height=24, help_keys=KEYS)  # the smallest terminal: two columns, every key
+    assert any("n, space" in line and "t, Ctrl-T" in line for line in shown.splitlines())
+    assert all(label in shown for label, _ in KEYS)

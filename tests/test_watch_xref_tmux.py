@@ -1,9 +1,6 @@
 """Find and cross-reference and the data-file monitor in the real ``softplc
 watch``, in tmux: ``/`` finds, ``x``/``X`` step through the uses, ``d``
-shows a data file, ``R`` changes its radix, Esc closes it.
-
-Wired by the lead (session.py, terminal.py, screen.py: /tmp/h18/xref_wiring.md);
-remove the skip mark when the wiring is in."""
+shows a data file, ``R`` changes its radix, Esc closes it."""
 
 from __future__ import annotations
 
@@ -12,9 +9,7 @@ import sys
 import time
 
 import pytest
-from test_watch_tmux import Tmux
-
-pytestmark = pytest.mark.skip(reason="wired by the lead")
+from tmux_helpers import Tmux
 
 
 @pytest.fixture

@@ -158,6 +158,25 @@ class Breakpoints:
         compiled.blocks[k] = watched
         return True
 
+    def program_replaced(self, changes) -> list[tuple[int, int]]:
+        """After Engine.replace_program (an online edit): the old code and its
+        watched blocks are gone, so every rung breakpoint is set again on the
+        new code. A breakpoint on a rung whose text is unchanged moves to the
+        rung's new number; the others are dropped and returned as (file, old
+        rung). Condition breakpoints read the table, which is kept: they stay."""
+        old = sorted(self.rungs)
+        self.rungs.clear()
+        self._original.clear()  # the old program's blocks: never to be put back in the new code
+        self.hits.clear()
+        dropped = []
+        for file, rung in old:
+            new = changes.new_rung(file, rung)
+            if new is None:
+                dropped.append((file, rung))
+            else:
+                self.toggle(file, new)
+        return dropped
+
     # -- conditions -------------------------------------------------------------------------
     def add_condition(self, text: str, symbols=None) -> Condition:
         cond = Condition(text, symbols)

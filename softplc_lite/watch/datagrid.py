@@ -22,6 +22,7 @@ from rich.console import Console, ConsoleOptions, RenderResult
 from rich.text import Text
 
 from ..datatable import DataTable, DataTableError
+from ..datatable.display import format_float
 from ..datatable.filetypes import Storage
 from ..datatable.table import member_order, read_string
 
@@ -39,9 +40,10 @@ def next_radix(radix: str) -> str:
 
 
 def float_text(value: float) -> str:
-    """A float as a person reads it: 7 significant digits (a float32 holds
-    about that many); the JSON and --dump forms keep every digit."""
-    return f"{value:.7g}"
+    """A float as a person reads it, as everywhere in the view
+    (datatable/display.py: 7 significant digits, a float32 holds about that
+    many); the JSON and --dump forms keep every digit."""
+    return format_float(value)
 
 
 def word_in_radix(word: int, radix: str, bits: int = 16) -> str:

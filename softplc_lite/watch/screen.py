@@ -15,10 +15,12 @@ from ..ladder import status as S
 from ..ladder.engine import Mode
 from .portsview import PortsView
 from .session import WatchSession
+from .xref import XrefPanel
 
 WIDE = 120  # from this width the side panels go beside the rungs
 FORCES_SHOWN = 64  # forces listed by name; the rest are counted
 SIDE_WIDTH = 46
+FIND_LINES = 8  # the find list's lines at most (its title and seven uses around the current one)
 # The keys line at the foot, the longest that fits (from 80 columns "? help" and "q quit" always show);
 # "?" lists every key (terminal.py's table).
 KEY_LINES = ("n step  r run  p pause  +/- speed  ↑↓ rung  g go to  f file  b break  ⌫ back  F/U force  = set  "
@@ -33,7 +35,7 @@ KEY_LINES = ("n step  r run  p pause  +/- speed  ↑↓ rung  g go to  f file  b
 class HelpOverlay:
     """Every key and what it does (the ``?`` key; any key closes it):
     ``keys`` is terminal.py's table of (key label, help text). In two
-    columns when one does not fit the height."""
+    columns (or more) when one does not fit the height: 80x24 takes two."""
 
     def __init__(self, keys) -> None:
         self.keys = keys
@@ -41,7 +43,7 @@ class HelpOverlay:
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         yield Text(" keys (any key closes this)", style="bold underline")
         height = (options.height or console.height) - 1
-        columns = 2 if len(self.keys) > height else 1
+        columns = max(1, -(-len(self.keys) // max(1, height)))  # as many as the height needs
         rows = -(-len(self.keys) // columns)
         width = options.max_width // columns
         label_w = max(cell_len(label) for label, _ in self.keys)
@@ -54,6 +56,24 @@ class HelpOverlay:
                 entry.truncate(width, overflow="ellipsis", pad=True)
                 line.append_text(entry)
             yield line
+
+
+class EditErrors:
+    """Every error of a rejected online program edit (the ``E`` key; any
+    key closes it): ``report`` is OnlineEdit.report(), one
+    ``file:line:col: message`` an error, each with its source line."""
+
+    def __init__(self, report: str) -> None:
+        self.report = report
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        yield Text(" online edit errors (any key closes this)", style="bold underline")
+        lines = self.report.splitlines()
+        room = max(1, (options.height or console.height) - 1)
+        if len(lines) > room:  # the rest is in the editor's file anyway: say how much is left out
+            lines = lines[:room - 1] + [f"... and {len(lines) - room + 1} more lines"]
+        for line in lines:
+            yield Text(f" {line}", no_wrap=True, overflow="ellipsis")
 
 
 class StatusBar:
@@ -187,6 +207,8 @@ class WatchScreen:
 
     def side(self) -> Group:
         parts = [self.session.watch, self.forces]
+        if self.session.finding is not None:  # the find list first, above the watch list
+            parts.insert(0, XrefPanel(self.session.finding, height=FIND_LINES))
         if self.ports:
             parts.append(self.ports)
         return Group(*parts)
@@ -202,8 +224,13 @@ class WatchScreen:
             bottom = Text(f" {keys}", style="dim", no_wrap=True, overflow="ellipsis")
         root.split_column(Layout(self.status, size=2), Layout(name="body"), Layout(bottom, size=1))
         body = root["body"]
-        if self.help:
-            body.update(HelpOverlay(self.help))
+        overlay = HelpOverlay(self.help) if self.help else None  # the help wins over the rest
+        if overlay is None and self.session.edit_report is not None:
+            overlay = EditErrors(self.session.edit_report)
+        if overlay is None and self.session.grid is not None:  # the data-file monitor: the body until Esc
+            overlay = self.session.grid
+        if overlay is not None:
+            body.update(overlay)
             yield from root.__rich_console__(console, options.update(height=height))
             return
         side = self.side()

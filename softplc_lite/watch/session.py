@@ -15,11 +15,14 @@ from ..datatable.display import format_read
 from ..ladder.ast import AddressRef, walk
 from ..ladder.engine import Mode, ModeError
 from ..ladder.symbols import is_symbol_text, resolve_name
+from ..online import ProgramWatcher
 from ..runner import RunOptions, Runner
 from .breakpoints import Breakpoints, Hit
+from .datagrid import DataGrid, grid_for, next_radix
 from .forces import Forces, parse_force
 from .history import History
 from .watchlist import WatchList
+from .xref import Finding, XrefIndex
 
 # Run speeds ("+" and "-"): scans per second of wall time; 0 = as fast as it goes.
 SPEEDS = (1, 2, 5, 10, 20, 50, 100, 200, 500, 1000, 0)
@@ -34,6 +37,9 @@ class WatchOptions:
     forces: tuple[str, ...] = ()
     break_when: tuple[str, ...] = ()
     speed: int = 6  # index into SPEEDS: 100 scans/s
+    # online program edit: watch the app's .lad files and put a saved valid version in place
+    # (off for a snapshot, which must not depend on a file saved meanwhile)
+    online: bool = True
 
 
 class WatchSession:
@@ -69,7 +75,14 @@ class WatchSession:
         self.message = ""
         self.comments = COMMENTS[0]
         self.last_hit: Hit | None = None
+        self.xref: XrefIndex | None = None  # built at the first find, again when the program is replaced
+        self.finding: Finding | None = None  # the last find: its uses, the current one
+        self.grid: DataGrid | None = None  # the data-file monitor, while it is shown
         self.watch.sample(engine.table)
+        self.online = ProgramWatcher(app) if options.online else None
+        self.pending_edit = None  # an accepted edit polled while stepping back: put in when live
+        self.last_edit = None  # the last online edit (the E key shows its errors)
+        self.edit_report: str | None = None  # the E overlay's text while it is shown
 
     # -- scanning ---------------------------------------------------------------------------
     def scan(self) -> Hit | None:
@@ -221,6 +234,118 @@ class WatchSession:
         k = self.files.index(self.file)
         self.file = self.files[(k + 1) % len(self.files)]
         self.selected = self.top = 0
+
+    # -- find and cross-reference, the data-file monitor (docs/watch.md) ---------------------
+    def find(self, text: str) -> None:
+        """Every rung that reads or writes what ``text`` names (an address,
+        a word, a file, a symbol); selects the first use at or after the
+        selected rung."""
+        program = self.app.program
+        if self.xref is None or self.xref.program is not program:
+            self.xref = XrefIndex(program, self.app.instructions)
+        try:
+            finding = self.xref.find(text)
+        except DataTableError as e:  # an AddressError's reason, without the text quoted again
+            self.message = f"find {text.strip()}: {getattr(e, 'reason', e)}"
+            return
+        self.finding = finding
+        finding.start_at(self.file, self.selected)
+        self.next_use()
+
+    def next_use(self) -> None:
+        self._to_use(self.finding.next() if self.finding is not None else None)
+
+    def prev_use(self) -> None:
+        self._to_use(self.finding.previous() if self.finding is not None else None)
+
+    def _to_use(self, where) -> None:
+        f = self.finding
+        if f is None:
+            self.message = "nothing found yet: / finds an address or symbol"
+            return
+        if where is None:
+            self.message = f"find {f.title}: not used in any rung"
+            return
+        self.file = where[0]
+        self.goto(where[1])
+        self.message = f"{f.title} {f.current + 1} of {len(f.uses)}: {f.uses[f.current].describe()}"
+
+    def show_file(self, text: str) -> None:
+        """Show a data file as a grid (``N7``, or ``N7:20`` from element 20)."""
+        try:
+            self.grid = grid_for(self.engine.table, text)
+        except DataTableError as e:
+            self.message = str(e)
+            return
+        self.message = f"data file {self.grid.file.name}: R radix, PgUp/PgDn page, Esc closes"
+
+    def cycle_radix(self) -> None:
+        if self.grid is None:
+            self.message = "R is the data-file grid's radix: d shows a data file"
+            return
+        self.grid.radix = next_radix(self.grid.radix)
+        floats = " (an F file shows floats in any radix)" if self.grid.file.ftype.letter == "F" else ""
+        self.message = f"data file {self.grid.file.name}: radix {self.grid.radix}{floats}"
+
+    def close_panels(self) -> None:
+        """Esc: the grid first, then the find list."""
+        if self.grid is not None:
+            self.grid = None
+        else:
+            self.finding = None
+        self.message = ""
+
+    # -- online program edit (docs/engine.md, "Online program edit") ---------------------------
+    def poll_online(self) -> None:
+        """Between scans (the terminal loop calls it every turn, running or
+        paused): a saved version of the program files is put in place when
+        valid, its errors kept when not."""
+        if self.online is None:
+            return
+        edit = self.online.poll()
+        if edit is not None:
+            self.pending_edit = edit
+        edit = self.pending_edit
+        if edit is None or (edit.accepted and not self.history.live):
+            return  # stepping back in history: the new program goes in once live again
+        self.pending_edit = None
+        edit = self.online.install(self.engine, edit)
+        self.last_edit = edit
+        extra = self._program_replaced(edit.changes) if edit.applied else ""
+        if edit.accepted:
+            self.message = f"{edit.summary()} (at scan {self.engine.scans}){extra}"
+        else:
+            self.message = f"{edit.summary()}  (E: every error)"
+
+    def _program_replaced(self, changes) -> str:
+        """The view follows the new program: files, the selected rung (where
+        it went), breakpoints, the last find. Returns what the message adds."""
+        dropped = self.breaks.program_replaced(changes)
+        self.files = sorted(self.app.program.files)
+        if self.file not in self.files:
+            self.file = 2 if 2 in self.files else self.files[0] if self.files else None
+            self.selected = self.top = 0
+        else:
+            new = changes.new_rung(self.file, self.selected)
+            self.selected = new if new is not None else min(self.selected, max(len(self.rungs) - 1, 0))
+            self.top = min(self.top, self.selected)
+        self.xref = None  # indexed again from the new program
+        if self.finding is not None:  # the list shows the new rung numbers; the selection stays
+            file, selected, top = self.file, self.selected, self.top
+            query, said = self.finding.query, self.message
+            self.find(query)
+            self.file, self.selected, self.top, self.message = file, selected, top, said
+        return f"; {len(dropped)} breakpoint(s) on edited rungs cleared" if dropped else ""
+
+    def show_edit_errors(self) -> None:
+        """The E key: every error of the last rejected online edit (an overlay;
+        any key closes it)."""
+        edit = self.last_edit
+        if edit is None or edit.accepted:
+            self.message = "no rejected online edit" if edit is None else \
+                f"the last online edit was accepted: {edit.summary()}"
+            return
+        self.edit_report = edit.report()
 
     def toggle_breakpoint(self) -> None:
         if not self.rungs:

@@ -26,7 +26,7 @@ from .session import WatchSession
 REDRAW_HZ = 10  # at most
 DRAW_SHARE = 0.04  # of the wall time spent drawing while running, at most
 SLICE_S = 0.02  # scanning time between two looks at the keyboard
-PROMPT_MAX = 200  # characters a prompt (g, F, U, M, =, t) takes
+PROMPT_MAX = 200  # characters a prompt (g, F, U, M, =, t, /, d) takes
 
 _ESCAPES = {"\x1b[A": "up", "\x1b[B": "down", "\x1bOA": "up", "\x1bOB": "down",
             "\x1b[5~": "pgup", "\x1b[6~": "pgdown",
@@ -48,8 +48,6 @@ class Binding(NamedTuple):
 
 # Every key of the view, the one list: the Controller dispatches from it,
 # the help overlay ("?") and ``softplc watch --help`` (KEYS) show it.
-# "/", "x", "X", "d" and "R" are kept free for find / cross-reference and
-# the data-file grid.
 BINDINGS: tuple[Binding, ...] = (
     Binding("n, space", ("n", " "), "step", "one scan forward (from history when stepped back)"),
     Binding("r", ("r",), "run", "run: scan continuously"),
@@ -69,6 +67,12 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("U", ("U",), "unforce", "remove the force on ADDR"),
     Binding("M", ("M",), "mode", "change mode: program, run or test"),
     Binding("C", ("C",), "clear_fault", "clear the major fault (to PROGRAM; then M run)"),
+    Binding("/", ("/",), "find", "find an address or symbol: the rungs that read or write it"),
+    Binding("x / X", ("x", "X"), "use", "the next / previous rung of the last find"),
+    Binding("d", ("d",), "data_file", "show a data file as a grid (N7, or N7:20 from element 20)"),
+    Binding("R", ("R",), "radix", "the grid's radix: decimal, hex, binary, ASCII (cycles)"),
+    Binding("Esc", ("esc",), "close", "close the data-file grid, then the find list"),
+    Binding("E", ("E",), "edit_errors", "every error of the last rejected online program edit"),
     Binding("?", ("?",), "help", "show every key and what it does (any key closes the list)"),
     Binding("q", ("q",), "quit", "quit (saves the retentive data table)"),
 )
@@ -77,7 +81,8 @@ KEYS: tuple[tuple[str, str], ...] = tuple((b.label, b.help) for b in BINDINGS)
 _ACTIONS = {k: b.action for b in BINDINGS for k in b.keys}
 # The prompts: kind -> the text before what is typed.
 PROMPTS = {"g": "go to rung: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: ",
-           "M": "mode (program, run, test): ", "=": "set ADDR = VALUE: ", "t": "toggle bit: "}
+           "M": "mode (program, run, test): ", "=": "set ADDR = VALUE: ", "t": "toggle bit: ",
+           "/": "find address or symbol: ", "d": "data file (N7, T4, ST9; N7:20): "}
 
 
 class RawKeys:
@@ -131,8 +136,11 @@ class Controller:
         self.help = False  # the help overlay is shown
 
     def key(self, k: str) -> None:
-        if self.help:  # any key closes the help
+        if self.help:  # any key (Esc too) closes the help, and does nothing else
             self.help = False
+            return
+        if self.session.edit_report is not None:  # the same for the online edit's errors (E)
+            self.session.edit_report = None
             return
         if self.prompt_kind:
             self._prompt_key(k)
@@ -155,6 +163,10 @@ class Controller:
         self.session.faster() if k == "+" else self.session.slower()
 
     def _do_move(self, k: str) -> None:
+        grid = self.session.grid
+        if grid is not None and k in ("pgup", "pgdown"):  # the grid is shown: page it
+            grid.page(1 if k == "pgdown" else -1)
+            return
         self.session.move({"down": 1, "j": 1, "up": -1, "k": -1, "pgdown": 10, "pgup": -10}[k])
 
     def _do_ends(self, k: str) -> None:
@@ -192,6 +204,24 @@ class Controller:
 
     def _do_clear_fault(self, k: str) -> None:
         self.session.clear_fault()
+
+    def _do_find(self, k: str) -> None:
+        self._ask("/")
+
+    def _do_use(self, k: str) -> None:
+        self.session.next_use() if k == "x" else self.session.prev_use()
+
+    def _do_data_file(self, k: str) -> None:
+        self._ask("d")
+
+    def _do_radix(self, k: str) -> None:
+        self.session.cycle_radix()
+
+    def _do_close(self, k: str) -> None:
+        self.session.close_panels()
+
+    def _do_edit_errors(self, k: str) -> None:
+        self.session.show_edit_errors()
 
     def _do_help(self, k: str) -> None:
         self.help = True
@@ -234,6 +264,10 @@ class Controller:
                 s.set_value(text)
             elif kind == "t":
                 s.toggle(text)
+            elif kind == "/":
+                s.find(text)
+            elif kind == "d":
+                s.show_file(text)
         except (ValueError, DataTableError) as e:
             s.message = f"{text}: {e}"
 
@@ -255,6 +289,10 @@ class ViewLoop:
 
     def tick(self, k: str | None) -> None:
         session = self.session
+        said = session.message
+        session.poll_online()  # between scans, in the scanning thread: a saved program goes in here
+        if session.message != said:
+            self.dirty = True
         if k is not None:
             self.control.key(k)
             self.dirty = True
