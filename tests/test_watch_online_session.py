@@ -317,3 +317,83 @@ def test_help_goes_to_two_columns_when_one_does_not_fit(session):
     shown = draw(s, width=80, height=24, help_keys=KEYS)  # the smallest terminal: two columns, every key
     assert any("n, space" in line and "t, Ctrl-T" in line for line in shown.splitlines())
     assert all(label in shown for label, _ in KEYS)
+
+
+# -- online program edit: what the view does when the program is replaced -------------------------
+
+def wait_for_edit(s: WatchSession, seconds: float = 10.0) -> None:
+    """Poll as the terminal loop does (bounded) until an edit is taken or refused."""
+    import time
+
+    deadline = time.monotonic() + seconds
+    while s.last_edit is None and s.pending_edit is None and time.monotonic() < deadline:
+        s.poll_online()
+        time.sleep(0.05)
+    assert s.last_edit is not None or s.pending_edit is not None, "no online edit seen"
+
+
+def resave(path, text: str) -> None:
+    import os
+
+    before = path.stat().st_mtime_ns
+    path.write_text(text)
+    os.utime(path, ns=(before, before + 10_000_000))  # a new timestamp even within one tick
+
+
+def test_online_edit_moves_breakpoints_the_selection_and_the_find_list(session):
+    s = session()
+    main = s.app.path / "main.lad"
+    s.goto(1)
+    s.toggle_breakpoint()  # rung 1 (XIC Start OTE O:0/0): unchanged by the edit, it moves to rung 2
+    s.goto(3)
+    s.toggle_breakpoint()  # rung 3 (MOV F8:0 F8:1): changed by the edit, its breakpoint goes
+    s.find("N7:2")
+    assert {(u.file, u.rung) for u in s.finding.uses} == {(2, 2)}
+    s.goto(1)
+    resave(main, PROGRAM.replace("// count scans", "MOV 7 N7:5\n// count scans").replace("F8:1", "F8:2"))
+    wait_for_edit(s)
+    assert s.message.startswith("online edit accepted: file 2: 1 rung added (0), 1 changed (4)"), s.message
+    assert s.message.endswith("; 1 breakpoint(s) on edited rungs cleared")
+    assert s.breaks.rungs == {(2, 2)} and s.selected == 2  # the selected rung followed its text
+    assert {(u.file, u.rung) for u in s.finding.uses} == {(2, 3)}  # the list shows the new numbers
+    s.scan()
+    assert s.engine.table.read("N7:5") == 7  # the added rung runs
+    s.set_value("Start = 1")
+    hit = s.scan()
+    assert hit is not None and (hit.file, hit.rung) == (2, 2)  # the moved breakpoint stops on the new code
+
+
+def test_an_accepted_edit_waits_while_stepping_back(session):
+    s = session()
+    main = s.app.path / "main.lad"
+    s.scan()
+    s.scan()
+    s.back()
+    resave(main, PROGRAM + "MOV 9 N7:6\n")
+    wait_for_edit(s)
+    assert s.pending_edit is not None and s.last_edit is None and len(s.rungs) == 5  # not in while in history
+    s.scan()  # forward to the newest scan: live
+    s.poll_online()
+    assert s.last_edit is s.online.last and s.last_edit.applied and len(s.rungs) == 6
+
+
+def test_a_rejected_edit_keeps_the_program_and_E_shows_it(session):
+    s = session()
+    control = Controller(s)
+    main = s.app.path / "main.lad"
+    control.key("E")
+    assert s.message == "no rejected online edit" and s.edit_report is None
+    resave(main, PROGRAM + "ADD N7:1 1\n")
+    wait_for_edit(s)
+    assert s.message.startswith("online edit rejected, the program is unchanged: ")
+    assert "main.lad:12:1: ADD takes 3 operands" in s.message and s.message.endswith("(E: every error)")
+    assert len(s.rungs) == 5 and s.app.program is s.engine.program
+    control.key("E")
+    assert s.edit_report is not None, s.message
+    shown = draw(s, width=100, height=24)
+    assert "online edit errors (any key closes this)" in shown, shown
+    overlay = "".join(shown.split("closes this)", 1)[1].split())  # long lines wrap: compare without spaces
+    assert "".join(f"{main}:12:1: ADD takes 3 operands (ADD a b dest), got 2".split()) in overlay
+    control.key("n")  # closes the errors, scans nothing
+    assert s.edit_report is None and s.engine.scans == 0
+    assert "online edit errors" not in draw(s, width=100, height=24)

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 def key_rows() -> tuple[tuple[str, str], ...]:
     """(label, what it does) of every key of the view."""
-    from .terminal import KEYS  # terminal.py imports termios: only when the help is asked for
+    # terminal.py imports termios: only when the help is asked for
+    from .terminal import KEYS
 
     return KEYS
 

@@ -60,8 +60,8 @@ class HelpOverlay:
 
 class EditErrors:
     """Every error of a rejected online program edit (the ``E`` key; any
-    key closes it): ``report`` is OnlineEdit.report(), one
-    ``file:line:col: message`` an error, each with its source line."""
+    key closes it): ``report`` is OnlineEdit.report(), a header line, then
+    one ``file:line:col: message`` an error."""
 
     def __init__(self, report: str) -> None:
         self.report = report
@@ -73,7 +73,7 @@ class EditErrors:
         if len(lines) > room:  # the rest is in the editor's file anyway: say how much is left out
             lines = lines[:room - 1] + [f"... and {len(lines) - room + 1} more lines"]
         for line in lines:
-            yield Text(f" {line}", no_wrap=True, overflow="ellipsis")
+            yield Text(f" {line}", overflow="fold")  # wrapped, not cut: a long path must not hide the message
 
 
 class StatusBar:

@@ -16,7 +16,7 @@ from ..ladder.ast import AddressRef, walk
 from ..ladder.engine import Mode, ModeError
 from ..ladder.symbols import is_symbol_text, resolve_name
 from ..online import ProgramWatcher
-from ..runner import RunOptions, Runner
+from ..runner import Runner, RunOptions
 from .breakpoints import Breakpoints, Hit
 from .datagrid import DataGrid, grid_for, next_radix
 from .forces import Forces, parse_force
