@@ -24,7 +24,8 @@ class Tmux:
         self.session = name
 
     def run(self, *args: str) -> str:
-        out = subprocess.run(["tmux", "-L", self.socket, *args], capture_output=True, text=True, timeout=10)
+        out = subprocess.run(["tmux", "-L", self.socket, *args], capture_output=True, text=True, timeout=10,
+                             check=False)
         return out.stdout
 
     def start(self, command: str, width: int = 100, height: int = 30) -> None:
@@ -63,10 +64,13 @@ class Tmux:
 
     def alive(self) -> bool:
         return subprocess.run(["tmux", "-L", self.socket, "has-session", "-t", self.session],
-                              capture_output=True, timeout=10).returncode == 0
+                              capture_output=True, timeout=10, check=False).returncode == 0
 
     def kill(self) -> None:
-        subprocess.run(["tmux", "-L", self.socket, "kill-server"], capture_output=True, timeout=10)
+        subprocess.run(["tmux", "-L", self.socket, "kill-server"], capture_output=True, timeout=10, check=False)
+        # the server's socket file can outlive it: remove ours, so test runs leave nothing behind
+        socket_dir = Path(os.environ.get("TMUX_TMPDIR", "/tmp")) / f"tmux-{os.getuid()}"
+        (socket_dir / self.socket).unlink(missing_ok=True)
 
     def wait_gone(self, seconds: float = 10.0) -> bool:
         """Wait (bounded) for the command to end; True when it did."""
