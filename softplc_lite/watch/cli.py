@@ -54,7 +54,8 @@ def watch_command(args) -> int:
     save = not snapshot or getattr(args, "save", False)
     run = RunOptions(scan_ms=args.scan_ms, realtime=args.realtime, fresh=args.fresh, sets=tuple(args.set),
                      ports=tuple(args.port), replay=args.replay, save_state=save)
-    options = WatchOptions(run=run, watch=tuple(watch), forces=tuple(args.force), break_when=tuple(args.break_when))
+    options = WatchOptions(run=run, watch=tuple(watch), forces=tuple(args.force), break_when=tuple(args.break_when),
+                           online=not snapshot)  # a snapshot renders once: nothing to watch
     session = WatchSession(app, options)
     problems = address_problems("--watch", session.engine.table, list(args.watch), app.program.symbols) + \
         address_problems(f"--watch-file {args.watch_file}:", session.engine.table, watch[len(args.watch):],
