@@ -14,6 +14,7 @@ from softplc_lite.datatable import DataTable
 from softplc_lite.datatable.filetypes import FILE_TYPES
 
 from clocks import Clock
+from tmux_helpers import tmux  # noqa: F401  (the fixture of the terminal tests)
 
 
 @st.composite

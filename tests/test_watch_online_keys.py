@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import sys
 
-from tmux_helpers import tmux  # noqa: F401  (the fixture)
 
 PROGRAM = """FILE 2 MAIN
 SYMBOL InfeedConveyorPhotoEyeBlockedSeconds F8:1
