@@ -156,6 +156,21 @@ def attach_options(modules: list[TLM], options: Mapping[str, object]) -> tuple[d
     return per_module, recorder
 
 
+def read_module_file(path: Path) -> str:
+    """A module's config file as text: a BOM or UTF-16 from a Windows
+    editor is read, DOS-era bytes as latin-1 (textfile.py); a bad byte or an
+    OS error is a ModuleError (located, or said in words)."""
+    from ..errors import LocatedError
+    from ..textfile import read_text
+
+    try:
+        return read_text(path, fallback="latin-1")
+    except LocatedError as e:
+        raise ModuleError(e.message, e.path, e.line, e.column) from None
+    except OSError as e:  # errors.FileAccessError: "cannot read PATH: permission denied"
+        raise ModuleError(str(e)) from None
+
+
 def find_file(directory: Path, name: str) -> Path | None:
     """``name`` in ``directory``, matched without regard to case (SoftPLC
     config names are upper case; files copied from elsewhere may not be)."""

@@ -22,10 +22,8 @@ from dataclasses import dataclass
 from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
 
-from ..errors import LocatedError
 from ..ladder.instructions import InstructionSet
-from ..textfile import read_text
-from .api import TLM, find_file
+from .api import TLM, find_file, read_module_file
 from .errors import ModuleError, ModuleErrors
 
 GROUP = "softplc_lite.tlms"
@@ -86,12 +84,7 @@ def _read_modules_lst(app_dir: Path) -> tuple[Path | None, list[Enabled], list[M
     path = find_file(app_dir, MODULES_FILE)
     if path is None:
         return None, [], []
-    try:  # a BOM or UTF-16 from a Windows editor is read; DOS-era bytes as latin-1 (textfile.py)
-        text = read_text(path, fallback="latin-1")
-    except LocatedError as e:
-        raise ModuleError(e.message, e.path, e.line, e.column) from None
-    except OSError as e:  # errors.FileAccessError: "cannot read PATH: permission denied"
-        raise ModuleError(str(e)) from None
+    text = read_module_file(path)
     out: list[Enabled] = []
     seen: dict[str, int] = {}
     problems: list[ModuleError] = []  # every one, not just the first (softplc check)

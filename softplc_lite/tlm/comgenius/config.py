@@ -26,11 +26,9 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ...errors import LocatedError
 from ...ports import COM_NAME
 from ...ports.urlhandler.protocol_sim import url_problem as sim_url_problem  # COM1..COM99: in [DRIVER] keys and [PORTS]
-from ...textfile import read_text
-from ..api import find_file
+from ..api import find_file, read_module_file
 from ..errors import ModuleError, ModuleErrors
 from .strings import MAX_LENGTH, MAX_STRINGS, EscapeError, StringTable, decode_escapes
 
@@ -217,10 +215,4 @@ def load_config(app_dir: Path) -> ComGeniusConfig:
     if path is None:
         raise ModuleError(f"COMGENIUS is enabled in MODULES.LST but {app_dir / CONFIG_FILE} does not exist "
                           "(it holds the [DRIVER], [PORTS] and [STRINGS] sections)")
-    try:  # a BOM or UTF-16 from a Windows editor is read; DOS-era bytes as latin-1 (textfile.py)
-        text = read_text(path, fallback="latin-1")
-    except LocatedError as e:
-        raise ModuleError(e.message, e.path, e.line, e.column) from None
-    except OSError as e:  # errors.FileAccessError: "cannot read PATH: permission denied"
-        raise ModuleError(str(e)) from None
-    return parse_config(text, str(path))
+    return parse_config(read_module_file(path), str(path))
