@@ -15,19 +15,19 @@ import time
 from pathlib import Path
 
 import pytest
+from tmux_helpers import ROOT, Tmux
 
-ROOT = Path(__file__).resolve().parent.parent
 SOFTPLC = f"{shlex.quote(sys.executable)} -m softplc_lite"
 
 
-class Terminal:
+class Terminal(Tmux):
+    """A Tmux whose pane runs one shell line and shows its exit status."""
+
     def __init__(self, name: str) -> None:
+        super().__init__(name)
         self.socket = f"softplc-cli-{os.getpid()}-{name}"
         self.session = "t"
-
-    def tmux(self, *args: str) -> str:
-        return subprocess.run(["tmux", "-L", self.socket, *args], capture_output=True, text=True,
-                              timeout=10, check=False).stdout
+        self.tmux = self.run
 
     def start(self, command: str, cwd: Path = ROOT, width: int = 120, height: int = 30) -> None:
         """Run ``command`` (a shell line); when it ends the pane shows
@@ -37,14 +37,8 @@ class Terminal:
         subprocess.run(["tmux", "-L", self.socket, "new-session", "-d", "-s", self.session, "-x", str(width),
                         "-y", str(height), line], check=True, timeout=10)
 
-    def screen(self) -> str:
-        return self.tmux("capture-pane", "-p", "-t", self.session)
-
-    def keys(self, *keys: str) -> None:
-        for k in keys:
-            self.tmux("send-keys", "-t", self.session, k)
-
     def wait_for(self, pattern: str, seconds: float = 20.0) -> re.Match:
+        """Wait (bounded) for the regular expression ``pattern`` on the screen."""
         deadline = time.monotonic() + seconds
         while True:
             screen = self.screen()
@@ -71,11 +65,6 @@ class Terminal:
                     return int(pid)
             time.sleep(0.1)
         raise AssertionError("the softplc process did not start")
-
-    def kill(self) -> None:
-        subprocess.run(["tmux", "-L", self.socket, "kill-server"], capture_output=True, timeout=10, check=False)
-        # tmux leaves the socket file behind
-        Path(os.environ.get("TMUX_TMPDIR", "/tmp"), f"tmux-{os.getuid()}", self.socket).unlink(missing_ok=True)
 
 
 def open_terminal(request):
