@@ -6,7 +6,7 @@ every PATH (a .lad file, an app directory: each of its .lad files, or
 plus the modules MODULES.LST enables) and printed by
 ``ladder.fmt.format_source``, which keeps every comment.
 
-* A file fmt cannot parse is refused: every problem, as file:line:col, on
+* A file fmt cannot parse, or a program ``softplc check`` refuses, is refused: every problem, as file:line:col, on
   standard error, "N problems found", exit 1; with ``--write`` nothing is
   written, not even the files that were fine.
 * ``--check``: exit 1 naming each file whose text is not what fmt prints
@@ -30,7 +30,9 @@ from .app import AppError, app_instructions, lad_files
 from .errors import LocatedError, file_error
 from .ladder.errors import LadderError
 from .ladder.fmt import STYLES, format_source, unprintable
+from .ladder.ast import Program
 from .ladder.parser import parse_program, syntax_problems
+from .ladder.validate import check
 from .textfile import decode_text, read_bytes
 
 STDIN = "-"
@@ -62,6 +64,19 @@ def _format_text(text: str, name: str, style: str, instructions) -> tuple[str | 
     if found:
         return None, found
     return format_source(program, text, style), []
+
+
+def _invalid(texts: dict, instruction_sets: dict) -> list:
+    """What ``softplc check`` would refuse in the programs being formatted
+    (the files of one app directory together: a JSR may call a file of
+    another .lad file): fmt prints only valid programs."""
+    problems: list = []
+    for key, files in texts.items():
+        program = Program()
+        for name, text in files:
+            parse_program(text, name, instruction_sets[key], program=program)
+        problems += check(program, instruction_sets[key])[1]
+    return problems
 
 
 def _sources(paths: Sequence[str], stdin: IO[bytes]) -> tuple[list[tuple[str, Path | None, bytes, Path]], list]:
@@ -117,6 +132,7 @@ def fmt_command(paths: Sequence[str], style: str = "mnemonic", check: bool = Fal
     sources, problems = _sources(paths, stdin)
     results: list[Formatted] = []
     instruction_sets: dict[Path, object] = {}
+    texts: dict[Path, list[tuple[str, str]]] = {}  # app directory -> (name, text) of its files being formatted
     for name, path, raw, app_dir in sources:
         try:
             text = decode_text(raw, name)
@@ -134,6 +150,9 @@ def fmt_command(paths: Sequence[str], style: str = "mnemonic", check: bool = Fal
             problems += found
             continue
         results.append(Formatted(name, path, raw, after))
+        texts.setdefault(key, []).append((name, text))
+    if not problems:
+        problems = _invalid(texts, instruction_sets)
     if problems:
         for p in problems:
             print(p.report(), file=stderr)

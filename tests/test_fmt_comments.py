@@ -225,3 +225,14 @@ def test_comments_anywhere_in_shipped_programs_are_kept(path, style):
         again = parse_program(once, str(path), instructions)
         assert again == parsed
         assert format_source(again, once, style) == once
+
+
+def test_what_check_refuses_is_refused_and_an_apps_files_are_validated_together(tmp_path):
+    code, out, err = run_fmt("-", stdin=b"XIC B3/0 OTE\n")
+    assert code == 1 and out == "" and "<stdin>:1:10: OTE takes 1 operand" in err and "nothing formatted" in err
+    app = tmp_path / "app"
+    app.mkdir()
+    (app / "main.lad").write_text("XIC B3/0 JSR 3\n")  # calls a file defined in the other .lad file
+    (app / "sub.lad").write_text("FILE 3\nXIC B3/1 OTE O:0/1\n")
+    code, out, err = run_fmt(app)
+    assert code == 0 and "JSR 3" in out and "FILE 3" in out, err

@@ -391,20 +391,32 @@ def test_every_softplc_toml_problem_is_located(tmp_path, capsys, toml, says):
 
 
 @pytest.mark.parametrize("lad, style", [
-    ("XIC(B3/0)OTE(O:0/0);\n;\n", "mnemonic"),  # an empty rung: once a blank line, then nothing
-    ("XIC(B3/0)OTE(O:0/0);\n;\n", "neutral"),
-    ("XIC B3/0 BST NXB XIC B3/1 BND OTE O:0/0\n", "neutral"),
     ("SYMBOL Temp N7:[N9:2]\nDATA N9 5 = 1 2 3 70 7\n\nFILE 2", "mnemonic"),  # an empty main file
     ("SYMBOL Temp N7:[N9:2]\nDATA N9 5 = 1 2 3 70 7\n\nFILE 2", "neutral"),
 ])
-def test_fmt_is_a_fixed_point_even_for_rungs_check_refuses(tmp_path, capsys, lad, style):
+def test_fmt_is_a_fixed_point(tmp_path, capsys, lad, style):
     (tmp_path / "a.lad").write_text(lad)
     code, once, _ = run_cli(capsys, "fmt", "--style", style, str(tmp_path / "a.lad"))
     (tmp_path / "b.lad").write_text(once)
     code2, twice, _ = run_cli(capsys, "fmt", "--style", style, str(tmp_path / "b.lad"))
     assert code == code2 == 0 and twice == once
-    assert run_cli(capsys, "check", str(tmp_path / "a.lad"))[2] == run_cli(capsys, "check", str(tmp_path / "b.lad"))[2] \
-        .replace("b.lad", "a.lad")
+
+
+@pytest.mark.parametrize("lad, style", [
+    ("XIC(B3/0)OTE(O:0/0);\n;\n", "mnemonic"),  # an empty rung
+    ("XIC(B3/0)OTE(O:0/0);\n;\n", "neutral"),
+    ("XIC B3/0 BST NXB XIC B3/1 BND OTE O:0/0\n", "neutral"),  # an empty branch leg
+    ("XIC B3/0 OTE\n", "mnemonic"),  # an operand missing
+])
+def test_fmt_refuses_what_check_refuses_with_the_same_problems(tmp_path, capsys, lad, style):
+    """Issue 18: fmt refuses invalid programs (exit 1), every problem as
+    softplc check lists it; nothing is printed."""
+    (tmp_path / "a.lad").write_text(lad)
+    code, out, err = run_cli(capsys, "fmt", "--style", style, str(tmp_path / "a.lad"))
+    check_code, _, check_err = run_cli(capsys, "check", str(tmp_path / "a.lad"))
+    assert code == check_code == 1 and out == ""
+    problems = [line for line in check_err.splitlines() if ":" in line and "problem" not in line]
+    assert problems and all(p in err for p in problems) and "nothing formatted" in err
 
 
 @pytest.mark.parametrize("lad, style, says", [
