@@ -283,3 +283,16 @@ def test_a_rung_condition_used_once_is_folded_into_its_use():
     assert "if w3_0 & 1:" in source or "if f3[0] & 1:" in source
     assert source.count("\n        c = ") == 2 and "if True:" in source
     assert e.table.read("B3/0") == 0 and e.table.read("B3/2") == 1 and e.table.read("B3/4") == 1
+
+
+@pytest.mark.parametrize("text", [
+    "SUB N7:4 1 N7:4\n",                                  # a borrow from the operand that is the destination
+    "XIC B3/0 SUB N7:4 1 N7:4\nXIC S:0/0 OTE B3/1\n",       # S:0 held: the carry left pending
+    "ADD N7:5 N7:4 N7:4\nADD N7:4 N7:5 N7:4\nXIC S:0/0 OTE B3/2\n",
+])
+def test_add_and_sub_into_their_own_operand_set_the_carry_from_the_operand(text):
+    """ADD/SUB whose destination is also an operand held in a local: the
+    carry (borrow) is worked out from the operand as it was, not from the
+    stored result (found by the differential test: SUB Start 1 Start)."""
+    e = _both("DATA N7 10\n" + text, values={"B3/0": 1, "N7:5": -1})
+    assert e.table.read("S:0") & 1 == 1  # 0 - 1 borrows; -1 + -1 and -1 + -2 carry

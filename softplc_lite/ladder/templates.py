@@ -117,11 +117,13 @@ class TableTemplates:
         self.emit(ind, "if c:")
         a, b = self.value(ind + 1, ops[0]), self.value(ind + 1, ops[1])
         if self.inline_dest is not None:  # ADD/SUB of words into a held word (in_place)
-            # Operands read in place are read once (the sum, the carry and a fallback use them).
-            if not _SIMPLE.match(a):
+            # Operands read in place are read once (the sum, the carry and a fallback use them);
+            # an operand that is the destination's local too (SUB N7:4 1 N7:4) is copied, as the
+            # carry is worked out after the store.
+            if not _SIMPLE.match(a) or a == self.inline_dest:
                 self.emit(ind + 1, f"_a = {a}")
                 a = "_a"
-            if not _SIMPLE.match(b):
+            if not _SIMPLE.match(b) or b == self.inline_dest:
                 self.emit(ind + 1, f"_b = {b}")
                 b = "_b"
             self.bind("_s", self.machine.s)
