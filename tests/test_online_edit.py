@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import time
+import weakref
 
 import pytest
 
@@ -20,12 +21,14 @@ from softplc_lite.tlm.registry import instruction_set
 EXECUTORS = ["compiled", "reference"]
 # "precompiled": the compiled executor given the code compiled beforehand, as the watcher's thread does
 HOW = [*EXECUTORS, "precompiled"]
-PRECOMPILED: set[int] = set()  # ids of the engines built "precompiled"
+# the engines built "precompiled": weak, because an id() outlives its engine and is reused
+# (a reference engine once got a dead precompiled engine's id)
+PRECOMPILED: weakref.WeakSet[Engine] = weakref.WeakSet()
 
 
 def replace(e: Engine, program):
     """Engine.replace_program, with the code precompiled for a "precompiled" engine."""
-    if id(e) not in PRECOMPILED:
+    if e not in PRECOMPILED:
         return e.replace_program(program)
     code = precompile(program, e.settings)
     assert code is not None
@@ -39,7 +42,7 @@ def replace(e: Engine, program):
 def running(text: str, how: str, scans: int = 0, **values) -> Engine:
     e = Engine(load_text(text), executor="reference" if how == "reference" else "compiled")
     if how == "precompiled":
-        PRECOMPILED.add(id(e))
+        PRECOMPILED.add(e)
     for address, value in values.items():
         e.table.write(address, value)
     e.set_mode(Mode.RUN)
