@@ -29,7 +29,7 @@ from softplc_lite.tlm.modbmast.config import (
     parse_config,
 )
 from softplc_lite.tlm.modbmast.requests import REQUEST_KINDS
-from softplc_lite.tlm.modbmast.xmlreader import MAX_BYTES
+from softplc_lite.tlm.xmlreader import MAX_BYTES
 
 PATH = "MODBMAST.XML"
 

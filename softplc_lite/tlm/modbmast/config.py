@@ -28,8 +28,9 @@ from ...textfile import read_bytes
 from ...ports.urlhandler.protocol_sim import url_problem as sim_url_problem
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
+from ..xmlcheck import MANY, Attr, XmlChecker, content, parse_integer
+from ..xmlreader import XmlNode, XmlSyntaxError, read_xml
 from .requests import REQUEST_KINDS, RequestKind
-from .xmlreader import XmlNode, XmlSyntaxError, read_xml
 
 CONFIG_FILE = "MODBMAST.XML"
 ALIAS_FILE = "MODBUS.XML"  # the manual's other name for it (section 5.1)
@@ -126,21 +127,7 @@ class ModbmastConfig:
 
 # -- attributes ------------------------------------------------------------------------------
 
-@dataclass(frozen=True)
-class Attr:
-    """One allowed attribute: a choice list or an integer range, required or
-    with a default (None: optional and inherited, or absent)."""
-
-    name: str
-    low: int | None = None
-    high: int | None = None
-    choices: tuple[str, ...] = ()
-    required: bool = False
-    default: object = None
-    extension: bool = False  # softplc_lite's, not the manual's
-    text: bool = False  # any text (a device)
-
-
+_ADDRESS = "a data table address"
 _INHERITED = (Attr("minPeriod", 0, 3_600_000), Attr("requestTimeout", 1, 60_000), Attr("attempts", 1, 100))
 _DEMOTE = (Attr("demoteAfter", 0, 1000, extension=True), Attr("demotePeriod", 10, 3_600_000, extension=True))
 DEFAULTS = {"minPeriod": 0, "requestTimeout": 30, "attempts": 1, "demoteAfter": 0, "demotePeriod": 5000}
@@ -153,12 +140,12 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
              Attr("baudrate", 300, 230400, required=True), Attr("dataBits", 7, 8, default=8),
              Attr("parity", choices=("none", "even", "odd", "mark"), default="none"),
              Attr("stopBits", 1, 2, default=1), *_INHERITED, Attr("requestGap", 0, 250, default=3),
-             Attr("device", text=True, extension=True), *_DEMOTE),
+             Attr("device", text=True, extension=True, what="a device path or URL"), *_DEMOTE),
     "ModemControl": (Attr("waitDelayCTS", 0, 60_000, required=True),),
     "Slave": (Attr("id", 1, 247, required=True), *_INHERITED, *_DEMOTE),
-    "toBlock": (Attr("dest", text=True, required=True), Attr("count", 1, 2000, required=True),
+    "toBlock": (Attr("dest", text=True, required=True, what=_ADDRESS), Attr("count", 1, 2000, required=True),
                 Attr("fmt", choices=("i2", "bit"), required=True)),
-    "fromBlock": (Attr("source", text=True), Attr("count", 1, 2000, required=True),
+    "fromBlock": (Attr("source", text=True, what=_ADDRESS), Attr("count", 1, 2000, required=True),
                   Attr("fmt", choices=("i2", "bit"), required=True)),
     "refNum": (), "andMask": (), "const": (),
 }
@@ -166,148 +153,10 @@ REQUEST_ATTRIBUTES = (Attr("when", choices=("run", "start", "stop"), default="ru
 for _kind in REQUEST_KINDS:
     ATTRIBUTES[_kind] = REQUEST_ATTRIBUTES
 
-_INTEGER = re.compile(r"^\s*([+-]?)(0[xX][0-9A-Fa-f]{1,8}|[0-9]{1,10})\s*$")
 _REFNUM = re.compile(r"^\s*([0-9])([0-9]{1,6})\s*$")
 
 
-def parse_integer(text: str) -> int | None:
-    """A decimal or ``0x`` hex integer (manual 4.3: "16" or "0x0010"), or None."""
-    m = _INTEGER.match(text)
-    if m is None:
-        return None
-    value = int(m.group(2), 16 if m.group(2)[:2].lower() == "0x" else 10)
-    return -value if m.group(1) == "-" else value
-
-
-MAX_PROBLEMS = 200  # listed; a file with more gets a count of the rest
-
-
-class _Checker:
-    """Walks the tree, collecting every problem."""
-
-    def __init__(self, path: str) -> None:
-        self.path = path
-        self.problems: list[ModuleError] = []
-        self.more = 0  # problems past MAX_PROBLEMS, counted
-
-    def error(self, node: XmlNode, message: str, attr: str | None = None) -> None:
-        if len(self.problems) >= MAX_PROBLEMS:
-            self.more += 1
-            return
-        line, column = node.where(attr)
-        self.problems.append(ModuleError(message, self.path, line, column))
-
-    def found(self) -> list[ModuleError]:
-        """The problems, with a last line counting those not listed."""
-        if not self.more:
-            return self.problems
-        last = self.problems[-1]
-        return self.problems + [ModuleError(f"... and {self.more} more problem{'s' if self.more != 1 else ''} "
-                                            f"(the first {MAX_PROBLEMS} are listed)", self.path, last.line,
-                                            last.column + 1)]
-
-    # - - - attributes - - -
-    def attributes(self, node: XmlNode) -> dict[str, object]:
-        """The node's attribute values, converted; defaults filled in; a
-        problem for each unknown, missing or bad one (its value is then left out)."""
-        allowed = {a.name: a for a in ATTRIBUTES[node.name]}
-        out: dict[str, object] = {}
-        for key, raw in node.attrs.items():
-            spec = allowed.get(key)
-            if spec is None:
-                names = ", ".join(allowed) or "none"
-                close = difflib.get_close_matches(key, list(allowed), n=1)
-                hint = f"; did you mean {close[0]}?" if close else ""
-                self.error(node, f"<{node.name}> has no attribute {key!r} (its attributes: {names}){hint}", key)
-                continue
-            value = self._value(node, spec, raw)
-            if value is not None:
-                out[key] = value
-        for spec in allowed.values():
-            if spec.name not in node.attrs:
-                if spec.required:
-                    self.error(node, f"<{node.name}> needs the attribute {spec.name} ({_expected(spec)})")
-                elif spec.default is not None:
-                    out[spec.name] = spec.default
-        return out
-
-    def _value(self, node: XmlNode, spec: Attr, raw: str) -> object:
-        if spec.text:
-            if not raw.strip():
-                self.error(node, f"{spec.name} is empty; expected {_expected(spec)}", spec.name)
-                return None
-            return raw.strip()
-        if spec.choices:
-            for choice in spec.choices:
-                if raw.strip().lower() == choice.lower():
-                    return choice
-            self.error(node, f"{spec.name}={raw!r}: expected {_expected(spec)}", spec.name)
-            return None
-        value = parse_integer(raw)
-        if value is None or not spec.low <= value <= spec.high:
-            self.error(node, f"{spec.name}={raw!r}: expected {_expected(spec)}", spec.name)
-            return None
-        return value
-
-    # - - - content - - -
-    def children(self, node: XmlNode, model: list[tuple[str, int, int]]) -> list[list[XmlNode]]:
-        """Match the children against a sequence of (name, min, max): the
-        children found for each item, and a problem for what does not fit."""
-        groups: list[list[XmlNode]] = [[] for _ in model]
-        i = 0  # the model item the last child fitted
-        for kid in node.children:
-            # The first item from here on this child fits (a later one when this one is full).
-            j = next((j for j in range(i, len(model)) if model[j][0] == kid.name
-                      and (j > i or len(groups[j]) < model[j][2])), None)
-            if j is None:  # fits nowhere from here: reported, and the next child matched on
-                self._extra(node, kid, model)
-                continue
-            for k in range(i, j):  # items skipped over
-                if len(groups[k]) < model[k][1]:
-                    self.error(kid, f"<{node.name}> needs <{model[k][0]}> here ({_content(model)})")
-            i = j
-            groups[j].append(kid)
-        for k in range(i, len(model)):
-            if len(groups[k]) < model[k][1]:
-                self.error(node, f"<{node.name}> needs <{model[k][0]}> here ({_content(model)})")
-        return groups
-
-    def _extra(self, node: XmlNode, extra: XmlNode, model: list[tuple[str, int, int]]) -> None:
-        known = extra.name in ATTRIBUTES or extra.name == ROOT
-        close = difflib.get_close_matches(extra.name, [n for n, _, _ in model] + list(REQUEST_KINDS), n=1)
-        what = f"<{extra.name}> is not allowed here" if known else f"unknown element <{extra.name}>"
-        hint = f"; did you mean <{close[0]}>?" if close and not known else ""
-        self.error(extra, f"{what} (<{node.name}> contains {_content(model)}){hint}")
-
-    def text_integer(self, node: XmlNode, low: int, high: int, what: str) -> int | None:
-        self.attributes(node)
-        self.children(node, [])
-        value = parse_integer(node.text)
-        if value is None or not low <= value <= high:
-            self.error(node, f"<{node.name}>{node.text.strip()[:40]}</{node.name}>: expected {what}")
-            return None
-        return value
-
-
-def _expected(spec: Attr) -> str:
-    if spec.text:
-        return "a device path or URL" if spec.name == "device" else "a data table address"
-    if spec.choices:
-        return " or ".join(repr(c) for c in spec.choices)
-    return f"an integer {spec.low}..{spec.high}"
-
-
-def _content(model: list[tuple[str, int, int]]) -> str:
-    if not model:
-        return "no elements"
-    marks = {(1, 1): "", (0, 1): "?", (1, 10**9): "+", (0, 10**9): "*"}
-    return ", ".join(f"<{name}>{marks.get((low, high), '')}" for name, low, high in model)
-
-
-MANY = 10**9
-
-
-def _check_port(c: _Checker, node: XmlNode) -> PortConfig | None:
+def _check_port(c: XmlChecker, node: XmlNode) -> PortConfig | None:
     a = c.attributes(node)
     modem_nodes, slave_nodes = c.children(node, [("ModemControl", 0, 1), ("Slave", 0, MANY)])
     wait_cts = None
@@ -345,7 +194,7 @@ def _inherit(name: str, *levels: dict) -> int:
     return DEFAULTS[name]
 
 
-def _check_slave(c: _Checker, node: XmlNode, port: dict) -> Slave | None:
+def _check_slave(c: XmlChecker, node: XmlNode, port: dict) -> Slave | None:
     a = c.attributes(node)
     kids = []
     for kid in node.children:  # Table 8: any number of each request, in any order
@@ -367,7 +216,7 @@ def _check_slave(c: _Checker, node: XmlNode, port: dict) -> Slave | None:
                  node.line)
 
 
-def _check_request(c: _Checker, node: XmlNode, slave_id: int, slave: dict, port: dict) -> Request | None:
+def _check_request(c: XmlChecker, node: XmlNode, slave_id: int, slave: dict, port: dict) -> Request | None:
     kind = REQUEST_KINDS[node.name]
     a = c.attributes(node)
     ok = len(c.problems)  # (a content problem, too, leaves the quantities unchecked)
@@ -407,7 +256,7 @@ def _check_request(c: _Checker, node: XmlNode, slave_id: int, slave: dict, port:
                    and_mask, node.line, node.column)
 
 
-def _check_refnum(c: _Checker, node: XmlNode, kind: RequestKind, k: int) -> int | None:
+def _check_refnum(c: XmlChecker, node: XmlNode, kind: RequestKind, k: int) -> int | None:
     """The protocol address of a refNum (Table 7: first digit the region,
     the rest the element number, from 1)."""
     c.attributes(node)
@@ -433,7 +282,7 @@ def _check_refnum(c: _Checker, node: XmlNode, kind: RequestKind, k: int) -> int 
     return element - 1
 
 
-def _check_block(c: _Checker, node: XmlNode, kind: RequestKind, to: bool) -> Block | None:
+def _check_block(c: XmlChecker, node: XmlNode, kind: RequestKind, to: bool) -> Block | None:
     a = c.attributes(node)
     consts = c.children(node, [] if to else [("const", 0, 1)])
     attr = "dest" if to else "source"
@@ -459,7 +308,7 @@ def _check_block(c: _Checker, node: XmlNode, kind: RequestKind, to: bool) -> Blo
     return Block(address, a["count"], fmt, const, node.line, node.column)
 
 
-def _check_address(c: _Checker, node: XmlNode, attr: str, text: str, kind: RequestKind, to: bool,
+def _check_address(c: XmlChecker, node: XmlNode, attr: str, text: str, kind: RequestKind, to: bool,
                    fmt: str | None, count: int | None) -> Address | None:
     try:
         address = parse_address(text)
@@ -493,7 +342,7 @@ def _check_address(c: _Checker, node: XmlNode, attr: str, text: str, kind: Reque
     return address
 
 
-def _check_const(c: _Checker, node: XmlNode, fmt: str | None, count: int | None) -> tuple[int, ...] | None:
+def _check_const(c: XmlChecker, node: XmlNode, fmt: str | None, count: int | None) -> tuple[int, ...] | None:
     items = [t for t in re.split(r"[\s,;]+", node.text.strip()) if t]
     low, high, what = (0, 1, "0 or 1") if fmt == "bit" else (-32768, 65535, "an integer -32768..65535")
     values = []
@@ -512,7 +361,7 @@ def _check_const(c: _Checker, node: XmlNode, fmt: str | None, count: int | None)
 
 def parse_config(data: bytes, path: str = CONFIG_FILE) -> ModbmastConfig:
     """Check MODBMAST.XML's bytes; ModuleErrors listing every problem."""
-    c = _Checker(path)
+    c = XmlChecker(path, ATTRIBUTES, ROOT, REQUEST_KINDS)
     try:
         root = read_xml(data)
     except XmlSyntaxError as e:

@@ -1,4 +1,5 @@
-"""Reading MODBMAST.XML into a plain tree that remembers where things are.
+"""Reading a module's XML configuration file (MODBMAST.XML, MODBTCPS.XML) into a
+plain tree that remembers where things are.
 
 The standard library's expat parser reads the bytes (honouring the file's
 encoding declaration; UTF-8 without one). Every element becomes an
@@ -7,7 +8,7 @@ so that every problem in the file can be reported at its place. A document
 type declaration or an entity declaration is refused: a configuration file
 needs neither, and refusing them keeps entity expansion (and its tricks) out.
 The tree is built with an explicit stack, so nesting depth costs no Python
-recursion; the configuration's own rules stop at five levels.
+recursion; the configurations themselves stop at five levels (MODBMAST.XML).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ import re
 import xml.parsers.expat
 from dataclasses import dataclass, field
 
-MAX_BYTES = 16 * 1024 * 1024  # a scan list of 32 ports x 247 slaves fits in far less
+MAX_BYTES = 16 * 1024 * 1024  # a scan list of 32 ports x 247 slaves (MODBMAST.XML) fits in far less
 
 
 @dataclass
