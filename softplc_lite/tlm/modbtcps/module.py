@@ -1,0 +1,279 @@
+"""The MODBTCPS module (TLM): a Modbus TCP server over the data table, for
+HMIs and SCADA (docs/modbtcps.md).
+
+Registered like any third-party module, in pyproject.toml::
+
+    [project.entry-points."softplc_lite.tlms"]
+    MODBTCPS = "softplc_lite.tlm.modbtcps:ModbTcpServer"
+
+It reads MODBTCPS.XML (config.py) and, when an engine takes it, starts the
+server process (serverproc.py: pymodbus's server). From then on, at each
+scan:
+
+- input point: the writes clients made since the last scan are applied, in
+  arrival order (before the forces, so a forced bit stays forced);
+- output point: the mapped words are published to the image clients read
+  (image.py), so a read is always one whole scan's table; the writes applied
+  this scan are acknowledged to the server, which only now answers them; the
+  server's counters go to the status words (status.py).
+
+The scan never waits for the server: the pipe is read without blocking, and
+the image is written without a lock (a seqlock: the server retries a copy
+the scan overlapped).
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import select
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Mapping
+
+from ..api import TLM
+from ..errors import ModuleError
+from . import messages as msg
+from . import status as C
+from .config import CONFIG_FILE, ServerConfig, config_references, load_config
+from .image import SharedImage
+from .layout import Layout
+
+START_TIMEOUT_S = 20.0  # the server process imports pymodbus: about 0.3 s here, far more on a loaded machine
+
+
+class ModbTcpServer(TLM):
+    name = "MODBTCPS"
+    title = "Modbus TCP server over the data table (for HMIs and SCADA)"
+    config_file = CONFIG_FILE
+
+    def __init__(self, config: ServerConfig | None = None) -> None:
+        self.config = config or ServerConfig()
+        self.engine = None
+        self.layout: Layout | None = None
+        self.image: SharedImage | None = None
+        self.process: subprocess.Popen | None = None
+        self.port: int | None = None
+        self.failed: str | None = None
+        self._from_server = -1
+        self._reader = msg.Reader()
+        self._files: list = []
+        self._applied = 0  # the sequence number of the last write applied
+        self._acked = 0
+        self._writes_applied = 0
+        self._status = None
+        self._rate_mark = (time.monotonic(), 0)
+        self.rate = 0
+
+    # -- configuration ----------------------------------------------------------------------
+    def configure(self, app_dir: Path | None) -> list[str]:
+        if app_dir is not None:
+            self.config = load_config(app_dir)
+        return list(self.config.warnings)
+
+    def config_references(self) -> list:
+        return config_references(self.config)
+
+    # -- the server process -----------------------------------------------------------------
+    def attach(self, engine, options: Mapping[str, object]) -> list[str]:
+        self.engine = engine
+        table = engine.table
+        for address in self.config_references():
+            table.reference(address)
+        self.layout = Layout.build(self.config, table)
+        self._files = [(table.file(s.file).data, s.index, s.words, s.offset)
+                       for s in self.layout.slots]
+        if self.config.status is not None:
+            loc = table.resolve(self.config.status)
+            self._status = (loc.file.data, loc.index)
+        self.image = SharedImage.create(self.layout.size)
+        self._publish()
+        self._start()
+        return []
+
+    def _start(self) -> None:
+        read_fd, write_fd = os.pipe()
+        try:
+            self.process = subprocess.Popen(
+                [sys.executable, "-m", "softplc_lite.tlm.modbtcps.serverproc", str(write_fd)],
+                stdin=subprocess.PIPE, pass_fds=(write_fd,), close_fds=True)
+        except OSError as e:
+            os.close(read_fd)
+            self._discard_image()
+            raise ModuleError(f"MODBTCPS: cannot start the server process: {e.strerror or e}") from None
+        finally:
+            os.close(write_fd)
+        self._from_server = read_fd
+        init = pickle.dumps({"config": self.config, "layout": self.layout, "image": self.image.path,
+                             "size": self.image.size})
+        try:
+            self.process.stdin.write(msg.LENGTH.pack(len(init)) + init)
+            self.process.stdin.flush()
+        except OSError:
+            pass  # the process died at once: said below
+        first = self._wait_ready()
+        self.image.unlink()  # both processes have it mapped; nothing is left in /dev/shm
+        if first is None or first[0] != msg.READY:
+            why = first[1] if first is not None and first[0] == msg.FAILED else "the server process did not start"
+            self.close()
+            raise ModuleError(f"MODBTCPS: {why} (MODBTCPS.XML address and port; docs/modbtcps.md)")
+        self.port = first[1]
+        os.set_blocking(self._from_server, False)
+
+    def _wait_ready(self) -> tuple | None:
+        deadline = time.monotonic() + START_TIMEOUT_S
+        while time.monotonic() < deadline:
+            ready, _, _ = select.select([self._from_server], [], [], 0.05)
+            if ready:
+                data = os.read(self._from_server, 4096)
+                if not data:
+                    return None
+                messages = self._reader.feed(data)
+                if messages:
+                    return messages[0]
+            elif self.process.poll() is not None:
+                return None
+        return None
+
+    @property
+    def listening(self) -> str:
+        return f"{self.config.host}:{self.port}"
+
+    # -- each scan ---------------------------------------------------------------------------
+    def on_input(self, engine) -> None:
+        if self._from_server < 0:
+            return
+        try:
+            data = os.read(self._from_server, 1 << 20)
+        except BlockingIOError:
+            return
+        except OSError:
+            data = b""
+        if not data:
+            self._lost("the server process ended")
+            return
+        table = engine.table
+        for m in self._reader.feed(data):
+            if m[0] == msg.WRITE:
+                _, seq, unit, kind, address, values = m
+                pieces = self.layout.find(unit, kind, address, len(values))
+                if pieces is not None:  # the server checked it against the same layout
+                    Layout.store(pieces, values, table)
+                self._applied = seq
+                self._writes_applied += 1
+            elif m[0] == msg.MASK:
+                _, seq, unit, address, and_mask, or_mask = m
+                pieces = self.layout.find(unit, "holding_registers", address, 1)
+                if pieces is not None:
+                    s, off, _ = pieces[0]
+                    current = _register(table, s, off)
+                    Layout.store(pieces, [(current & and_mask) | (or_mask & ~and_mask & 0xFFFF)], table)
+                self._applied = seq
+                self._writes_applied += 1
+
+    def on_output(self, engine, outputs_enabled: bool) -> None:
+        if self.image is None:
+            return
+        self._publish()
+        if self._applied != self._acked and self.process is not None:
+            self._acked = self._applied
+            try:
+                self.process.stdin.write(msg.ack(self._acked))
+                self.process.stdin.flush()
+            except (OSError, ValueError):
+                self._lost("the server process ended")
+        if self._status is not None:
+            self._status_words()
+
+    def _publish(self) -> None:
+        image = self.image
+        image.begin()
+        for data, index, n, offset in self._files:
+            image.put(offset, data[index:index + n])
+        image.end()
+
+    def _status_words(self) -> None:
+        counters = self.image.counters()
+        data, i = self._status
+        now = time.monotonic()
+        mark_t, mark_n = self._rate_mark
+        if now - mark_t >= 1.0:
+            self.rate = int(round((counters[C.REQUESTS] - mark_n) / (now - mark_t)))
+            self._rate_mark = (now, counters[C.REQUESTS])
+        bits = 0
+        if counters[C.LISTENING] and self.failed is None:
+            bits |= C.BIT_LISTENING
+        if self.failed is not None:
+            bits |= C.BIT_FAILED
+        if counters[C.CONNECTED]:
+            bits |= C.BIT_CLIENT
+        data[i + C.W_BITS] = bits
+        for w, c in C.COPIED:
+            data[i + w] = C.word(counters[c])
+        data[i + C.W_RATE] = C.word(min(self.rate, 32767))
+        data[i + C.W_WRITES_APPLIED] = C.word(self._writes_applied)
+        data[i + C.W_REFUSALS] = C.word(sum(counters[c] for c in C.REFUSAL_COUNTERS))
+
+    def _lost(self, why: str) -> None:
+        if self.failed is None:
+            self.failed = why
+            self.log(f"{why}; clients are no longer served (the scan goes on)")
+        if self._from_server >= 0:
+            os.close(self._from_server)
+            self._from_server = -1
+
+    def server_status(self) -> C.ServerStatus | None:
+        """The server as the watch view shows it."""
+        if self.image is None:
+            return None
+        counters = self.image.counters()
+        refused = {name: counters[c] for name, c in REFUSAL_NAMES if counters[c]}
+        return C.ServerStatus(self.failed or self.listening, self.failed is None, counters[C.CONNECTED],
+                              self.rate, counters[C.REQUESTS], self._writes_applied, sum(refused.values()),
+                              refused)
+
+    def network_servers(self) -> list:
+        status = self.server_status()
+        return [status] if status is not None else []
+
+    # -- the end -----------------------------------------------------------------------------
+    def close(self) -> None:
+        process, self.process = self.process, None
+        if process is not None:
+            try:
+                process.stdin.close()  # the server's signal to stop
+            except OSError:
+                pass
+            try:
+                process.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait()
+        if self._from_server >= 0:
+            os.close(self._from_server)
+            self._from_server = -1
+        self._discard_image()
+
+    def _discard_image(self) -> None:
+        if self.image is not None:
+            self.image.unlink()
+            self.image.close()
+            self.image = None
+
+
+REFUSAL_NAMES = (("not allowed", C.REFUSED_NETWORK), ("connection limit", C.REFUSED_LIMIT),
+                 ("rate limit", C.REFUSED_RATE), ("exception 01", C.EXCEPTION_01), ("exception 02", C.EXCEPTION_02),
+                 ("exception 03", C.EXCEPTION_03), ("exception 0B", C.EXCEPTION_0B), ("malformed", C.MALFORMED),
+                 ("idle", C.IDLE))
+
+
+def _register(table, s, off: int) -> int:
+    """The current value of one register of slot ``s``, from the table."""
+    from .layout import registers_of
+
+    first, past = s.table_range(off, 1)
+    data = table.file(s.file).data
+    regs = registers_of(s, data[s.index + first:s.index + past].tobytes())
+    return regs[off - first * (2 if s.value == "float" else 1)]

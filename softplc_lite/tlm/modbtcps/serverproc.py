@@ -1,0 +1,437 @@
+"""The server process: pymodbus's Modbus TCP server over the shared image.
+
+Run by the module (``python -m softplc_lite.tlm.modbtcps.serverproc FD``):
+its own process, so that however busy the clients keep it, the scan never
+waits for it (no shared interpreter lock). It reads its configuration from
+standard input, answers reads from the image the scan publishes, and passes
+writes to the scan through the pipe FD, answering a write once the scan has
+applied it (so a read that follows sees it). It exits when standard input
+closes: when the runtime stops, or dies.
+
+pymodbus does the protocol (framing, the PDUs, their encoding); this module
+adds what a PLC's server needs around it: the allow-list, the connection and
+request-rate limits, idle connections closed, malformed frames closing their
+connection, and every refusal counted (status.py).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextvars
+import ipaddress
+import logging
+import os
+import pickle
+import socket
+import sys
+import time
+
+from pymodbus.constants import ExcCodes
+from pymodbus.datastore import ModbusServerContext
+from pymodbus.pdu import ExceptionResponse
+from pymodbus.pdu.register_message import MaskWriteRegisterRequest, MaskWriteRegisterResponse
+from pymodbus.server import ModbusTcpServer
+from pymodbus.server.requesthandler import ServerRequestHandler
+
+from . import messages as msg
+from . import status as C
+from .image import SharedImage
+from .layout import Layout
+
+KIND_OF_FUNCTION = {1: "coils", 5: "coils", 15: "coils", 2: "discrete_inputs",
+                    3: "holding_registers", 6: "holding_registers", 16: "holding_registers",
+                    22: "holding_registers", 23: "holding_registers", 4: "input_registers"}
+WRITES = {5, 6, 15, 16, 22, 23}
+MAX_READ = {"coils": 2000, "discrete_inputs": 2000, "holding_registers": 125, "input_registers": 125}
+PEER: contextvars.ContextVar[str] = contextvars.ContextVar("peer", default="?")  # whose request a task serves
+MAX_PENDING = 10_000  # writes waiting for the scan; more are answered busy (06)
+MBAP = 7  # transaction, protocol, length, unit
+MAX_LENGTH = 254  # the MBAP length field: unit id + the largest PDU (253)
+
+
+class Counters:
+    def __init__(self, image: SharedImage) -> None:
+        self.image = image
+
+    def add(self, counter: int, n: int = 1) -> None:
+        self.image.add(counter, n)
+
+
+class TableContext(ModbusServerContext):
+    """The data table as pymodbus's datastore: reads from the image, writes
+    through the scan."""
+
+    def __init__(self, server: "Server") -> None:  # no super().__init__: it builds pymodbus's own store
+        self.server = server
+        self.old_simulator = True  # pymodbus then calls this object as it is
+        self.simdevices = []
+        self._devices = {}
+
+    def device_ids(self) -> list[int]:
+        return sorted(self.server.layout.units())
+
+    async def async_getValues(self, device_id, func_code, address, count=1):
+        kind = KIND_OF_FUNCTION[func_code]
+        if func_code not in WRITES and not 1 <= count <= MAX_READ[kind]:
+            return self.server.refuse(ExcCodes.ILLEGAL_VALUE)
+        pieces = self.server.layout.find(device_id, kind, address, count)
+        if pieces is None:
+            return self.server.refuse(ExcCodes.ILLEGAL_ADDRESS)
+        spans = Layout.spans(pieces)
+        while (raws := self.server.image.read(spans)) is None:
+            await asyncio.sleep(0)  # the scan is publishing: a few microseconds
+        values = Layout.values(pieces, raws)
+        return [bool(v) for v in values] if kind in ("coils", "discrete_inputs") else values
+
+    async def async_setValues(self, device_id, func_code, address, values):
+        problem = self.server.writable(device_id, func_code, address, len(values))
+        if problem is not None:
+            return self.server.refuse(problem)
+        if len(self.server.pending) >= MAX_PENDING:  # the scan is not taking writes (stopped): busy
+            self.server.count(C.REFUSED_RATE, f"{PEER.get()}: exception 06, {MAX_PENDING} writes wait for the scan")
+            return ExcCodes.DEVICE_BUSY
+        kind = KIND_OF_FUNCTION[func_code]
+        if kind == "holding_registers":
+            pieces = self.server.layout.find(device_id, kind, address, len(values))
+            if not string_lengths_fit(pieces, values):
+                return self.server.refuse(ExcCodes.ILLEGAL_VALUE)
+        await self.server.through_scan(lambda seq: msg.write(seq, device_id, kind, address,
+                                                             [int(v) for v in values]))
+        return None
+
+
+def string_lengths_fit(pieces, values) -> bool:
+    """A string's LEN register takes 0..82 (its character count)."""
+    k = 0
+    for s, off, n in pieces:
+        if s.value == "string":
+            for j in range(n):
+                if (off + j) % 83 == 0 and values[k + j] > 82:
+                    return False
+        k += n
+    return True
+
+
+class Connection(ServerRequestHandler):
+    """One client connection, with the server's rules around pymodbus's handler."""
+
+    def __init__(self, owner: "Server", *args) -> None:
+        super().__init__(owner, *args)
+        self.owner = owner
+        self.peer = "?"
+        self.idle_timer: asyncio.TimerHandle | None = None
+        self.counted = False
+
+    def callback_connected(self) -> None:
+        owner = self.owner
+        peer = self.transport.get_extra_info("peername") or ("?", 0)
+        self.peer = f"{peer[0]}:{peer[1]}"
+        try:
+            ip = ipaddress.ip_address(str(peer[0]).split("%")[0])
+        except ValueError:
+            ip = None
+        if ip is None or not any(ip in net for net in owner.config.allow):
+            owner.count(C.REFUSED_NETWORK, f"{self.peer}: refused, not in the allow-list")
+            self.close()
+            return
+        if owner.open_connections >= owner.config.max_connections:
+            owner.count(C.REFUSED_LIMIT, f"{self.peer}: refused, maxConnections "
+                                         f"{owner.config.max_connections} reached")
+            self.close()
+            return
+        self.counted = True
+        owner.open_connections += 1
+        owner.counters.add(C.CONNECTIONS)
+        owner.image.set(C.CONNECTED, owner.open_connections)
+        owner.log(2, f"{self.peer}: connected")
+        self._rearm()
+
+    def callback_disconnected(self, exc) -> None:
+        super().callback_disconnected(exc)
+        self._drop()
+
+    def close(self, reconnect: bool = False) -> None:
+        super().close(reconnect)
+        self._drop()
+
+    def _drop(self) -> None:
+        if self.idle_timer is not None:
+            self.idle_timer.cancel()
+            self.idle_timer = None
+        if self.counted:
+            self.counted = False
+            self.owner.open_connections -= 1
+            self.owner.image.set(C.CONNECTED, self.owner.open_connections)
+            self.owner.log(2, f"{self.peer}: disconnected")
+
+    def _rearm(self) -> None:
+        if self.idle_timer is not None:
+            self.idle_timer.cancel()
+        self.idle_timer = self.owner.loop.call_later(self.owner.config.idle_timeout_ms / 1000, self._idle)
+
+    def _idle(self) -> None:
+        self.idle_timer = None
+        self.owner.count(C.IDLE, f"{self.peer}: closed, no whole request for "
+                                 f"{self.owner.config.idle_timeout_ms} ms")
+        self.close()
+
+    def callback_data(self, data: bytes, addr=None) -> int:
+        """Every whole frame in ``data``, each served in its own task (a
+        write waiting for the scan holds up nothing else)."""
+        used = 0
+        while len(data) - used >= MBAP:
+            pid = int.from_bytes(data[used + 2:used + 4], "big")
+            length = int.from_bytes(data[used + 4:used + 6], "big")
+            if pid != 0 or not 2 <= length <= MAX_LENGTH:
+                self.owner.count(C.MALFORMED, f"{self.peer}: closed, not a Modbus TCP frame "
+                                              f"(protocol id {pid}, length {length})")
+                self.close()
+                return len(data)
+            end = used + 6 + length
+            if len(data) < end:
+                break
+            self._request(data[used:end])
+            used = end
+            if self.transport is None:
+                return len(data)
+        return used
+
+    def _request(self, frame: bytes) -> None:
+        owner = self.owner
+        self._rearm()
+        tid, unit, function = int.from_bytes(frame[:2], "big"), frame[6], frame[7]
+        if not owner.rate_ok(self.peer.rsplit(":", 1)[0]):
+            owner.count(C.REFUSED_RATE, f"{self.peer}: exception 06, over maxRequestsPerSecond")
+            return self._answer(ExceptionResponse(function, ExcCodes.DEVICE_BUSY), unit, tid)
+        if function not in KIND_OF_FUNCTION:
+            owner.count(C.EXCEPTION_01, f"{self.peer}: exception 01, function {function} is not served")
+            return self._answer(ExceptionResponse(function & 0x7F, ExcCodes.ILLEGAL_FUNCTION), unit, tid)
+        pdu = owner.decoder.decode(frame[7:])
+        if pdu is None:
+            owner.count(C.MALFORMED, f"{self.peer}: closed, function {function} with a body that does not decode")
+            self.close()
+            return None
+        pdu.dev_id, pdu.transaction_id = unit, tid
+        if unit not in owner.units:
+            owner.count(C.EXCEPTION_0B, f"{self.peer}: exception 0B, unit id {unit} is not configured")
+            return self._answer(ExceptionResponse(function, ExcCodes.GATEWAY_NO_RESPONSE), unit, tid)
+        owner.log(2, f"{self.peer}: {pdu}")
+        PEER.set(self.peer)  # the task takes a copy: its log lines name this client
+        owner.loop.create_task(self._serve(pdu))
+        return None
+
+    async def _serve(self, pdu) -> None:
+        owner = self.owner
+        try:
+            if isinstance(pdu, MaskWriteRegisterRequest):
+                response = await owner.mask_write(pdu)
+            else:
+                response = await pdu.datastore_update(owner.context, pdu.dev_id)
+        except Exception as exc:  # pymodbus or this module: the client gets exception 04, nothing else stops
+            owner.log(1, f"{self.peer}: exception 04: {type(exc).__name__}: {exc}")
+            response = ExceptionResponse(pdu.function_code, ExcCodes.DEVICE_FAILURE)
+        if not isinstance(response, ExceptionResponse):
+            owner.counters.add(C.REQUESTS)
+        self._answer(response, pdu.dev_id, pdu.transaction_id)
+
+    def _answer(self, response, unit: int, tid: int) -> None:
+        if self.transport is None:
+            return
+        response.dev_id, response.transaction_id = unit, tid
+        self.pdu_send(response)
+
+
+class Server(ModbusTcpServer):
+    def __init__(self, config, layout: Layout, image: SharedImage, out_fd: int, address) -> None:
+        self.config = config
+        self.layout = layout
+        self.image = image
+        self.counters = Counters(image)
+        self.units = layout.units()
+        self.open_connections = 0
+        self.out_fd = out_fd
+        self.sequence = 0
+        self.pending: dict[int, asyncio.Future] = {}
+        self.outbox = bytearray()
+        self.writer_armed = False
+        self.buckets: dict[str, list[float]] = {}
+        self.last_refusal = ExcCodes.ILLEGAL_ADDRESS
+        super().__init__(TableContext(self), address=address)
+
+    def callback_new_connection(self) -> Connection:
+        return Connection(self, self.trace_packet, self.trace_pdu, self.trace_connect)
+
+    # -- rules -------------------------------------------------------------------------------
+    def log(self, level: int, message: str) -> None:
+        if self.config.debug >= level:
+            print(f"MODBTCPS: {time.strftime('%H:%M:%S')} {message}", file=sys.stderr, flush=True)
+
+    def count(self, counter: int, message: str) -> None:
+        self.counters.add(counter)
+        self.log(1, message)
+
+    def refuse(self, code: ExcCodes) -> ExcCodes:
+        counter = {ExcCodes.ILLEGAL_FUNCTION: C.EXCEPTION_01, ExcCodes.ILLEGAL_ADDRESS: C.EXCEPTION_02,
+                   ExcCodes.ILLEGAL_VALUE: C.EXCEPTION_03}[code]
+        self.count(counter, f"{PEER.get()}: exception {int(code):02X}")
+        return code
+
+    def rate_ok(self, client: str) -> bool:
+        """A token bucket per client address: maxRequestsPerSecond, with a
+        burst of one second's worth."""
+        limit = self.config.max_requests_per_second
+        now = time.monotonic()
+        bucket = self.buckets.get(client)
+        if bucket is None:
+            bucket = self.buckets[client] = [float(limit), now]
+        bucket[0] = min(float(limit), bucket[0] + (now - bucket[1]) * limit)
+        bucket[1] = now
+        if bucket[0] < 1.0:
+            return False
+        bucket[0] -= 1.0
+        return True
+
+    def writable(self, unit: int, function: int, address: int, count: int) -> ExcCodes | None:
+        kind = KIND_OF_FUNCTION[function]
+        if not self.layout.has(unit, kind, writable=True):
+            return ExcCodes.ILLEGAL_FUNCTION  # this unit takes no writes of this kind at all
+        pieces = self.layout.find(unit, kind, address, count)
+        if pieces is None or not all(s.writable for s, _, _ in pieces):
+            return ExcCodes.ILLEGAL_ADDRESS
+        return None
+
+    # -- writes through the scan --------------------------------------------------------------
+    async def through_scan(self, make) -> None:
+        """Send a write to the scan; return when the scan has applied it."""
+        self.sequence += 1
+        seq = self.sequence
+        future = self.loop.create_future()
+        self.pending[seq] = future
+        self.counters.add(C.WRITES)
+        self.send(make(seq))
+        await future
+
+    async def mask_write(self, pdu):
+        problem = self.writable(pdu.dev_id, 22, pdu.address, 1)
+        if problem is not None:
+            return ExceptionResponse(22, self.refuse(problem))
+        await self.through_scan(lambda seq: msg.mask(seq, pdu.dev_id, pdu.address, pdu.and_mask, pdu.or_mask))
+        return MaskWriteRegisterResponse(address=pdu.address, and_mask=pdu.and_mask, or_mask=pdu.or_mask,
+                                         dev_id=pdu.dev_id, transaction_id=pdu.transaction_id)
+
+    def acked(self, seq: int) -> None:
+        for k in [k for k in self.pending if k <= seq]:
+            future = self.pending.pop(k)
+            if not future.done():
+                future.set_result(None)
+
+    def send(self, data: bytes) -> None:
+        """To the runtime; what the pipe cannot take now waits here (the
+        runtime may be stopped between scans: reads go on meanwhile)."""
+        self.outbox += data
+        self._flush()
+
+    def _flush(self) -> None:
+        while self.outbox:
+            try:
+                n = os.write(self.out_fd, self.outbox)
+            except BlockingIOError:
+                if not self.writer_armed:
+                    self.writer_armed = True
+                    self.loop.add_writer(self.out_fd, self._flush)
+                return
+            except OSError:  # the runtime is gone: standard input closes next, and this process ends
+                self.outbox.clear()
+                return
+            del self.outbox[:n]
+        if self.writer_armed:
+            self.writer_armed = False
+            self.loop.remove_writer(self.out_fd)
+
+
+def _bind_problem(host: str, port: int) -> str | None:
+    """Why the address cannot be listened on, in words (pymodbus only logs it)."""
+    try:
+        infos = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM, flags=socket.AI_PASSIVE)
+    except OSError as e:
+        return f"cannot listen on {host}:{port}: {e.strerror or e}"
+    family, kind, proto, _, sockaddr = infos[0]
+    with socket.socket(family, kind, proto) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind(sockaddr)
+        except OSError as e:
+            return f"cannot listen on {host}:{port}: {e.strerror or e}"
+    return None
+
+
+async def serve(init: dict) -> None:
+    config, layout = init["config"], init["layout"]
+    image = SharedImage.attach(init["image"], init["size"])
+    out_fd = init["out_fd"]
+    problem = _bind_problem(config.host, config.port)
+    if problem is not None:
+        os.write(out_fd, msg.failed(problem))  # blocking still: a few bytes into an empty pipe
+        return
+    server = Server(config, layout, image, out_fd, (config.host, config.port))
+    await server.serve_forever(background=True)
+    port = server.transport.sockets[0].getsockname()[1]
+    image.set(C.LISTENING, 1)
+    server.log(1, f"listening on {config.host}:{port}")
+    os.set_blocking(out_fd, False)
+    server.send(msg.ready(port))
+
+    loop = asyncio.get_running_loop()
+    done = loop.create_future()
+    reader = msg.Reader()
+    stdin = 0
+    os.set_blocking(stdin, False)
+
+    def from_runtime() -> None:
+        try:
+            data = os.read(stdin, 65536)
+        except BlockingIOError:
+            return
+        if not data:  # the runtime closed the pipe: stopped, or gone
+            if not done.done():
+                done.set_result(None)
+            return
+        for m in reader.feed(data):
+            if m[0] == msg.ACK:
+                server.acked(m[1])
+            elif m[0] == msg.STOP and not done.done():
+                done.set_result(None)
+
+    loop.add_reader(stdin, from_runtime)
+    await done
+    loop.remove_reader(stdin)
+    image.set(C.LISTENING, 0)
+    await server.shutdown()
+
+
+def _read_exactly(fd: int, n: int) -> bytes:
+    out = bytearray()
+    while len(out) < n:
+        chunk = os.read(fd, n - len(out))
+        if not chunk:
+            break
+        out += chunk
+    return bytes(out)
+
+
+def main() -> int:
+    logging.getLogger("pymodbus").setLevel(logging.CRITICAL)  # this module says what matters, counted
+    header = _read_exactly(0, 4)
+    if len(header) < 4:
+        return 1
+    init = pickle.loads(_read_exactly(0, msg.LENGTH.unpack(header)[0]))
+    init["out_fd"] = int(sys.argv[1])
+    try:
+        asyncio.run(serve(init))
+    except KeyboardInterrupt:
+        pass
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
