@@ -113,6 +113,10 @@ class Runner:
         # callables run between two scans, each given this runner (see the module docstring)
         self.between_scans: list[Callable[[Runner], None]] = []
         self.stop_requested = False  # request_stop(): end ``run`` at the next scan boundary
+        # Real time: scans that started a whole period or more after they were due (they missed
+        # their slot, as a periodic task's overlap does), and the latest start seen, in ms.
+        self.late_scans = 0
+        self.max_lateness_ms = 0.0
 
     @property
     def realtime(self) -> bool:
@@ -173,6 +177,13 @@ class Runner:
         once when no port plays anything back: there is nothing to wait for)."""
         return all(p.finished and not p.in_waiting for p in self.replay_ports())
 
+    def _lateness(self, late_s: float, period: float) -> None:
+        """Keep count of late starts (``late_scans``, ``max_lateness_ms``)."""
+        if late_s > self.max_lateness_ms / 1000:
+            self.max_lateness_ms = late_s * 1000
+        if late_s >= period:
+            self.late_scans += 1
+
     def request_stop(self) -> None:
         """End ``run`` after the scan under way (safe from a signal handler)."""
         self.stop_requested = True
@@ -221,7 +232,9 @@ class Runner:
                     delay = next_at - time.monotonic()
                     if delay > 0:
                         time.sleep(delay)
+                        self._lateness(time.monotonic() - next_at, period)  # woken late
                     else:
+                        self._lateness(-delay, period)  # the scan overran its period
                         next_at = time.monotonic()  # overran: don't try to catch up
         except KeyboardInterrupt:
             pass

@@ -207,10 +207,10 @@ class Connection(ServerRequestHandler):
             owner.count(C.EXCEPTION_01, f"{self.peer}: exception 01, function {function} is not served")
             return self._answer(ExceptionResponse(function & 0x7F, ExcCodes.ILLEGAL_FUNCTION), unit, tid)
         pdu = owner.decoder.decode(frame[7:])
-        if pdu is None:
-            owner.count(C.MALFORMED, f"{self.peer}: closed, function {function} with a body that does not decode")
-            self.close()
-            return None
+        if pdu is None:  # a quantity out of range, a byte count that disagrees (Modbus spec 7: exception 03)
+            owner.count(C.EXCEPTION_03, f"{self.peer}: exception 03, function {function} with a body that "
+                                        "does not decode")
+            return self._answer(ExceptionResponse(function, ExcCodes.ILLEGAL_VALUE), unit, tid)
         pdu.dev_id, pdu.transaction_id = unit, tid
         if unit not in owner.units:
             owner.count(C.EXCEPTION_0B, f"{self.peer}: exception 0B, unit id {unit} is not configured")

@@ -1,0 +1,118 @@
+"""Building MODBTCPS apps for tests: an app directory with MODULES.LST,
+MODBTCPS.XML and a ladder file, and a Runner scanning it in a thread of the
+test process (the server is its own process either way), stopped and closed
+after the test."""
+
+from __future__ import annotations
+
+import threading
+import time
+from pathlib import Path
+
+from softplc_lite.app import load_app
+from softplc_lite.runner import RunOptions, Runner
+
+from modbus_peer import free_tcp_port
+
+LIMIT_S = 15.0  # any one wait; a step normally takes well under a second
+
+UNIT_1 = """
+  <Unit id="1">
+    <Coils            start="0"   count="40" address="B3/0"   writable="yes"/>
+    <Coils            start="100" count="8"  address="O:0/0"/>
+    <DiscreteInputs   start="0"   count="20" address="I:0/4"/>
+    <HoldingRegisters start="0"   count="20" address="N7:0"   writable="yes"/>
+    <HoldingRegisters start="50"  count="5"  address="N7:50"/>
+    <HoldingRegisters start="100" count="4"  address="F8:0"   writable="yes"/>
+    <HoldingRegisters start="110" count="2"  address="F8:10"  writable="yes" wordOrder="low-high"/>
+    <HoldingRegisters start="200" count="2"  address="ST9:0"  writable="yes"/>
+    <InputRegisters   start="0"   count="10" address="N11:0"/>
+    <InputRegisters   start="20"  count="2"  address="F8:20"/>
+  </Unit>
+"""
+
+
+def server_xml(units: str = UNIT_1, port: int | None = None, **root: object) -> str:
+    attrs = {"port": port or free_tcp_port(), "status": "N40:0", **root}
+    text = " ".join(f'{k}="{v}"' for k, v in attrs.items())
+    return f'<?xml version="1.0"?>\n<ModbusTcpServer {text}>\n{units}</ModbusTcpServer>\n'
+
+
+def write_app(directory: Path, xml: str, ladder: str = "ADD N11:0 1 N11:0\n", modules: str = "MODBTCPS\n",
+              extra: dict[str, str] | None = None) -> Path:
+    directory.mkdir(parents=True, exist_ok=True)
+    (directory / "MODULES.LST").write_text(modules)
+    (directory / "MODBTCPS.XML").write_text(xml)
+    (directory / "main.lad").write_text(ladder)
+    for name, text in (extra or {}).items():
+        (directory / name).write_text(text)
+    return directory
+
+
+class Running:
+    """A runner scanning in a background thread until ``stop``."""
+
+    def __init__(self, app_dir: Path, realtime: bool = True, scan_ms: int | None = None) -> None:
+        app = load_app(app_dir)
+        if scan_ms is not None:
+            app.settings.scan_ms = scan_ms
+        self.runner = Runner(app, RunOptions(realtime=realtime, save_state=False))
+        self.engine = self.runner.engine
+        self.module = next(m for m in self.engine.modules if m.name == "MODBTCPS")
+        self.port = self.module.port
+        self.error: BaseException | None = None
+        self.stopped = False
+        self.thread = threading.Thread(target=self._run, name="modbtcps-test-runner", daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        try:
+            self.runner.run(None)
+        except BaseException as e:  # the test sees it in stop()
+            self.error = e
+
+    def read(self, address: str):
+        return self.engine.table.read(address)
+
+    def status(self, word: int) -> int:
+        return self.engine.table.read(f"N40:{word}")
+
+    def wait_for(self, condition, what: str, limit: float = LIMIT_S) -> None:
+        deadline = time.monotonic() + limit
+        while not condition():
+            if time.monotonic() > deadline:
+                raise AssertionError(f"timed out waiting for {what}")
+            time.sleep(0.01)
+
+    def stop(self) -> None:
+        if self.stopped:
+            return
+        self.stopped = True
+        self.runner.request_stop()
+        self.thread.join(LIMIT_S)
+        self.runner.close()
+        if self.error is not None:
+            raise self.error
+
+
+class Apps:
+    """Makes running apps and stops them after the test."""
+
+    def __init__(self, tmp_path: Path) -> None:
+        self.tmp_path = tmp_path
+        self.running: list[Running] = []
+        self.count = 0
+
+    def start(self, xml: str | None = None, ladder: str = "ADD N11:0 1 N11:0\n", **kw) -> Running:
+        self.count += 1
+        app = write_app(self.tmp_path / f"app{self.count}", xml or server_xml(), ladder)
+        r = Running(app, **kw)
+        self.running.append(r)
+        return r
+
+    def close(self) -> None:
+        for r in self.running:
+            try:
+                r.stop()
+            except BaseException:  # the test has failed already, or says so itself
+                pass
