@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import ipaddress
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -763,3 +765,43 @@ def test_config_references_create_the_words_in_a_data_table():
 def test_item_address_is_the_bit_k_places_on(first_bit, k):
     r = Region("coils", 0, k + 1, parse_address(f"B3/{first_bit}"), False, "bit", "high-low", 1, 1)
     assert item_address(r, k) == parse_address(f"B3/{first_bit + k}")
+
+
+# -- 12. softplc check reports it all (a real subprocess, the module registered by its entry point) -------
+
+def check_app(tmp_path: Path, xml: str | None) -> subprocess.CompletedProcess:
+    (tmp_path / "MODULES.LST").write_text("MODBTCPS\n")
+    (tmp_path / "main.lad").write_text("ADD N11:0 1 N11:0\n")
+    if xml is not None:
+        (tmp_path / CONFIG_FILE).write_text(xml)
+    return subprocess.run([sys.executable, "-m", "softplc_lite", "check", str(tmp_path)], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=60)
+
+
+def test_check_reports_every_problem_with_file_line_and_column(tmp_path):
+    proc = check_app(tmp_path, MANY_PROBLEMS)
+    assert proc.returncode == 1
+    assert "Traceback" not in proc.stdout + proc.stderr
+    path = tmp_path / CONFIG_FILE
+    lines = [line for line in (proc.stdout + proc.stderr).splitlines() if line.startswith(str(path))]
+    expected = [f"{path}:{p.line}:{p.column}: {p.message}" for p in problems(MANY_PROBLEMS)]
+    assert lines == expected and len(lines) == 11
+
+
+def test_check_says_what_a_missing_file_holds(tmp_path):
+    proc = check_app(tmp_path, None)
+    assert proc.returncode == 1
+    out = proc.stdout + proc.stderr
+    assert "Traceback" not in out
+    assert f"{tmp_path / CONFIG_FILE} does not exist: it holds the <ModbusTcpServer> configuration" in out
+    assert "docs/modbtcps.md" in out
+
+
+def test_check_passes_the_doc_example_and_shows_warnings(tmp_path):
+    proc = check_app(tmp_path, doc_example())
+    assert (proc.returncode, proc.stderr) == (0, "")
+    assert "module MODBTCPS" in proc.stdout and "warning" not in proc.stdout
+    proc = check_app(tmp_path, server(root='address="0.0.0.0"'))
+    assert proc.returncode == 0
+    assert f"warning: {tmp_path / CONFIG_FILE}:1: listening on 0.0.0.0 but no <Allow> is given" in \
+        proc.stdout + proc.stderr
