@@ -350,7 +350,7 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
         host = host_to_listen(a["address"])
         if host is None:
             c.error(root, f"address={a['address']!r}: expected {_HOST} (127.0.0.1: only this machine; "
-                          "0.0.0.0: every interface)", "address")
+                          "0.0.0.0: every IPv4 interface)", "address")
     status = _check_status(c, root, a["status"]) if "status" in a else None
     allow_nodes, unit_nodes = c.children(root, [("Allow", 0, MANY), ("Unit", 1, MANY)])
     allow: list = []
