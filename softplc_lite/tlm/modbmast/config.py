@@ -28,7 +28,7 @@ from ...textfile import read_bytes
 from ...ports.urlhandler.protocol_sim import url_problem as sim_url_problem
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
-from ..xmlcheck import MANY, Attr, XmlChecker, content, parse_integer
+from ..xmlcheck import MANY, Attr, XmlChecker, parse_integer
 from ..xmlreader import XmlNode, XmlSyntaxError, read_xml
 from .requests import REQUEST_KINDS, RequestKind
 
