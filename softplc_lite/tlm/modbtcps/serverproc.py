@@ -68,7 +68,7 @@ class TableContext(ModbusServerContext):
         self._devices = {}
 
     def device_ids(self) -> list[int]:
-        return sorted(self.server.layout.units())
+        return sorted(self.server.units)
 
     async def async_getValues(self, device_id, func_code, address, count=1):
         kind = KIND_OF_FUNCTION[func_code]
@@ -247,7 +247,7 @@ class Server(ModbusTcpServer):
         self.layout = layout
         self.image = image
         self.counters = Counters(image)
-        self.units = layout.units()
+        self.units = set(config.units)  # a unit with no regions answers exception 02 to everything
         self.open_connections = 0
         self.out_fd = out_fd
         self.sequence = 0
