@@ -1,0 +1,149 @@
+"""MODBTCPS end to end (issue 19, section 2): 20 clients writing counters
+while the ladder runs on the wall clock, and two runtimes, one polling the
+other with COMGENIUS over a ``socket://`` port.
+
+The runtimes are ``softplc run`` processes (the clients' threads must not
+share an interpreter with the scan they judge); each is ended with SIGTERM,
+which prints its --print values, and said how many scans were late."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from pymodbus.client import ModbusTcpClient
+
+from modbtcps_apps import LIMIT_S, server_xml, write_app
+from modbus_peer import free_tcp_port, wait_for_tcp
+
+pytestmark = pytest.mark.timeout(120)
+PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
+CLIENTS = 20
+SECONDS = 10.0
+
+
+class Runtime:
+    """``softplc run APP --realtime`` until ``stop``: (stdout, stderr)."""
+
+    def __init__(self, app: Path, *args: str) -> None:
+        self.proc = subprocess.Popen([sys.executable, "-m", "softplc_lite", "run", str(app), "--realtime",
+                                      "--fresh", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                     text=True)
+
+    def stop(self) -> tuple[str, str]:
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGTERM)
+        try:
+            out, err = self.proc.communicate(timeout=LIMIT_S)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            out, err = self.proc.communicate()
+        assert self.proc.returncode == 0, err
+        return out, err
+
+
+def prints(addresses: list[str]) -> list[str]:
+    return [arg for a in addresses for arg in ("--print", a)]
+
+
+def printed(stdout: str) -> dict[str, str]:
+    return dict(line.split(" = ", 1) for line in stdout.splitlines() if " = " in line)
+
+
+def late_scans(stderr: str) -> tuple[int, int]:
+    m = re.search(r": (\d+) late scans? of (\d+),", stderr)
+    assert m, stderr
+    return int(m.group(1)), int(m.group(2))
+
+
+def test_20_clients_write_counters_for_10_seconds_every_write_lands_and_no_scan_is_late(tmp_path):
+    port = free_tcp_port()
+    units = '<Unit id="1"><HoldingRegisters start="0" count="20" address="N7:0" writable="yes"/></Unit>\n'
+    # The ladder works on what the clients write: the sum of the counters, every scan.
+    ladder = "CLR N9:0\n" + "".join(f"ADD N9:0 N7:{k} N9:0\n" for k in range(CLIENTS))
+    app = write_app(tmp_path / "app", server_xml(units, port=port, maxRequestsPerSecond=100000,
+                                                 maxConnections=CLIENTS + 2), ladder)
+    runtime = Runtime(app, *prints([f"N7:{k}" for k in range(CLIENTS)] + ["S:9"]))
+    try:
+        wait_for_tcp(port, LIMIT_S)
+        last = [0] * CLIENTS
+        errors: list[str] = []
+        start = threading.Barrier(CLIENTS)
+
+        def client(k: int) -> None:
+            try:
+                with ModbusTcpClient("127.0.0.1", port=port, timeout=LIMIT_S, retries=0) as c:
+                    start.wait()
+                    end = time.monotonic() + SECONDS
+                    value = 0
+                    while time.monotonic() < end:
+                        value = (value + 1) & 0x7FFF
+                        r = c.write_register(k, value, device_id=1)
+                        if r.isError():
+                            errors.append(f"client {k}: {r}")
+                            return
+                        last[k] = value
+            except Exception as e:  # said by the assertion below
+                errors.append(f"client {k}: {type(e).__name__}: {e}")
+
+        threads = [threading.Thread(target=client, args=(k,)) for k in range(CLIENTS)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(SECONDS + LIMIT_S)
+    finally:
+        out, err = runtime.stop()
+    assert not errors, errors[:3]
+    values = printed(out)
+    assert [int(values[f"N7:{k}"]) for k in range(CLIENTS)] == last  # every client's last write is there
+    assert min(last) > 50  # each client wrote many times (a write takes one scan at most 10 ms apart)
+    late, scans = late_scans(err)
+    assert late == 0 and scans >= SECONDS * 100 * 0.8, err
+    assert int(values["S:9"]) < 100  # the longest scan, far under the 500 ms watchdog
+
+
+MBAP_STRINGS = """\
+[STRINGS]
+1 "unused"
+2 "\\x00\\x01\\x00\\x00\\x00\\x06\\x01\\x03%.2C%.2C"
+3 "unused"
+4 "\\x00\\x01\\x00\\x00\\x00\\x17\\x01\\x03\\x14%.20C"
+5 "\\x00\\x01\\x00\\x00\\x00\\x03\\x01\\x83%c"
+"""
+
+
+def test_one_runtime_polls_another_with_comgenius_over_socket(tmp_path):
+    """Runtime B serves its N7 over MODBTCPS; runtime A is the shipped
+    COMGENIUS Modbus master with Modbus TCP (MBAP) formats instead of RTU
+    ones, its port 0 on socket:// to B, reading 10 registers each poll."""
+    port = free_tcp_port()
+    units = '<Unit id="1"><HoldingRegisters start="0" count="10" address="N7:0"/></Unit>\n'
+    server = write_app(tmp_path / "b", server_xml(units, port=port), "ADD N7:0 1 N7:0\nMOV 4242 N7:5\n")
+    client = tmp_path / "a"
+    shutil.copytree(PROGRAMS / "modbus_master", client)
+    (client / "softplc.toml").unlink()  # its [display] is about the simulated slave's registers
+    lst = (client / "COMGENIUS.LST").read_text()
+    (client / "COMGENIUS.LST").write_text(lst[:lst.index("\n[STRINGS]\n") + 1] + MBAP_STRINGS)
+    ladder = (client / "main.lad").read_text()
+    (client / "main.lad").write_text(ladder.replace("DATA N7 22 = 0 125", "DATA N7 22 = 0 10"))
+    b = Runtime(server)
+    a = None
+    try:
+        wait_for_tcp(port, LIMIT_S)
+        a = Runtime(client, "--port", f"0=socket://127.0.0.1:{port}",
+                    *prints(["N11:0", "N11:5", "C5:1.ACC", "C5:2.ACC", "C5:3.ACC", "C5:4.ACC"]))
+        time.sleep(3.0)
+    finally:
+        out_a, err_a = a.stop() if a is not None else ("", "")
+        out_b, _ = b.stop()
+    values = printed(out_a)
+    assert int(values["C5:1.ACC"]) >= 10, (out_a, err_a)  # good replies: about one every 60 ms
+    assert values["N11:5"] == "4242" and int(values["N11:0"]) > 0
+    assert values["C5:2.ACC"] == values["C5:3.ACC"] == values["C5:4.ACC"] == "0"  # no exception, timeout, garbage
