@@ -275,3 +275,27 @@ def test_writes_land_in_program_mode_and_outputs_stay_idle(apps):
     finally:
         stop.set()
         t.join(LIMIT_S)
+
+
+# -- the server process ------------------------------------------------------------------
+
+
+def test_an_address_in_use_refuses_to_start_saying_why(apps):
+    from softplc_lite.tlm.errors import ModuleError
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        with pytest.raises(ModuleError, match=f"cannot listen on 127.0.0.1:{port}: Address already in use"):
+            apps.start(server_xml(port=port))
+
+
+def test_a_server_process_that_dies_sets_the_failed_bit_and_the_scan_goes_on(plc):
+    plc.wait_for(lambda: plc.status(S.W_BITS) & S.BIT_LISTENING, "listening")
+    plc.module.process.kill()
+    plc.wait_for(lambda: plc.status(S.W_BITS) & S.BIT_FAILED, "the failed bit")
+    assert not plc.status(S.W_BITS) & S.BIT_LISTENING
+    scans = plc.engine.scans
+    plc.wait_for(lambda: plc.engine.scans > scans + 5, "scans after the server died")
+    assert plc.module.server_status().up is False
