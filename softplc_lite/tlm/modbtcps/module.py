@@ -89,8 +89,12 @@ class ModbTcpServer(TLM):
             loc = table.resolve(self.config.status)
             self._status = (loc.file.data, loc.index)
         self.image = SharedImage.create(self.layout.size)
-        self._publish()
-        self._start()
+        try:
+            self._publish()
+            self._start()
+        except BaseException:
+            self.close()  # nothing left behind: no process, no file in /dev/shm
+            raise
         return []
 
     def _start(self) -> None:
