@@ -147,3 +147,28 @@ def test_one_runtime_polls_another_with_comgenius_over_socket(tmp_path):
     assert int(values["C5:1.ACC"]) >= 10, (out_a, err_a)  # good replies: about one every 60 ms
     assert values["N11:5"] == "4242" and int(values["N11:0"]) > 0
     assert values["C5:2.ACC"] == values["C5:3.ACC"] == values["C5:4.ACC"] == "0"  # no exception, timeout, garbage
+
+
+def children(pid: int) -> list[int]:
+    path = Path(f"/proc/{pid}/task/{pid}/children")
+    return [int(p) for p in path.read_text().split()] if path.exists() else []
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux's /proc")
+def test_the_server_process_ends_when_its_runtime_is_killed(tmp_path):
+    port = free_tcp_port()
+    runtime = Runtime(write_app(tmp_path / "app", server_xml(port=port)))
+    try:
+        wait_for_tcp(port, LIMIT_S)
+        (server,) = children(runtime.proc.pid)
+        runtime.proc.kill()  # no close(): the server sees its standard input end
+        runtime.proc.wait(LIMIT_S)
+        deadline = time.monotonic() + LIMIT_S
+        while Path(f"/proc/{server}").exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not Path(f"/proc/{server}").exists() or "Z" in Path(f"/proc/{server}/stat").read_text().split()[2]
+        assert not list(Path("/dev/shm").glob("softplc-modbtcps-*"))  # the image was unlinked at start
+    finally:
+        if runtime.proc.poll() is None:
+            runtime.proc.kill()
+        runtime.proc.communicate()
