@@ -152,6 +152,12 @@ def _cmd_run(args: argparse.Namespace) -> int:
     finally:
         runner.close()
     engine = runner.engine
+    if engine.clock.realtime and engine.scans:
+        # On the wall clock, whether the scan kept its period (a scan late by a whole period missed its
+        # slot). On standard error, so that standard output stays the --print values a script reads;
+        # before the final save, so that a save's error stays the last line.
+        print(f"{app.name}: {runner.late_scans} late scan{'s' if runner.late_scans != 1 else ''} "
+              f"of {engine.scans}, the latest start {runner.max_lateness_ms:.1f} ms after due", file=sys.stderr)
     storage_problems = runner.finish()  # the final save; a failure is reported, and the output still printed
     if args.dump:
         try:
@@ -164,11 +170,6 @@ def _cmd_run(args: argparse.Namespace) -> int:
         print(f"{app.name}: {engine.scans} scans, {engine.clock.now_ms / 1000:.2f} s {clock} time")
         for line in app.display.summary_lines(runner.table):
             print(line)
-    if engine.clock.realtime and engine.scans:
-        # On the wall clock, whether the scan kept its period (a scan late by a whole period missed its
-        # slot); on standard error, so that standard output stays the --print values a script reads.
-        print(f"{app.name}: {runner.late_scans} late scan{'s' if runner.late_scans != 1 else ''} "
-              f"of {engine.scans}, the latest start {runner.max_lateness_ms:.1f} ms after due", file=sys.stderr)
     _print_values(runner.table, args.print, app.program.symbols)
     if engine.mode is Mode.FAULTED:
         print(f"softplc: {app.name}: {engine.fault}", file=sys.stderr)
