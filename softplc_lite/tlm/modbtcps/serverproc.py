@@ -8,17 +8,15 @@ writes to the scan through the pipe FD, answering a write once the scan has
 applied it (so a read that follows sees it). It exits when standard input
 closes: when the runtime stops, or dies.
 
-pymodbus does the protocol (framing, the PDUs, their encoding); this module
-adds what a PLC's server needs around it: the allow-list, the connection and
-request-rate limits, idle connections closed, malformed frames closing their
-connection, and every refusal counted (status.py).
+pymodbus does the protocol (the PDUs, their encoding); connection.py adds
+what a PLC's server needs around each client: the allow-list, the connection
+and request-rate limits, idle connections closed, malformed frames closing
+their connection, and every refusal counted (status.py).
 """
 
 from __future__ import annotations
 
 import asyncio
-import contextvars
-import ipaddress
 import logging
 import os
 import pickle
@@ -29,39 +27,26 @@ import time
 from pymodbus.constants import ExcCodes
 from pymodbus.datastore import ModbusServerContext
 from pymodbus.pdu import ExceptionResponse
-from pymodbus.pdu.register_message import MaskWriteRegisterRequest, MaskWriteRegisterResponse
+from pymodbus.pdu.register_message import MaskWriteRegisterResponse
 from pymodbus.server import ModbusTcpServer
-from pymodbus.server.requesthandler import ServerRequestHandler
 
 from . import messages as msg
 from . import status as C
+from .connection import KIND_OF_FUNCTION, PEER, Connection
 from .image import SharedImage
 from .layout import Layout
 
-KIND_OF_FUNCTION = {1: "coils", 5: "coils", 15: "coils", 2: "discrete_inputs",
-                    3: "holding_registers", 6: "holding_registers", 16: "holding_registers",
-                    22: "holding_registers", 23: "holding_registers", 4: "input_registers"}
 WRITES = {5, 6, 15, 16, 22, 23}
 MAX_READ = {"coils": 2000, "discrete_inputs": 2000, "holding_registers": 125, "input_registers": 125}
-PEER: contextvars.ContextVar[str] = contextvars.ContextVar("peer", default="?")  # whose request a task serves
 MAX_PENDING = 10_000  # writes waiting for the scan; more are answered busy (06)
-MBAP = 7  # transaction, protocol, length, unit
-MAX_LENGTH = 254  # the MBAP length field: unit id + the largest PDU (253)
-
-
-class Counters:
-    def __init__(self, image: SharedImage) -> None:
-        self.image = image
-
-    def add(self, counter: int, n: int = 1) -> None:
-        self.image.add(counter, n)
+MAX_BUCKETS = 4096  # client addresses remembered by the rate limit
 
 
 class TableContext(ModbusServerContext):
     """The data table as pymodbus's datastore: reads from the image, writes
     through the scan."""
 
-    def __init__(self, server: "Server") -> None:  # no super().__init__: it builds pymodbus's own store
+    def __init__(self, server: Server) -> None:  # no super().__init__: it builds pymodbus's own store
         self.server = server
         self.old_simulator = True  # pymodbus then calls this object as it is
         self.simdevices = []
@@ -112,141 +97,11 @@ def string_lengths_fit(pieces, values) -> bool:
     return True
 
 
-class Connection(ServerRequestHandler):
-    """One client connection, with the server's rules around pymodbus's handler."""
-
-    def __init__(self, owner: "Server", *args) -> None:
-        super().__init__(owner, *args)
-        self.owner = owner
-        self.peer = "?"
-        self.idle_timer: asyncio.TimerHandle | None = None
-        self.counted = False
-
-    def callback_connected(self) -> None:
-        owner = self.owner
-        peer = self.transport.get_extra_info("peername") or ("?", 0)
-        self.peer = f"{peer[0]}:{peer[1]}"
-        try:
-            ip = ipaddress.ip_address(str(peer[0]).split("%")[0])
-        except ValueError:
-            ip = None
-        if ip is None or not any(ip in net for net in owner.config.allow):
-            owner.count(C.REFUSED_NETWORK, f"{self.peer}: refused, not in the allow-list")
-            self.close()
-            return
-        if owner.open_connections >= owner.config.max_connections:
-            owner.count(C.REFUSED_LIMIT, f"{self.peer}: refused, maxConnections "
-                                         f"{owner.config.max_connections} reached")
-            self.close()
-            return
-        self.counted = True
-        owner.open_connections += 1
-        owner.counters.add(C.CONNECTIONS)
-        owner.image.set(C.CONNECTED, owner.open_connections)
-        owner.log(2, f"{self.peer}: connected")
-        self._rearm()
-
-    def callback_disconnected(self, exc) -> None:
-        super().callback_disconnected(exc)
-        self._drop()
-
-    def close(self, reconnect: bool = False) -> None:
-        super().close(reconnect)
-        self._drop()
-
-    def _drop(self) -> None:
-        if self.idle_timer is not None:
-            self.idle_timer.cancel()
-            self.idle_timer = None
-        if self.counted:
-            self.counted = False
-            self.owner.open_connections -= 1
-            self.owner.image.set(C.CONNECTED, self.owner.open_connections)
-            self.owner.log(2, f"{self.peer}: disconnected")
-
-    def _rearm(self) -> None:
-        if self.idle_timer is not None:
-            self.idle_timer.cancel()
-        self.idle_timer = self.owner.loop.call_later(self.owner.config.idle_timeout_ms / 1000, self._idle)
-
-    def _idle(self) -> None:
-        self.idle_timer = None
-        self.owner.count(C.IDLE, f"{self.peer}: closed, no whole request for "
-                                 f"{self.owner.config.idle_timeout_ms} ms")
-        self.close()
-
-    def callback_data(self, data: bytes, addr=None) -> int:
-        """Every whole frame in ``data``, each served in its own task (a
-        write waiting for the scan holds up nothing else)."""
-        used = 0
-        while len(data) - used >= MBAP:
-            pid = int.from_bytes(data[used + 2:used + 4], "big")
-            length = int.from_bytes(data[used + 4:used + 6], "big")
-            if pid != 0 or not 2 <= length <= MAX_LENGTH:
-                self.owner.count(C.MALFORMED, f"{self.peer}: closed, not a Modbus TCP frame "
-                                              f"(protocol id {pid}, length {length})")
-                self.close()
-                return len(data)
-            end = used + 6 + length
-            if len(data) < end:
-                break
-            self._request(data[used:end])
-            used = end
-            if self.transport is None:
-                return len(data)
-        return used
-
-    def _request(self, frame: bytes) -> None:
-        owner = self.owner
-        self._rearm()
-        tid, unit, function = int.from_bytes(frame[:2], "big"), frame[6], frame[7]
-        if not owner.rate_ok(self.peer.rsplit(":", 1)[0]):
-            owner.count(C.REFUSED_RATE, f"{self.peer}: exception 06, over maxRequestsPerSecond")
-            return self._answer(ExceptionResponse(function, ExcCodes.DEVICE_BUSY), unit, tid)
-        if function not in KIND_OF_FUNCTION:
-            owner.count(C.EXCEPTION_01, f"{self.peer}: exception 01, function {function} is not served")
-            return self._answer(ExceptionResponse(function & 0x7F, ExcCodes.ILLEGAL_FUNCTION), unit, tid)
-        pdu = owner.decoder.decode(frame[7:])
-        if pdu is None:  # a quantity out of range, a byte count that disagrees (Modbus spec 7: exception 03)
-            owner.count(C.EXCEPTION_03, f"{self.peer}: exception 03, function {function} with a body that "
-                                        "does not decode")
-            return self._answer(ExceptionResponse(function, ExcCodes.ILLEGAL_VALUE), unit, tid)
-        pdu.dev_id, pdu.transaction_id = unit, tid
-        if unit not in owner.units:
-            owner.count(C.EXCEPTION_0B, f"{self.peer}: exception 0B, unit id {unit} is not configured")
-            return self._answer(ExceptionResponse(function, ExcCodes.GATEWAY_NO_RESPONSE), unit, tid)
-        owner.log(2, f"{self.peer}: {pdu}")
-        PEER.set(self.peer)  # the task takes a copy: its log lines name this client
-        owner.loop.create_task(self._serve(pdu))
-        return None
-
-    async def _serve(self, pdu) -> None:
-        owner = self.owner
-        try:
-            if isinstance(pdu, MaskWriteRegisterRequest):
-                response = await owner.mask_write(pdu)
-            else:
-                response = await pdu.datastore_update(owner.context, pdu.dev_id)
-        except Exception as exc:  # pymodbus or this module: the client gets exception 04, nothing else stops
-            owner.log(1, f"{self.peer}: exception 04: {type(exc).__name__}: {exc}")
-            response = ExceptionResponse(pdu.function_code, ExcCodes.DEVICE_FAILURE)
-        if not isinstance(response, ExceptionResponse):
-            owner.counters.add(C.REQUESTS)
-        self._answer(response, pdu.dev_id, pdu.transaction_id)
-
-    def _answer(self, response, unit: int, tid: int) -> None:
-        if self.transport is None:
-            return
-        response.dev_id, response.transaction_id = unit, tid
-        self.pdu_send(response)
-
-
 class Server(ModbusTcpServer):
     def __init__(self, config, layout: Layout, image: SharedImage, out_fd: int, address) -> None:
         self.config = config
         self.layout = layout
         self.image = image
-        self.counters = Counters(image)
         self.units = set(config.units)  # a unit with no regions answers exception 02 to everything
         self.open_connections = 0
         self.out_fd = out_fd
@@ -255,7 +110,6 @@ class Server(ModbusTcpServer):
         self.outbox = bytearray()
         self.writer_armed = False
         self.buckets: dict[str, list[float]] = {}
-        self.last_refusal = ExcCodes.ILLEGAL_ADDRESS
         super().__init__(TableContext(self), address=address)
 
     def callback_new_connection(self) -> Connection:
@@ -267,7 +121,7 @@ class Server(ModbusTcpServer):
             print(f"MODBTCPS: {time.strftime('%H:%M:%S')} {message}", file=sys.stderr, flush=True)
 
     def count(self, counter: int, message: str) -> None:
-        self.counters.add(counter)
+        self.image.add(counter)
         self.log(1, message)
 
     def refuse(self, code: ExcCodes) -> ExcCodes:
@@ -283,6 +137,8 @@ class Server(ModbusTcpServer):
         now = time.monotonic()
         bucket = self.buckets.get(client)
         if bucket is None:
+            if len(self.buckets) >= MAX_BUCKETS:  # forget the addresses whose buckets are full again
+                self.buckets = {k: b for k, b in self.buckets.items() if now - b[1] < 1.0}
             bucket = self.buckets[client] = [float(limit), now]
         bucket[0] = min(float(limit), bucket[0] + (now - bucket[1]) * limit)
         bucket[1] = now
@@ -307,7 +163,7 @@ class Server(ModbusTcpServer):
         seq = self.sequence
         future = self.loop.create_future()
         self.pending[seq] = future
-        self.counters.add(C.WRITES)
+        self.image.add(C.WRITES)
         self.send(make(seq))
         await future
 
