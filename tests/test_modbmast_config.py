@@ -31,6 +31,8 @@ from softplc_lite.tlm.modbmast.config import (
 from softplc_lite.tlm.modbmast.requests import REQUEST_KINDS
 from softplc_lite.tlm.xmlreader import MAX_BYTES
 
+from located import locate, where
+
 PATH = "MODBMAST.XML"
 
 # The manual's Table 3 / Table 7 facts, written out here rather than taken from the code:
@@ -69,18 +71,6 @@ def only_problem(xml: str | bytes) -> ModuleError:
     found = problems(xml)
     assert len(found) == 1, ModuleErrors(found).report()
     return found[0]
-
-
-def locate(text: str, needle: str, nth: int = 1) -> tuple[int, int]:
-    """(line, column), 1-based, of the ``nth`` occurrence of ``needle``."""
-    i = -1
-    for _ in range(nth):
-        i = text.index(needle, i + 1)
-    return text.count("\n", 0, i) + 1, i - (text.rfind("\n", 0, i) + 1) + 1
-
-
-def where(problem: ModuleError) -> tuple[int, int]:
-    return problem.line, problem.column
 
 
 def in_slave(inner: str, port: str = 'num="1" baudrate="19200"', slave: str = 'id="2"') -> str:

@@ -40,6 +40,8 @@ from softplc_lite.tlm.modbtcps.config import (
 )
 from softplc_lite.tlm.xmlcheck import MAX_PROBLEMS
 
+from located import locate, where
+
 ROOT = Path(__file__).resolve().parent.parent
 DOC = ROOT / "docs" / "modbtcps.md"
 PATH = "MODBTCPS.XML"
@@ -62,18 +64,6 @@ def only_problem(xml: str | bytes) -> ModuleError:
     found = problems(xml)
     assert len(found) == 1, ModuleErrors(found).report()
     return found[0]
-
-
-def locate(text: str, needle: str, nth: int = 1) -> tuple[int, int]:
-    """(line, column), 1-based, of the ``nth`` occurrence of ``needle``."""
-    i = -1
-    for _ in range(nth):
-        i = text.index(needle, i + 1)
-    return text.count("\n", 0, i) + 1, i - (text.rfind("\n", 0, i) + 1) + 1
-
-
-def where(problem: ModuleError) -> tuple[int, int]:
-    return problem.line, problem.column
 
 
 UNIT = '<Unit id="1"><Coils start="0" count="1" address="B3/0"/></Unit>'  # a unit that maps something
