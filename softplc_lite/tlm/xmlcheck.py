@@ -16,8 +16,8 @@ import re
 from dataclasses import dataclass
 from typing import Iterable, Mapping
 
-from .errors import ModuleError
-from .xmlreader import XmlNode
+from .errors import ModuleError, ModuleErrors
+from .xmlreader import XmlNode, XmlSyntaxError, read_xml
 
 MAX_PROBLEMS = 200  # listed; a file with more gets a count of the rest
 MANY = 10**9  # no upper bound, in a content model
@@ -91,6 +91,19 @@ class XmlChecker:
             return
         line, column = node.where(attr)
         self.problems.append(ModuleError(message, self.path, line, column))
+
+    def read_root(self, data: bytes, source: str) -> XmlNode:
+        """The file's top element, which must be the checker's root; else
+        ModuleErrors (a syntax error, or the wrong root: ``source`` says
+        where the root is documented)."""
+        try:
+            root = read_xml(data)
+        except XmlSyntaxError as e:
+            raise ModuleErrors([ModuleError(e.message, self.path, e.line, e.column)]) from None
+        if root.name != self.root:
+            self.error(root, f"the top element is <{root.name}>; expected <{self.root}> ({source})")
+            raise ModuleErrors(self.found())
+        return root
 
     def found(self) -> list[ModuleError]:
         """The problems, with a last line counting those not listed."""

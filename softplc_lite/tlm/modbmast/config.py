@@ -29,7 +29,7 @@ from ...ports.urlhandler.protocol_sim import url_problem as sim_url_problem
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
 from ..xmlcheck import MANY, Attr, XmlChecker, parse_integer
-from ..xmlreader import XmlNode, XmlSyntaxError, read_xml
+from ..xmlreader import XmlNode
 from .requests import REQUEST_KINDS, RequestKind
 
 CONFIG_FILE = "MODBMAST.XML"
@@ -362,13 +362,7 @@ def _check_const(c: XmlChecker, node: XmlNode, fmt: str | None, count: int | Non
 def parse_config(data: bytes, path: str = CONFIG_FILE) -> ModbmastConfig:
     """Check MODBMAST.XML's bytes; ModuleErrors listing every problem."""
     c = XmlChecker(path, ATTRIBUTES, ROOT, REQUEST_KINDS)
-    try:
-        root = read_xml(data)
-    except XmlSyntaxError as e:
-        raise ModuleErrors([ModuleError(e.message, path, e.line, e.column)]) from None
-    if root.name != ROOT:
-        c.error(root, f"the top element is <{root.name}>; expected <{ROOT}> (manual Table 8)")
-        raise ModuleErrors(c.found())
+    root = c.read_root(data, "manual Table 8")
     a = c.attributes(root)
     (port_nodes,) = c.children(root, [("Port", 0, MANY)])
     config = ModbmastConfig(path=path, debug=a.get("debug", 0), port_errors=a.get("portErrors", "stop"),

@@ -31,7 +31,7 @@ from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
 from ..xmlcheck import MANY, Attr, XmlChecker, parse_integer
-from ..xmlreader import XmlNode, XmlSyntaxError, read_xml
+from ..xmlreader import XmlNode
 
 CONFIG_FILE = "MODBTCPS.XML"
 ROOT = "ModbusTcpServer"
@@ -337,13 +337,7 @@ def _check_unit(c: XmlChecker, node: XmlNode, config: dict) -> Unit | None:
 def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
     """Check MODBTCPS.XML's bytes; ModuleErrors listing every problem."""
     c = XmlChecker(path, ATTRIBUTES, ROOT, HINT_NAMES)
-    try:
-        root = read_xml(data)
-    except XmlSyntaxError as e:
-        raise ModuleErrors([ModuleError(e.message, path, e.line, e.column)]) from None
-    if root.name != ROOT:
-        c.error(root, f"the top element is <{root.name}>; expected <{ROOT}> (docs/modbtcps.md)")
-        raise ModuleErrors(c.found())
+    root = c.read_root(data, "docs/modbtcps.md")
     a = c.attributes(root)
     host = None
     if "address" in a:
