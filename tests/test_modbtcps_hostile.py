@@ -413,6 +413,40 @@ def test_a_client_that_never_reads_its_replies_holds_up_no_one_and_not_the_scan(
     assert_server_alive(plc)
 
 
+def test_a_client_sending_faster_than_it_reads_is_no_longer_read_and_then_closed_idle(apps, raws, pollers):
+    """Flow control: once its unread replies fill the kernel's buffers and
+    pass the transport's high-water mark, the server stops serving and
+    reading it (its requests wait as bytes, not as replies in the server's
+    memory), so the answered count stops growing; with nothing read,
+    idleTimeout then closes it."""
+    plc = apps.start(server_xml(units='<Unit id="1">\n<HoldingRegisters start="0" count="200" address="N7:0"/>\n'
+                                      '</Unit>\n', maxRequestsPerSecond="100000", idleTimeout="1500"))
+    stuck = raws(plc.port, rcvbuf=4096)
+    stuck.sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 16384)
+    poller = pollers(plc.port, period=0.05)
+    requests = b"".join(read_request(k % 65536, 0, 125) for k in range(100_000))  # 1.2 MB
+    stuck.sock.setblocking(False)
+    sent, samples = 0, []
+    start = time.monotonic()
+    while time.monotonic() - start < 1.2:
+        try:
+            sent += stuck.sock.send(requests[sent:sent + 65536])
+        except BlockingIOError:
+            time.sleep(0.01)
+        if time.monotonic() - start > 0.6 and len(samples) < 1:
+            samples.append(plc.status(S.W_REQUESTS) - poller.answered)
+    samples.append(plc.status(S.W_REQUESTS) - poller.answered)
+    assert samples[1] - samples[0] < 100, f"answers went on while its replies lay unread: {samples}"
+    plc.wait_for(lambda: plc.status(S.W_IDLE) == 1, "an idle close (no request read for idleTimeout)",
+                 limit=5.0)
+    stuck.sock.setblocking(True)
+    assert stuck.closed_within(5.0) is not None, "what was sent before the close, then the end"
+    assert plc.status(S.W_CONNECTED) == 1, "the poller only"
+    poller.stop()
+    assert poller.slowest < 1.0, poller.slowest
+    assert_server_alive(plc)
+
+
 # -- 8. pipelined requests ---------------------------------------------------------------------
 
 

@@ -54,7 +54,10 @@ class Connection(ServerRequestHandler):
         self.inbox = bytearray()  # received, not yet a whole frame
         self.queue: deque = deque()  # requests to serve in order: a PDU, or an exception response ready
         self.worker: asyncio.Task | None = None
+        self.serving = False  # the worker awaits a request's answer (a write: the scan)
         self.paused: set[str] = set()  # why reading is paused: "queue" full, "writing" (replies unread)
+        self.can_write = asyncio.Event()  # cleared while the client leaves its replies unread
+        self.can_write.set()
 
     def callback_connected(self) -> None:
         owner = self.owner
@@ -86,6 +89,8 @@ class Connection(ServerRequestHandler):
         self._drop()
 
     def close(self, reconnect: bool = False) -> None:
+        if self.transport is not None:  # replies it has not read are dropped: a client that stops
+            self.transport.abort()  # reading must not keep its socket and their memory (close() waits)
         super().close(reconnect)
         self._drop()
 
@@ -113,18 +118,22 @@ class Connection(ServerRequestHandler):
 
     def _idle(self) -> None:
         self.idle_timer = None
-        if self.worker is not None:  # waiting for the scan to apply its write: not idle
+        if self.serving:  # waiting for the scan to apply its write: not idle
             self._rearm()
             return
         self.owner.count(C.IDLE, f"{self.peer}: closed, no whole request for "
                                  f"{self.owner.config.idle_timeout_ms} ms")
         self.close()
 
-    # -- flow control: a client that sends faster than it reads stops being read -------------------
+    # -- flow control: a client that sends faster than it reads stops being served and read --------
     def pause_writing(self) -> None:
+        """Its unread replies passed the transport's high-water mark (64 KiB)."""
+        self.owner.log(2, f"{self.peer}: does not read its replies; not read until it does")
+        self.can_write.clear()
         self._pause("writing")
 
     def resume_writing(self) -> None:
+        self.can_write.set()
         self._resume("writing")
 
     def _pause(self, why: str) -> None:
@@ -140,21 +149,26 @@ class Connection(ServerRequestHandler):
 
     # -- requests ---------------------------------------------------------------------------------
     def data_received(self, data: bytes) -> None:
-        if self.transport is None:
-            return
-        self.inbox += data
+        if self.transport is not None:
+            self.inbox += data
+            self._take_frames()
+
+    def _take_frames(self) -> None:
+        """Queue the whole frames received, up to MAX_QUEUED (the rest wait
+        in ``inbox`` as bytes: one read may bring thousands)."""
         try:
-            used = self.callback_data(bytes(self.inbox))
+            used = self.callback_data(self.inbox)
         except Exception as exc:  # noqa: BLE001 - a bug here must cost this connection only, and be said
             self.owner.log(1, f"{self.peer}: closed, {type(exc).__name__}: {exc}")
             self.close()
             return
         del self.inbox[:used]
 
-    def callback_data(self, data: bytes, addr=None) -> int:
-        """Every whole frame in ``data`` queued; the bytes used."""
+    def callback_data(self, data: bytearray, addr=None) -> int:
+        """The whole frames at the start of ``data`` queued (MAX_QUEUED at
+        most); the bytes used."""
         used = 0
-        while len(data) - used >= MBAP:
+        while len(data) - used >= MBAP and len(self.queue) < MAX_QUEUED:
             pid = int.from_bytes(data[used + 2:used + 4], "big")
             length = int.from_bytes(data[used + 4:used + 6], "big")
             if pid != 0 or not 2 <= length <= MAX_LENGTH:
@@ -165,7 +179,7 @@ class Connection(ServerRequestHandler):
             end = used + 6 + length
             if len(data) < end:
                 break
-            self._request(data[used:end])
+            self._request(bytes(data[used:end]))
             used = end
         if len(self.queue) >= MAX_QUEUED:
             self._pause("queue")
@@ -206,10 +220,18 @@ class Connection(ServerRequestHandler):
         PEER.set(self.peer)  # this task's log lines name its client
         try:
             while self.queue and self.transport is not None:
+                await self.can_write.wait()
                 item = self.queue.popleft()
-                if len(self.queue) <= MAX_QUEUED // 2:
-                    self._resume("queue")
-                response = item if isinstance(item, ExceptionResponse) else await self._serve(item)
+                if "queue" in self.paused and len(self.queue) <= MAX_QUEUED // 2:
+                    self._take_frames()  # those received already first, then the socket again
+                    if len(self.queue) < MAX_QUEUED:
+                        self._resume("queue")
+                if isinstance(item, ExceptionResponse):
+                    response = item
+                else:
+                    self.serving = True
+                    response = await self._serve(item)
+                    self.serving = False
                 if self.transport is not None:
                     self.pdu_send(response)
         finally:
