@@ -265,6 +265,23 @@ def test_a_burst_past_the_rate_gets_exception_06_for_the_excess_and_no_one_else_
     assert_server_alive(plc)
 
 
+def test_a_flood_of_refusals_is_counted_whole_but_logged_in_moderation(apps, raws, capfd):
+    plc = apps.start(server_xml(maxRequestsPerSecond="5", debug="1"))
+    raw = raws(plc.port)
+    replies = burst(raw, 300)
+    refused = sum(pdu == bytes([0x83, 0x06]) for _, pdu in replies)
+    assert refused >= 290
+    plc.wait_for(lambda: plc.status(S.W_REFUSED_RATE) == refused, "every refusal counted")
+    time.sleep(1.1)
+    burst(raw, 10, 400)  # a second later: the lines not logged are summed up
+    plc.wait_for(lambda: plc.status(S.W_REFUSED_RATE) >= refused + 4, "the later refusals counted")
+    time.sleep(0.2)
+    err = capfd.readouterr().err
+    lines = [line for line in err.splitlines() if "exception 06" in line]
+    assert 5 <= len(lines) <= 30, len(lines)  # 20 a second at most, not 300
+    assert f"{refused - 20} more refusals not logged one by one" in err, err[-500:]
+
+
 # -- 4. garbage ------------------------------------------------------------------------------
 
 

@@ -40,6 +40,7 @@ WRITES = {5, 6, 15, 16, 22, 23}
 MAX_READ = {"coils": 2000, "discrete_inputs": 2000, "holding_registers": 125, "input_registers": 125}
 MAX_PENDING = 10_000  # writes waiting for the scan; more are answered busy (06)
 MAX_BUCKETS = 4096  # client addresses remembered by the rate limit
+LOGGED_PER_SECOND = 20  # refusals logged one by one each second at debug 1; the rest summed
 
 
 class TableContext(ModbusServerContext):
@@ -110,6 +111,7 @@ class Server(ModbusTcpServer):
         self.outbox = bytearray()
         self.writer_armed = False
         self.buckets: dict[str, list[float]] = {}
+        self.log_second, self.logged, self.unlogged = 0.0, 0, 0
         super().__init__(TableContext(self), address=address)
 
     def callback_new_connection(self) -> Connection:
@@ -121,8 +123,21 @@ class Server(ModbusTcpServer):
             print(f"MODBTCPS: {time.strftime('%H:%M:%S')} {message}", file=sys.stderr, flush=True)
 
     def count(self, counter: int, message: str) -> None:
+        """A refusal: counted always, logged at debug 1 up to LOGGED_PER_SECOND
+        (a flood of bad requests must not become a flood of lines)."""
         self.image.add(counter)
-        self.log(1, message)
+        if self.config.debug < 1:
+            return
+        now = time.monotonic()
+        if now - self.log_second >= 1.0:
+            if self.unlogged:
+                self.log(1, f"{self.unlogged} more refusals not logged one by one (the status words count them)")
+            self.log_second, self.logged, self.unlogged = now, 0, 0
+        if self.logged < LOGGED_PER_SECOND:
+            self.logged += 1
+            self.log(1, message)
+        else:
+            self.unlogged += 1
 
     def refuse(self, code: ExcCodes) -> ExcCodes:
         counter = {ExcCodes.ILLEGAL_FUNCTION: C.EXCEPTION_01, ExcCodes.ILLEGAL_ADDRESS: C.EXCEPTION_02,
