@@ -507,7 +507,8 @@ def test_a_write_then_a_read_sees_the_value(apps):
 
 
 def test_a_write_while_scans_are_held_is_answered_when_they_resume(apps, raws):
-    plc = apps.start()
+    """Also: its connection is not idle meanwhile (idleTimeout 500 ms < the 1 s hold)."""
+    plc = apps.start(server_xml(idleTimeout="500"))
     hold = threading.Event()
     held = threading.Event()
 
@@ -530,3 +531,4 @@ def test_a_write_while_scans_are_held_is_answered_when_they_resume(apps, raws):
     assert waited >= 0.5, f"answered after {waited:.2f} s: before the scan applied it"
     assert plc.read("N7:4") == 1234
     assert served(raw, 6)
+    assert plc.status(S.W_IDLE) == 0

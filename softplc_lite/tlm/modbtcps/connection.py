@@ -234,6 +234,9 @@ class Connection(ServerRequestHandler):
                     self.serving = False
                 if self.transport is not None:
                     self.pdu_send(response)
+        except Exception as exc:  # noqa: BLE001 - a reply that cannot be built: this connection ends, said
+            self.owner.log(1, f"{self.peer}: closed, {type(exc).__name__}: {exc}")
+            self.close()
         finally:
             if self.worker is asyncio.current_task():
                 self.worker = None
