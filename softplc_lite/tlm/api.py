@@ -20,7 +20,8 @@ for that app:
    ignores keys it does not use. Raise ModuleError to refuse to start. A
    module that drives serial ports lists them in ``port_claims()`` (after
    ``configure``), so that ``--port N=...`` finds its owner and no two ports
-   open one device;
+   open one device; one that serves a network (MODBTCPS) reports its
+   servers in ``network_servers()``, for the watch view;
 5. ``create(instr, ctx)`` makes one instance per instruction in the
    program. Each scan the engine calls the instance with the rung-in
    condition and takes its return value as the rung-out condition;
@@ -100,6 +101,12 @@ class TLM:
 
     def serial_ports(self) -> list:
         """The module's open ports (ports.SerialPort), for the watch view."""
+        return []
+
+    def network_servers(self) -> list:
+        """The module's network servers, for the watch view: one item per
+        server, with the fields of tlm.modbtcps.status.ServerStatus
+        (listening, up, clients, rate, requests, writes, refusals, refused)."""
         return []
 
     # driver hooks: no-ops unless overridden
