@@ -1,7 +1,8 @@
 """The watch view's screen: the status bar over the rungs, the watch list,
-ports and forces beside them (or below, on a narrow terminal), and the
-keys at the bottom. Each part is a renderable of its own; this module only
-composes them for the space there is (80x24 and up)."""
+forces, ports and network servers beside them (or below, on a narrow
+terminal), and the keys at the bottom. Each part is a renderable of its
+own; this module only composes them for the space there is (80x24 and
+up)."""
 
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ from rich.text import Text
 from ..ladder import status as S
 from ..ladder.engine import Mode
 from .portsview import PortsView
+from .serversview import ServersView
 from .session import WatchSession
 from .xref import XrefPanel
 
@@ -201,6 +203,7 @@ class WatchScreen:
         self.status = StatusBar(session, measured)
         self.rungs = RungsPanel(session, view_factory)
         self.ports = PortsView(session.engine)
+        self.servers = ServersView(session.engine)
         self.forces = ForcesView(session)
         self.prompt = prompt
         self.help = None  # the key table while the help overlay is shown
@@ -211,6 +214,8 @@ class WatchScreen:
             parts.insert(0, XrefPanel(self.session.finding, height=FIND_LINES))
         if self.ports:
             parts.append(self.ports)
+        if self.servers:
+            parts.append(self.servers)
         return Group(*parts)
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
