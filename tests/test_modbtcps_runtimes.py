@@ -141,8 +141,10 @@ def test_one_runtime_polls_another_with_comgenius_over_socket(tmp_path):
                     *prints(["N11:0", "N11:5", "C5:1.ACC", "C5:2.ACC", "C5:3.ACC", "C5:4.ACC"]))
         time.sleep(3.0)
     finally:
-        out_a, err_a = a.stop() if a is not None else ("", "")
-        out_b, _ = b.stop()
+        try:
+            out_a, err_a = a.stop() if a is not None else ("", "")
+        finally:
+            b.stop()
     values = printed(out_a)
     assert int(values["C5:1.ACC"]) >= 10, (out_a, err_a)  # good replies: about one every 60 ms
     assert values["N11:5"] == "4242" and int(values["N11:0"]) > 0

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import socket
 import struct
+import time
 
 import pytest
 from pymodbus.client import ModbusTcpClient
@@ -234,11 +235,12 @@ def test_a_client_never_sees_half_a_scan(apps):
     plc = apps.start(server_xml(maxRequestsPerSecond=100000), ladder=ladder, realtime=False)
     with ModbusTcpClient("127.0.0.1", port=plc.port, timeout=LIMIT_S, retries=0) as c:
         seen = set()
-        for _ in range(300):
+        end = time.monotonic() + 2.0
+        while time.monotonic() < end:
             regs = c.read_input_registers(0, count=10, device_id=1).registers
             assert len(set(regs)) == 1, regs
             seen.add(regs[0])
-    assert len(seen) > 100  # the scan moved on between reads: the reads did overlap scans
+    assert len(seen) > 20  # the scan moved on between reads: the reads did overlap scans
 
 
 def test_status_words_show_the_server(plc, client):
