@@ -239,6 +239,8 @@ def _run_with_status(runner: Runner, app, scans: int | None, unbounded: bool) ->
         if now - last >= 0.1:
             last = now
             line.update(engine.table, engine.scans, engine.clock.now_ms, engine.clock.realtime, now - start)
+            servers = [s for m in engine.modules for s in m.network_servers()]
+            line.clients = sum(s.clients for s in servers) if servers else None
 
     with Live(line, console=console, refresh_per_second=5, transient=False):
         runner.run(scans, on_scan=refresh)

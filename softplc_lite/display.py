@@ -142,6 +142,7 @@ class StatusLine:
         self.values: list[str] = ["-"] * len(items)
         self.rate: float | None = None  # scans a second of wall-clock time
         self.ratio: float | None = None  # PLC seconds per wall-clock second
+        self.clients: int | None = None  # clients of the app's network servers (MODBTCPS); None: it has none
         self._last: tuple[float, int, int] | None = None  # (wall_s, scans, now_ms) of the update before
 
     def update(self, table: DataTable, scans: int, now_ms: int, realtime: bool, wall_s: float | None = None) -> None:
@@ -163,6 +164,8 @@ class StatusLine:
         t.append(f"  scan {self.scans}  {self.now_ms / 1000:.2f} s {clock}", style="dim")
         if self.rate is not None and self.ratio is not None:
             t.append(f"  {self.rate:.0f} scans/s  x{self.ratio:.2f} real time", style="dim")
+        if self.clients is not None:
+            t.append(f"  {self.clients} client{'s' if self.clients != 1 else ''}", style="dim")
         for item, value in zip(self.items, self.values):
             t.append("  ")
             t.append(f"{item.label} ", style="cyan")

@@ -52,6 +52,21 @@ def test_status_line_renders_scan_time_and_values():
     assert console.export_text().rstrip() == "modbus_master  scan 3000  3.00 s simulated  polls 12  regs 12 0"
 
 
+def test_status_line_counts_the_clients_of_an_app_with_a_server():
+    line = StatusLine("hmi_server", [])
+    line.update(DataTable(), scans=10, now_ms=100, realtime=True)
+    console = Console(width=100, record=True, color_system=None, file=open("/dev/null", "w"))
+    line.clients = 2
+    console.print(line)
+    line.clients = 1
+    console.print(line)
+    line.clients = None  # no network server: nothing said
+    console.print(line)
+    assert console.export_text().splitlines() == ["hmi_server  scan 10  0.10 s real  2 clients",
+                                                  "hmi_server  scan 10  0.10 s real  1 client",
+                                                  "hmi_server  scan 10  0.10 s real"]
+
+
 @pytest.mark.parametrize("display,message", [
     ('status = { polls = 5 }\n', "[display] polls = 5; expected an address"),
     ('status = { polls = "N7:x" }\n', "[display] polls = 'N7:x': "),

@@ -118,8 +118,6 @@ def test_requests_writes_rate_and_refusals_by_kind_add_up(apps, clients):
     assert row[5] == "3 (exception 01 1, exception 02 1, exception 0B 1)"
 
 
-@pytest.mark.xfail(strict=True, reason="module.py measures the rate in _status_words, which runs only with a "
-                                       "status block (issue 19 watch helper's report): remove this mark with the fix")
 def test_req_per_s_is_measured_without_a_status_block_too(apps, clients):
     xml = server_xml().replace(' status="N40:0"', "")
     assert "status=" not in xml

@@ -26,6 +26,7 @@ from .session import WatchSession
 REDRAW_HZ = 10  # at most
 DRAW_SHARE = 0.04  # of the wall time spent drawing while running, at most
 SLICE_S = 0.02  # scanning time between two looks at the keyboard
+PAUSED_SERVERS_S = 1.0  # while paused, the servers panel is redrawn this often (its counts are live)
 PROMPT_MAX = 200  # characters a prompt (g, F, U, M, =, t, /, d) takes
 
 _ESCAPES = {"\x1b[A": "up", "\x1b[B": "down", "\x1bOA": "up", "\x1bOB": "down",
@@ -300,6 +301,8 @@ class ViewLoop:
             session.run_for(SLICE_S)
             self.dirty = True
         now = time.monotonic()
+        if not session.running and self.screen.servers and now - self.last_draw >= PAUSED_SERVERS_S:
+            self.dirty = True  # a server's clients and counts change while the scan is paused
         if k is not None or (self.dirty and now - self.last_draw >= self.interval):
             self.screen.prompt = self.control.prompt
             self.screen.help = KEYS if self.control.help else None

@@ -188,8 +188,10 @@ class ModbTcpServer(TLM):
                 self.process.stdin.flush()
             except (OSError, ValueError):
                 self._lost("the server process ended")
+        counters = self.image.counters()
+        self._measure_rate(counters[C.REQUESTS])
         if self._status is not None:
-            self._status_words()
+            self._status_words(counters)
 
     def _publish(self) -> None:
         image = self.image
@@ -198,14 +200,16 @@ class ModbTcpServer(TLM):
             image.put(offset, data[index:index + n])
         image.end()
 
-    def _status_words(self) -> None:
-        counters = self.image.counters()
-        data, i = self._status
+    def _measure_rate(self, requests: int) -> None:
+        """Requests answered normally a second, over each whole second (the watch view and word 2)."""
         now = time.monotonic()
         mark_t, mark_n = self._rate_mark
         if now - mark_t >= 1.0:
-            self.rate = int(round((counters[C.REQUESTS] - mark_n) / (now - mark_t)))
-            self._rate_mark = (now, counters[C.REQUESTS])
+            self.rate = int(round((requests - mark_n) / (now - mark_t)))
+            self._rate_mark = (now, requests)
+
+    def _status_words(self, counters) -> None:
+        data, i = self._status
         bits = 0
         if counters[C.LISTENING] and self.failed is None:
             bits |= C.BIT_LISTENING
