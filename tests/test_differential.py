@@ -21,6 +21,8 @@ and 4).
 
 from __future__ import annotations
 
+import dataclasses
+
 from pathlib import Path
 from unittest import mock
 
@@ -35,6 +37,7 @@ from softplc_lite.ladder.fmt import format_program
 from softplc_lite.app import app_instructions, load_app
 from softplc_lite.ladder.parser import parse_program
 from softplc_lite.tlm import load_modules
+from modbus_peer import free_tcp_port
 
 SCANS = 50
 REPO = Path(__file__).resolve().parent.parent
@@ -170,7 +173,12 @@ def test_programs_dir_executors_agree(path):
     app = load_app(path)
     words = [((k * 40503) & 0xFFFF, None) for k in range(SCANS)]
     app_dir = path if path.is_dir() else path.parent
-    modules = lambda: load_modules(app_dir)[0]  # noqa: E731 - fresh modules for each engine
+    def modules():  # fresh modules for each engine
+        found = load_modules(app_dir)[0]
+        for m in found:
+            if m.name == "MODBTCPS":  # two engines at once: two servers, each on a port of its own
+                m.config = dataclasses.replace(m.config, port=free_tcp_port())
+        return found
     for k, compiled, reference in run_pair(app.program, {}, words, space=(), modules=modules):
         assert fault_of(compiled) == fault_of(reference), f"scan {k}"
         assert compiled.table == reference.table, f"scan {k}\n" + table_diff(compiled.table, reference.table)
