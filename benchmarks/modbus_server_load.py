@@ -227,13 +227,14 @@ async def one_raw_client(spec: dict, start_at: float, end_at: float, tally: Tall
 
 
 async def run_clients(spec: dict) -> dict:
-    """K clients, started together ``lead_s`` from now (time to connect and
-    warm up; ``ready_late_s`` > 0 says it was not enough), for ``window_s``."""
+    """K clients, started together at ``start_at`` (CLOCK_MONOTONIC; the
+    parent leaves time to connect and warm up, ``ready_late_s`` > 0 says it
+    was not enough), for ``window_s``."""
     logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
     tally = Tally()
     ready: asyncio.Queue = asyncio.Queue()
     k = spec["clients"]
-    start_at = time.monotonic() + spec["lead_s"]
+    start_at = spec["start_at"]
     end_at = start_at + spec["window_s"]
     body = one_raw_client if spec.get("raw") else one_client
     tasks = [asyncio.create_task(body(spec, start_at, end_at, tally, ready)) for _ in range(k)]
