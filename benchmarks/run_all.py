@@ -21,7 +21,8 @@ import _common as C
 BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_load_cache",
     "bench_comgenius_format",
-    "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_watch",
+    "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_modbus_server",
+    "bench_watch",
 )
 
 
@@ -163,6 +164,15 @@ def main() -> int:
                      f"the request (vs 3.5 chars): {gaps}")
         lines.append(f"          scan us: empty app {su['empty']:.1f}, slave idle {su['idle']:.1f}, serving read 1 "
                      f"{su['read 1']:,.0f}, read 125 {su['read 125']:,.0f}, write 123 {su['write 123']:,.0f}")
+
+    mts = load("bench_modbus_server")
+    if mts:
+        row = next(r for r in mts["rows"] if r["kind"] == "read" and r["clients"] == 16 and r["processes"] == 1)
+        med = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731
+        lines.append(f"modbtcps  reads of 100 by 16 clients: {med(row['modbtcps_rates']):,.0f}/s vs pymodbus's server "
+                     f"{med(row['pymodbus_rates']):,.0f}/s = {row['ratio']:.2f}x; under 50 busy clients "
+                     f"{mts['busy']['scans'].get('late_scans', 0)} late scans, the ladder's longest "
+                     f"{mts['state']['max_ladder_ms']:.2f} ms")
 
     watch = load("bench_watch")
     if watch:
