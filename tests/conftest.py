@@ -100,3 +100,13 @@ def run(request):
 
     return _run
 
+
+@pytest.fixture
+def tcp_apps(tmp_path):
+    """MODBTCPS apps started by the test (tests/modbtcps_apps.py), each
+    stopped after it with its server process."""
+    from modbtcps_apps import Apps
+
+    apps = Apps(tmp_path)
+    yield apps
+    apps.close()

@@ -8,7 +8,7 @@ other clients must go on being served by the same server process, which
 survives it all. Raw sockets play the misbehaving clients (pymodbus's
 client will not send bad frames); pymodbus's client plays the well-behaved
 one. Every socket is closed by the test that opens it, every runtime by the
-``apps`` fixture."""
+``tcp_apps`` fixture."""
 
 from __future__ import annotations
 
@@ -32,13 +32,6 @@ pytestmark = pytest.mark.timeout(60)
 
 CLOSE_S = 3.0  # a refused or malformed connection is closed well within this
 OTHER_LOOPBACK = "127.0.0.2"  # Linux routes all of 127.0.0.0/8 to lo: a second client address
-
-
-@pytest.fixture
-def apps(tmp_path):
-    a = Apps(tmp_path)
-    yield a
-    a.close()
 
 
 # -- a raw Modbus TCP client -------------------------------------------------------------
@@ -187,8 +180,8 @@ def pollers():
 # -- 1. the allow-list ---------------------------------------------------------------------
 
 
-def test_a_client_outside_the_allow_list_is_closed_at_once_counted_and_logged(apps, raws, capfd):
-    plc = apps.start(server_xml(units='<Allow network="10.0.0.0/8"/>\n<Unit id="1">\n'
+def test_a_client_outside_the_allow_list_is_closed_at_once_counted_and_logged(tcp_apps, raws, capfd):
+    plc = tcp_apps.start(server_xml(units='<Allow network="10.0.0.0/8"/>\n<Unit id="1">\n'
                                       '<HoldingRegisters start="0" count="10" address="N7:0"/>\n</Unit>\n',
                                 debug="1"))
     for k in range(2):
@@ -201,15 +194,15 @@ def test_a_client_outside_the_allow_list_is_closed_at_once_counted_and_logged(ap
     assert_server_alive(plc)
 
 
-def test_the_default_allow_list_is_loopback_any_address_of_it(apps, raws):
-    plc = apps.start()  # no <Allow>: 127.0.0.0/8 and ::1
+def test_the_default_allow_list_is_loopback_any_address_of_it(tcp_apps, raws):
+    plc = tcp_apps.start()  # no <Allow>: 127.0.0.0/8 and ::1
     assert served(raws(plc.port))
     assert served(raws(plc.port, source=OTHER_LOOPBACK))
     assert plc.status(S.W_REFUSED_NETWORK) == 0
 
 
-def test_an_allow_list_of_one_address_refuses_its_neighbour(apps, raws):
-    plc = apps.start(server_xml(units='<Allow network="127.0.0.2/32"/>\n<Unit id="1">\n'
+def test_an_allow_list_of_one_address_refuses_its_neighbour(tcp_apps, raws):
+    plc = tcp_apps.start(server_xml(units='<Allow network="127.0.0.2/32"/>\n<Unit id="1">\n'
                                       '<HoldingRegisters start="0" count="10" address="N7:0"/>\n</Unit>\n'))
     allowed = raws(plc.port, source=OTHER_LOOPBACK)
     refused = raws(plc.port)  # from 127.0.0.1
@@ -222,8 +215,8 @@ def test_an_allow_list_of_one_address_refuses_its_neighbour(apps, raws):
 # -- 2. the connection limit ---------------------------------------------------------------
 
 
-def test_the_connection_past_the_limit_is_closed_and_counted_and_a_freed_place_is_taken(apps, raws):
-    plc = apps.start(server_xml(maxConnections="2"))
+def test_the_connection_past_the_limit_is_closed_and_counted_and_a_freed_place_is_taken(tcp_apps, raws):
+    plc = tcp_apps.start(server_xml(maxConnections="2"))
     first, second = raws(plc.port), raws(plc.port)
     assert served(first) and served(second)
     third = raws(plc.port)
@@ -249,8 +242,8 @@ def burst(raw: Raw, n: int, first_tid: int = 1) -> list[tuple[int, bytes]]:
     return [(tid, pdu) for tid, _, pdu in (raw.reply() for _ in range(n))]
 
 
-def test_a_burst_past_the_rate_gets_exception_06_for_the_excess_and_no_one_else_does(apps, raws):
-    plc = apps.start(server_xml(maxRequestsPerSecond="20"))
+def test_a_burst_past_the_rate_gets_exception_06_for_the_excess_and_no_one_else_does(tcp_apps, raws):
+    plc = tcp_apps.start(server_xml(maxRequestsPerSecond="20"))
     greedy, other = raws(plc.port), raws(plc.port, source=OTHER_LOOPBACK)
     replies = burst(greedy, 100)
     assert [tid for tid, _ in replies] == list(range(1, 101)), "every request answered, in order"
@@ -267,8 +260,8 @@ def test_a_burst_past_the_rate_gets_exception_06_for_the_excess_and_no_one_else_
     assert_server_alive(plc)
 
 
-def test_a_flood_of_refusals_is_counted_whole_but_logged_in_moderation(apps, raws, capfd):
-    plc = apps.start(server_xml(maxRequestsPerSecond="5", debug="1"))
+def test_a_flood_of_refusals_is_counted_whole_but_logged_in_moderation(tcp_apps, raws, capfd):
+    plc = tcp_apps.start(server_xml(maxRequestsPerSecond="5", debug="1"))
     raw = raws(plc.port)
     replies = burst(raw, 300)
     refused = sum(pdu == bytes([0x83, 0x06]) for _, pdu in replies)
@@ -305,8 +298,8 @@ GARBAGE = {
 }
 
 
-def test_malformed_frames_close_their_connection_only_and_are_counted(apps, raws, pollers):
-    plc = apps.start()
+def test_malformed_frames_close_their_connection_only_and_are_counted(tcp_apps, raws, pollers):
+    plc = tcp_apps.start()
     poller = pollers(plc.port)
     bystander = raws(plc.port)
     for k, (what, data) in enumerate(GARBAGE.items()):
@@ -320,8 +313,8 @@ def test_malformed_frames_close_their_connection_only_and_are_counted(apps, raws
     assert_server_alive(plc)
 
 
-def test_a_request_in_one_byte_segments_is_served(apps, raws):
-    plc = apps.start()
+def test_a_request_in_one_byte_segments_is_served(tcp_apps, raws):
+    plc = tcp_apps.start()
     plc.engine.table.write("N7:5", 4321)
     plc.wait_for(lambda: plc.status(S.W_BITS) & S.BIT_LISTENING, "listening")
     time.sleep(0.1)  # a published scan with N7:5
@@ -368,8 +361,8 @@ def test_any_bytes_never_stop_the_server_or_its_other_clients(shared_plc, data):
 # -- 5. half-open and slowloris ----------------------------------------------------------------
 
 
-def test_silent_and_slowloris_connections_are_closed_after_idle_timeout_active_ones_never(apps, raws, pollers):
-    plc = apps.start(server_xml(idleTimeout="500"))
+def test_silent_and_slowloris_connections_are_closed_after_idle_timeout_active_ones_never(tcp_apps, raws, pollers):
+    plc = tcp_apps.start(server_xml(idleTimeout="500"))
     active = pollers(plc.port, period=0.1)
     silent = raws(plc.port)
     slow = raws(plc.port)
@@ -404,8 +397,8 @@ def test_silent_and_slowloris_connections_are_closed_after_idle_timeout_active_o
 # -- 6. a stuck client -------------------------------------------------------------------------
 
 
-def test_a_client_that_never_reads_its_replies_holds_up_no_one_and_not_the_scan(apps, raws, pollers):
-    plc = apps.start(server_xml(units='<Unit id="1">\n<HoldingRegisters start="0" count="200" address="N7:0"/>\n'
+def test_a_client_that_never_reads_its_replies_holds_up_no_one_and_not_the_scan(tcp_apps, raws, pollers):
+    plc = tcp_apps.start(server_xml(units='<Unit id="1">\n<HoldingRegisters start="0" count="200" address="N7:0"/>\n'
                                       '</Unit>\n', maxRequestsPerSecond="100000"), scan_ms=10)
     plc.wait_for(lambda: plc.engine.scans > 20, "scans running")
     baseline_ms = plc.runner.max_lateness_ms
@@ -432,13 +425,13 @@ def test_a_client_that_never_reads_its_replies_holds_up_no_one_and_not_the_scan(
     assert_server_alive(plc)
 
 
-def test_a_client_sending_faster_than_it_reads_is_no_longer_read_and_then_closed_idle(apps, raws, pollers):
+def test_a_client_sending_faster_than_it_reads_is_no_longer_read_and_then_closed_idle(tcp_apps, raws, pollers):
     """Flow control: once its unread replies fill the kernel's buffers and
     pass the transport's high-water mark, the server stops serving and
     reading it (its requests wait as bytes, not as replies in the server's
     memory), so the answered count stops growing; with nothing read,
     idleTimeout then closes it."""
-    plc = apps.start(server_xml(units='<Unit id="1">\n<HoldingRegisters start="0" count="200" address="N7:0"/>\n'
+    plc = tcp_apps.start(server_xml(units='<Unit id="1">\n<HoldingRegisters start="0" count="200" address="N7:0"/>\n'
                                       '</Unit>\n', maxRequestsPerSecond="100000", idleTimeout="1500"))
     stuck = raws(plc.port, rcvbuf=4096)
     stuck.sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 16384)
@@ -490,13 +483,13 @@ print(answered)
 """
 
 
-def test_fifty_busy_clients_do_not_make_the_scan_late(apps):
+def test_fifty_busy_clients_do_not_make_the_scan_late(tcp_apps):
     """The issue's "50 busy clients": reads of 100 registers as fast as each
     is answered, from another process, for 3 s, against a 10 ms real-time
     scan. The bound is generous (two shared cores run the scan, the server
     and the clients): this is not a benchmark, it catches a server that
     shares the scan's interpreter lock or makes it wait."""
-    plc = apps.start(server_xml(units='<Unit id="1">\n<HoldingRegisters start="0" count="100" address="N7:0"/>\n'
+    plc = tcp_apps.start(server_xml(units='<Unit id="1">\n<HoldingRegisters start="0" count="100" address="N7:0"/>\n'
                                       '</Unit>\n', maxRequestsPerSecond="100000", maxConnections="60"),
                      scan_ms=10)
     plc.wait_for(lambda: plc.engine.scans > 20, "scans running")
@@ -517,8 +510,8 @@ def test_fifty_busy_clients_do_not_make_the_scan_late(apps):
 # -- 8. pipelined requests ---------------------------------------------------------------------
 
 
-def test_pipelined_requests_in_one_segment_are_all_answered_in_order(apps, raws):
-    plc = apps.start()
+def test_pipelined_requests_in_one_segment_are_all_answered_in_order(tcp_apps, raws):
+    plc = tcp_apps.start()
     raw = raws(plc.port)
     raw.send(write_request(41, 3, 555) + read_request(42, 3, 1) + read_request(43, 0, 200))
     assert raw.reply() == (41, 1, write_request(0, 3, 555)[7:])  # a write's reply echoes it
@@ -527,10 +520,10 @@ def test_pipelined_requests_in_one_segment_are_all_answered_in_order(apps, raws)
     assert_server_alive(plc)
 
 
-def test_a_request_begun_in_the_segment_of_the_one_before_is_served(apps, raws):
+def test_a_request_begun_in_the_segment_of_the_one_before_is_served(tcp_apps, raws):
     """The reply to the first is sent while the second's first bytes wait
     (pymodbus's own buffer lost them: every send cleared it)."""
-    plc = apps.start()
+    plc = tcp_apps.start()
     raw = raws(plc.port)
     second = write_request(45, 3, 555)
     raw.send(read_request(44, 3, 1) + second[:5])
@@ -544,8 +537,8 @@ def test_a_request_begun_in_the_segment_of_the_one_before_is_served(apps, raws):
 # -- 9. a write answered once applied ------------------------------------------------------------
 
 
-def test_a_write_then_a_read_sees_the_value(apps):
-    plc = apps.start()
+def test_a_write_then_a_read_sees_the_value(tcp_apps):
+    plc = tcp_apps.start()
     client = ModbusTcpClient("127.0.0.1", port=plc.port, timeout=LIMIT_S, retries=0)
     assert client.connect()
     try:
@@ -556,9 +549,9 @@ def test_a_write_then_a_read_sees_the_value(apps):
         client.close()
 
 
-def test_a_write_while_scans_are_held_is_answered_when_they_resume(apps, raws):
+def test_a_write_while_scans_are_held_is_answered_when_they_resume(tcp_apps, raws):
     """Also: its connection is not idle meanwhile (idleTimeout 500 ms < the 1 s hold)."""
-    plc = apps.start(server_xml(idleTimeout="500"))
+    plc = tcp_apps.start(server_xml(idleTimeout="500"))
     hold = threading.Event()
     held = threading.Event()
 

@@ -20,21 +20,14 @@ from softplc_lite.ladder.engine import Mode
 from softplc_lite.tlm.modbtcps import status as S
 from softplc_lite.watch.forces import Forces, parse_force
 
-from modbtcps_apps import LIMIT_S, Apps, server_xml
+from modbtcps_apps import LIMIT_S, server_xml
 
 pytestmark = pytest.mark.timeout(120)
 
 
 @pytest.fixture
-def apps(tmp_path):
-    a = Apps(tmp_path)
-    yield a
-    a.close()
-
-
-@pytest.fixture
-def plc(apps):
-    return apps.start()
+def plc(tcp_apps):
+    return tcp_apps.start()
 
 
 @pytest.fixture
@@ -187,9 +180,9 @@ def test_read_only_regions_refuse_writes(plc, client):
     assert plc.read("N7:50") == 0 and plc.read("O:0/0") == 0 and plc.read("N7:19") == 0
 
 
-def test_a_unit_with_no_writable_region_refuses_the_function(apps):
+def test_a_unit_with_no_writable_region_refuses_the_function(tcp_apps):
     units = '<Unit id="3"><HoldingRegisters start="0" count="4" address="N7:0"/></Unit>\n'
-    plc = apps.start(server_xml(units))
+    plc = tcp_apps.start(server_xml(units))
     with ModbusTcpClient("127.0.0.1", port=plc.port, timeout=LIMIT_S, retries=0) as c:
         assert exception_code(c.write_register(0, 1, device_id=3)) == 1
         assert c.read_holding_registers(0, count=4, device_id=3).registers == [0, 0, 0, 0]
@@ -228,11 +221,11 @@ def test_a_function_not_served_is_exception_01(plc, client):
 # -- the scan's view ---------------------------------------------------------------------
 
 
-def test_a_client_never_sees_half_a_scan(apps):
+def test_a_client_never_sees_half_a_scan(tcp_apps):
     """Each scan writes one value into ten words; reads of all ten, while the
     PLC scans as fast as it can, always find them equal."""
     ladder = "ADD N11:0 1 N11:0\nFLL N11:0 #N11:1 9\n"
-    plc = apps.start(server_xml(maxRequestsPerSecond=100000), ladder=ladder, realtime=False)
+    plc = tcp_apps.start(server_xml(maxRequestsPerSecond=100000), ladder=ladder, realtime=False)
     with ModbusTcpClient("127.0.0.1", port=plc.port, timeout=LIMIT_S, retries=0) as c:
         seen = set()
         end = time.monotonic() + 2.0
@@ -252,8 +245,8 @@ def test_status_words_show_the_server(plc, client):
     plc.wait_for(lambda: plc.status(S.W_CONNECTED) == 0, "the disconnection counted")
 
 
-def test_writes_land_in_program_mode_and_outputs_stay_idle(apps):
-    plc = apps.start(ladder="XIC B3/0 OTE O:0/1\n")
+def test_writes_land_in_program_mode_and_outputs_stay_idle(tcp_apps):
+    plc = tcp_apps.start(ladder="XIC B3/0 OTE O:0/1\n")
     plc.runner.request_stop()
     plc.thread.join(LIMIT_S)
     engine = plc.engine
@@ -282,7 +275,7 @@ def test_writes_land_in_program_mode_and_outputs_stay_idle(apps):
 # -- the server process ------------------------------------------------------------------
 
 
-def test_an_address_in_use_refuses_to_start_saying_why(apps):
+def test_an_address_in_use_refuses_to_start_saying_why(tcp_apps):
     from softplc_lite.tlm.errors import ModuleError
 
     with socket.socket() as taken:
@@ -290,7 +283,7 @@ def test_an_address_in_use_refuses_to_start_saying_why(apps):
         taken.listen()
         port = taken.getsockname()[1]
         with pytest.raises(ModuleError, match=f"cannot listen on 127.0.0.1:{port}: Address already in use"):
-            apps.start(server_xml(port=port))
+            tcp_apps.start(server_xml(port=port))
 
 
 def test_a_server_process_that_dies_sets_the_failed_bit_and_the_scan_goes_on(plc):

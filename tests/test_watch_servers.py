@@ -23,20 +23,13 @@ from softplc_lite.watch.cli import render
 from softplc_lite.watch.serversview import TABLE_WIDTH, ServersView
 from softplc_lite.watch.session import WatchOptions, WatchSession
 
-from modbtcps_apps import LIMIT_S, Apps, Running, server_xml, write_app
+from modbtcps_apps import LIMIT_S, Running, server_xml, write_app
 from modbus_peer import free_tcp_port
 
 pytestmark = pytest.mark.timeout(120)
 
 ROOT_PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
 NOT_SERVED = 999  # no holding register there in UNIT_1: exception 02
-
-
-@pytest.fixture
-def apps(tmp_path):
-    a = Apps(tmp_path)
-    yield a
-    a.close()
 
 
 @pytest.fixture
@@ -70,8 +63,8 @@ def lines_with(text: str, word: str) -> list[str]:
     return [line for line in text.splitlines() if word in line]
 
 
-def test_a_connected_client_and_its_refused_request_in_both_forms(apps, clients):
-    plc = apps.start()
+def test_a_connected_client_and_its_refused_request_in_both_forms(tcp_apps, clients):
+    plc = tcp_apps.start()
     client = clients(plc.port)
     assert client.read_holding_registers(NOT_SERVED, count=1, device_id=1).isError()
     plc.wait_for(lambda: plc.module.server_status().refusals == 1 and plc.module.server_status().clients == 1,
@@ -97,8 +90,8 @@ def test_a_connected_client_and_its_refused_request_in_both_forms(apps, clients)
                                                               "  refusals 1 (exception 02 1)"]
 
 
-def test_requests_writes_rate_and_refusals_by_kind_add_up(apps, clients):
-    plc = apps.start()
+def test_requests_writes_rate_and_refusals_by_kind_add_up(tcp_apps, clients):
+    plc = tcp_apps.start()
     client = clients(plc.port)
     assert not client.write_register(0, 7, device_id=1).isError()  # answered once the scan applied it
     assert client.read_holding_registers(NOT_SERVED, count=1, device_id=1).isError()  # exception 02
@@ -118,10 +111,10 @@ def test_requests_writes_rate_and_refusals_by_kind_add_up(apps, clients):
     assert row[5] == "3 (exception 01 1, exception 02 1, exception 0B 1)"
 
 
-def test_req_per_s_is_measured_without_a_status_block_too(apps, clients):
+def test_req_per_s_is_measured_without_a_status_block_too(tcp_apps, clients):
     xml = server_xml().replace(' status="N40:0"', "")
     assert "status=" not in xml
-    plc = apps.start(xml)
+    plc = tcp_apps.start(xml)
     client = clients(plc.port)
     deadline = time.monotonic() + 3.0  # three of the rate's one-second windows
     while time.monotonic() < deadline and plc.module.server_status().rate == 0:
@@ -131,8 +124,8 @@ def test_req_per_s_is_measured_without_a_status_block_too(apps, clients):
     assert status.requests > 0 and status.rate > 0, status
 
 
-def test_a_client_outside_the_allow_list_is_a_refusal_not_a_client(apps):
-    plc = apps.start(server_xml(units='<Allow network="10.0.0.0/8"/>\n<Unit id="1">\n'
+def test_a_client_outside_the_allow_list_is_a_refusal_not_a_client(tcp_apps):
+    plc = tcp_apps.start(server_xml(units='<Allow network="10.0.0.0/8"/>\n<Unit id="1">\n'
                                       '<HoldingRegisters start="0" count="10" address="N7:0"/>\n</Unit>\n'))
     with socket.create_connection(("127.0.0.1", plc.port), timeout=LIMIT_S) as s:
         assert s.recv(1) == b""  # closed at once
@@ -142,8 +135,8 @@ def test_a_client_outside_the_allow_list_is_a_refusal_not_a_client(apps):
     assert "  refusals 1 (not allowed 1)" in text
 
 
-def test_a_server_that_died_is_down_in_red_with_why(apps):
-    plc = apps.start()
+def test_a_server_that_died_is_down_in_red_with_why(tcp_apps):
+    plc = tcp_apps.start()
     plc.module.process.kill()
     plc.wait_for(lambda: not plc.module.server_status().up, "the module to see its server gone")
     assert lines_with(shown(plc.engine, 46), "MODBTCPS") == ["MODBTCPS down the server process ended"]
@@ -173,8 +166,8 @@ def test_the_panel_is_in_the_watch_screen_only_for_apps_with_a_server(tmp_path):
         plain.quit()
 
 
-def test_the_table_form_starts_where_its_columns_fit(apps):
-    plc = apps.start()
+def test_the_table_form_starts_where_its_columns_fit(tcp_apps):
+    plc = tcp_apps.start()
     table = shown(plc.engine, TABLE_WIDTH).splitlines()
     assert [line.split() for line in table if "┃" in line] == [
         ["server", "┃", "clients", "┃", "req/s", "┃", "requests", "┃", "writes", "┃", "refusals"]]
