@@ -8,6 +8,7 @@ which prints its --print values, and said how many scans were late."""
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 import signal
@@ -174,3 +175,26 @@ def test_the_server_process_ends_when_its_runtime_is_killed(tmp_path):
         if runtime.proc.poll() is None:
             runtime.proc.kill()
         runtime.proc.communicate()
+
+
+def test_ctrl_c_to_the_terminal_group_ends_the_run_cleanly_server_last(tmp_path):
+    """Ctrl-C in a terminal signals the whole process group: the runtime
+    saves and prints, and its server process, which ignores SIGINT, ends
+    when the runtime closes it, without a word."""
+    port = free_tcp_port()
+    app = write_app(tmp_path / "app", server_xml(port=port))
+    proc = subprocess.Popen([sys.executable, "-m", "softplc_lite", "run", str(app), "--fresh", "--print", "N40:0"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        wait_for_tcp(port, LIMIT_S)
+        (server,) = children(proc.pid)
+        os.killpg(proc.pid, signal.SIGINT)
+        out, err = proc.communicate(timeout=LIMIT_S)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == 0, err
+    assert out == "N40:0 = 1\n"  # still listening at the last scan
+    assert "MODBTCPS" not in err and "Traceback" not in err, err
+    assert not Path(f"/proc/{server}").exists() or "Z" in Path(f"/proc/{server}/stat").read_text().split()[2]

@@ -20,6 +20,7 @@ import asyncio
 import logging
 import os
 import pickle
+import signal
 import socket
 import sys
 import time
@@ -291,16 +292,26 @@ def _read_exactly(fd: int, n: int) -> bytes:
 
 
 def main() -> int:
+    # Ctrl-C reaches the whole terminal's process group: the runtime decides when this process ends
+    # (it closes standard input after its final scan), so a Ctrl-C does not end it first.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     logging.getLogger("pymodbus").setLevel(logging.CRITICAL)  # this module says what matters, counted
-    header = _read_exactly(0, 4)
-    if len(header) < 4:
-        return 1
-    init = pickle.loads(_read_exactly(0, msg.LENGTH.unpack(header)[0]))
-    init["out_fd"] = int(sys.argv[1])
+    out_fd = int(sys.argv[1])
     try:
+        header = _read_exactly(0, 4)
+        if len(header) < 4:
+            return 1
+        init = pickle.loads(_read_exactly(0, msg.LENGTH.unpack(header)[0]))
+        init["out_fd"] = out_fd
         asyncio.run(serve(init))
-    except KeyboardInterrupt:
-        pass
+    except Exception as exc:  # said in one line, to the runtime if it still waits for READY; no traceback
+        why = f"the server process failed: {type(exc).__name__}: {exc}"
+        print(f"MODBTCPS: {why}", file=sys.stderr, flush=True)
+        try:
+            os.write(out_fd, msg.failed(why))
+        except OSError:
+            pass
+        return 1
     return 0
 
 
