@@ -26,6 +26,7 @@ UNIT_1 = """
     <HoldingRegisters start="100" count="4"  address="F8:0"   writable="yes"/>
     <HoldingRegisters start="110" count="2"  address="F8:10"  writable="yes" wordOrder="low-high"/>
     <HoldingRegisters start="200" count="2"  address="ST9:0"  writable="yes"/>
+    <HoldingRegisters start="400" count="2"  address="ST9:2"  writable="yes" stringFormat="packed"/>
     <InputRegisters   start="0"   count="10" address="N11:0"/>
     <InputRegisters   start="20"  count="2"  address="F8:20"/>
   </Unit>

@@ -795,3 +795,21 @@ def test_check_passes_the_doc_example_and_shows_warnings(tmp_path):
     assert proc.returncode == 0
     assert f"warning: {tmp_path / CONFIG_FILE}:1: listening on 0.0.0.0 but no <Allow> is given" in \
         proc.stdout + proc.stderr
+
+
+def test_string_format_packed_takes_41_registers_an_element():
+    r = region(tag("HoldingRegisters", address="ST9:0", count="2", stringFormat="packed"))
+    assert (r.string_format, r.registers_per_item, r.span) == ("packed", 41, 82)
+    assert region(tag("InputRegisters", address="ST9:0")).string_format == "ucs2"  # the default
+    assert region(tag("InputRegisters", address="ST9:0", stringFormat="UCS2")).registers_per_item == 83
+
+
+@pytest.mark.parametrize("address, value", [("N7:0", "word"), ("F8:0", "float")])
+def test_string_format_only_on_string_regions(address, value):
+    text = in_unit(tag("InputRegisters", address=address, stringFormat="packed"))
+    problem = only_problem(text)
+    assert problem.message == (f"stringFormat applies to a string region (an ST file address); {address} holds "
+                               f"{value}s")
+    assert where(problem) == locate(text, "stringFormat=")
+    problem = only_problem(in_unit(tag("HoldingRegisters", address="ST9:0", stringFormat="ascii")))
+    assert problem.message == "stringFormat='ascii': expected 'ucs2' or 'packed'"

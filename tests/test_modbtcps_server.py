@@ -126,6 +126,22 @@ def test_write_registers_words_floats_and_strings(plc, client):
     assert plc.read("ST9:0") == "PUMP"
 
 
+def test_packed_strings_are_two_characters_a_register_as_hmis_read_them(plc, client):
+    plc.engine.table.write("ST9:2", "Tank 1")
+    plc.engine.table.write("ST9:3", "Ω!")  # a code unit over 255 reads as ?
+    plc.wait_for(lambda: client.read_holding_registers(400, count=1, device_id=1).registers == [0x5461], "'Ta'")
+    regs = client.read_holding_registers(400, count=41, device_id=1).registers
+    assert client.convert_from_registers(regs, client.DATATYPE.STRING) == "Tank 1"  # pymodbus's own decoding
+    assert regs[3:] == [0] * 38  # NULs after the text
+    assert client.read_holding_registers(441, count=1, device_id=1).registers == [(ord("?") << 8) | ord("!")]
+    # written the way an HMI writes one: the string ends at the first NUL, LEN follows
+    regs = client.convert_to_registers("PUMP 7", client.DATATYPE.STRING)
+    assert not client.write_registers(441, regs, device_id=1).isError()
+    assert plc.read("ST9:3") == "PUMP 7"
+    assert not client.write_register(400, 0x4F00, device_id=1).isError()  # "O", then NUL: the string ends
+    assert plc.read("ST9:2") == "O"
+
+
 def test_write_half_a_float_keeps_the_other_half(plc, client):
     plc.engine.table.write("F8:2", 1.0)
     high, low = f32_registers(1.0)

@@ -48,6 +48,8 @@ WORD_FILES = ("O", "I", "S", "B", "N")  # registers and bits come from 16-bit wo
 STATUS_FILES = ("N", "B")
 READ_ONLY_KINDS = ("discrete_inputs", "input_registers")  # Modbus has no function that writes them
 REGISTERS_PER_ITEM = {"bit": 1, "word": 1, "float": 2, "string": 1 + STRING_CHARS}
+STRING_FORMATS = ("ucs2", "packed")
+PACKED_STRING_REGISTERS = STRING_CHARS // 2  # two 8-bit characters a register
 
 
 @dataclass(frozen=True)
@@ -64,11 +66,14 @@ class Region:
     word_order: str  # "high-low" or "low-high" (meaningful for floats)
     line: int
     column: int
+    string_format: str = "ucs2"  # strings: "ucs2" (LEN, then one code unit a register) or "packed"
 
     @property
     def registers_per_item(self) -> int:
         """Protocol items one data table item takes: 1 for a bit or word, 2
         for a float, 83 for a string (its LEN, then 82 UCS-2 code units)."""
+        if self.value == "string" and self.string_format == "packed":
+            return PACKED_STRING_REGISTERS
         return REGISTERS_PER_ITEM[self.value]
 
     @property
@@ -118,6 +123,7 @@ _REGION = (Attr("start", 0, MODBUS_ADDRESSES - 1, required=True),
            Attr("address", text=True, required=True, what="a data table address"))
 _WRITABLE = Attr("writable", choices=("yes", "no"), default="no")
 _REGION_WORD_ORDER = Attr("wordOrder", choices=WORD_ORDERS)  # absent: the root's
+_STRING_FORMAT = Attr("stringFormat", choices=STRING_FORMATS, default="ucs2")
 
 ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
     ROOT: (Attr("address", text=True, default="127.0.0.1", what=_HOST),
@@ -134,8 +140,8 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
     "Unit": (Attr("id", 0, 255, required=True),),
     "Coils": (*_REGION, _WRITABLE),
     "DiscreteInputs": (*_REGION, _WRITABLE),
-    "HoldingRegisters": (*_REGION, _WRITABLE, _REGION_WORD_ORDER),
-    "InputRegisters": (*_REGION, _WRITABLE, _REGION_WORD_ORDER),
+    "HoldingRegisters": (*_REGION, _WRITABLE, _REGION_WORD_ORDER, _STRING_FORMAT),
+    "InputRegisters": (*_REGION, _WRITABLE, _REGION_WORD_ORDER, _STRING_FORMAT),
 }
 HINT_NAMES = ("Allow", "Unit", *ELEMENT_OF_KIND)
 
@@ -270,10 +276,14 @@ def _check_region(c: XmlChecker, node: XmlNode, root_order: str) -> Region | Non
     if "wordOrder" in a and value is not None and value != "float":
         c.error(node, f"wordOrder applies to a float region (an F file address); {a['address']} holds "
                       f"{value}s", "wordOrder")
+    if "stringFormat" in node.attrs and value is not None and value != "string":
+        c.error(node, f"stringFormat applies to a string region (an ST file address); {a['address']} holds "
+                      f"{value}s", "stringFormat")
     if len(c.problems) > ok or found is None or "start" not in a or "count" not in a:
         return None
     region = Region(kind, a["start"], a["count"], found[0], writable, value,
-                    a.get("wordOrder", root_order) if value == "float" else root_order, node.line, node.column)
+                    a.get("wordOrder", root_order) if value == "float" else root_order, node.line, node.column,
+                    a.get("stringFormat", "ucs2"))
     if region.end > MODBUS_ADDRESSES:
         unit = "bits" if value == "bit" else "registers"
         c.error(node, f"<{node.name}> leaves the Modbus address space: {region.span} {unit} from start "

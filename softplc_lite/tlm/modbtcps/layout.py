@@ -7,7 +7,8 @@ formats"):
 
 - a word (O I S B N): one register, its 16 bits as they are;
 - a string (ST): 83 registers, the element's words as they are: LEN, then 82
-  UCS-2 code units, one a register;
+  UCS-2 code units, one a register; or, with ``stringFormat="packed"``, 41
+  registers of two 8-bit characters each (the HMI convention);
 - a float (F): two registers holding the IEEE-754 single, the high half first
   ("high-low", the default) or the low half first ("low-high");
 - a bit: one coil or discrete input; bits run on into the next word (B3/15,
@@ -24,10 +25,11 @@ import sys
 from array import array
 from dataclasses import dataclass
 
-from ...datatable.filetypes import WORD_BITS
-from .config import Region, ServerConfig
+from ...datatable.filetypes import STRING_CHARS, WORD_BITS
+from .config import PACKED_STRING_REGISTERS, Region, ServerConfig
 
 BIT_KINDS = ("coils", "discrete_inputs")
+STRING_WORDS = 1 + STRING_CHARS  # an ST element: LEN, then the code units
 # The word order whose registers are the two halves of a float in memory, swapped.
 _SWAPPED = "high-low" if sys.byteorder == "little" else "low-high"
 
@@ -48,6 +50,7 @@ class Slot:
     words: int  # words (floats for F) the image holds for it
     bit0: int  # bit regions: the first bit within the first word
     offset: int  # bytes into the image
+    string_format: str = "ucs2"
 
     @property
     def itemsize(self) -> int:
@@ -57,15 +60,30 @@ class Slot:
     def nbytes(self) -> int:
         return self.words * self.itemsize
 
+    @property
+    def per_element(self) -> tuple[int, int]:
+        """(registers, words or floats) of one element, converted whole: a
+        float is 2 registers of 1 float; a packed string 41 registers of its
+        83 words; a word, or a UCS-2 string's word, 1 register of 1 word."""
+        if self.value == "float":
+            return 2, 1
+        if self.value == "string" and self.string_format == "packed":
+            return PACKED_STRING_REGISTERS, STRING_WORDS
+        return 1, 1
+
     def table_range(self, off: int, n: int) -> tuple[int, int]:
         """The words (floats) of the region that protocol addresses
         start+off .. start+off+n-1 touch, as (first, past the last)."""
         if self.value == "bit":
             b = self.bit0 + off
             return b // WORD_BITS, (b + n - 1) // WORD_BITS + 1
-        if self.value == "float":
-            return off // 2, (off + n + 1) // 2
-        return off, off + n
+        registers, words = self.per_element
+        return off // registers * words, ((off + n - 1) // registers + 1) * words
+
+    def skip(self, off: int) -> int:
+        """Registers before ``off`` in the elements ``table_range`` converts."""
+        registers, _ = self.per_element
+        return off % registers
 
 
 def _slot(region: Region, unit: int, offset: int, table) -> Slot:
@@ -75,9 +93,9 @@ def _slot(region: Region, unit: int, offset: int, table) -> Slot:
         words = (bit0 + region.count - 1) // WORD_BITS + 1
     else:
         bit0 = 0
-        words = region.span if region.value != "float" else region.count
+        words = region.count * (1 if region.value == "float" else STRING_WORDS if region.value == "string" else 1)
     return Slot(unit, region.kind, region.start, region.end, region.value, region.word_order, region.writable,
-                loc.file.name, loc.index, words, bit0, offset)
+                loc.file.name, loc.index, words, bit0, offset, region.string_format)
 
 
 class Layout:
@@ -148,7 +166,7 @@ class Layout:
                 out += [(words[(b + k) >> 4] >> ((b + k) & 15)) & 1 for k in range(n)]
             else:
                 regs = registers_of(s, raw)
-                skip = off - first * (2 if s.value == "float" else 1)
+                skip = s.skip(off)
                 out += regs[skip:skip + n]
         return out
 
@@ -169,14 +187,17 @@ class Layout:
             else:
                 i, past_i = s.index + first, s.index + past
                 regs = registers_of(s, data[i:past_i].tobytes())
-                skip = off - first * (2 if s.value == "float" else 1)
+                skip = s.skip(off)
                 regs[skip:skip + n] = array("H", values[k:k + n])
                 data[i:past_i] = array(data.typecode, raw_of(s, regs))
             k += n
 
 
 def registers_of(s: Slot, raw: bytes) -> array:
-    """Registers from a region's raw words (floats: in its word order)."""
+    """Registers from a region's raw words (floats: in its word order;
+    packed strings: two characters a register)."""
+    if s.value == "string" and s.string_format == "packed":
+        return _packed(array("H", raw))
     regs = array("H", raw)  # a float is [low half, high half] in memory here (little-endian)
     if s.value == "float" and s.word_order == _SWAPPED:
         regs[0::2], regs[1::2] = regs[1::2], regs[0::2]
@@ -185,7 +206,39 @@ def registers_of(s: Slot, raw: bytes) -> array:
 
 def raw_of(s: Slot, regs: array) -> bytes:
     """The inverse of ``registers_of``."""
+    if s.value == "string" and s.string_format == "packed":
+        return _unpacked(regs).tobytes()
     if s.value == "float" and s.word_order == _SWAPPED:
         regs = array("H", regs)
         regs[0::2], regs[1::2] = regs[1::2], regs[0::2]
     return regs.tobytes()
+
+
+def _packed(words: array) -> array:
+    """ST elements (LEN, 82 code units each) as packed registers: the LEN
+    characters, 8 bits each (a code unit over 255 is ``?``), two a register,
+    the first in the high byte, then NULs."""
+    out = array("H")
+    for e in range(0, len(words), STRING_WORDS):
+        length = min(words[e], STRING_CHARS)
+        chars = bytes(u if u < 256 else 0x3F for u in words[e + 1:e + 1 + length]).ljust(STRING_CHARS, b"\0")
+        out.frombytes(chars)
+    if sys.byteorder == "little":
+        out.byteswap()  # the first character of each pair in the high byte
+    return out
+
+
+def _unpacked(regs: array) -> array:
+    """Packed registers back to ST elements: the characters up to the first
+    NUL (at most 82) are the string, LEN its length."""
+    regs = array("H", regs)
+    if sys.byteorder == "little":
+        regs.byteswap()
+    raw = regs.tobytes()
+    out = array("H")
+    for e in range(0, len(raw), STRING_CHARS):
+        text = raw[e:e + STRING_CHARS].split(b"\0", 1)[0]
+        out.append(len(text))
+        out.extend(text)
+        out.extend(bytes(STRING_CHARS - len(text)))
+    return out

@@ -284,4 +284,4 @@ def _register(table, s, off: int) -> int:
     first, past = s.table_range(off, 1)
     data = table.file(s.file).data
     regs = registers_of(s, data[s.index + first:s.index + past].tobytes())
-    return regs[off - first * (2 if s.value == "float" else 1)]
+    return regs[s.skip(off)]

@@ -91,7 +91,7 @@ def string_lengths_fit(pieces, values) -> bool:
     """A string's LEN register takes 0..82 (its character count)."""
     k = 0
     for s, off, n in pieces:
-        if s.value == "string":
+        if s.value == "string" and s.string_format == "ucs2":  # a packed string has no LEN register
             for j in range(n):
                 if (off + j) % 83 == 0 and values[k + j] > 82:
                     return False
