@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import socket
 import struct
+import threading
 import time
 
 import pytest
@@ -261,14 +262,15 @@ def test_status_words_show_the_server(plc, client):
     plc.wait_for(lambda: plc.status(S.W_CONNECTED) == 0, "the disconnection counted")
 
 
-def test_writes_land_in_program_mode_and_outputs_stay_idle(tcp_apps):
-    plc = tcp_apps.start(ladder="XIC B3/0 OTE O:0/1\n")
+@pytest.mark.parametrize("mode", [Mode.PROGRAM, Mode.TEST])
+def test_writes_land_in_program_and_test_mode(tcp_apps, mode):
+    """HMI setpoints are kept whatever the mode; the ladder runs in TEST mode only."""
+    plc = tcp_apps.start(ladder="XIC B3/0 OTE B3/1\n")
     plc.runner.request_stop()
     plc.thread.join(LIMIT_S)
     engine = plc.engine
     engine.set_mode(Mode.PROGRAM)
-    import threading
-
+    engine.set_mode(mode)
     stop = threading.Event()
 
     def scan() -> None:
@@ -281,8 +283,9 @@ def test_writes_land_in_program_mode_and_outputs_stay_idle(tcp_apps):
         with ModbusTcpClient("127.0.0.1", port=plc.port, timeout=LIMIT_S, retries=0) as c:
             assert not c.write_coil(0, True, device_id=1).isError()
             assert not c.write_register(0, 555, device_id=1).isError()
+            assert c.read_coils(0, count=2, device_id=1).bits[:2] == [True, mode is Mode.TEST]
         assert plc.read("B3/0") == 1 and plc.read("N7:0") == 555
-        assert plc.read("O:0/1") == 0  # the ladder does not run in PROGRAM mode
+        assert plc.read("B3/1") == (1 if mode is Mode.TEST else 0)  # the ladder ran on the write, or not
     finally:
         stop.set()
         t.join(LIMIT_S)
