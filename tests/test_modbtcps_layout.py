@@ -32,13 +32,8 @@ def fresh() -> tuple[DataTable, Layout]:
 
 
 def read(layout: Layout, table: DataTable, kind: str, address: int, count: int) -> list[int]:
-    """What the server would answer, from an image made of the table now."""
-    pieces = layout.find(1, kind, address, count)
-    raws = []
-    for s, off, n in pieces:
-        first, past = s.table_range(off, n)
-        raws.append(table.file(s.file).data[s.index + first:s.index + past].tobytes())
-    return Layout.values(pieces, raws)
+    """What the server would answer from an image made of the table now."""
+    return Layout.load(layout.find(1, kind, address, count), table)
 
 
 def words(table: DataTable) -> dict[str, bytes]:

@@ -28,7 +28,6 @@ from dataclasses import dataclass
 from ...datatable.filetypes import STRING_CHARS, WORD_BITS
 from .config import PACKED_STRING_REGISTERS, Region, ServerConfig
 
-BIT_KINDS = ("coils", "discrete_inputs")
 STRING_WORDS = 1 + STRING_CHARS  # an ST element: LEN, then the code units
 # The word order whose registers are the two halves of a float in memory, swapped.
 _SWAPPED = "high-low" if sys.byteorder == "little" else "low-high"
@@ -121,11 +120,9 @@ class Layout:
                 slots.append(s)
         return cls(slots)
 
-    def units(self) -> set[int]:
-        return {s.unit for s in self.slots}
-
-    def has(self, unit: int, kind: str, writable: bool = False) -> bool:
-        return any(s.writable or not writable for s in self._by.get((unit, kind), ()))
+    def takes_writes(self, unit: int, kind: str) -> bool:
+        """Does the unit have a writable region of this table at all?"""
+        return any(s.writable for s in self._by.get((unit, kind), ()))
 
     def find(self, unit: int, kind: str, address: int, count: int) -> list[tuple[Slot, int, int]] | None:
         """The (slot, offset in the slot, items) pieces that cover
@@ -170,7 +167,17 @@ class Layout:
                 out += regs[skip:skip + n]
         return out
 
-    # -- the scan's side: into the data table -------------------------------------------------
+    # -- the scan's side: the data table itself -------------------------------------------------
+    @staticmethod
+    def load(pieces: list[tuple[Slot, int, int]], table) -> list[int]:
+        """Registers or bits as they are in the data table now (what
+        ``values`` makes of the image, read from the table instead)."""
+        raws = []
+        for s, off, n in pieces:
+            first, past = s.table_range(off, n)
+            raws.append(table.file(s.file).data[s.index + first:s.index + past].tobytes())
+        return Layout.values(pieces, raws)
+
     @staticmethod
     def store(pieces: list[tuple[Slot, int, int]], values: list[int], table) -> None:
         """Write a client's registers or bits into the data table."""

@@ -4,8 +4,9 @@ Each message is a 4-byte length and a body whose first byte says what it
 is. The server sends WRITE and MASK (a client's write, in arrival order),
 READY (listening, with the port bound) and FAILED (cannot listen, why); the
 runtime sends ACK (every write up to this sequence number is in the data
-table and in the image) and STOP. The configuration goes first, pickled:
-both ends are this package, never a client.
+table and in the image), and stops the server by closing the pipe. The
+configuration goes first, pickled: both ends are this package, never a
+client.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import struct
 from array import array
 
 LENGTH = struct.Struct("=I")
-WRITE, MASK, READY, FAILED, ACK, STOP = b"W", b"M", b"R", b"F", b"A", b"S"
+WRITE, MASK, READY, FAILED, ACK = b"W", b"M", b"R", b"F", b"A"
 _WRITE = struct.Struct("=IBBHH")  # sequence, unit, kind (0 coils, 1 registers), address, count
 _MASK = struct.Struct("=IBHHH")  # sequence, unit, address, and-mask, or-mask
 _U32 = struct.Struct("=I")
@@ -50,7 +51,7 @@ def failed(why: str) -> bytes:
 def decode(body: bytes) -> tuple:
     """A message body as a tuple: (WRITE, seq, unit, kind, address, values),
     (MASK, seq, unit, address, and, or), (READY, port), (FAILED, why),
-    (ACK, seq) or (STOP,)."""
+    or (ACK, seq)."""
     tag, rest = body[:1], body[1:]
     if tag == WRITE:
         seq, unit, kind, address, count = _WRITE.unpack_from(rest)
@@ -61,7 +62,7 @@ def decode(body: bytes) -> tuple:
         return tag, _U32.unpack(rest)[0]
     if tag == FAILED:
         return FAILED, rest.decode("utf-8", "replace")
-    return (STOP,)
+    raise ValueError(f"not a MODBTCPS message: {body[:16]!r}")  # both ends are this package: a bug
 
 
 class Reader:

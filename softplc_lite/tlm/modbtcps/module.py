@@ -162,20 +162,19 @@ class ModbTcpServer(TLM):
         for m in self._reader.feed(data):
             if m[0] == msg.WRITE:
                 _, seq, unit, kind, address, values = m
-                pieces = self.layout.find(unit, kind, address, len(values))
-                if pieces is not None:  # the server checked it against the same layout
-                    Layout.store(pieces, values, table)
-                self._applied = seq
-                self._writes_applied += 1
-            elif m[0] == msg.MASK:
+            elif m[0] == msg.MASK:  # applied to the register as the table holds it now (Modbus spec 6.16)
                 _, seq, unit, address, and_mask, or_mask = m
-                pieces = self.layout.find(unit, "holding_registers", address, 1)
-                if pieces is not None:
-                    s, off, _ = pieces[0]
-                    current = _register(table, s, off)
-                    Layout.store(pieces, [(current & and_mask) | (or_mask & ~and_mask & 0xFFFF)], table)
-                self._applied = seq
-                self._writes_applied += 1
+                kind, values = "holding_registers", None
+            else:  # a FAILED the server sends as it ends: the end of the pipe says it next
+                continue
+            pieces = self.layout.find(unit, kind, address, 1 if values is None else len(values))
+            if pieces is not None:  # the server checked it against the same layout
+                if values is None:
+                    current = Layout.load(pieces, table)[0]
+                    values = [(current & and_mask) | (or_mask & ~and_mask & 0xFFFF)]
+                Layout.store(pieces, values, table)
+            self._applied = seq
+            self._writes_applied += 1
 
     def on_output(self, engine, outputs_enabled: bool) -> None:
         if self.image is None:
@@ -237,7 +236,7 @@ class ModbTcpServer(TLM):
         if self.image is None:
             return None
         counters = self.image.counters()
-        refused = {name: counters[c] for name, c in REFUSAL_NAMES if counters[c]}
+        refused = {name: counters[c] for name, c in C.REFUSAL_NAMES if counters[c]}
         return C.ServerStatus(self.failed or self.listening, self.failed is None, counters[C.CONNECTED],
                               self.rate, counters[C.REQUESTS], self._writes_applied, sum(refused.values()),
                               refused)
@@ -269,19 +268,3 @@ class ModbTcpServer(TLM):
             self.image.unlink()
             self.image.close()
             self.image = None
-
-
-REFUSAL_NAMES = (("not allowed", C.REFUSED_NETWORK), ("connection limit", C.REFUSED_LIMIT),
-                 ("rate limit", C.REFUSED_RATE), ("exception 01", C.EXCEPTION_01), ("exception 02", C.EXCEPTION_02),
-                 ("exception 03", C.EXCEPTION_03), ("exception 0B", C.EXCEPTION_0B), ("malformed", C.MALFORMED),
-                 ("idle", C.IDLE))
-
-
-def _register(table, s, off: int) -> int:
-    """The current value of one register of slot ``s``, from the table."""
-    from .layout import registers_of
-
-    first, past = s.table_range(off, 1)
-    data = table.file(s.file).data
-    regs = registers_of(s, data[s.index + first:s.index + past].tobytes())
-    return regs[s.skip(off)]

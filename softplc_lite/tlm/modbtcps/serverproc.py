@@ -31,11 +31,12 @@ from pymodbus.pdu import ExceptionResponse
 from pymodbus.pdu.register_message import MaskWriteRegisterResponse
 from pymodbus.server import ModbusTcpServer
 
+from ...datatable.filetypes import STRING_CHARS
 from . import messages as msg
 from . import status as C
 from .connection import KIND_OF_FUNCTION, PEER, Connection
 from .image import SharedImage
-from .layout import Layout
+from .layout import STRING_WORDS, Layout
 
 WRITES = {5, 6, 15, 16, 22, 23}
 MAX_READ = {"coils": 2000, "discrete_inputs": 2000, "holding_registers": 125, "input_registers": 125}
@@ -71,19 +72,12 @@ class TableContext(ModbusServerContext):
         return [bool(v) for v in values] if kind in ("coils", "discrete_inputs") else values
 
     async def async_setValues(self, device_id, func_code, address, values):
-        problem = self.server.writable(device_id, func_code, address, len(values))
+        values = [int(v) for v in values]
+        problem = self.server.write_refused(device_id, func_code, address, len(values), values)
         if problem is not None:
-            return self.server.refuse(problem)
-        if len(self.server.pending) >= MAX_PENDING:  # the scan is not taking writes (stopped): busy
-            self.server.count(C.REFUSED_RATE, f"{PEER.get()}: exception 06, {MAX_PENDING} writes wait for the scan")
-            return ExcCodes.DEVICE_BUSY
+            return problem
         kind = KIND_OF_FUNCTION[func_code]
-        if kind == "holding_registers":
-            pieces = self.server.layout.find(device_id, kind, address, len(values))
-            if not string_lengths_fit(pieces, values):
-                return self.server.refuse(ExcCodes.ILLEGAL_VALUE)
-        await self.server.through_scan(lambda seq: msg.write(seq, device_id, kind, address,
-                                                             [int(v) for v in values]))
+        await self.server.through_scan(lambda seq: msg.write(seq, device_id, kind, address, values))
         return None
 
 
@@ -93,7 +87,7 @@ def string_lengths_fit(pieces, values) -> bool:
     for s, off, n in pieces:
         if s.value == "string" and s.string_format == "ucs2":  # a packed string has no LEN register
             for j in range(n):
-                if (off + j) % 83 == 0 and values[k + j] > 82:
+                if (off + j) % STRING_WORDS == 0 and values[k + j] > STRING_CHARS:
                     return False
         k += n
     return True
@@ -163,13 +157,21 @@ class Server(ModbusTcpServer):
         bucket[0] -= 1.0
         return True
 
-    def writable(self, unit: int, function: int, address: int, count: int) -> ExcCodes | None:
+    def write_refused(self, unit: int, function: int, address: int, count: int,
+                      values: list[int] | None = None) -> ExcCodes | None:
+        """The exception that refuses a write (counted), or None. ``values``:
+        the registers written, when known (a mask write's are not)."""
         kind = KIND_OF_FUNCTION[function]
-        if not self.layout.has(unit, kind, writable=True):
-            return ExcCodes.ILLEGAL_FUNCTION  # this unit takes no writes of this kind at all
+        if not self.layout.takes_writes(unit, kind):
+            return self.refuse(ExcCodes.ILLEGAL_FUNCTION)  # this unit takes no writes of this kind at all
         pieces = self.layout.find(unit, kind, address, count)
         if pieces is None or not all(s.writable for s, _, _ in pieces):
-            return ExcCodes.ILLEGAL_ADDRESS
+            return self.refuse(ExcCodes.ILLEGAL_ADDRESS)
+        if len(self.pending) >= MAX_PENDING:  # the scan is not taking writes (stopped): busy
+            self.count(C.REFUSED_RATE, f"{PEER.get()}: exception 06, {MAX_PENDING} writes wait for the scan")
+            return ExcCodes.DEVICE_BUSY
+        if values is not None and kind == "holding_registers" and not string_lengths_fit(pieces, values):
+            return self.refuse(ExcCodes.ILLEGAL_VALUE)
         return None
 
     # -- writes through the scan --------------------------------------------------------------
@@ -184,9 +186,9 @@ class Server(ModbusTcpServer):
         await future
 
     async def mask_write(self, pdu):
-        problem = self.writable(pdu.dev_id, 22, pdu.address, 1)
+        problem = self.write_refused(pdu.dev_id, 22, pdu.address, 1)
         if problem is not None:
-            return ExceptionResponse(22, self.refuse(problem))
+            return ExceptionResponse(22, problem)
         await self.through_scan(lambda seq: msg.mask(seq, pdu.dev_id, pdu.address, pdu.and_mask, pdu.or_mask))
         return MaskWriteRegisterResponse(address=pdu.address, and_mask=pdu.and_mask, or_mask=pdu.or_mask,
                                          dev_id=pdu.dev_id, transaction_id=pdu.transaction_id)
@@ -271,8 +273,6 @@ async def serve(init: dict) -> None:
         for m in reader.feed(data):
             if m[0] == msg.ACK:
                 server.acked(m[1])
-            elif m[0] == msg.STOP and not done.done():
-                done.set_result(None)
 
     loop.add_reader(stdin, from_runtime)
     await done

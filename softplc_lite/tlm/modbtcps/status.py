@@ -55,8 +55,11 @@ COPIED = ((W_CONNECTED, CONNECTED), (W_REQUESTS, REQUESTS), (W_REFUSED_NETWORK, 
           (W_REFUSED_LIMIT, REFUSED_LIMIT), (W_REFUSED_RATE, REFUSED_RATE), (W_EXCEPTION_02, EXCEPTION_02),
           (W_EXCEPTION_01, EXCEPTION_01), (W_EXCEPTION_03, EXCEPTION_03), (W_EXCEPTION_0B, EXCEPTION_0B),
           (W_MALFORMED, MALFORMED), (W_IDLE, IDLE))
-REFUSAL_COUNTERS = (REFUSED_NETWORK, REFUSED_LIMIT, REFUSED_RATE, EXCEPTION_01, EXCEPTION_02, EXCEPTION_03,
-                    EXCEPTION_0B, MALFORMED, IDLE)
+# every refusal, by the name the watch view gives it
+REFUSAL_NAMES = (("not allowed", REFUSED_NETWORK), ("connection limit", REFUSED_LIMIT), ("rate limit", REFUSED_RATE),
+                 ("exception 01", EXCEPTION_01), ("exception 02", EXCEPTION_02), ("exception 03", EXCEPTION_03),
+                 ("exception 0B", EXCEPTION_0B), ("malformed", MALFORMED), ("idle", IDLE))
+REFUSAL_COUNTERS = tuple(counter for _, counter in REFUSAL_NAMES)
 
 
 def word(value: int) -> int:
