@@ -26,7 +26,7 @@ from pathlib import Path
 
 from ...datatable import DataTableError, parse_address
 from ...datatable.address import Address
-from ...datatable.filetypes import MAX_ELEMENTS, STRING_CHARS, WORD_BITS
+from ...datatable.filetypes import MAX_ELEMENTS, STRING, STRING_CHARS, WORD_BITS
 from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
@@ -47,7 +47,7 @@ EVERYONE = (ipaddress.ip_network("0.0.0.0/0"), ipaddress.ip_network("::/0"))
 WORD_FILES = ("O", "I", "S", "B", "N")  # registers and bits come from 16-bit words of these files
 STATUS_FILES = ("N", "B")
 READ_ONLY_KINDS = ("discrete_inputs", "input_registers")  # Modbus has no function that writes them
-REGISTERS_PER_ITEM = {"bit": 1, "word": 1, "float": 2, "string": 1 + STRING_CHARS}
+REGISTERS_PER_ITEM = {"bit": 1, "word": 1, "float": 2, "string": STRING.words_per_element}
 STRING_FORMATS = ("ucs2", "packed")
 PACKED_STRING_REGISTERS = STRING_CHARS // 2  # two 8-bit characters a register
 

@@ -25,10 +25,10 @@ import sys
 from array import array
 from dataclasses import dataclass
 
-from ...datatable.filetypes import STRING_CHARS, WORD_BITS
+from ...datatable.filetypes import STRING, STRING_CHARS, WORD_BITS
 from .config import PACKED_STRING_REGISTERS, Region, ServerConfig
 
-STRING_WORDS = 1 + STRING_CHARS  # an ST element: LEN, then the code units
+STRING_WORDS = STRING.words_per_element  # an ST element: LEN, then the code units
 # The word order whose registers are the two halves of a float in memory, swapped.
 _SWAPPED = "high-low" if sys.byteorder == "little" else "low-high"
 
