@@ -9,14 +9,14 @@ import io
 import pytest
 from rich.console import Console
 
-from softplc_lite.app import load_app
 from softplc_lite.datatable.display import format_value
 from softplc_lite.ladder import status as S
 from softplc_lite.ladder.engine import Mode
-from softplc_lite.runner import RunOptions
 from softplc_lite.watch.screen import WatchScreen, rung_view
-from softplc_lite.watch.session import WatchOptions, WatchSession
+from softplc_lite.watch.session import WatchSession
 from softplc_lite.watch.terminal import BINDINGS, KEYS, PROMPTS, Controller
+
+from watch_sessions import sessions
 
 PROGRAM = """
 SYMBOL Start I:0/0
@@ -34,20 +34,7 @@ MOV T4:0.PRE N7:3
 
 @pytest.fixture
 def session(tmp_path):
-    made = []
-
-    def make(text: str = PROGRAM, **kw) -> WatchSession:
-        d = tmp_path / f"app{len(made)}"
-        d.mkdir()
-        (d / "main.lad").write_text(text)
-        (d / "datatable.json").write_text('{"ST9": [""]}')
-        app = load_app(d, state_dir=tmp_path / f"state{len(made)}")
-        s = WatchSession(app, WatchOptions(run=RunOptions(fresh=True), **kw))
-        made.append(s)
-        return s
-    yield make
-    for s in made:
-        s.quit()
+    yield from sessions(tmp_path, PROGRAM, {"datatable.json": '{"ST9": [""]}'})
 
 
 def press(control: Controller, *keys: str) -> None:

@@ -15,6 +15,8 @@ from softplc_lite.watch.forces import ForceError, parse_force
 from softplc_lite.watch.history import DEPTH
 from softplc_lite.watch.session import WatchOptions, WatchSession
 
+from watch_sessions import sessions
+
 PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
 
 MOTOR = """
@@ -33,19 +35,7 @@ OTE O:0/1
 
 @pytest.fixture
 def session(tmp_path):
-    made = []
-
-    def make(text: str = MOTOR, **kw) -> WatchSession:
-        d = tmp_path / f"app{len(made)}"
-        d.mkdir()
-        (d / "main.lad").write_text(text)
-        app = load_app(d, state_dir=tmp_path / f"state{len(made)}")
-        s = WatchSession(app, WatchOptions(run=RunOptions(fresh=True), **kw))
-        made.append(s)
-        return s
-    yield make
-    for s in made:
-        s.quit()
+    yield from sessions(tmp_path, MOTOR)
 
 
 def read(s: WatchSession, addr: str):

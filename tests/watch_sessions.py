@@ -1,0 +1,31 @@
+"""Watch sessions over one-file apps made in a test's directory: the
+``session`` fixtures of the watch session tests."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from softplc_lite.app import load_app
+from softplc_lite.runner import RunOptions
+from softplc_lite.watch.session import WatchOptions, WatchSession
+
+
+def sessions(tmp_path: Path, program: str, files: dict[str, str] | None = None):
+    """A generator for a fixture: yields ``make(text=program, **watch_options)``,
+    which writes an app (main.lad and ``files``) and opens a fresh session
+    on it; every session made is quit at the end."""
+    made: list[WatchSession] = []
+
+    def make(text: str = program, **kw) -> WatchSession:
+        d = tmp_path / f"app{len(made)}"
+        d.mkdir()
+        (d / "main.lad").write_text(text)
+        for name, content in (files or {}).items():
+            (d / name).write_text(content)
+        app = load_app(d, state_dir=tmp_path / f"state{len(made)}")
+        s = WatchSession(app, WatchOptions(run=RunOptions(fresh=True), **kw))
+        made.append(s)
+        return s
+    yield make
+    for s in made:
+        s.quit()
