@@ -187,10 +187,12 @@ class ModbTcpServer(TLM):
                 self.process.stdin.flush()
             except (OSError, ValueError):
                 self._lost("the server process ended")
-        counters = self.image.counters()
-        self._measure_rate(counters[C.REQUESTS])
         if self._status is not None:
+            counters = self.image.counters()
+            self._measure_rate(counters[C.REQUESTS])
             self._status_words(counters)
+        else:
+            self._measure_rate(None)
 
     def _publish(self) -> None:
         image = self.image
@@ -199,11 +201,15 @@ class ModbTcpServer(TLM):
             image.put(offset, data[index:index + n])
         image.end()
 
-    def _measure_rate(self, requests: int) -> None:
-        """Requests answered normally a second, over each whole second (the watch view and word 2)."""
+    def _measure_rate(self, requests: int | None) -> None:
+        """Requests answered normally a second, over each whole second (the
+        watch view and word 2); ``requests`` None: read from the image only
+        when a second has passed (no status words want the counters each scan)."""
         now = time.monotonic()
         mark_t, mark_n = self._rate_mark
         if now - mark_t >= 1.0:
+            if requests is None:
+                requests = self.image.counters()[C.REQUESTS]
             self.rate = int(round((requests - mark_n) / (now - mark_t)))
             self._rate_mark = (now, requests)
 
