@@ -187,6 +187,11 @@ def test_ctrl_c_to_the_terminal_group_ends_the_run_cleanly_server_last(tmp_path)
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
         wait_for_tcp(port, LIMIT_S)
+        with ModbusTcpClient("127.0.0.1", port=port, timeout=LIMIT_S, retries=0) as c:
+            deadline = time.monotonic() + LIMIT_S  # scanning, past start-up (a Ctrl-C there exits 130)
+            while c.read_input_registers(0, count=1, device_id=1).registers[0] < 3:
+                assert time.monotonic() < deadline, "the runtime did not scan"
+                time.sleep(0.01)
         (server,) = children(proc.pid)
         os.killpg(proc.pid, signal.SIGINT)
         out, err = proc.communicate(timeout=LIMIT_S)
@@ -195,6 +200,7 @@ def test_ctrl_c_to_the_terminal_group_ends_the_run_cleanly_server_last(tmp_path)
             proc.kill()
             proc.communicate()
     assert proc.returncode == 0, err
-    assert out == "N40:0 = 1\n"  # still listening at the last scan
+    bits = int(printed(out)["N40:0"])  # bit /2 (a client) may still show the probe connections
+    assert bits & 1 and not bits & 2, out  # still listening at the last scan, not failed
     assert "MODBTCPS" not in err and "Traceback" not in err, err
     assert not Path(f"/proc/{server}").exists() or "Z" in Path(f"/proc/{server}/stat").read_text().split()[2]
