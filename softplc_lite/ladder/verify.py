@@ -14,7 +14,10 @@ LadderError located at file:line:col:
   place, and is left alone);
 - a symbol never used in the program;
 - a decimal constant that a word destination cannot hold (MOV 40000 N7:0),
-  by validate.constant_fits.
+  by validate.constant_fits;
+- an input instruction after an output instruction in series, on the rung or
+  within a branch leg (outputs end a rung or leg in RSLogix 5/500); in
+  neutral text a forgotten ';' joins two rungs so, and the warning says so.
 
 Sources and choices: docs/language.md, "softplc check warnings".
 """
@@ -25,7 +28,7 @@ from collections import defaultdict
 from typing import Iterable
 
 from ..datatable import Address, ValueKind
-from .ast import AddressRef, Const, Instruction, Program, SymbolRef, Text, leaves, walk
+from .ast import AddressRef, Branch, Const, Instruction, Program, Rung, SymbolRef, Text, leaves, walk
 from .errors import LadderError
 from .instructions import BUILTIN, InstructionSet, K
 from .parser import parse_expression
@@ -72,6 +75,7 @@ def verify(program: Program, instructions: InstructionSet = BUILTIN, parsed: Pro
                         elements[str(op.address)].append(ins)
                 if ins.mnemonic in _STORES:
                     found += _constant_warnings(ins, overflow)
+            found += _input_after_output(rung, instructions)
             if rung.elements and not has_output and not only_markers:
                 found.append(LadderError(rung.pos, "rung has no output instruction: its conditions "
                                          "are evaluated and nothing is done with them"))
@@ -93,6 +97,50 @@ def verify(program: Program, instructions: InstructionSet = BUILTIN, parsed: Pro
     if parsed is not None:
         found += _unused_symbols(parsed, instructions, shown)
     return sorted(found, key=lambda e: (e.pos.source, e.pos.line, e.pos.column))
+
+
+def _input_after_output(rung: Rung, instructions: InstructionSet) -> list[LadderError]:
+    """The first input instruction of ``rung`` that an output instruction
+    precedes in series (on the rung, or inside a branch leg, or after a
+    branch one of whose legs ends in an output); outputs in parallel legs,
+    each last in its leg, are the way to have several."""
+    first: list[tuple[Instruction, Instruction]] = []
+
+    def series(elements, before: Instruction | None) -> Instruction | None:
+        # ``before``: the last output on the path into ``elements``; returns the same after them.
+        for el in elements:
+            if first:
+                return before
+            if isinstance(el, Branch):
+                after = [series(leg, before) for leg in el.legs]
+                before = next((o for o in after if o is not None), None)
+                continue
+            spec = instructions.lookup(el.mnemonic)
+            if spec is None:
+                continue
+            if spec.output:
+                before = el
+            elif before is not None:
+                first.append((el, before))
+        return before
+
+    series(rung.elements, None)
+    if not first:
+        return []
+    ins, output = first[0]
+    message = (f"{ins.mnemonic} after {output.mnemonic} at {output.pos} in series: an output instruction "
+               "ends its rung or branch leg")
+    spans = ins.pos.line != output.pos.line
+    head = rung.elements[0]
+    sor = spans and (head.pos.line, head.pos.column) != (rung.pos.line, rung.pos.column)
+    if spans and not sor:
+        # Only a neutral-text rung runs on over lines without SOR ... EOR.
+        message += (f" (a ';' missing after the {output.mnemonic} on line {output.pos.line} "
+                    "would join two rungs into this one)")
+    elif not spans:
+        message += (" (if two rungs were meant, end the first: ';' in neutral text, "
+                    "a new line in mnemonic form)")
+    return [LadderError(ins.pos, message)]
 
 
 def _direct(op) -> Address | None:
