@@ -37,20 +37,74 @@ open), as parser.py's LadderPostLex declares it.
 
 from __future__ import annotations
 
+import logging
 import re
 
 from lark import Lark, Token
-from lark.lexer import UnlessCallback
-from lark.parse_tree_builder import ExpandSingleChild
-from lark.parsers.lalr_analysis import Shift
-from lark.utils import sre_constants, sre_parse
+from lark import __version__ as LARK_VERSION
 
+# Every internal of lark that softplc_lite reads is read here, and only here
+# (the rest of the ladder package uses lark's documented API). They are
+# those of lark 1.3 (pyproject.toml pins lark>=1.3,<1.4); where one is
+# missing or unlike what this module expects, ``fast_parser`` gives a
+# stand-in and every parse goes through lark's own parser, with the same
+# results (softplc choice: slower, never wrong).
+try:
+    from lark.lexer import UnlessCallback
+    from lark.parse_tree_builder import ExpandSingleChild
+    from lark.parsers.lalr_analysis import Shift
+    from lark.utils import sre_constants, sre_parse
+
+    _ZERO_WIDTH = (sre_constants.AT, sre_constants.ASSERT, sre_constants.ASSERT_NOT)
+    _REPEATS = (sre_constants.MAX_REPEAT, sre_constants.MIN_REPEAT, sre_constants.POSSESSIVE_REPEAT)
+except (ImportError, AttributeError) as e:
+    _MISSING: Exception | None = e
+else:
+    _MISSING = None
+
+# What reading another lark's tables raises (a name moved, a table shaped otherwise).
+_LARK_CHANGED = (AttributeError, KeyError, IndexError, ImportError, TypeError, ValueError, re.error)
+
+_log = logging.getLogger(__name__)
 _new_str = str.__new__
 
 
 class NotFastPath(Exception):
     """The text needs lark's own parser (a syntax error, or a lexer this
     loop does not model); nothing of this attempt is kept."""
+
+
+class _LarkUnlike(NotFastPath):
+    """Lark's objects are not as this loop reads them: lark's own parser
+    for the rest of the process."""
+
+
+class LarkOnly:
+    """Stands in for FastLalr when the loop cannot run on this lark: every
+    parse is left to lark's own parser."""
+
+    def __init__(self, why: str) -> None:
+        self.why = why
+
+    def parse(self, text: str, start: str):
+        raise NotFastPath(self.why)
+
+
+def fast_parser(lark: Lark, token_actions: dict | None = None) -> FastLalr | LarkOnly:
+    """The fast loop over ``lark``'s tables, or, when they cannot be read
+    as lark 1.3 lays them out, a LarkOnly (one debug line says why)."""
+    try:
+        if _MISSING is not None:
+            raise _MISSING
+        return FastLalr(lark, token_actions)
+    except (_LarkUnlike, *_LARK_CHANGED) as e:
+        return LarkOnly(_gave_up(e))
+
+
+def _gave_up(e: Exception) -> str:
+    why = f"lark {LARK_VERSION} is not laid out as this loop reads it ({e!r})"
+    _log.debug("the fast parse loop is off for this process: %s; lark's own parser parses", why)
+    return why
 
 
 class _StateLexer:
@@ -73,7 +127,7 @@ class _StateLexer:
         flags = basic.g_regex_flags
         if (len(scanner._mres) != 1 or scanner._mres[0].pattern != alternation or scanner.use_bytes
                 or scanner.re_ is not re):
-            raise NotFastPath("a lexer unlike lark 1.3's")
+            raise _LarkUnlike("a lexer unlike lark 1.3's")
         skips = []
         for i, t in enumerate(terminals):
             if t.name in basic.ignore_types:
@@ -93,7 +147,7 @@ class _StateLexer:
         self.keyword_of = {}
         for name, callback in basic.callback.items():
             if not isinstance(callback, UnlessCallback):
-                raise NotFastPath("a lexer callback")
+                raise _LarkUnlike("a lexer callback")
             self.keyword_of[name] = ({}, callback.scanner)
 
 
@@ -119,9 +173,11 @@ class FastLalr:
     """Parses with one ``Lark`` object (parser="lalr", lexer="contextual",
     a post-lexer declaring ``span_changes`` and ``dropped_inside``), giving
     exactly what ``lark.parse`` gives for a text it accepts. Construction
-    raises NotFastPath for a ``Lark`` set up otherwise."""
+    raises a NotFastPath for a ``Lark`` set up otherwise, or whatever
+    reading another lark's objects raises: ``fast_parser`` takes either."""
 
     def __init__(self, lark: Lark, token_actions: dict | None = None) -> None:
+        self.off: str | None = None  # why lark's own parser parses instead, once it must
         frontend = lark.parser
         connector = frontend.lexer
         postlex = connector.postlexer
@@ -133,7 +189,7 @@ class FastLalr:
         table = parser.parse_table
         callbacks = parser.callbacks
         if any(isinstance(k, str) for k in callbacks):
-            raise NotFastPath("terminal callbacks")
+            raise _LarkUnlike("terminal callbacks")
         self.start_states = table.start_states
         self.end_states = table.end_states
         # state -> {symbol: (shift_to, None) or (None, (size, origin, callback))}
@@ -160,6 +216,22 @@ class FastLalr:
                                       set(self.span_changes) | set(self.dropped_inside))
 
     def parse(self, text: str, start: str):
+        """What ``lark.parse(text, start=start)`` gives, or NotFastPath. A
+        failure to read lark's objects (a state's lexer is built on first
+        use) turns this loop off for the rest of the process."""
+        if self.off is not None:
+            raise NotFastPath(self.off)
+        try:
+            return self._parse(text, start)
+        except NotFastPath as e:
+            if not isinstance(e, _LarkUnlike):
+                raise
+            self.off = _gave_up(e)
+        except _LARK_CHANGED as e:
+            self.off = _gave_up(e)
+        raise NotFastPath(self.off)
+
+    def _parse(self, text: str, start: str):
         """Lark's contextual lexer, post-lexer and LALR parser as one loop."""
         actions = self.actions
         list_steps = self.list_steps
@@ -416,8 +488,6 @@ def _count_lines(text: str, begin: int, stop: int, line: int, line_start: int) -
 # get_regexp_width uses). None stands for "any character, or cannot tell":
 # the answer may be too large, never too small.
 
-_ZERO_WIDTH = (sre_constants.AT, sre_constants.ASSERT, sre_constants.ASSERT_NOT)
-_REPEATS = (sre_constants.MAX_REPEAT, sre_constants.MIN_REPEAT, sre_constants.POSSESSIVE_REPEAT)
 _MOST_CHARS = 512  # a larger class counts as "any character"
 
 

@@ -38,7 +38,7 @@ from .ast import (
     SymbolDecl,
 )
 from .errors import LadderError
-from .lalr_driver import FastLalr, NotFastPath
+from .lalr_driver import FastLalr, LarkOnly, NotFastPath, fast_parser
 from .limits import (
     MAX_BRANCH_DEPTH,
     MAX_EXPRESSION_DEPTH,
@@ -148,9 +148,11 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
 
 
 @lru_cache(maxsize=1)
-def _fast_parser() -> FastLalr:
+def _fast_parser() -> FastLalr | LarkOnly:
+    """lalr_driver's loop over this grammar's tables, or a LarkOnly where
+    this lark's objects are not laid out as that loop reads them."""
     lark = _ast_parser()
-    return FastLalr(lark, token_actions={"mn_tokens": lark.options.transformer.mn_token})
+    return fast_parser(lark, token_actions={"mn_tokens": lark.options.transformer.mn_token})
 
 
 def _parse_fast_or_lark(parser: Lark, text: str, start: str, problems: list[LadderError] | None):
