@@ -78,7 +78,7 @@ def test_check_lists_every_problem_and_exits_1(tmp_path):
     p = softplc("check", str(d))
     assert p.returncode == 1
     lines = p.stderr.splitlines()
-    assert any(line.endswith("a.lad:1:10: unknown instruction 'XIX' (did you mean XIO?)") for line in lines)
+    assert any(line.endswith("a.lad:1:10: unknown instruction 'XIX' (did you mean XIC?)") for line in lines)
     assert any("a.lad:2:5: JMP to label 4" in line for line in lines)
     assert any("b.lad:2:" in line for line in lines)
     assert lines[-1] == "3 problems found"

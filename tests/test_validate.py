@@ -14,7 +14,7 @@ def problems(text: str) -> list[str]:
 
 
 CASES = [
-    ("XIC B3/0 XIX B3/1 OTE O:0/0\n", "v.lad:1:10: unknown instruction 'XIX' (did you mean XIO?)"),
+    ("XIC B3/0 XIX B3/1 OTE O:0/0\n", "v.lad:1:10: unknown instruction 'XIX' (did you mean XIC?)"),
     ("XIX(B3/0)OTE(O:0/0);\n", "v.lad:1:1: unknown instruction 'XIX'"),
     ("TON T4:0 0.5 100 0\n", "v.lad:1:10: TON operand 2 (base) must be the time base 1.0, 0.01 or 0.001"),
     ("TON(T4:0,1.0,100);\n", "v.lad:1:1: TON takes 4 operands (TON timer base preset accum), got 3"),

@@ -8,11 +8,9 @@ this order. Plug-in modules (TLMs) add their instructions through an
 
 from __future__ import annotations
 
-import difflib
-
-
 from .ab_mnemonics import ab_instruction
 from .instr import BOUND as _BOUND
+from .spelling import closest
 from .specs import K, OperandSpec, InstructionSpec, _spec  # noqa: F401 - re-exported
 
 # Input parameters a JSR may pass, and return parameters it may receive (each).
@@ -115,20 +113,25 @@ class InstructionSet:
     def all_specs(self) -> list[InstructionSpec]:
         return list(self.table.values())
 
-    def suggest(self, name: str) -> str | None:
-        """The closest known mnemonic, for "did you mean" hints."""
-        close = difflib.get_close_matches(name.upper(), list(self.table), n=1, cutoff=0.5)
-        return close[0] if close else None
+    def suggest(self, name: str, output: bool | None = None) -> str | None:
+        """The closest known mnemonic, for "did you mean" hints (spelling.py):
+        ``output`` True where the name stands where an output instruction
+        stands (last in its rung or branch leg), False where an input does
+        (something follows it in series); among equally close mnemonics,
+        those of that role are preferred."""
+        prefer = None if output is None else (lambda m: self.table[m].output == output)
+        return closest(name, self.table, prefer)
 
-    def hint(self, name: str) -> str:
-        """What to say after "unknown instruction NAME"."""
+    def hint(self, name: str, output: bool | None = None) -> str:
+        """What to say after "unknown instruction NAME" (``output``: as for
+        ``suggest``)."""
         module = self.unavailable.get(name.upper())
         if module is not None:
             return f" ({name.upper()} is an instruction of the {module} module: add {module} to the app's MODULES.LST)"
         real = ab_instruction(name) if self.lookup(name) is None else None  # the live table decides
         if real is not None:
             return f" ({real} softplc_lite does not implement; docs/instructions.md lists those it does)"
-        close = self.suggest(name)
+        close = self.suggest(name, output)
         return f" (did you mean {close}?)" if close else ""
 
 
@@ -149,6 +152,6 @@ def all_specs() -> list[InstructionSpec]:
     return BUILTIN.all_specs()
 
 
-def suggest(name: str) -> str | None:
+def suggest(name: str, output: bool | None = None) -> str | None:
     """The closest built-in mnemonic, for "did you mean" hints."""
-    return BUILTIN.suggest(name)
+    return BUILTIN.suggest(name, output)

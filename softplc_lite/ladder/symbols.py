@@ -20,7 +20,6 @@ Text shaped like an address (one or two letters, optional digits, then
 
 from __future__ import annotations
 
-import difflib
 import re
 from typing import Mapping
 
@@ -28,6 +27,7 @@ from ..datatable import MAX_ELEMENTS, Address, AddressError, parse_address
 from ..datatable.address import SLC_MAX_SLOT, SLC_SLOT_WORDS, SLC_WORDS
 from ..datatable.errors import DataTableError
 from ..datatable.filetypes import WORD_BITS
+from .spelling import closest
 
 # The ladder grammar's ADDRESS terminal, as far as it decides: text that
 # starts this way is lexed as an address (ladder.lark), so here too.
@@ -64,10 +64,9 @@ class SymbolIndex:
         return self.get(symbol_base(text) or text)
 
     def nearest(self, name: str) -> str | None:
-        """The declared symbol closest to ``name``, for "did you mean"."""
-        spelt = {n.upper(): n for n in self.names}
-        close = difflib.get_close_matches(name.upper(), list(spelt), n=1, cutoff=0.6)
-        return spelt[close[0]] if close else None
+        """The declared symbol closest to ``name``, for "did you mean"
+        (spelling.py: a swap of two letters is one edit, ``Strat`` is Start)."""
+        return closest(name, self.names)
 
 
 def index(symbols) -> SymbolIndex:

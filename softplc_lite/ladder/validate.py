@@ -107,39 +107,41 @@ class _Checker:
         self.errors.append(LadderError(pos, message))
 
     # -- operands -------------------------------------------------------------------
-    def resolve(self, operand: Operand) -> Operand | None:
-        """Symbols -> addresses, recursively through expressions."""
+    def resolve(self, operand: Operand, wants: str | None = None) -> Operand | None:
+        """Symbols -> addresses, recursively through expressions; ``wants``
+        says what the operand takes, for an unknown symbol's message."""
         if isinstance(operand, SymbolRef):
-            return self.symbol(operand)
+            return self.symbol(operand, wants)
         if isinstance(operand, BinOp):
-            left, right = self.resolve(operand.left), self.resolve(operand.right)
+            left, right = self.resolve(operand.left, wants), self.resolve(operand.right, wants)
             if left is None or right is None:
                 return None
             if left is operand.left and right is operand.right:
                 return operand  # nothing to resolve: keep the parsed node
             return BinOp(operand.op, left, right, operand.pos)
         if isinstance(operand, UnaryOp):
-            inner = self.resolve(operand.operand)
+            inner = self.resolve(operand.operand, wants)
             if inner is None:
                 return None
             return operand if inner is operand.operand else UnaryOp(operand.op, inner, operand.pos)
         if isinstance(operand, Call):
-            inner = self.resolve(operand.arg)
+            inner = self.resolve(operand.arg, wants)
             if inner is None:
                 return None
             return operand if inner is operand.arg else Call(operand.func, inner, operand.pos)
         return operand
 
-    def symbol(self, ref: SymbolRef) -> AddressRef | None:
+    def symbol(self, ref: SymbolRef, wants: str | None = None) -> AddressRef | None:
         """A symbol, with its offset, member or bit (PollTimer/DN), as an
         address (symbols.py); an unknown name suggests the nearest declared
-        symbol first, then a mnemonic it may be a misspelling of."""
+        symbol, else says what the operand takes (``wants``). It never
+        suggests an instruction: a name in an operand's place is an operand
+        (a misspelt mnemonic in mnemonic text is found as an operand too
+        many, validate.instruction)."""
         name = symbol_base(ref.name) or ref.name
         if self.symbols.get(name) is None:
             near = self.symbols.nearest(name)
-            mnemonic = None if near else self.instructions.suggest(name)
-            extra = (f" (did you mean {near}?)" if near else
-                     f" (is {name} a misspelt instruction? did you mean {mnemonic}?)" if mnemonic else "")
+            extra = f" (did you mean {near}?)" if near else f": {wants}" if wants else ""
             self.error(ref.pos, f"unknown symbol {name!r}{extra}")
             return None
         try:
@@ -152,14 +154,15 @@ class _Checker:
             self.error(Pos(ref.pos.source, ref.pos.line, ref.pos.column + e.position), reason)
             return None
 
-    def expression(self, operand: Operand, mnemonic: str) -> Operand | None:
+    def expression(self, operand: Operand, mnemonic: str, where=None) -> Operand | None:
         if isinstance(operand, Text):
             try:
                 operand = parse_expression(operand.value, operand.pos)
             except LadderError as e:
                 self.errors.append(e)
                 return None
-        operand = self.resolve(operand)
+        wants = None if where is None else f"{where()} takes numbers, word and float addresses and declared symbols"
+        operand = self.resolve(operand, wants)
         if operand is None:
             return None
         ok = True
@@ -180,15 +183,20 @@ class _Checker:
     def operand(self, instr: Instruction, index: int, kind: K, operand: Operand) -> Operand | None:
         if kind is K.FILE_MODE:
             return self.file_mode(instr, index, operand)
-        if kind is K.EXPRESSION:
-            return self.expression(operand, instr.mnemonic)
-        if kind is K.ANY:
-            return self.resolve(operand)
-        resolved = self.resolve(operand)
-        if resolved is None:
-            return None
         def where() -> str:
             return f"{instr.mnemonic} operand {index + 1} ({self.instructions.lookup(instr.mnemonic).operand_at(index).name})"
+
+        if kind is K.EXPRESSION:
+            return self.expression(operand, instr.mnemonic, where)
+        wants = None
+        if isinstance(operand, SymbolRef) and self.symbols.declaration(operand.name) is None:
+            wants = f"{where()} takes {_a(kind.value)}" + ("" if kind in _CONSTANT_KINDS else
+                                                           f", and no SYMBOL line declares {operand.name}")
+        if kind is K.ANY:
+            return self.resolve(operand, wants)
+        resolved = self.resolve(operand, wants)
+        if resolved is None:
+            return None
 
         def bad(expected: str) -> None:
             self.error(_pos(resolved), f"{where()} must be {expected}, not {_describe(resolved)}")
@@ -277,23 +285,30 @@ class _Checker:
             plan = self._plans[mnemonic] = None if spec is None else _Plan(spec, mnemonic)
         return plan
 
-    def instruction(self, instr: Instruction, file_number: int, labels: set[int], first: bool) -> Instruction:
+    def instruction(self, instr: Instruction, file_number: int, labels: set[int], first: bool,
+                    at_end: bool | None = None) -> Instruction:
+        """``instr`` validated; ``first``: it opens its rung; ``at_end``: it
+        stands where an output does, nothing after it in series (None: not
+        known), which a did-you-mean for a misspelt mnemonic follows."""
         given = instr.operands  # once: a property (ast.Instruction)
         for op in given:
             if isinstance(op, _EXPRESSIONS) and expression_depth(op) > MAX_EXPRESSION_DEPTH:
                 raise _OverLimit  # before anything walks it recursively
         plan = self.plan(instr.mnemonic)
         if plan is None:
-            self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}{self.instructions.hint(instr.mnemonic)}")
+            self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}{self.instructions.hint(instr.mnemonic, at_end)}")
             return instr
         spec = plan.spec
         n = len(given)
         if not plan.min_operands <= n <= plan.max_operands:
             extras = given[spec.max_operands:]
-            stray = next((o for o in extras if isinstance(o, SymbolRef)
-                      and self.symbols.declaration(o.name) is None), None)
-            if stray is not None:
-                self.error(stray.pos, f"unknown instruction {stray.name!r}{self.instructions.hint(stray.name)}")
+            strays = [o for o in extras if isinstance(o, SymbolRef) and self.symbols.declaration(o.name) is None]
+            if strays:
+                # In mnemonic text a misspelt mnemonic reads as an operand of the instruction before it:
+                # it stands where an output does if that instruction does and no other misspelt one follows.
+                stray = strays[0]
+                output = at_end and len(strays) == 1
+                self.error(stray.pos, f"unknown instruction {stray.name!r}{self.instructions.hint(stray.name, output)}")
                 return instr
             want = (f"{spec.min_operands}..{spec.max_operands}" if spec.optional else str(spec.max_operands))
             plural = "" if want == "1" else "s"
@@ -397,25 +412,29 @@ class _Checker:
         return shape
 
     def series(self, elements: list[Element], file_number: int, labels: set[int], first: bool,
-               depth: int = 0) -> tuple[Element, ...]:
+               depth: int = 0, tail: bool = True) -> tuple[Element, ...]:
         """The validated series (``depth``: branches around it). Raises
         _OverLimit past the language's limits (limits.py), checked on the
         way rather than by a walk of every rung beforehand. A part already
-        in validated form (tuples, nothing to resolve) is shared, not copied."""
+        in validated form (tuples, nothing to resolve) is shared, not copied.
+        ``tail``: the series ends at the right rail (nothing follows it), so
+        its last element stands where an output does."""
         out: list[Element] = []
+        end = len(elements) - 1
         for el in elements:
             if isinstance(el, Branch):
                 if depth >= MAX_BRANCH_DEPTH:
                     raise _OverLimit
                 if len(el.legs) < 2:
                     self.error(el.pos, "a branch needs at least two legs (BST ... NXB ... BND)")
-                legs = tuple([self.series(leg, file_number, labels, False, depth + 1) for leg in el.legs])
+                at_end = tail and len(out) == end
+                legs = tuple([self.series(leg, file_number, labels, False, depth + 1, at_end) for leg in el.legs])
                 for leg in el.legs:
                     if not leg:
                         self.error(el.pos, "empty branch leg")
                 out.append(el if _same(legs, el.legs) else el.copy_with(legs))
             else:
-                out.append(self.instruction(el, file_number, labels, first and not out))
+                out.append(self.instruction(el, file_number, labels, first and not out, tail and len(out) == end))
         return elements if _same(out, elements) else tuple(out)  # a tuple: no spare capacity
 
     def run(self) -> Program:
@@ -574,6 +593,11 @@ def _s(n: int) -> str:
 
 def _pos(operand):
     return getattr(operand, "pos")
+
+
+def _a(kind: str) -> str:
+    """An operand kind with its article: "a bit address", "an integer constant"."""
+    return f"{'an' if kind[0] in 'aeiou' else 'a'} {kind}"
 
 
 def _describe(operand: Operand) -> str:
