@@ -5,6 +5,7 @@ enabled by MODULES.LST and run by both executors, exactly as COMGENIUS is."""
 from __future__ import annotations
 
 import os
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -260,13 +261,14 @@ def test_without_modules_lst_an_app_has_no_modules(tmp_path):
     assert app.modules == [] and app.warnings == []
 
 
-def _install(site: Path, name: str, source: str, entry: str) -> None:
+def _install(site: Path, name: str, source: str, entry: str, requires: tuple[str, ...] = ()) -> None:
     pkg = site / name.lower()
     pkg.mkdir(parents=True, exist_ok=True)
     (pkg / "__init__.py").write_text(source)
     info = site / f"{name.lower()}-1.0.dist-info"
     info.mkdir()
-    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name.lower()}\nVersion: 1.0\n")
+    requirements = "".join(f"Requires-Dist: {r}\n" for r in requires)
+    (info / "METADATA").write_text(f"Metadata-Version: 2.1\nName: {name.lower()}\nVersion: 1.0\n{requirements}")
     (info / "entry_points.txt").write_text(f"[softplc_lite.tlms]\n{name} = {entry}\n")
 
 
@@ -288,11 +290,74 @@ def test_a_module_claiming_a_builtin_mnemonic_is_refused(tmp_path, monkeypatch):
 
 def test_a_module_that_fails_to_import_is_named_with_its_package(tmp_path, monkeypatch):
     site = tmp_path / "site"
-    _install(site, "BROKEN", "import not_a_module_anywhere\n", "broken:Broken")
+    _install(site, "BROKEN", "raise RuntimeError('no license key')\n", "broken:Broken")
     monkeypatch.syspath_prepend(str(site))
-    app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="BROKEN\n")
-    with pytest.raises(ModuleError, match=r"module BROKEN \(package broken\) failed to load: ModuleNotFoundError"):
+    app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="; modules\nBROKEN\n")
+    with pytest.raises(ModuleError) as e:
         load_modules(app)
+    assert str(e.value) == (f"{app / 'MODULES.LST'}:2: module BROKEN (package broken) failed to load: an error in "
+                            "its code (no license key) (python -c 'import broken' shows where)")
+    sys.modules.pop("broken", None)
+
+
+# A library a module needs and that is not installed: (how the module gets it, what it says)
+MISSING = {
+    "imported": ("import not_a_module_anywhere\n", (), "needs the Python package 'not_a_module_anywhere', which "
+                 "is not installed (install it into the Python that runs softplc)"),
+    "required": ("from not_a_module_anywhere import thing\n", ("not-a-module-anywhere>=2,<3",),
+                 "needs the Python package 'not_a_module_anywhere', which is not installed "
+                 "(pip install 'not-a-module-anywhere>=2,<3')"),
+    # imported later (in a process of its own, on first use), so declared in ``libraries``
+    "declared": ("from softplc_lite.tlm import TLM\nclass Lib(TLM):\n    libraries = ('not_a_module_anywhere',)\n",
+                 ("not_a_module_anywhere==1.0",), "needs the Python package 'not_a_module_anywhere', which is not "
+                 "installed (pip install not_a_module_anywhere==1.0)"),
+    "a part of one": ("import softplc_lite.not_a_module_anywhere\n", (), "needs "
+                      "'softplc_lite.not_a_module_anywhere', which the installed softplc-lite "),
+}
+
+
+@pytest.mark.parametrize("case", MISSING)
+def test_a_module_whose_library_is_missing_says_which_in_one_located_line(case, tmp_path):
+    # Through the real command, as a user meets it: one line naming the
+    # package, at the MODULES.LST line that enables the module; the exit
+    # code of a config error; no traceback; nothing started.
+    source, requires, said = MISSING[case]
+    site = tmp_path / "site"
+    _install(site, "NEEDY", source, "needy:Lib", requires)
+    app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="; the test module\nneedy\n")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")]),
+               PYTHONDONTWRITEBYTECODE="1")
+    for command in (["run", str(app), "--fresh", "--scans", "3"], ["check", str(app)]):
+        proc = subprocess.run([sys.executable, "-m", "softplc_lite", *command], capture_output=True, text=True,
+                              env=env, timeout=60, cwd=tmp_path)
+        assert proc.returncode == 1, proc.stderr
+        assert "Traceback" not in proc.stderr and proc.stdout == ""
+        lines = proc.stderr.splitlines()
+        assert len(lines) == (1 if command[0] == "run" else 2), proc.stderr  # check adds its count line
+        assert lines[0].startswith(f"{app / 'MODULES.LST'}:2: module NEEDY {said}"), lines[0]
+
+
+def test_modbtcps_in_an_install_without_pymodbus_says_so_at_load(tmp_path):
+    # A broken install: no process can import pymodbus (a sitecustomize hides
+    # it from this one and from the server process it would start).
+    # MODBTCPS imports pymodbus only in its server process, and declares it
+    # in ``libraries`` so that the load finds it missing, before any process
+    # starts and before MODBTCPS.XML's address and port are looked at.
+    hide = tmp_path / "hide"
+    hide.mkdir()
+    (hide / "sitecustomize.py").write_text("import sys\nsys.modules['pymodbus'] = None\n")
+    app = tmp_path / "hmi_server"
+    shutil.copytree(Path(__file__).resolve().parent.parent / "programs" / "hmi_server", app,
+                    ignore=shutil.ignore_patterns(".softplc"))
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(hide), os.environ.get("PYTHONPATH", "")]),
+               PYTHONDONTWRITEBYTECODE="1")
+    proc = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(app), "--fresh", "--scans", "100",
+                           "--print", "Level"], capture_output=True, text=True, env=env, timeout=60, cwd=tmp_path)
+    assert proc.returncode == 1, proc.stderr
+    assert proc.stderr.splitlines() == [
+        f"{app / 'MODULES.LST'}:2: module MODBTCPS needs the Python package 'pymodbus', which is not installed "
+        "(pip install 'pymodbus<3.17,>=3.16.1')"]
+    assert proc.stdout == ""
 
 
 def test_the_softplc_command_runs_a_third_party_module(demo_path, tmp_path):

@@ -14,12 +14,21 @@ An app enables modules explicitly, as SoftPLC's MODULES.LST does: a file
 ``MODULES.LST`` in the app directory names one module a line, in any case;
 ``;`` starts a comment. Naming a module that is not installed is an error
 that lists the installed ones; so are two modules claiming one mnemonic.
+
+A module whose library is not installed fails at load with one line that
+names the package (``_not_installed``): a ModuleNotFoundError met importing
+the module, or a name of the module class's ``libraries`` (the libraries it
+imports later: in a process of its own, on first use) that Python cannot
+find.
 """
 
 from __future__ import annotations
 
+import re
+import shlex
 from dataclasses import dataclass
-from importlib.metadata import EntryPoint, entry_points
+from importlib.metadata import EntryPoint, PackageNotFoundError, entry_points, packages_distributions, version
+from importlib.util import find_spec
 from pathlib import Path
 
 from ..ladder.instructions import InstructionSet
@@ -43,23 +52,92 @@ def _package(ep: EntryPoint) -> str:
     return f"package {dist.name}" if dist is not None else f"entry point {ep.value}"
 
 
-def load_module(name: str, available: dict[str, EntryPoint] | None = None) -> TLM:
-    """A new instance of the installed module ``name`` (any case)."""
+def _requirement(ep: EntryPoint, library: str) -> str | None:
+    """The requirement of the module's distribution that names ``library``
+    (``pymodbus<3.17,>=3.16.1``), without its markers; None if none does."""
+    dist = getattr(ep, "dist", None)
+    wanted = _normal(library)
+    for requirement in (dist.requires or []) if dist is not None else []:
+        spec = requirement.split(";", 1)[0].strip()
+        found = re.match(r"[A-Za-z0-9][A-Za-z0-9._-]*", spec)
+        if found and _normal(found.group()) == wanted:
+            return spec
+    return None
+
+
+def _normal(name: str) -> str:
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def _not_installed(ep: EntryPoint, missing: str) -> str:
+    """Why the module cannot load, the Python module ``missing`` (``pymodbus``,
+    ``pymodbus.server``) not being found, in one line that names the package."""
+    top = missing.split(".", 1)[0]
+    if top == ep.module.split(".", 1)[0]:
+        return (f"module {ep.name}: its own code ({missing}) is missing from its installation "
+                f"({_package(ep)}: reinstall it)")
+    requirement = _requirement(ep, top)
+    pip = f"pip install {shlex.quote(requirement)}" if requirement else None
+    if top == missing or find_spec(top) is None:
+        return (f"module {ep.name} needs the Python package '{top}', which is not installed "
+                f"({pip or 'install it into the Python that runs softplc'})")
+    have = ", ".join(f"{d} {_version(d)}" for d in packages_distributions().get(top, [])) or top
+    return (f"module {ep.name} needs '{missing}', which the installed {have} does not have "
+            f"({pip or 'the module may be written for another version of it'})")
+
+
+def _version(dist: str) -> str:
+    try:
+        return version(dist)
+    except PackageNotFoundError:  # pragma: no cover - listed a moment ago
+        return "?"
+
+
+def _words(e: Exception) -> str:
+    """An error of a module's own code, without Python's type names."""
+    text = getattr(e, "msg", None) if isinstance(e, (ImportError, SyntaxError)) else None
+    text = text or str(e)
+    return f"an error in its code ({text})" if text else "an error in its code"
+
+
+def _missing_library(factory: object) -> str | None:
+    """The first of ``factory.libraries`` Python cannot find, if any."""
+    for library in getattr(factory, "libraries", ()):
+        try:
+            if find_spec(library) is None:
+                return library
+        except ModuleNotFoundError:  # a dotted name whose package is missing
+            return library
+    return None
+
+
+def load_module(name: str, available: dict[str, EntryPoint] | None = None, path: str | None = None,
+                line: int = 0) -> TLM:
+    """A new instance of the installed module ``name`` (any case); ``path``
+    and ``line`` locate a problem (where MODULES.LST names the module)."""
     available = installed() if available is None else available
     ep = available.get(name.upper())
     if ep is None:
         names = ", ".join(available) or "none"
-        raise ModuleError(f"no module named {name!r} is installed (installed modules: {names})")
+        raise ModuleError(f"no module named {name!r} is installed (installed modules: {names})", path, line)
     try:
         factory = ep.load()
-    except Exception as e:  # any import failure of third-party code
-        raise ModuleError(f"module {ep.name} ({_package(ep)}) failed to load: {type(e).__name__}: {e}") from None
+    except ModuleNotFoundError as e:  # a library the module imports is not installed
+        if not e.name:
+            raise ModuleError(f"module {ep.name} ({_package(ep)}) failed to load: {e}", path, line) from None
+        raise ModuleError(_not_installed(ep, e.name), path, line) from None
+    except Exception as e:  # any other import failure of third-party code: said in words, the way to see it
+        raise ModuleError(f"module {ep.name} ({_package(ep)}) failed to load: {_words(e)} "
+                          f"(python -c 'import {ep.module}' shows where)", path, line) from None
+    missing = _missing_library(factory)
+    if missing is not None:
+        raise ModuleError(_not_installed(ep, missing), path, line)
     try:
         module = factory()
     except Exception as e:
-        raise ModuleError(f"module {ep.name} ({_package(ep)}) failed to start: {type(e).__name__}: {e}") from None
+        raise ModuleError(f"module {ep.name} ({_package(ep)}) failed to start: {_words(e)}", path, line) from None
     if not isinstance(module, TLM):
-        raise ModuleError(f"module {ep.name} ({_package(ep)}): {ep.value} is not a softplc_lite.tlm.TLM")
+        raise ModuleError(f"module {ep.name} ({_package(ep)}): {ep.value} is not a softplc_lite.tlm.TLM", path, line)
     module.name = ep.name.upper()
     return module
 
@@ -122,7 +200,7 @@ def load_modules(app_dir: Path | None, configure: bool = True) -> tuple[list[TLM
                                         str(path), entry.line))
             continue
         try:
-            modules.append(load_module(entry.name, available))
+            modules.append(load_module(entry.name, available, str(path), entry.line))
         except ModuleError as e:
             problems.append(e)
     if problems:

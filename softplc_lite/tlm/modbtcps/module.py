@@ -48,6 +48,7 @@ class ModbTcpServer(TLM):
     name = "MODBTCPS"
     title = "Modbus TCP server over the data table (for HMIs and SCADA)"
     config_file = CONFIG_FILE
+    libraries = ("pymodbus",)  # imported by the server process only: the load checks it is installed (registry)
 
     def __init__(self, config: ServerConfig | None = None) -> None:
         self.config = config or ServerConfig()
