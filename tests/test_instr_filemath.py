@@ -284,7 +284,7 @@ def test_ave_word_file_rounds_the_average_into_the_destination():
     assert e.table.read("N7:20") == 3  # 11 / 4 = 2.75
     assert control(e) == {"EN": 1, "DN": 1, "LEN": 4, "POS": 4}
     e, _ = drive("AVE #N7:0 N7:20 R6:0 2 0", ({}, 1), values={"N7:0": -1, "N7:1": -2})
-    assert e.table.read("N7:20") == -2  # -1.5: half away from zero
+    assert e.table.read("N7:20") == -2  # -1.5: half to even
     assert e.table.read("S:0") & (1 << S.SIGN)
     # the sum of words does not overflow: 32767 * 3 / 3
     e, _ = drive("AVE #N7:0 F8:0 R6:0 3 0", ({}, 1), values={"N7:0": 32767, "N7:1": 32767, "N7:2": 32766})

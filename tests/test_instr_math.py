@@ -62,7 +62,7 @@ def test_sin_cos_tan_asn_acs_atn_ln_log_agree_with_cpt(run, name):
     assert e.table.read("N7:1") == e.table.read("N7:2")
 
 
-def test_sin_cos_into_words_round_half_away_from_zero(run):
+def test_sin_cos_into_words_round_to_the_nearest_integer(run):
     # sin(2) = 0.909 -> 1; cos(2) = -0.416 -> 0; atan(-10) = -1.47 -> -1; ln(20) = 2.996 -> 3
     e = run("SIN 2 N7:0\nCOS 2 N7:1\nATN -10 N7:2\nLN 20 N7:3\nLOG 1000 N7:4")
     assert [e.table.read(f"N7:{k}") for k in range(5)] == [1, 0, -1, 3, 3]

@@ -74,17 +74,17 @@ def test_jsr_on_a_false_rung_passes_nothing_and_returns_nothing(run):
 
 
 def test_sbr_floats_and_mixed_parameters_convert_as_mov(run):
-    # float into an integer rounds half away from zero; an integer into a float is exact
+    # float into an integer rounds half to even; an integer into a float is exact
     e = run("JSR 3 3 F8:0 N7:0 -2.5 F8:10 N7:10 N7:11\nFILE 3\nSBR N7:20 F8:20 N7:21\n"
             "RET N7:20 F8:20 N7:21",
             values={"F8:0": 2.5, "N7:0": -7})
-    assert read(e, "N7:20", "F8:20", "N7:21") == (3, -7.0, -3)
-    assert read(e, "F8:10", "N7:10", "N7:11") == (3.0, -7, -3)
+    assert read(e, "N7:20", "F8:20", "N7:21") == (2, -7.0, -2)
+    assert read(e, "F8:10", "N7:10", "N7:11") == (2.0, -7, -2)
 
 
 def test_ret_float_into_an_integer_return_parameter_rounds(run):
     e = run("JSR 3 1 1.25 N7:1\nFILE 3\nSBR F8:0\nMUL F8:0 2 F8:1\nRET F8:1", values={"N7:1": 0})
-    assert read(e, "F8:0", "F8:1", "N7:1") == (1.25, 2.5, 3)
+    assert read(e, "F8:0", "F8:1", "N7:1") == (1.25, 2.5, 2)
 
 
 @pytest.mark.parametrize("overflow,stored", [("clamp", 32767), ("wrap", -25536)])

@@ -14,14 +14,16 @@ import math
 from typing import Callable
 
 from .ast import AddressRef, BinOp, Call, Const, UnaryOp
+from .rounding import round_half_even
 
 
 def _int(v) -> int:
-    """Bitwise operators work on integers: floats are rounded first."""
+    """Bitwise operators (and TOD, FRD) work on integers: a float is rounded
+    first, as a store into a word rounds it (rounding.round_half_even)."""
     if isinstance(v, float):
         if not math.isfinite(v):
             return 0
-        return int(math.floor(abs(v) + 0.5)) * (1 if v >= 0 else -1)
+        return round_half_even(v)
     return v
 
 

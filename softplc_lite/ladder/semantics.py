@@ -19,6 +19,7 @@ from ..datatable import DataTable
 from ..datatable.filetypes import LONG_MAX, LONG_MIN, Storage
 from ..datatable.table import STRING_CHARS, read_string
 from . import status as S
+from .rounding import round_half_even
 
 # Word-0 bit masks (signed 16-bit, see datatable.bit_mask).
 EN, TT, DN = -32768, 1 << 14, 1 << 13  # timer
@@ -116,9 +117,10 @@ class Machine:
     # -- storing numbers ------------------------------------------------------------
     def store(self, value: int | float, d: array, i: int, carry: bool = False) -> None:
         """Store a math result the PLC-5 way: float destinations take float32;
-        integer destinations round floats (half away from zero), and out of
-        range values set overflow (S:0/1, minor fault) and are clamped or
-        wrapped per the app setting. Sets S:0 carry/overflow/zero/sign."""
+        integer destinations round floats to the nearest integer, a half to
+        the even one (rounding.round_half_even), and out of range values set
+        overflow (S:0/1, minor fault) and are clamped or wrapped per the app
+        setting. Sets S:0 carry/overflow/zero/sign."""
         if d.typecode == "f":
             v = float(value)
             over = False
@@ -147,7 +149,7 @@ class Machine:
                 # No low bits to keep: the extreme of its sign whatever the overflow setting.
                 value, over = (hi if value > 0 else lo), True
             else:
-                value = int(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
+                value = round_half_even(value)
         if not lo <= value <= hi:
             over = True
             value = (hi if value > 0 else lo) if self.clamp else wrap(value)
@@ -430,7 +432,7 @@ class Machine:
                 elif math.isinf(value):
                     value = LONG_MAX if value > 0 else LONG_MIN
                 else:
-                    value = int(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
+                    value = round_half_even(value)
             value = max(LONG_MIN, min(LONG_MAX, value)) if self.clamp else signed32(value)
             dd[di:di + n] = array(dd.typecode, [value]) * n
         else:
@@ -440,7 +442,7 @@ class Machine:
                 elif math.isinf(value):
                     value = 32767 if value > 0 else -32768
                 else:
-                    value = int(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
+                    value = round_half_even(value)
             value = max(-32768, min(32767, value)) if self.clamp else signed16(value)
             dd[di:di + n] = array("h", [value]) * n
 

@@ -23,6 +23,7 @@ import struct
 from array import array
 
 from ..bound import BoundInstruction, block, file_references
+from ..rounding import round_half_even
 from ..specs import K, _spec
 
 BLOCK_WORDS = 23
@@ -87,9 +88,9 @@ def _put_state(d: array, i: int, sign: int, now_ms: int) -> None:
 
 
 def _round(v: float) -> int:
-    """Half away from zero, into a 16-bit word."""
-    r = int(math.floor(abs(v) + 0.5)) * (1 if v >= 0 else -1)
-    return max(-32768, min(32767, r))
+    """Into a 16-bit word, rounded as every float stored into a word
+    (rounding.round_half_even), then clamped."""
+    return max(-32768, min(32767, round_half_even(v)))
 
 
 def _clamp(v, lo, hi):
