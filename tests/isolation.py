@@ -1,0 +1,95 @@
+"""What keeps the suite to itself (docs/testing.md, "Isolation"): nothing a
+test run does may land inside the repository, so the suite can run from a
+checkout beside a user's running PLC and on several workers at once.
+
+* Hypothesis keeps its example database and caches in one temporary
+  directory per run (its default is ``.hypothesis/`` in the working
+  directory), handed to xdist workers and to pytest runs the tests start
+  through ``HYPOTHESIS_STORAGE_DIRECTORY``.
+* The session hooks list the repository tree before and after the run and
+  fail the run, naming each path, when anything appeared in it. They act in
+  the process that runs the session: the xdist controller, whose session
+  starts before any worker and finishes after the last one, so the check
+  sees every test of every worker once. Bytecode caches (``__pycache__``)
+  are the interpreter's, not a test's, and are not counted; nor is a new
+  source file (.py, .md) in a directory that was there: that is a
+  developer's edit made while the suite ran, and no test writes either.
+
+conftest.py imports the hooks, which pytest finds there by name.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import pytest
+from hypothesis.configuration import set_hypothesis_home_dir
+
+ROOT = Path(__file__).resolve().parent.parent
+SKIPPED = {".git", "__pycache__"}
+SOURCES = (".py", ".md")
+
+
+def hypothesis_home() -> None:
+    home = os.environ.get("HYPOTHESIS_STORAGE_DIRECTORY")
+    if not home:
+        home = tempfile.mkdtemp(prefix="softplc-hypothesis-")
+        os.environ["HYPOTHESIS_STORAGE_DIRECTORY"] = home
+        atexit.register(shutil.rmtree, home, ignore_errors=True)
+    set_hypothesis_home_dir(home)
+
+
+def repo_listing(root: Path = ROOT) -> set[str]:
+    """Every file and directory under ``root`` (relative, '/' after a
+    directory), without .git and bytecode caches."""
+    found: set[str] = set()
+    for top, dirs, files in os.walk(root):
+        dirs[:] = [d for d in dirs if d not in SKIPPED]
+        rel = Path(top).relative_to(root)
+        found.update(f"{(rel / d).as_posix()}/" for d in dirs)
+        found.update((rel / f).as_posix() for f in files)
+    return found
+
+
+def _controller(session: pytest.Session) -> bool:
+    return not hasattr(session.config, "workerinput")
+
+
+_BEFORE = pytest.StashKey[set]()
+_APPEARED = pytest.StashKey[list]()
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    if _controller(session):
+        session.config.stash[_BEFORE] = repo_listing()
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    before = session.config.stash.get(_BEFORE, None)
+    if before is None:
+        return
+    def edited(path: str) -> bool:
+        parent = path.rpartition("/")[0]
+        return path.endswith(SOURCES) and (not parent or f"{parent}/" in before)
+
+    appeared = sorted(p for p in repo_listing() - before if not edited(p))
+    if appeared:
+        session.config.stash[_APPEARED] = appeared
+        if session.exitstatus == pytest.ExitCode.OK:
+            session.exitstatus = pytest.ExitCode.TESTS_FAILED
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus: int, config: pytest.Config) -> None:
+    appeared = config.stash.get(_APPEARED, [])
+    if appeared:
+        shown = appeared[:20] + ([f"... and {len(appeared) - 20} more"] if len(appeared) > 20 else [])
+        terminalreporter.section("written inside the repository", sep="=", red=True, bold=True)
+        terminalreporter.write_line("The run wrote inside the repository tree; a test must write only in its "
+                                    "tmp_path (docs/testing.md, \"Isolation\"). New paths:")
+        for path in shown:
+            terminalreporter.write_line(f"  {path}")

@@ -1,0 +1,52 @@
+"""The shipped apps (programs/) as tests run them: copied into the test's
+temporary directory without their ``.softplc`` state, so nothing is written
+inside the repository, and with every Modbus TCP server moved to a port
+found free, so a PLC already running on this machine (serving the shipped
+127.0.0.1:5020) does not stand in the way (docs/testing.md, "Isolation")."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+from modbus_peer import free_tcp_port
+
+ROOT = Path(__file__).resolve().parent.parent
+PROGRAMS = ROOT / "programs"
+SHIPPED_PORT = 5020  # programs/hmi_server/MODBTCPS.XML
+SERVER_CONFIG = "MODBTCPS.XML"
+_PORT = re.compile(r'(<ModbusTcpServer\b[^>]*?\bport=")(\d+)(")')
+
+
+def free_server_port(app_dir: Path) -> int | None:
+    """Moves the app's MODBTCPS server to a free port; the port, or None
+    for an app without one."""
+    config = app_dir / SERVER_CONFIG
+    if not config.exists():
+        return None
+    port = free_tcp_port()
+    text, n = _PORT.subn(lambda m: f"{m.group(1)}{port}{m.group(3)}", config.read_text(encoding="utf-8"), count=1)
+    assert n == 1, f"{config}: no port attribute to move"
+    config.write_text(text, encoding="utf-8")
+    return port
+
+
+def copy_app(name: str, dest: Path) -> Path:
+    """programs/NAME copied to DEST/NAME, its server on a free port."""
+    app = dest / name
+    shutil.copytree(PROGRAMS / name, app, ignore=shutil.ignore_patterns(".softplc"))
+    free_server_port(app)
+    return app
+
+
+def copy_programs(dest: Path) -> dict[str, int]:
+    """All of programs/ copied to DEST/programs; each server's new port by
+    app name."""
+    target = dest / "programs"
+    shutil.copytree(PROGRAMS, target, ignore=shutil.ignore_patterns(".softplc"))
+    ports = {}
+    for app in sorted(p for p in target.iterdir() if p.is_dir()):
+        if (port := free_server_port(app)) is not None:
+            ports[app.name] = port
+    return ports
