@@ -18,6 +18,7 @@ import struct
 
 FLOAT32_MAX = 3.4028234663852886e38
 _F32 = struct.Struct("<f")
+_pack, _unpack = _F32.pack, _F32.unpack  # bound once: a store of a float into a word calls them
 
 
 def round_half_even(v: float) -> int:
@@ -30,5 +31,5 @@ def round_half_even(v: float) -> int:
     clamps it or keeps its low bits as it does every out-of-range result.
     NaN and the infinities have no integer: callers decide what they store."""
     if -FLOAT32_MAX <= v <= FLOAT32_MAX:
-        v = _F32.unpack(_F32.pack(v))[0]
+        v = _unpack(_pack(v))[0]
     return round(v)
