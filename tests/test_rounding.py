@@ -185,6 +185,12 @@ def test_fal_and_cpt_functions_round_half_to_even(executor):
     assert [e.table.read(f"N7:{k}") for k in range(4)] == [12, 2, -3, 18]
 
 
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_cop_copies_a_float_s_bits_without_rounding(executor):
+    e = run_text("COP #F8:0 #N7:0 2", executor=executor, values={"F8:0": 2.5})
+    assert [e.table.read("N7:0"), e.table.read("N7:1")] == [0, 0x4020]  # 2.5 = 0x40200000, low word first
+
+
 # -- float32 semantics: a result into a word is the F element's value, rounded --------------------
 
 PAIR = 'CPT N7:0 "F8:0 * F8:1"\nCPT F8:2 "F8:0 * F8:1"\nMOV F8:2 N7:1\nADD F8:0 F8:1 N7:2\nADD F8:0 F8:1 F8:3\nMOV F8:3 N7:3'
