@@ -193,7 +193,9 @@ def test_cop_copies_a_float_s_bits_without_rounding(executor):
 
 # -- float32 semantics: a result into a word is the F element's value, rounded --------------------
 
-PAIR = 'CPT N7:0 "F8:0 * F8:1"\nCPT F8:2 "F8:0 * F8:1"\nMOV F8:2 N7:1\nADD F8:0 F8:1 N7:2\nADD F8:0 F8:1 F8:3\nMOV F8:3 N7:3'
+# the same result straight into a word, and into an F element then MOVed
+PAIR = ('CPT N7:0 "F8:0 * F8:1"\nCPT F8:2 "F8:0 * F8:1"\nMOV F8:2 N7:1\n'
+        'ADD F8:0 F8:1 N7:2\nADD F8:0 F8:1 F8:3\nMOV F8:3 N7:3')
 _engines: dict[str, Engine] = {}
 
 
