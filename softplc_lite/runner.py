@@ -26,24 +26,38 @@ from .app import App, save_code_cache
 from .datatable import DataTable, DataTableError, jsonio
 from .ladder import status as S
 from .ladder.engine import Engine, Mode, RealClock, SimulatedClock
-from .ladder.symbols import resolve_name
+from .ladder.symbols import SymbolError, resolve_name
 from .ports import parse_port_overrides
 from .ports.recorder import MAX_PENDING
 from .ports.trace import covered_scans
 from .retentive import Retentive, StorageFaults, restore_snapshot
 
 
+def apply_assignment(table: DataTable, text: str, symbols=None) -> None:
+    """``--set TEXT`` into ``table``; any problem is a DataTableError that
+    names the option as typed: ``--set StopOk=abc: I:0/1 holds a bit (0 or
+    1), got abc``."""
+    shown = text if len(text) <= 60 else f"{text[:40]}... ({len(text)} characters)"
+    try:
+        addr, value = parse_assignment(text, symbols)
+        table.write(addr, value)
+    except SymbolError as e:  # its text is the name, which the option shows already
+        raise DataTableError(f"--set {shown}: {e.reason}") from None
+    except DataTableError as e:
+        raise DataTableError(f"--set {shown}: {e}") from None
+
+
 def parse_assignment(text: str, symbols=None) -> tuple[object, object]:
     """``ADDR=VALUE`` (ADDR may be a program symbol): VALUE is JSON (5, 1.5, "text", {"PRE": 10}) or, failing
     that, taken as a plain string (for ST elements)."""
     if "=" not in text:
-        raise DataTableError(f"--set {text!r}: expected ADDR=VALUE, e.g. N7:0=5")
+        raise DataTableError("expected ADDR=VALUE, e.g. N7:0=5")
     name, _, raw = text.partition("=")
     name = name.strip()
     addr = resolve_name(name, symbols)
     problem = jsonio.json_limit_problem(raw)
     if problem is not None:
-        raise DataTableError(f"--set {name}: the value at {problem}")
+        raise DataTableError(f"the value at {problem}")
     try:
         value = json.loads(raw)
     except (ValueError, RecursionError):
@@ -102,8 +116,7 @@ class Runner:
         for f in options.load:
             jsonio.load_file(self.table, f)
         for text in options.sets:
-            addr, value = parse_assignment(text, app.program.symbols)
-            self.table.write(addr, value)
+            apply_assignment(self.table, text, app.program.symbols)
         # Removes the temp files of a save a killed run left; saves from the first scan on.
         self.retentive = Retentive(path, settings.save_ms, self.faults) \
             if path is not None and options.save_state else None

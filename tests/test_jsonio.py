@@ -120,7 +120,7 @@ BAD = [
     ('{"ST9": [{"LEN": 3, "FOO": 1}]}', "unknown member 'FOO'"),
     ('{"F8": ["1.5"]}', "F8:0 holds a float"),
     ('{"F8": [1e39]}', "does not fit F8:0, which holds a float32"),
-    ('{"N7": [1.5]}', "N7:0 holds a 16-bit signed integer; got 1.5"),
+    ('{"N7": [1.5]}', "N7:0 holds a 16-bit signed integer (-32768..32767), got 1.5"),
     ('{"N2": [1]}', "N files are numbered 3..9999"),
     ('{"N7": [' + ",".join(["0"] * 10001) + ']}', "a file holds at most 10000"),
 ]

@@ -18,6 +18,7 @@ PLC rules, not Python ones:
 
 from __future__ import annotations
 
+import json
 import struct
 import sys
 from array import array
@@ -68,11 +69,31 @@ def _as_address(addr: AddressLike) -> Address:
     return parse_address(addr) if isinstance(addr, str) else addr
 
 
+def shown(value: Any) -> str:
+    """A value as a person typed it, for messages: text as it is (quoted
+    only when empty or padded), a number as a number, an object or a list
+    as JSON; never a Python type name."""
+    if isinstance(value, str):
+        return value if value and value.strip() == value else json.dumps(value)
+    if isinstance(value, (bool, int, float)):
+        return str(int(value) if isinstance(value, bool) else value)
+    try:
+        return json.dumps(value)
+    except (TypeError, ValueError):
+        return "a value of another kind"
+
+
+def _example_member(ftype) -> str:
+    words = ftype.word_members or ftype.bit_members
+    return words[0].name if words else "PRE"
+
+
 def _check_int(value: Any, lo: int, hi: int, where: str, what: str) -> int:
     if isinstance(value, bool):
         value = int(value)
     if not isinstance(value, int):
-        raise ValueRangeError(f"{where} holds {what}; got {value!r} ({type(value).__name__})")
+        span = "0 or 1" if (lo, hi) == (0, 1) else f"{lo}..{hi}"
+        raise ValueRangeError(f"{where} holds {what} ({span}), got {shown(value)}")
     if not lo <= value <= hi:
         raise ValueRangeError(f"{value} does not fit {where}, which holds {what} ({lo}..{hi})")
     return value
@@ -82,7 +103,7 @@ def check_float32(value: Any, where: str) -> float:
     """A number that fits a float32 element (inf and nan are allowed, as on
     the PLC; a finite value too large for float32 is refused)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueRangeError(f"{where} holds a float; got {value!r} ({type(value).__name__})")
+        raise ValueRangeError(f"{where} holds a float (a number), got {shown(value)}")
     try:
         struct.pack("<f", value)
     except (OverflowError, struct.error):
@@ -340,7 +361,9 @@ class DataTable:
         ftype = f.ftype
         if not isinstance(value, dict):
             raise ValueRangeError(
-                f"{a} is a {ftype.title} element; write a dict of members ({ftype.member_names()})"
+                f"{a} is a {ftype.title} element: give its members as an object, e.g. "
+                f"{{\"{_example_member(ftype)}\": 10}} (members {ftype.member_names()}), or one member "
+                f"({a}.{_example_member(ftype)})"
             )
         checked: list[tuple[Any, int]] = []
         for name, v in value.items():
@@ -512,7 +535,7 @@ def read_string(data: array, start: int) -> str:
 
 def write_string(data: array, start: int, text: Any, where: str) -> None:
     if not isinstance(text, str):
-        raise ValueRangeError(f"{where} holds a string; got {text!r} ({type(text).__name__})")
+        raise ValueRangeError(f"{where} holds a string (text), got {shown(text)}")
     if len(text) > STRING_CHARS:
         raise ValueRangeError(
             f"a {len(text)}-character string does not fit {where}: at most {STRING_CHARS} characters"

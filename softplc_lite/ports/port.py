@@ -23,6 +23,9 @@ numbers ("0"), MODBMAST's "MODBMAST:1".
 
 from __future__ import annotations
 
+import errno
+import os
+import re
 import time
 from collections import deque
 from dataclasses import dataclass
@@ -305,8 +308,34 @@ def quiet_close(s) -> None:
         pass
 
 
+# errno -> why a port is down, in words (a device, not a file: ENOENT is "no such device").
+_DEVICE_WORDS = {
+    errno.ENOENT: "no such device", errno.ENXIO: "no such device", errno.ENODEV: "no such device",
+    errno.EACCES: "permission denied", errno.EPERM: "permission denied",
+    errno.EISDIR: "it is a directory, not a device", errno.ENOTTY: "not a serial device",
+    errno.EBUSY: "the device is busy", errno.EIO: "input/output error on the device",
+    errno.ECONNREFUSED: "connection refused", errno.ETIMEDOUT: "timed out", errno.EHOSTUNREACH: "host unreachable",
+    errno.ENETUNREACH: "network unreachable", errno.ECONNRESET: "connection reset",
+}
+# pyserial puts the OS's error inside its own text: "could not open port X: [Errno 2] No such file ...",
+# "Could not configure port: (25, 'Inappropriate ioctl for device')".
+_ERRNO_IN_TEXT = re.compile(r"\[Errno (\d+)\]|\((\d+), '")
+
+
 def reason(e: BaseException) -> str:
-    text = str(e) or type(e).__name__
-    if isinstance(e, OSError) and e.strerror:
-        text = f"{e.strerror}" + (f": {e.filename}" if e.filename else "")
-    return text
+    """Why a port is down, in words: "no such device", "permission denied";
+    never Python's "[Errno 2] ..." text or an exception's class name."""
+    text = str(e)
+    number = e.errno if isinstance(e, OSError) and isinstance(e.errno, int) else None
+    if number is None and isinstance(e.args, tuple) and len(e.args) == 2 and isinstance(e.args[0], int):
+        number = e.args[0]  # termios.error: (errno, message)
+    if number is None:
+        found = _ERRNO_IN_TEXT.search(text)
+        if found:
+            number = int(found.group(1) or found.group(2))
+    if number is not None:
+        if number in _DEVICE_WORDS:
+            return _DEVICE_WORDS[number]
+        words = os.strerror(number)
+        return words[:1].lower() + words[1:]
+    return text or "the device refused it"

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from ..datatable import DataTable, DataTableError, bit_mask, parse_address
 from ..datatable.address import Address
-from ..ladder.symbols import resolve_name
+from ..ladder.symbols import SymbolError, resolve_name
 from .breakpoints import quoted
 
 
@@ -32,19 +32,28 @@ class Force:
         return f"{self.address}={int(self.on)}"
 
 
-def parse_force(text: str, symbols=None) -> Force:
-    """``ADDR=1`` or ``ADDR=0`` (ADDR a bit address or a program symbol)."""
+def parse_force(text: str, symbols=None, prompt: bool = False) -> Force:
+    """``ADDR=1`` or ``ADDR=0`` (ADDR a bit address or a program symbol).
+    A ForceError names where the text came from: ``--force 'TEXT'``, or
+    ``force TEXT`` as typed at the view's prompt (``prompt``)."""
+    where = f"force {text}" if prompt else f"--force {quoted(text)}"
+    example = "I:0/0=1" if prompt else "--force I:0/0=1"
     name, eq, value = text.partition("=")
     name, value = name.strip(), value.strip()
     if not eq or value not in ("0", "1"):
-        raise ForceError(f"--force {quoted(text)}: expected ADDR=1 or ADDR=0, e.g. --force I:0/0=1")
-    address = resolve_name(name, symbols)
-    return Force(_bit_address(address, text), value == "1")
+        raise ForceError(f"{where}: expected ADDR=1 or ADDR=0, e.g. {example}")
+    try:
+        address = resolve_name(name, symbols)
+    except SymbolError as e:
+        raise ForceError(f"{where}: {e.reason}") from None
+    except DataTableError as e:
+        raise ForceError(f"{where}: {e}") from None
+    return Force(_bit_address(address, where), value == "1")
 
 
-def _bit_address(address: Address, text: str) -> Address:
+def _bit_address(address: Address, where: str) -> Address:
     if address.bit is None or not address.is_direct:
-        raise ForceError(f"--force {quoted(text)}: only a direct bit address can be forced (e.g. O:0/0, B3/5, N7:0/3)")
+        raise ForceError(f"{where}: only a direct bit address can be forced (e.g. O:0/0, B3/5, N7:0/3)")
     return address
 
 
@@ -71,7 +80,8 @@ class Forces:
         data[index] = (data[index] | mask) if force.on else (data[index] & ~mask)  # at once, in the table shown
 
     def remove(self, address: str | Address) -> bool:
-        key = str(address if isinstance(address, Address) else _bit_address(parse_address(address), address))
+        key = str(address if isinstance(address, Address) else
+                  _bit_address(parse_address(address), f"unforce {address}"))
         found = self.forces.pop(key, None) is not None
         self._resolved.pop(key, None)
         self._hook(bool(self._resolved))

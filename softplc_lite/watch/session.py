@@ -14,7 +14,7 @@ from ..datatable import DataTableError, ValueKind
 from ..datatable.display import format_read
 from ..ladder.ast import AddressRef, walk
 from ..ladder.engine import Mode, ModeError
-from ..ladder.symbols import is_symbol_text, resolve_name
+from ..ladder.symbols import SymbolError, resolve_name
 from ..online import ProgramWatcher
 from ..runner import Runner, RunOptions
 from .breakpoints import Breakpoints, Hit
@@ -355,8 +355,15 @@ class WatchSession:
         self.message = f"breakpoint {'set' if on else 'cleared'}: file {self.file} rung {self.selected}"
 
     def force(self, text: str) -> None:
+        """``ADDR=1`` or ``ADDR=0`` typed at the prompt; a bad entry changes
+        nothing and the message names what was typed."""
+        try:
+            force = parse_force(text, self.app.program.symbols, prompt=True)
+        except DataTableError as e:
+            self.message = str(e)
+            return
         self._go_live()
-        self.forces.set(parse_force(text, self.app.program.symbols))
+        self.forces.set(force)
         self._edited()
         self.message = f"forced {text}"
 
@@ -384,7 +391,7 @@ class WatchSession:
             self._go_live()
             self.engine.table.write(address, value)
         except (DataTableError, ValueError, TypeError, OverflowError) as e:
-            self.message = f"set {name}: {e}"
+            self.message = f"set {name}: {_reason(e)}"
             return
         self._edited()
         self.message = f"set {name} = {format_read(self.engine.table, address)}{self._forced_note(address)}"
@@ -401,7 +408,7 @@ class WatchSession:
             table = self.engine.table
             table.write(address, 1 - table.read(address))
         except (DataTableError, ValueError) as e:
-            self.message = f"toggle {name}: {e}"
+            self.message = f"toggle {name}: {_reason(e)}"
             return
         self._edited()
         self.message = f"toggled {name}: now {self.engine.table.read(address)}{self._forced_note(address)}"
@@ -482,8 +489,16 @@ class WatchSession:
             self.goto(fault.rung)
 
     def unforce(self, text: str) -> None:
-        symbols = self.app.program.symbols
-        found = self.forces.remove(resolve_name(text, symbols) if is_symbol_text(text.strip()) else text)
+        text = text.strip()
+        try:
+            address = resolve_name(text, self.app.program.symbols)
+        except DataTableError as e:
+            self.message = f"unforce {text}: {_reason(e)}"
+            return
+        if address.bit is None or not address.is_direct:
+            self.message = f"unforce {text}: only a direct bit address is forced (e.g. O:0/0, B3/5, N7:0/3)"
+            return
+        found = self.forces.remove(address)
         self.watch.sample(self.engine.table, trend=False)
         self.message = f"force removed: {text}" if found else f"{text} is not forced"
 
@@ -497,3 +512,9 @@ class WatchSession:
             self.runner.save()
         finally:
             self.engine.close()
+
+
+def _reason(e: Exception) -> str:
+    """An error's text after the name the message already shows (a
+    symbol's error repeats the name it was given)."""
+    return e.reason if isinstance(e, SymbolError) else str(e)

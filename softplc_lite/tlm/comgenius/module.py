@@ -80,7 +80,7 @@ class ComGenius(TLM):
         if replay:
             for number in self.config.ports:
                 overrides.setdefault(number, f"replay://{replay}?port={number}")
-        self.ports = PortSet(self.config, self.debug, now_ns, overrides)
+        self.ports = PortSet(self.config, self.debug, now_ns, overrides, given=set(options.get("ports") or {}))
         warnings = self.ports.open_all()
         self.recorder = options.get("recorder")
         if self.recorder is not None:

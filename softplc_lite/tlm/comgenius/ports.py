@@ -132,13 +132,15 @@ class PortSet:
     """The ports of one COMGENIUS instance, opened from its config."""
 
     def __init__(self, config: ComGeniusConfig, log: Callable[[int, str], None], now_ns: Callable[[], int],
-                 overrides: dict[int, str] | None = None) -> None:
+                 overrides: dict[int, str] | None = None, given: set[int] = frozenset()) -> None:
+        # ``given``: the ports whose device a ``--port`` option names (their errors name the option)
         from ...ports.urlhandler import register  # sim:// and replay:// join pyserial's URL schemes
 
         register()
         self.config = config
         self.log = log
         self.ports: dict[int, ComPort] = {}
+        self.given = {number: (overrides or {})[number] for number in given if number in (overrides or {})}
         for number, pc in sorted(config.ports.items()):
             physical = (overrides or {}).get(number, pc.physical)
             url = port_url(physical, config.com_devices)
@@ -159,9 +161,13 @@ class PortSet:
             except serial.SerialException:
                 message = f"port {port.number}: cannot open {port.url}: {port.error}"
                 if not keep_going:
+                    why = port.error
                     self.close()
-                    raise ModuleError(f"[PORTS]: {message} (set PORT_ERRORS=RETRY in [DRIVER] to run on "
-                                      "without it)", self.config.path, port.config.line) from None
+                    retry = "(set PORT_ERRORS=RETRY in [DRIVER] to run on without it)"
+                    if port.number in self.given:  # the device is the option's, not the [PORTS] line's
+                        raise ModuleError(f"--port {port.number}={self.given[port.number]}: cannot open {port.url}: "
+                                          f"{why} {retry}") from None
+                    raise ModuleError(f"[PORTS]: {message} {retry}", self.config.path, port.config.line) from None
                 warnings.append(f"{self.config.path}:{port.config.line}: [PORTS]: {message}; running on, "
                                 f"its instructions set ER and it is retried every {self.config.retry_ms} ms")
         return warnings

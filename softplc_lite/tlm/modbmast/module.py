@@ -140,9 +140,13 @@ class Modbmast(TLM):
             except serial.SerialException:
                 message = f"port {number}: cannot open {url}: {port.error}"
                 if config.port_errors != "retry":
+                    why = port.error
                     self._close_ports()
-                    raise ModuleError(f"<Port>: {message} (set portErrors=\"retry\" on <ModbusSerial> to run on "
-                                      "without it)", config.path, pc.line) from None
+                    retry = "(set portErrors=\"retry\" on <ModbusSerial> to run on without it)"
+                    if overrides.get(number):  # the device is a --port option's, not the <Port>'s
+                        raise ModuleError(f"--port {self.name}:{number}={overrides[number]}: cannot open {url}: "
+                                          f"{why} {retry}") from None
+                    raise ModuleError(f"<Port>: {message} {retry}", config.path, pc.line) from None
                 warnings.append(f"{config.path}:{pc.line}: <Port>: {message}; running on: its slaves are Not "
                                 f"Present and it is retried every {config.retry_ms} ms")
                 for s in self.status[number].values():
