@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 from cli_tmux import open_terminal
-from modbus_peer import free_tcp_port
+from shipped_apps import copy_programs
 from test_cli_readme import try_it_lines
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -72,13 +72,9 @@ def _clean_env() -> dict[str, str]:
 @pytest.fixture
 def programs(tmp_path) -> Path:
     """A copy of programs/ (the lines run in it; they write their state there)."""
-    shutil.copytree(ROOT / "programs", tmp_path / "programs", ignore=shutil.ignore_patterns(".softplc"))
     # programs/hmi_server serves 127.0.0.1:5020 as written; the copy serves a free port instead,
     # so the test passes beside a user's running PLC (or another test run) holding 5020.
-    xml = tmp_path / "programs" / "hmi_server" / "MODBTCPS.XML"
-    text = xml.read_text(encoding="utf-8")
-    assert 'port="5020"' in text
-    xml.write_text(text.replace('port="5020"', f'port="{free_tcp_port()}"'), encoding="utf-8")
+    assert "hmi_server" in copy_programs(tmp_path)
     return tmp_path
 
 
