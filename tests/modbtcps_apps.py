@@ -60,17 +60,24 @@ class Running:
         self.runner = Runner(app, RunOptions(realtime=realtime, save_state=False))
         self.engine = self.runner.engine
         self.module = next(m for m in self.engine.modules if m.name == "MODBTCPS")
-        self.port = self.module.port
         self.error: BaseException | None = None
         self.stopped = False
         self.thread = threading.Thread(target=self._run, name="modbtcps-test-runner", daemon=True)
         self.thread.start()
+        self.module.wait_until_listening(LIMIT_S)  # the first scan starts the server: the test starts with it up
 
     def _run(self) -> None:
         try:
             self.runner.run(None)
         except BaseException as e:  # the test sees it in stop()
             self.error = e
+
+    @property
+    def port(self) -> int:
+        """The port the server listens on (the first scan starts it)."""
+        port = self.module.wait_until_listening(LIMIT_S)
+        assert port is not None, f"the server is not listening: {self.module.failed}"
+        return port
 
     def read(self, address: str):
         return self.engine.table.read(address)

@@ -294,15 +294,22 @@ def test_writes_land_in_program_and_test_mode(tcp_apps, mode):
 # -- the server process ------------------------------------------------------------------
 
 
-def test_an_address_in_use_refuses_to_start_saying_why(tcp_apps):
-    from softplc_lite.tlm.errors import ModuleError
-
+def test_an_address_in_use_fails_the_server_saying_why_and_the_scan_goes_on(tcp_apps, capfd):
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         port = taken.getsockname()[1]
-        with pytest.raises(ModuleError, match=f"cannot listen on 127.0.0.1:{port}: Address already in use"):
-            tcp_apps.start(server_xml(port=port))
+        plc = tcp_apps.start(server_xml(port=port))
+        plc.wait_for(lambda: plc.status(S.W_BITS) & S.BIT_FAILED, "the failed bit")
+        assert not plc.status(S.W_BITS) & S.BIT_LISTENING
+        scans = plc.engine.scans
+        plc.wait_for(lambda: plc.engine.scans > scans + 5, "scans after the server failed")
+    status = plc.module.server_status()
+    assert not status.up and status.listening == f"cannot listen on 127.0.0.1:{port}: the address is in use " \
+                                                 "(another program listens there)"
+    assert f"MODBTCPS: cannot listen on 127.0.0.1:{port}: the address is in use (another program listens there) " \
+           "(MODBTCPS.XML address and port; docs/modbtcps.md); clients are not served (the scan goes on)" \
+           in capfd.readouterr().err
 
 
 def test_a_server_process_that_dies_sets_the_failed_bit_and_the_scan_goes_on(plc):

@@ -158,7 +158,7 @@ def test_the_panel_is_in_the_watch_screen_only_for_apps_with_a_server(tmp_path):
         assert len(lines_with(narrow, "requests")) == 1 and "MODBTCPS 127.0.0.1:" in narrow
     finally:
         s.quit()
-    plain = WatchSession(load_app(ROOT_PROGRAMS / "blinker", state_dir=None), WatchOptions(run=RunOptions(fresh=True)))
+    plain = WatchSession(load_app(ROOT_PROGRAMS / "blinker", tmp_path / "state"), WatchOptions(run=RunOptions(fresh=True)))
     try:
         assert not ServersView(plain.engine)
         assert "servers" not in render(plain, 100, 30).export_text()
@@ -218,7 +218,9 @@ def test_softplc_watch_shows_the_server_in_a_real_terminal(tmux, tmp_path, clien
     tmux.start(f"{sys.executable} -m softplc_lite watch {app_dir} --fresh --state {tmp_path / 'state'}",
                width=100, height=30)
     screen = tmux.wait_for("servers", seconds=LIMIT_S)
-    assert f"MODBTCPS 127.0.0.1:{port} up" in screen
+    assert "not started" in screen and " up" not in screen
+    tmux.keys("n")  # the first scan starts the server
+    tmux.wait_for(f"MODBTCPS 127.0.0.1:{port} up", seconds=LIMIT_S)
     client = clients(port)
     assert client.read_holding_registers(NOT_SERVED, count=1, device_id=1).isError()
     tmux.keys("n")  # a scan: the view is redrawn (the counts come from the server, not the scan)

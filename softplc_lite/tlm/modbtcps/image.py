@@ -13,14 +13,23 @@ Layout of the file (native byte order: both processes run on this machine)::
     8     u32 x COUNTERS   the server's counters (status.py); only the server writes them
     ...   the image: each region's words at the offset the Layout gave it
 
-The file lives in /dev/shm where there is one (memory, not disk) and is
-unlinked as soon as both processes have it open.
+The memory is a file in /dev/shm where there is one (memory, not disk),
+named ``softplc-modbtcps-PID-RANDOM`` after the runtime that made it, and
+unlinked as soon as it is open: the server process gets the open file
+itself (its descriptor), never the name. A runtime killed in the
+microseconds between creating and unlinking it leaves the file behind; the
+next runtime that creates one removes every such file whose runtime is gone
+(``remove_stale``): named after a process that no longer exists, and locked
+by no one (its maker holds a lock on it while it has a name).
 """
 
 from __future__ import annotations
 
+import fcntl
 import mmap
 import os
+import re
+import secrets
 import struct
 import tempfile
 from array import array
@@ -30,46 +39,112 @@ from .status import COUNTERS
 SEQUENCE = struct.Struct("=Q")
 COUNTER_ARRAY = struct.Struct(f"={COUNTERS}I")
 IMAGE_START = SEQUENCE.size + COUNTER_ARRAY.size
+PREFIX = "softplc-modbtcps-"
+_NAME = re.compile(re.escape(PREFIX) + r"(\d+)-[0-9a-f]+$")
+
+
+def segment_directory() -> str:
+    return "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else tempfile.gettempdir()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # PermissionError: another user's process, alive
+        return True
+    return True
+
+
+def remove_stale(directory: str | None = None) -> list[str]:
+    """Remove the segments runtimes killed while they had a name left
+    behind; the names removed. A segment is removed only when the process
+    it is named after no longer exists and no one holds its lock: a live
+    runtime's (another test's, a user's running PLC's) is never touched."""
+    directory = directory or segment_directory()
+    removed = []
+    try:
+        names = os.listdir(directory)
+    except OSError:
+        return removed
+    for name in names:
+        m = _NAME.match(name)
+        if m is None or int(m.group(1)) == os.getpid() or _alive(int(m.group(1))):
+            continue
+        path = os.path.join(directory, name)
+        try:
+            fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+        except OSError:
+            continue
+        try:
+            if os.fstat(fd).st_uid != os.geteuid():
+                continue
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # held by its maker while it has a name
+            os.unlink(path)
+            removed.append(name)
+        except OSError:
+            continue
+        finally:
+            os.close(fd)
+    return removed
+
+
+def create_named(size: int, directory: str | None = None) -> tuple[int, str]:
+    """A new segment of ``size`` bytes, named after this process and locked:
+    (its descriptor, its path)."""
+    directory = directory or segment_directory()
+    while True:
+        path = os.path.join(directory, f"{PREFIX}{os.getpid()}-{secrets.token_hex(6)}")
+        try:
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
+            break
+        except FileExistsError:
+            continue
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        os.ftruncate(fd, size)
+    except BaseException:
+        os.close(fd)
+        os.unlink(path)
+        raise
+    return fd, path
 
 
 class SharedImage:
-    def __init__(self, path: str, size: int, create: bool) -> None:
-        self.path = path
+    def __init__(self, fd: int, size: int) -> None:
+        """Map the segment open on ``fd`` (kept open: the server process gets a copy of it)."""
+        self.fd = fd
         self.size = max(size, IMAGE_START)
-        if create:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL, 0o600)
-            os.ftruncate(fd, self.size)
-        else:
-            fd = os.open(path, os.O_RDWR)
-        try:
-            self.mm = mmap.mmap(fd, self.size)
-        finally:
-            os.close(fd)
+        self.mm = mmap.mmap(fd, self.size)
         self._sequence = 0
 
     @classmethod
     def create(cls, image_bytes: int) -> "SharedImage":
-        directory = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else None
-        fd, path = tempfile.mkstemp(prefix="softplc-modbtcps-", dir=directory)
-        os.close(fd)
-        os.unlink(path)  # mkstemp chose a free name; O_EXCL makes it ours again
-        return cls(path, IMAGE_START + image_bytes, create=True)
+        """A new image; its file is gone from the directory when this returns."""
+        directory = segment_directory()
+        remove_stale(directory)
+        size = max(IMAGE_START + image_bytes, IMAGE_START)
+        fd, path = create_named(size, directory)
+        os.unlink(path)
+        try:
+            return cls(fd, size)
+        except BaseException:
+            os.close(fd)
+            raise
 
     @classmethod
-    def attach(cls, path: str, size: int) -> "SharedImage":
-        return cls(path, size, create=False)
-
-    def unlink(self) -> None:
-        try:
-            os.unlink(self.path)
-        except OSError:
-            pass
+    def attach(cls, fd: int, size: int) -> "SharedImage":
+        return cls(fd, size)
 
     def close(self) -> None:
         try:
             self.mm.close()
         except (BufferError, ValueError):
             pass
+        if self.fd >= 0:
+            os.close(self.fd)
+            self.fd = -1
 
     # -- the scan's side ----------------------------------------------------------------------
     def begin(self) -> None:

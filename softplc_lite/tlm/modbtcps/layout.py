@@ -249,3 +249,17 @@ def _unpacked(regs: array) -> array:
         out.extend(text)
         out.extend(bytes(STRING_CHARS - len(text)))
     return out
+
+
+def string_lengths_fit(pieces: list[tuple[Slot, int, int]], values: list[int]) -> bool:
+    """A string's LEN register takes 0..82 (its character count): do the
+    registers ``values`` written over ``pieces`` keep every LEN they reach
+    in range? A packed string has no LEN register."""
+    k = 0
+    for s, off, n in pieces:
+        if s.value == "string" and s.string_format == "ucs2":
+            for j in range(n):
+                if (off + j) % STRING_WORDS == 0 and values[k + j] > STRING_CHARS:
+                    return False
+        k += n
+    return True

@@ -3,8 +3,10 @@
 Each message is a 4-byte length and a body whose first byte says what it
 is. The server sends WRITE and MASK (a client's write, in arrival order),
 READY (listening, with the port bound) and FAILED (cannot listen, why); the
-runtime sends ACK (every write up to this sequence number is in the data
-table and in the image), and stops the server by closing the pipe. The
+runtime sends REFUSED (this write was not applied: a mask write whose result
+is not a string length; before the ACK that covers it) and ACK (every other
+write up to this sequence number is in the data table and in the image), and
+stops the server by closing the pipe. The
 configuration goes first, pickled: both ends are this package, never a
 client.
 """
@@ -15,7 +17,7 @@ import struct
 from array import array
 
 LENGTH = struct.Struct("=I")
-WRITE, MASK, READY, FAILED, ACK = b"W", b"M", b"R", b"F", b"A"
+WRITE, MASK, READY, FAILED, ACK, REFUSED = b"W", b"M", b"R", b"F", b"A", b"X"
 _WRITE = struct.Struct("=IBBHH")  # sequence, unit, kind (0 coils, 1 registers), address, count
 _MASK = struct.Struct("=IBHHH")  # sequence, unit, address, and-mask, or-mask
 _U32 = struct.Struct("=I")
@@ -40,6 +42,10 @@ def ack(seq: int) -> bytes:
     return frame(ACK + _U32.pack(seq))
 
 
+def refused(seq: int) -> bytes:
+    return frame(REFUSED + _U32.pack(seq))
+
+
 def ready(port: int) -> bytes:
     return frame(READY + _U32.pack(port))
 
@@ -51,14 +57,14 @@ def failed(why: str) -> bytes:
 def decode(body: bytes) -> tuple:
     """A message body as a tuple: (WRITE, seq, unit, kind, address, values),
     (MASK, seq, unit, address, and, or), (READY, port), (FAILED, why),
-    or (ACK, seq)."""
+    (REFUSED, seq) or (ACK, seq)."""
     tag, rest = body[:1], body[1:]
     if tag == WRITE:
         seq, unit, kind, address, count = _WRITE.unpack_from(rest)
         return WRITE, seq, unit, KINDS_BY_CODE[kind], address, array("H", rest[_WRITE.size:]).tolist()
     if tag == MASK:
         return (MASK, *_MASK.unpack(rest))
-    if tag in (READY, ACK):
+    if tag in (READY, ACK, REFUSED):
         return tag, _U32.unpack(rest)[0]
     if tag == FAILED:
         return FAILED, rest.decode("utf-8", "replace")

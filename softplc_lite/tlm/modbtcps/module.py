@@ -6,9 +6,10 @@ Registered like any third-party module, in pyproject.toml::
     [project.entry-points."softplc_lite.tlms"]
     MODBTCPS = "softplc_lite.tlm.modbtcps:ModbTcpServer"
 
-It reads MODBTCPS.XML (config.py) and, when an engine takes it, starts the
-server process (serverproc.py: pymodbus's server). From then on, at each
-scan:
+It reads MODBTCPS.XML (config.py). An engine that takes it (``attach``)
+only places the map in its data table: a program that is compiled, checked
+or rendered starts no server. The first scan starts the server process
+(serverproc.py: pymodbus's server); from then on, at each scan:
 
 - input point: the writes clients made since the last scan are applied, in
   arrival order (before the forces, so a forced bit stays forced);
@@ -19,7 +20,10 @@ scan:
 
 The scan never waits for the server: the pipe is read without blocking, and
 the image is written without a lock (a seqlock: the server retries a copy
-the scan overlapped).
+the scan overlapped). The one exception is the first scan of a run in
+simulated time, which waits until the server listens (or cannot), so that
+every scan of a reproducible run sees it listening; on the wall clock the
+server comes up beside the scans.
 """
 
 from __future__ import annotations
@@ -39,9 +43,11 @@ from . import messages as msg
 from . import status as C
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config
 from .image import SharedImage
-from .layout import Layout
+from .layout import Layout, string_lengths_fit
 
 START_TIMEOUT_S = 20.0  # the server process imports pymodbus: about 0.3 s here, far more on a loaded machine
+WHERE = "MODBTCPS.XML address and port; docs/modbtcps.md"
+ZERO_COUNTERS = (0,) * C.COUNTERS
 
 
 class ModbTcpServer(TLM):
@@ -58,11 +64,14 @@ class ModbTcpServer(TLM):
         self.process: subprocess.Popen | None = None
         self.port: int | None = None
         self.failed: str | None = None
+        self.started = False  # the first scan starts the server
+        self._ready_by: float | None = None  # starting: the time it should listen by
         self._from_server = -1
         self._reader = msg.Reader()
         self._files: list = []
-        self._applied = 0  # the sequence number of the last write applied
+        self._applied = 0  # the sequence number of the last write applied (or refused)
         self._acked = 0
+        self._refused: list[int] = []  # writes the scan refused since the last acknowledgement
         self._writes_applied = 0
         self._status = None
         self._rate_mark = (time.monotonic(), 0)
@@ -89,102 +98,128 @@ class ModbTcpServer(TLM):
         if self.config.status is not None:
             loc = table.resolve(self.config.status)
             self._status = (loc.file.data, loc.index)
-        self.image = SharedImage.create(self.layout.size)
-        try:
-            self._publish()
-            self._start()
-        except BaseException:
-            self.close()  # nothing left behind: no process, no file in /dev/shm
-            raise
         return []
 
-    def _start(self) -> None:
+    def _start(self, engine) -> None:
+        """Start the server process (the first scan's input point); what
+        goes wrong is said once and leaves the server failed, the scan going on."""
+        self.started = True
+        try:
+            self.image = SharedImage.create(self.layout.size)
+            self._publish()
+            self._spawn()
+        except OSError as e:
+            self._discard_image()
+            self._lost(f"cannot start the server process: {e.strerror or 'the system refused'}")
+            return
+        self._ready_by = time.monotonic() + START_TIMEOUT_S
+        if not engine.clock.realtime:  # simulated time: every scan of the run sees it listening
+            self._wait_ready()
+
+    def _spawn(self) -> None:
         read_fd, write_fd = os.pipe()
         try:
             self.process = subprocess.Popen(
-                [sys.executable, "-m", "softplc_lite.tlm.modbtcps.serverproc", str(write_fd)],
-                stdin=subprocess.PIPE, pass_fds=(write_fd,), close_fds=True)
-        except OSError as e:
+                [sys.executable, "-m", "softplc_lite.tlm.modbtcps.serverproc", str(write_fd), str(self.image.fd)],
+                stdin=subprocess.PIPE, pass_fds=(write_fd, self.image.fd), close_fds=True)
+        except OSError:
             os.close(read_fd)
-            self._discard_image()
-            raise ModuleError(f"MODBTCPS: cannot start the server process: {e.strerror or e}") from None
+            raise
         finally:
             os.close(write_fd)
         self._from_server = read_fd
-        init = pickle.dumps({"config": self.config, "layout": self.layout, "image": self.image.path,
-                             "size": self.image.size})
+        os.set_blocking(read_fd, False)
+        init = pickle.dumps({"config": self.config, "layout": self.layout, "size": self.image.size})
         try:
-            self.process.stdin.write(msg.LENGTH.pack(len(init)) + init)
+            self.process.stdin.write(msg.LENGTH.pack(len(init)) + init)  # a few KiB: the pipe takes them
             self.process.stdin.flush()
         except OSError:
-            pass  # the process died at once: said below
-        first = self._wait_ready()
-        self.image.unlink()  # both processes have it mapped; nothing is left in /dev/shm
-        if first is None or first[0] != msg.READY:
-            why = first[1] if first is not None and first[0] == msg.FAILED else "the server process did not start"
-            self.close()
-            raise ModuleError(f"MODBTCPS: {why} (MODBTCPS.XML address and port; docs/modbtcps.md)")
-        self.port = first[1]
-        os.set_blocking(self._from_server, False)
+            pass  # the process died at once: the end of its pipe says so
 
-    def _wait_ready(self) -> tuple | None:
-        deadline = time.monotonic() + START_TIMEOUT_S
+    def _wait_ready(self) -> None:
+        """Block until the server listens or cannot (simulated time only)."""
+        while self._ready_by is not None and self._from_server >= 0:
+            select.select([self._from_server], [], [], 0.05)
+            self._read_server(None)
+
+    def wait_until_listening(self, timeout: float = START_TIMEOUT_S) -> int | None:
+        """For a caller beside the scan (a test, an example): the port, once
+        the server listens; None if it failed or did not start in time."""
+        deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
-            ready, _, _ = select.select([self._from_server], [], [], 0.05)
-            if ready:
-                data = os.read(self._from_server, 4096)
-                if not data:
-                    return None
-                messages = self._reader.feed(data)
-                if messages:
-                    return messages[0]
-            elif self.process.poll() is not None:
-                return None
-        return None
+            if self.port is not None or self.failed is not None:
+                break
+            time.sleep(0.01)
+        return self.port if self.failed is None else None
 
     @property
     def listening(self) -> str:
-        return f"{self.config.host}:{self.port}"
+        where = f"{self.config.host}:{self.port if self.port is not None else self.config.port}"
+        if not self.started:
+            return f"{where}, not started (the first scan starts it)"
+        return where if self.port is not None else f"{where}, starting"
 
     # -- each scan ---------------------------------------------------------------------------
     def on_input(self, engine) -> None:
-        if self._from_server < 0:
-            return
+        if not self.started:
+            self._start(engine)
+        if self._from_server >= 0:
+            self._read_server(engine.table)
+
+    def _read_server(self, table) -> None:
+        """What the server sent: READY, FAILED, and the clients' writes,
+        applied to ``table`` (None: before the first write can come)."""
         try:
             data = os.read(self._from_server, 1 << 20)
         except BlockingIOError:
+            if self._ready_by is not None and time.monotonic() > self._ready_by:
+                self._lost(f"the server process did not start in {START_TIMEOUT_S:.0f} s")
             return
         except OSError:
             data = b""
         if not data:
-            self._lost("the server process ended")
+            self._lost("the server process ended" if self._ready_by is None
+                       else "the server process ended as it started")
             return
-        table = engine.table
         for m in self._reader.feed(data):
-            if m[0] == msg.WRITE:
-                _, seq, unit, kind, address, values = m
-            elif m[0] == msg.MASK:  # applied to the register as the table holds it now (Modbus spec 6.16)
-                _, seq, unit, address, and_mask, or_mask = m
-                kind, values = "holding_registers", None
-            else:  # a FAILED the server sends as it ends: the end of the pipe says it next
-                continue
-            pieces = self.layout.find(unit, kind, address, 1 if values is None else len(values))
-            if pieces is not None:  # the server checked it against the same layout
-                if values is None:
-                    current = Layout.load(pieces, table)[0]
-                    values = [(current & and_mask) | (or_mask & ~and_mask & 0xFFFF)]
-                Layout.store(pieces, values, table)
-            self._applied = seq
-            self._writes_applied += 1
+            if m[0] == msg.READY:
+                self.port, self._ready_by = m[1], None
+            elif m[0] == msg.FAILED:  # the end of the pipe follows
+                self._lost(m[1])
+                return
+            elif table is not None:
+                self._apply(m, table)
+
+    def _apply(self, m: tuple, table) -> None:
+        if m[0] == msg.WRITE:
+            _, seq, unit, kind, address, values = m
+        else:  # MASK: applied to the register as the table holds it now (Modbus spec 6.16)
+            _, seq, unit, address, and_mask, or_mask = m
+            kind, values = "holding_registers", None
+        pieces = self.layout.find(unit, kind, address, 1 if values is None else len(values))
+        self._applied = seq
+        if pieces is None:  # the server checked it against the same layout
+            return
+        if values is None:
+            current = Layout.load(pieces, table)[0]
+            values = [(current & and_mask) | (or_mask & ~and_mask & 0xFFFF)]
+            if not string_lengths_fit(pieces, values):  # the LEN check of 6, 16 and 23, on the result
+                self._refused.append(seq)
+                return
+        Layout.store(pieces, values, table)
+        self._writes_applied += 1
 
     def on_output(self, engine, outputs_enabled: bool) -> None:
-        if self.image is None:
+        if self.image is None:  # not started, or could not start
+            if self._status is not None:
+                self._status_words(ZERO_COUNTERS)
             return
         self._publish()
         if self._applied != self._acked and self.process is not None:
             self._acked = self._applied
+            refused, self._refused = self._refused, []
             try:
-                self.process.stdin.write(msg.ack(self._acked))
+                self.process.stdin.write(b"".join(msg.refused(seq) for seq in refused) + msg.ack(self._acked))
                 self.process.stdin.flush()
             except (OSError, ValueError):
                 self._lost("the server process ended")
@@ -231,20 +266,25 @@ class ModbTcpServer(TLM):
         data[i + C.W_REFUSALS] = C.word(sum(counters[c] for c in C.REFUSAL_COUNTERS))
 
     def _lost(self, why: str) -> None:
+        self._ready_by = None
         if self.failed is None:
             self.failed = why
-            self.log(f"{why}; clients are no longer served (the scan goes on)")
+            if self.port is None:
+                self.log(f"{why} ({WHERE}); clients are not served (the scan goes on)")
+            else:
+                self.log(f"{why}; clients are no longer served (the scan goes on)")
         if self._from_server >= 0:
             os.close(self._from_server)
             self._from_server = -1
 
     def server_status(self) -> C.ServerStatus | None:
         """The server as the watch view shows it."""
-        if self.image is None:
+        if self.layout is None:  # not attached to an engine
             return None
-        counters = self.image.counters()
+        counters = self.image.counters() if self.image is not None else ZERO_COUNTERS
         refused = {name: counters[c] for name, c in C.REFUSAL_NAMES if counters[c]}
-        return C.ServerStatus(self.failed or self.listening, self.failed is None, counters[C.CONNECTED],
+        up = self.failed is None and self.port is not None
+        return C.ServerStatus(self.failed or self.listening, up, counters[C.CONNECTED],
                               self.rate, counters[C.REQUESTS], self._writes_applied, sum(refused.values()),
                               refused)
 
@@ -272,6 +312,5 @@ class ModbTcpServer(TLM):
 
     def _discard_image(self) -> None:
         if self.image is not None:
-            self.image.unlink()
             self.image.close()
             self.image = None
