@@ -34,7 +34,7 @@ from .ports.urlhandler.protocol_sim import url_problem as sim_url_problem
 from .tlm.api import TLM, find_file
 from .tlm.errors import ModuleError, ModuleErrors
 from .tlm.registry import configure_modules, installed, instruction_set, load_module, load_modules
-from .textfile import read_text
+from .textfile import PROGRAM, read_bytes, read_text
 
 SETTINGS_FILE = "softplc.toml"
 DATATABLE_FILE = "datatable.json"
@@ -83,8 +83,11 @@ class App:
 
 
 def lad_files(path: Path) -> list[Path]:
+    """The program files of an app: every ``*.lad`` entry of the directory
+    but a directory (a FIFO, a device or a dangling link among them is a
+    program file that cannot be read, reported as such, never left out)."""
     if path.is_dir():
-        return sorted(p for p in path.glob("*.lad") if p.is_file())
+        return sorted(p for p in path.glob("*.lad") if not p.is_dir())
     return [path]
 
 
@@ -95,7 +98,7 @@ def parse_files(files: list[Path], base: Path, instructions: InstructionSet = BU
     errors: list[LadderError] = []
     for f in files:
         try:
-            text = read_text(f)
+            text = read_text(f, limit=PROGRAM)
         except LocatedError as e:
             errors.append(LadderError(Pos(_display(f, base), e.line, e.column), e.message))
             continue
@@ -331,6 +334,8 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
             cache = None
         else:
             cached = cache.load(key)
+            if cache.problem is not None:  # damaged, or not a file: the program is loaded from its text
+                warnings.append(cache.problem)
     if cached is not None:
         # Loaded before from these very files: the validated program, its
         # warnings and compiled code (ladder/codecache.py), no parse or check.
@@ -399,15 +404,16 @@ def _settings_problems(path: Path | None) -> list:
 def _cache_parts(files: list[Path], path: Path, modules) -> list[tuple[str, bytes]]:
     """What an app's compiled code depends on, for its code cache key: every
     program file, the settings file, and each enabled module with its
-    version and config file."""
+    version and config file. A file is named as messages name it (from the
+    current directory): the cached tree's positions hold that name."""
     base = path if path.is_dir() else path.parent
-    parts = [(str(f.relative_to(base)), f.read_bytes()) for f in files]
+    parts = [(_display(f, base), read_bytes(f, PROGRAM)) for f in files]
     settings = base / SETTINGS_FILE
-    parts.append((SETTINGS_FILE, settings.read_bytes() if settings.exists() else b""))
+    parts.append((SETTINGS_FILE, read_bytes(settings) if settings.exists() else b""))
     for m in modules:
         config = base / m.config_file if getattr(m, "config_file", None) else None
         parts.append((f"module {m.name} {getattr(m, 'version', '')} {type(m).__module__}",
-                      config.read_bytes() if config is not None and config.exists() else b""))
+                      read_bytes(config) if config is not None and config.exists() else b""))
     return parts
 
 

@@ -33,7 +33,7 @@ from .ladder.fmt import STYLES, format_source, unprintable
 from .ladder.ast import Program
 from .ladder.parser import parse_program, syntax_problems
 from .ladder.validate import check
-from .textfile import decode_text, read_bytes
+from .textfile import PROGRAM, decode_text, read_bytes
 
 STDIN = "-"
 EXIT_OK, EXIT_ERROR = 0, 1
@@ -96,7 +96,7 @@ def _sources(paths: Sequence[str], stdin: IO[bytes]) -> tuple[list[tuple[str, Pa
             problems.append(LocatedError(f"{given}: the directory has no .lad program files"))
         for f in files:
             try:
-                found.append((str(f), f, read_bytes(f), path if path.is_dir() else path.parent))
+                found.append((str(f), f, read_bytes(f, PROGRAM), path if path.is_dir() else path.parent))
             except OSError as e:
                 problems.append(LocatedError(str(e)))
     return found, problems

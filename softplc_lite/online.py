@@ -31,6 +31,7 @@ from pathlib import Path
 from .app import App, AppError, lad_files, load_app
 from .ladder.ast import Program
 from .ladder.online import EditRefused, ProgramChanges, precompile, program_changes
+from .textfile import PROGRAM, read_bytes
 
 CHECK_INTERVAL_S = 0.2  # the least wall time between two looks at the files
 
@@ -101,7 +102,7 @@ class ProgramWatcher:
         out = []
         for f in self._files():
             try:
-                out.append((str(f), hashlib.sha256(f.read_bytes()).hexdigest()))
+                out.append((str(f), hashlib.sha256(read_bytes(f, PROGRAM)).hexdigest()))
             except OSError:
                 out.append((str(f), None))
         return tuple(out)

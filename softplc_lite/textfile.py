@@ -12,15 +12,85 @@ bytes it read itself), so every file kind gives the same answer:
   bad byte and what was expected, never a ``UnicodeDecodeError`` (a reader
   of DOS-era files may ask for a ``fallback`` codec instead, latin-1);
 * an OSError becomes errors.FileAccessError, still an OSError, whose
-  text is a sentence: "cannot read PATH: permission denied".
+  text is a sentence: "cannot read PATH: permission denied";
+* only a regular file is read, and no more than its kind's :class:`Limit`
+  (docs/cli.md, "Input file limits"): a FIFO, a device (a link to
+  ``/dev/zero``), a socket or a directory is refused without waiting or
+  reading ("cannot read PATH: not a regular file (a FIFO)"), and so is a
+  file over the limit ("cannot read PATH: 20.0 GiB, over the 16 MiB limit
+  for a program file"), before any of it is read. At most limit + 1 bytes
+  are ever read, so a file that grows while it is read is refused too.
+  The refusal is a :class:`FileRefused`, a FileAccessError.
 """
 
 from __future__ import annotations
 
 import codecs
+import errno
 import os
+import stat
+from dataclasses import dataclass
 
-from .errors import LocatedError, file_error
+from .errors import FileAccessError, LocatedError, file_error
+
+
+@dataclass(frozen=True)
+class Limit:
+    """The most softplc reads of one kind of file: ``size`` bytes, and
+    ``what`` the kind is, for the message ("a program file")."""
+
+    what: str
+    size: int
+
+
+MiB = 1 << 20
+# The caps of docs/cli.md, "Input file limits" (softplc_lite choices; the reasons are there).
+PROGRAM = Limit("a program file", 16 * MiB)
+CONFIG = Limit("a settings or config file", 1 * MiB)
+DATA_JSON = Limit("a data table JSON file", 64 * MiB)
+SNAPSHOT = Limit("a snapshot", 256 * MiB)
+TRACE = Limit("a port trace", 64 * MiB)
+WATCH_FILE = Limit("a watch file", 1 * MiB)
+CODE_CACHE = Limit("a code cache", 256 * MiB)
+
+
+class FileRefused(FileAccessError):
+    """A file not read because of what it is (not a regular file) or its
+    size (over its kind's Limit); ``str(e)`` is "cannot read PATH: WHY"."""
+
+    def __init__(self, path: str, why: str, too_large: bool = False) -> None:
+        super().__init__(f"cannot read {path}: {why}", path, OSError(None, why))
+        self.too_large = too_large  # else: not a regular file
+
+
+def size_text(n: float) -> str:
+    """``n`` bytes the way a person reads it: 512 bytes, 1.5 KiB, 16 MiB, 20.0 GiB."""
+    if n < 1024:
+        return f"{int(n)} byte{'s' if n != 1 else ''}"
+    for unit in ("KiB", "MiB", "GiB", "TiB"):
+        n /= 1024
+        if n < 1024 or unit == "TiB":
+            break
+    return f"{int(n)} {unit}" if n == int(n) else f"{n:.1f} {unit}"
+
+
+_NOT_REGULAR = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
+                (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+
+
+def _refusal(path: str, st: os.stat_result, limit: Limit) -> FileAccessError | None:
+    """Why a file with status ``st`` is not read, or None."""
+    if stat.S_ISDIR(st.st_mode):
+        return file_error(IsADirectoryError(errno.EISDIR, "Is a directory"), path)
+    if not stat.S_ISREG(st.st_mode):
+        kind = next((name for test, name in _NOT_REGULAR if test(st.st_mode)), "a special file")
+        return FileRefused(path, f"not a regular file ({kind})")
+    if st.st_size > limit.size:
+        size, cap = size_text(st.st_size), size_text(limit.size)
+        if size.split()[1:] == cap.split()[1:] and float(size.split()[0]) == float(cap.split()[0]):
+            size = f"{st.st_size:,} bytes"  # just over: "256.0 MiB, over the 256 MiB limit" would say nothing
+        return FileRefused(path, f"{size}, over the {cap} limit for {limit.what}", too_large=True)
+    return None
 
 # BOM -> codec; UTF-8's first (a UTF-16 LE BOM is a prefix of no UTF-8 BOM, but keep the longest first).
 BOMS = ((codecs.BOM_UTF8, "utf-8"), (codecs.BOM_UTF16_LE, "utf-16-le"), (codecs.BOM_UTF16_BE, "utf-16-be"))
@@ -63,16 +133,53 @@ def decode_text(raw: bytes, path: str, fallback: str | None = None) -> str:
                        "or as UTF-16 with a byte-order mark)", path) from None
 
 
-def read_bytes(path: str | os.PathLike[str]) -> bytes:
-    """The file's bytes; an OSError as errors.FileAccessError ('cannot read PATH: ...')."""
+def read_bytes(path: str | os.PathLike[str], limit: Limit = CONFIG) -> bytes:
+    """The bytes of the regular file at ``path``, at most ``limit.size``
+    of them; an OSError as errors.FileAccessError ('cannot read PATH:
+    ...'), a file that is not regular or is too large as FileRefused.
+
+    The path's status is looked at before it is opened (a device is never
+    opened), it is opened without blocking (a FIFO made after that look
+    does not hang the open) and the opened file's own status is checked
+    again; then at most limit.size + 1 bytes are read."""
+    name = os.fspath(path)
+    name = os.fsdecode(name) if isinstance(name, bytes) else name
     try:
-        with open(path, "rb") as f:
-            return f.read()
+        refused = _refusal(name, os.stat(name), limit)
+        if refused is not None:
+            raise refused
+        fd = os.open(name, os.O_RDONLY | os.O_NONBLOCK | os.O_NOCTTY | getattr(os, "O_CLOEXEC", 0))
+    except FileAccessError:
+        raise
     except OSError as e:
-        raise file_error(e, path) from None
+        raise file_error(e, name) from None
+    try:
+        st = os.fstat(fd)
+        refused = _refusal(name, st, limit)
+        if refused is not None:
+            raise refused
+        parts: list[bytes] = []
+        total = 0
+        while total <= limit.size:  # the size fstat gave in one read, then until the end or the limit
+            chunk = os.read(fd, min(limit.size + 1 - total, max(st.st_size + 1 - total, 1 << 16)))
+            if not chunk:
+                break
+            parts.append(chunk)
+            total += len(chunk)
+    except FileAccessError:
+        raise
+    except OSError as e:
+        raise file_error(e, name) from None
+    finally:
+        os.close(fd)
+    if total > limit.size:
+        raise FileRefused(name, f"more than {size_text(limit.size)} (it grew while being read), over the limit "
+                                f"for {limit.what}", too_large=True)
+    return b"".join(parts)
 
 
-def read_text(path: str | os.PathLike[str], fallback: str | None = None) -> str:
-    """The file's text (see decode_text); LocatedError for bad encoding,
-    FileAccessError (an OSError said in words) when it cannot be read."""
-    return decode_text(read_bytes(path), os.fspath(path), fallback)
+def read_text(path: str | os.PathLike[str], fallback: str | None = None, limit: Limit = CONFIG) -> str:
+    """The file's text (see decode_text), read as read_bytes does with
+    ``limit``; LocatedError for bad encoding, FileAccessError (an OSError
+    said in words) when it cannot or may not be read."""
+    return decode_text(read_bytes(path, limit), os.fspath(path), fallback)

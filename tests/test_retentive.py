@@ -225,32 +225,66 @@ def test_a_durable_step_that_fails_is_told_once_while_the_saves_go_on(tmp_path):
 # -- storage trouble: a fault, not a stop ----------------------------------------------------------------------
 
 
+# A full disk, for real: the child process may write files of at most FULL_AT bytes (RLIMIT_FSIZE; a
+# write past it fails with EFBIG, as one past a full disk's last block fails with ENOSPC, since Python
+# ignores SIGXFSZ), smaller than a snapshot; then the limit is lifted, as space is made again.
+FULL_AT = 100
+DISK_FULL_CHILD = r"""
+import json, resource, sys
+from softplc_lite.app import load_app
+from softplc_lite.ladder import status as S
+from softplc_lite.runner import RunOptions, Runner
+app, state = sys.argv[1:3]
+loaded = load_app(app, state)
+loaded.settings.save_ms = 20
+logged = []
+runner = Runner(loaded, RunOptions(realtime=True, scan_ms=5), log=logged.append)
+soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+out = {}
+def look(name):
+    s = runner.engine.s
+    out[name] = {"n7": runner.table.read("N7:0"), "bits": s[S.MINOR_FAULT_BITS], "code": s[S.MINOR_FAULT_CODE],
+                 "logged": list(logged), "files": sorted(p.name for p in __import__("pathlib").Path(state).iterdir())}
+try:
+    resource.setrlimit(resource.RLIMIT_FSIZE, (int(sys.argv[3]), hard))
+    runner.run(60)  # 0.3 s: about 15 tries
+    look("full")
+    resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))  # space again
+    runner.run(60)
+    look("space")
+finally:
+    resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
+    runner.engine.close()
+out["finish"] = runner.finish()
+print(json.dumps(out))
+"""
+
+
 def test_disk_full_is_a_minor_fault_retried_until_saving_works_again(tmp_path):
-    """The save's temp file is a link to /dev/full (every write: ENOSPC)."""
+    """Every save fails for want of space (a real write limit, DISK_FULL_CHILD), then works again;
+    a failed save leaves no partial temp file behind."""
+    import json
+
     app = make_app(tmp_path / "app")
     state = tmp_path / "state"
     state.mkdir()
-    runner, logged = realtime_runner(app, state, save_ms=20)
-    tmp = state / "datatable.snap.tmp"
-    tmp.symlink_to("/dev/full")  # after the start, which removes stale temp files
-    try:
-        runner.run(60)  # 0.3 s: about 15 tries
-        s = runner.engine.s
-        assert runner.table.read("N7:0") == 60  # the scan went on
-        assert s[S.MINOR_FAULT_BITS] & STORAGE and s[S.MINOR_FAULT_CODE] == S.MINOR_CODE_SAVE
-        assert not (state / "datatable.snap").exists()
-        assert len(logged) == 1, logged  # once, not every period
-        assert logged[0].startswith(f"warning: cannot save the retentive snapshot {state / 'datatable.snap'}: "
-                                    "No space left on device")
-        assert "minor fault S:17/4, code 9" in logged[0]
-        tmp.unlink()  # space again
-        runner.run(60)
-        assert not s[S.MINOR_FAULT_BITS] & STORAGE and s[S.MINOR_FAULT_CODE] == S.MINOR_CODE_SAVE
-        assert logged[1:] == [f"the retentive snapshot {state / 'datatable.snap'} is saved again"]
-        assert 60 < snapshot.load(state / "datatable.snap").read("N7:0") <= 120
-    finally:
-        runner.engine.close()
-    assert runner.finish() == []
+    p = subprocess.run([sys.executable, "-c", DISK_FULL_CHILD, str(app), str(state), str(FULL_AT)],
+                       capture_output=True, text=True, timeout=60, cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    full, space = out["full"], out["space"]
+    assert full["n7"] == 60  # the scan went on
+    assert full["bits"] & STORAGE and full["code"] == S.MINOR_CODE_SAVE
+    assert "datatable.snap" not in full["files"]
+    assert "datatable.snap.tmp" not in full["files"], full["files"]  # a failed write removes its temp file
+    assert len(full["logged"]) == 1, full["logged"]  # once, not every period
+    assert full["logged"][0].startswith(f"warning: cannot save the retentive snapshot {state / 'datatable.snap'}: "
+                                        "File too large")
+    assert "minor fault S:17/4, code 9" in full["logged"][0]
+    assert not space["bits"] & STORAGE and space["code"] == S.MINOR_CODE_SAVE
+    assert space["logged"][1:] == [f"the retentive snapshot {state / 'datatable.snap'} is saved again"]
+    assert 60 < snapshot.load(state / "datatable.snap").read("N7:0") <= 120
+    assert out["finish"] == []
 
 
 def test_an_unusable_state_directory_keeps_the_plc_running_and_exits_1(tmp_path):

@@ -29,7 +29,7 @@ from array import array
 from typing import Any
 
 from ..errors import LocatedError
-from ..textfile import read_text
+from ..textfile import DATA_JSON, read_text
 from .errors import DataTableError
 from .files import DataFile
 from .filetypes import FILE_TYPES, LONG_MAX, LONG_MIN, MAX_ELEMENTS, STRING_CHARS, FileType, Storage
@@ -195,7 +195,7 @@ def load_text(table: DataTable, text: str, source: str = "<json>") -> None:
 
 def load_file(table: DataTable, path: str) -> None:
     try:
-        text = read_text(path)
+        text = read_text(path, limit=DATA_JSON)
     except LocatedError as e:  # bad encoding
         raise DataTableJSONError(e.report()) from None
     except OSError as e:  # errors.FileAccessError: "cannot read PATH: permission denied"

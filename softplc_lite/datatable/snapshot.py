@@ -12,7 +12,10 @@ and A files came later under the same version: an older softplc refuses a
 snapshot holding one as an unknown file type.
 
 A short file, a wrong length, a bad CRC or a missing trailer is reported as
-:class:`SnapshotError`; nothing half-read is ever returned.
+:class:`SnapshotError`; nothing half-read is ever returned. So is a path
+that is not a regular file (a FIFO, a device, a dangling or looping link)
+or a file over the snapshot limit (textfile.SNAPSHOT): it is refused before
+anything is read.
 
 :func:`save` writes ``NAME.tmp``, fsyncs it, hard-links the current snapshot
 to ``NAME.prev`` (the previous good one), renames the temp file over ``NAME``
@@ -26,18 +29,22 @@ temp file and rename, without fsync for the frequent saves (a killed process
 does not lose the page cache); the durable ones are then fsynced and become
 ``NAME.prev`` (:func:`make_durable`): the newest snapshot known to be on
 disk, for after a power loss. :func:`remove_stale` deletes the temp files a killed
-process left.
+process left. A write that fails (a full disk, a file size limit) removes
+its own temp file: nothing partial is left behind.
 """
 
 from __future__ import annotations
 
+import errno
 import os
+import stat
 import struct
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..errors import file_error
+from ..errors import FileAccessError, file_error
+from ..textfile import SNAPSHOT, read_bytes
 from .errors import DataTableError, SnapshotError
 from .filetypes import FILE_TYPES, MAX_ELEMENTS
 from .table import DataTable
@@ -119,7 +126,7 @@ def save(table: DataTable, path: str | os.PathLike[str]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(path.name + ".tmp")
     prev = path.with_name(path.name + ".prev")
-    _write_tmp(encode(table), tmp, durable=True)
+    _write_tmp(encode(table), tmp, durable=True)  # removed again if it fails
     if path.exists():
         # A hard link, not a rename: NAME must never be missing, even for an
         # instant, or a kill right then would leave no current snapshot.
@@ -134,8 +141,7 @@ def write(data: bytes, path: str | os.PathLike[str], durable: bool) -> None:
     Creates the directory when missing. Not durable: no fsync, and
     ``NAME.prev`` is left alone (it stays the last durable snapshot).
     Durable: then :func:`make_durable`. Raises OSError; a failed write leaves
-    ``NAME`` and ``NAME.prev`` as they were (and perhaps a partial
-    ``NAME.tmp``, truncated by the next write)."""
+    ``NAME`` and ``NAME.prev`` as they were, and no ``NAME.tmp``."""
     path = Path(path)
     tmp = path.with_name(path.name + ".tmp")
     try:
@@ -143,7 +149,11 @@ def write(data: bytes, path: str | os.PathLike[str], durable: bool) -> None:
     except FileNotFoundError:
         path.parent.mkdir(parents=True, exist_ok=True)
         _write_tmp(data, tmp, False)
-    os.replace(tmp, path)
+    try:
+        os.replace(tmp, path)
+    except OSError:
+        _remove(tmp)
+        raise
     if durable:
         make_durable(path)
 
@@ -181,15 +191,48 @@ def remove_stale(path: str | os.PathLike[str]) -> list[Path]:
 
 
 def _write_tmp(data: bytes, tmp: Path, durable: bool) -> None:
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+    """Write ``data`` to the temp file ``tmp`` (a new regular file: whatever
+    else is found under its name, a FIFO, a device or a link, is removed,
+    never opened through or waited on); on any failure, such as a full
+    disk, the temp file is removed and the error raised."""
+    fd = _open_tmp(tmp)
     try:
         view = memoryview(data)
         while view:
             view = view[os.write(fd, view):]
         if durable:
             os.fsync(fd)
-    finally:
+    except BaseException:
         os.close(fd)
+        _remove(tmp)
+        raise
+    os.close(fd)
+
+
+_TMP_FLAGS = os.O_WRONLY | os.O_CREAT | os.O_NONBLOCK | os.O_NOCTTY | getattr(os, "O_NOFOLLOW", 0)
+
+
+def _open_tmp(tmp: Path) -> int:
+    """A file descriptor for writing ``tmp`` from its start, a regular file."""
+    try:
+        fd = os.open(tmp, _TMP_FLAGS | os.O_TRUNC, 0o644)
+    except OSError as e:
+        if e.errno not in (errno.ELOOP, errno.ENXIO):  # a link (O_NOFOLLOW), a FIFO nobody reads: removed below
+            raise
+        fd = None
+    if fd is not None:
+        if stat.S_ISREG(os.fstat(fd).st_mode):
+            return fd
+        os.close(fd)  # a FIFO someone reads, a device: not written through
+    tmp.unlink()
+    return os.open(tmp, _TMP_FLAGS | os.O_EXCL, 0o644)
+
+
+def _remove(path: Path) -> None:
+    try:
+        path.unlink()
+    except OSError:  # gone already, or the directory is unwritable: the next start's remove_stale tries again
+        pass
 
 
 def _link_as(path: Path, name: Path) -> None:
@@ -216,13 +259,16 @@ def load_into(table: DataTable, path: str | os.PathLike[str]) -> None:
 
 
 def load(path: str | os.PathLike[str]) -> DataTable:
-    """Read one snapshot file; raise SnapshotError if it is missing or bad."""
+    """Read one snapshot file; raise SnapshotError if it is missing or bad
+    (not a regular file, over the snapshot limit: textfile.read_bytes)."""
     try:
-        raw = Path(path).read_bytes()
-    except FileNotFoundError:
-        raise SnapshotError(f"{path}: no snapshot") from None
-    except OSError as e:
-        raise SnapshotError(file_error(e, path).report()) from None
+        raw = read_bytes(path, SNAPSHOT)
+    except OSError as e:  # errors.FileAccessError: "cannot read PATH: not a regular file (a FIFO)"
+        if e.errno == errno.ENOENT and os.path.islink(path):
+            raise SnapshotError(f"{path}: a symbolic link to {os.readlink(path)}, which does not exist") from None
+        if e.errno == errno.ENOENT:
+            raise SnapshotError(f"{path}: no snapshot") from None
+        raise SnapshotError(e.report() if isinstance(e, FileAccessError) else file_error(e, path).report()) from None
     return decode(raw, str(path))
 
 
@@ -242,11 +288,12 @@ def restore(path: str | os.PathLike[str]) -> Restored:
     but neither it nor the previous one is usable."""
     path = Path(path)
     prev = path.with_name(path.name + ".prev")
-    if not path.exists() and not prev.exists():
+    # lexists: a dangling or looping link is a snapshot that cannot be read, said so, not no snapshot.
+    if not os.path.lexists(path) and not os.path.lexists(prev):
         return Restored(None, None)
     problems: list[str] = []
     for candidate in (path, prev):
-        if not candidate.exists():
+        if not os.path.lexists(candidate):
             continue
         try:
             return Restored(load(candidate), candidate, problems)

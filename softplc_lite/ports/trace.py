@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 from typing import IO, Sequence
 
 from ..errors import LocatedError
-from ..textfile import read_text
+from ..textfile import TRACE, read_text
 from .errors import PortError
 
 HEADER = "# softplc_lite port trace 1"
@@ -149,10 +149,10 @@ def read_trace(path: str | os.PathLike) -> list[TraceEvent]:
     or parsed raises ``TraceError`` naming it."""
     name = os.fspath(path)
     try:
-        text = read_text(name)
+        text = read_text(name, limit=TRACE)
     except LocatedError as e:
         raise TraceError(e.message, name, e.line, e.column) from None
-    except OSError as e:
+    except OSError as e:  # errors.FileAccessError: "cannot read PATH: not a regular file (a FIFO)"
         raise TraceError(f"cannot read trace file: {e.strerror or e}", name) from e
     return parse_trace(text, name)
 
@@ -176,7 +176,7 @@ def covered_scans(path: str | os.PathLike) -> int | None:
     None without that comment or when the file cannot be read (opening the
     replay port then says why)."""
     try:
-        return scans_in(read_text(os.fspath(path)))
+        return scans_in(read_text(os.fspath(path), limit=TRACE))
     except (OSError, LocatedError):
         return None
 

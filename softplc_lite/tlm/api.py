@@ -34,6 +34,7 @@ The engine has no special case for any module; COMGENIUS uses exactly this.
 
 from __future__ import annotations
 
+import os
 import sys
 import time
 from array import array
@@ -182,11 +183,12 @@ def find_file(directory: Path, name: str) -> Path | None:
     """``name`` in ``directory``, matched without regard to case (SoftPLC
     config names are upper case; files copied from elsewhere may not be)."""
     exact = directory / name
-    if exact.is_file():
+    # Any entry but a directory: a FIFO, a device or a dangling link is found, and its reading says why it is refused.
+    if os.path.lexists(exact) and not exact.is_dir():
         return exact
     if directory.is_dir():
         for p in sorted(directory.iterdir()):
-            if p.name.upper() == name.upper() and p.is_file():
+            if p.name.upper() == name.upper() and not p.is_dir():
                 return p
     return None
 

@@ -15,13 +15,13 @@ from ..datatable.display import format_value
 from ..datatable.errors import AddressError
 from ..errors import LocatedError
 from ..ladder.symbols import resolve_name
-from ..textfile import decode_text
+from ..textfile import WATCH_FILE, FileRefused, decode_text, read_bytes
 
 BARS = "▁▂▃▄▅▆▇█"
 TREND = 24  # samples kept per address
 NAME_MIN = 8  # cells of a name kept however long a value (a read error's text) is
 WATCH_MAX = 256  # addresses in the watch list, --watch and --watch-file together
-WATCH_FILE_BYTES = 1 << 20  # the largest watch file read (1 MiB)
+WATCH_FILE_BYTES = WATCH_FILE.size  # the largest watch file read (1 MiB)
 
 
 def sparkline(values: list[float]) -> str:
@@ -134,11 +134,13 @@ def read_watch_file(path: str | Path, symbols=None, room: int = WATCH_MAX) -> li
     that are not UTF-8, an address that does not parse (nor names one of
     ``symbols``), more than ``room`` addresses, a file over
     WATCH_FILE_BYTES. OSError as the OS reports it."""
-    with open(path, "rb") as f:
-        raw = f.read(WATCH_FILE_BYTES + 1)
-    if len(raw) > WATCH_FILE_BYTES:
+    try:
+        raw = read_bytes(path, WATCH_FILE)  # a regular file only: a FIFO or a device is refused, not waited on
+    except FileRefused as e:
+        if not e.too_large:
+            raise
         raise LocatedError(f"larger than {WATCH_FILE_BYTES // 1024} KiB: a watch file lists at most {WATCH_MAX} "
-                           "addresses, one a line", str(path))
+                           "addresses, one a line", str(path)) from None
     text = decode_text(raw, str(path))
     out = []
     for number, line in enumerate(text.split("\n"), 1):
