@@ -17,23 +17,44 @@ made them). Any change of any of them is a different key: the cache is
 rebuilt, never used stale. A cache file that cannot be read, does not
 match, or is damaged is ignored (and replaced by the next successful
 load); it never stops a run. docs/performance.md, "Code cache".
+
+The file (little-endian)::
+
+    "SPLCCODE"  u16 FORMAT  u16 reserved  u64 payload length
+    32 bytes    SHA-256 of the key
+    32 bytes    SHA-256 of the 52 bytes above and the payload
+    payload     marshal of (tree, extra, warnings, compiled files)
+
+The payload's code objects are run, so nothing in it is unmarshalled
+before the digest over the whole file has matched: a flipped bit, a
+truncated or padded file is seen as damaged and the program compiled from
+its text (a marshal of code that decodes after a flip could run other
+logic, or crash the interpreter). The digest finds damage; it does not
+authenticate (docs/engine.md, "The code cache").
 """
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import marshal
+import struct
 import sys
 from pathlib import Path
 
 from ..datatable.snapshot import write as write_atomically
+from ..errors import FileAccessError
 from ..gcpause import gc_paused
+from ..textfile import CODE_CACHE, read_bytes
 from . import treecodec
 from .ast import Program, address_refs, instructions_of
 from .blocks import CompiledFile, run_block
 
 CACHE_FILE = "codecache.bin"
-FORMAT = 2  # of the cache file; part of the key
+FORMAT = 3  # of the cache file; part of the key
+MAGIC = b"SPLCCODE"
+_HEAD = struct.Struct("<8sHHQ32s")  # magic, format, reserved, payload length, key
+_DIGEST = 32  # SHA-256, after _HEAD
 
 
 def softplc_version() -> str:
@@ -218,33 +239,63 @@ class CodeCache:
 
     @gc_paused
     def load(self, key: str) -> tuple[Program, list, dict] | None:
-        """(program, warnings, compiled files' data) cached under ``key``, or None."""
+        """(program, warnings, compiled files' data) cached under ``key``, or
+        None: no cache, another key or format (silently), or a file that is
+        damaged or cannot be read (``problem`` says which)."""
+        self.problem = None
         try:
-            blob = self.path.read_bytes()
-        except FileNotFoundError:
+            blob = read_bytes(self.path, CODE_CACHE)  # a regular file of a sane size, or refused
+        except FileAccessError as e:
+            if e.errno not in (errno.ENOENT, errno.ENOTDIR):  # no cache (yet): nothing to say
+                self._ignored(e.words)
             return None
-        except OSError as e:
-            self.problem = f"{self.path}: {e.strerror or e}"
-            return None
+        if len(blob) < _HEAD.size + _DIGEST:
+            return self._ignored(f"{len(blob)} bytes, too short for a code cache (damaged)")
+        magic, fmt, _, length, stored_key = _HEAD.unpack_from(blob)
+        if magic != MAGIC:  # damaged, or from a softplc_lite before this format: said, it is never expected
+            return self._ignored("not a code cache this softplc_lite reads")
+        if fmt != FORMAT or stored_key != _key_bytes(key):
+            return None  # another softplc_lite's format or another program: replaced after this load, nothing wrong
+        payload = memoryview(blob)[_HEAD.size + _DIGEST:]
+        if len(payload) != length or _digest(blob, payload) != blob[_HEAD.size:_HEAD.size + _DIGEST]:
+            return self._ignored("damaged code cache (its digest does not match its contents)")
         try:
-            stored_key, tree, extra, warnings, files = marshal.loads(blob)
-            if stored_key != key:
-                return None
+            tree, extra, warnings, files = marshal.loads(payload)
             return treecodec.decode(tree, extra), list(warnings), files
-        except Exception as e:  # damaged, truncated, another format: rebuilt by the next save
-            self.problem = f"{self.path}: unreadable code cache ({type(e).__name__}), rebuilt"
-            return None
+        except Exception:  # a digest that matches: only a bug of ours can lead here
+            return self._ignored("a code cache this softplc_lite cannot decode")
+
+    def _ignored(self, why: str) -> None:
+        self.problem = f"{self.path}: {why}; ignored, the program is compiled from its text and the cache rewritten"
+        return None
 
     @gc_paused
     def save(self, key: str, program: Program, warnings: list, files: dict) -> bool:
         try:
             tree, extra = treecodec.encode(program)
-            blob = marshal.dumps((key, tree, extra, tuple(warnings), files))
+            payload = marshal.dumps((tree, extra, tuple(warnings), files))
+            if len(payload) + _HEAD.size + _DIGEST > CODE_CACHE.size:
+                self.problem = f"{self.path}: code cache not written (over the {CODE_CACHE.size >> 20} MiB limit)"
+                return False
+            head = _HEAD.pack(MAGIC, FORMAT, 0, len(payload), _key_bytes(key))
+            blob = b"".join((head, _digest(head, payload), payload))
             write_atomically(blob, self.path, durable=False)  # a cache: a lost write costs a compile
             return True
         except Exception as e:  # unwritable state directory, a tree the codec does not take: no cache
             self.problem = f"{self.path}: code cache not written ({type(e).__name__}: {e})"
             return False
+
+
+def _key_bytes(key: str) -> bytes:
+    """The 32 bytes of the header that stand for ``key`` (cache_key's hex, or any text)."""
+    return hashlib.sha256(key.encode("utf-8", "surrogatepass")).digest()
+
+
+def _digest(head, payload) -> bytes:
+    """SHA-256 of the header (its first _HEAD.size bytes) and the payload."""
+    h = hashlib.sha256(memoryview(head)[:_HEAD.size])
+    h.update(payload)
+    return h.digest()
 
 
 def export_engine(engine) -> dict | None:
