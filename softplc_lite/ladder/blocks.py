@@ -39,6 +39,11 @@ CHUNK_RUNGS = 1000
 RUNG_BOOL = "not not c"
 # Word locals per block (about: a block ends after the rung that passes it).
 LOCALS_BUDGET = 300
+# Instructions per block (about, as LOCALS_BUDGET): CPython's compile() of
+# one function needs several KB an instruction at once, so a block of many
+# large rungs is split, and a load's memory stays proportional to its
+# biggest block (one rung at most limits.MAX_RUNG_ELEMENTS), not its program.
+INSTRUCTIONS_BUDGET = 10_000
 
 IDENTIFIER = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _FEW_NAMES = 100  # up to this many names to bind, each is looked for in the text

@@ -393,7 +393,8 @@ class _FileCompiler(HeldWords, TableTemplates):
 
     def compile(self) -> CompiledFile:
         # A block starts at every label (a JMP lands at a block's start) and
-        # holds at most CHUNK_RUNGS rungs and about LOCALS_BUDGET word locals:
+        # holds at most CHUNK_RUNGS rungs, about LOCALS_BUDGET word locals and
+        # about INSTRUCTIONS_BUDGET instructions:
         # CPython's compile() slows down more than linearly with the number of
         # locals of one function, and a call's frame is made and cleared
         # local by local.
@@ -406,10 +407,12 @@ class _FileCompiler(HeldWords, TableTemplates):
         while k < count:
             first = k
             distinct = set(words[k])
+            size = len(instructions_of(self.rungs[k].elements))
             k += 1
             while k < count and k not in labels and k - first < blocks.CHUNK_RUNGS and \
-                    len(distinct) < blocks.LOCALS_BUDGET:
+                    len(distinct) < blocks.LOCALS_BUDGET and size < blocks.INSTRUCTIONS_BUDGET:
                 distinct.update(words[k])
+                size += len(instructions_of(self.rungs[k].elements))
                 k += 1
             cf.add(self.block(first, k, words))
         # The code is compiled: keep no text, and no caches a later isolate() can rebuild.

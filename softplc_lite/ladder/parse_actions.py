@@ -35,7 +35,15 @@ from .ast import (
     UnaryOp,
 )
 from .errors import LadderError
-from .limits import MAX_CONSTANT, MAX_NUMBER_DIGITS
+from .limits import (
+    MAX_BRANCH_DEPTH,
+    MAX_CONSTANT,
+    MAX_NUMBER_DIGITS,
+    MAX_RUNG_ELEMENTS,
+    limit_problem,
+    literal_problem,
+    rung_size_message,
+)
 
 _new_tuple = tuple.__new__  # _new_tuple(Pos, (...)): a Pos without its __new__'s Python frame
 
@@ -59,7 +67,7 @@ class _MnemonicRun:
     ``texts``: the quoted operands, (instruction, operand index), which
     parser.py parses as expressions where the instruction takes one."""
 
-    __slots__ = ("branches", "current", "deepest", "operands", "pos", "problem", "root", "series", "texts")
+    __slots__ = ("branches", "current", "deepest", "operands", "pos", "problem", "root", "series", "size", "texts")
 
     def __init__(self, pos: Pos) -> None:
         self.pos = pos  # the first token's
@@ -71,6 +79,7 @@ class _MnemonicRun:
         self.deepest = 0
         self.texts: list[tuple[Instruction, int]] = []
         self.problem: LadderError | None = None
+        self.size = 0  # its elements (limits.MAX_RUNG_ELEMENTS), set when the rung ends
 
     def operand(self, operand) -> None:
         operands = self.operands
@@ -176,6 +185,27 @@ class _ToAst(Transformer):
         # mnemonic, or "" for a name that is none, within one parse.
         self.instructions = None
         self.mnemonics: dict[str, str] = {}
+        # The elements of the current line item (a rung, a DATA line) so
+        # far, against size_limit (MAX_RUNG_ELEMENTS; none in an expression
+        # parse: parser._finish counts a quoted one into its rung). Reset
+        # by ``lines``. The first element past the limit ends the parse as
+        # a syntax error does (parsing resumes on the next line): the rest
+        # of a huge rung is never read into memory.
+        self.size = 0
+        self.size_limit = MAX_RUNG_ELEMENTS
+
+    def new_parse(self, counted: bool) -> None:
+        """Start counting elements afresh (each parse, and lark's parse
+        again after the fast loop gave up)."""
+        self.size = 0
+        self.size_limit = MAX_RUNG_ELEMENTS if counted else 1 << 62
+
+    def _grow(self, pos_of) -> None:
+        """Count one element (``pos_of``: its token or node); past the
+        limit, raise the size problem there."""
+        self.size += 1
+        if self.size > self.size_limit:
+            raise LadderError(self._pos(pos_of), rung_size_message())
 
     def _fail(self, error: LadderError, placeholder):
         if self.problems is None:
@@ -231,10 +261,12 @@ class _ToAst(Transformer):
     # The rules below take lark's child list as it is: a v_args wrapper
     # costs three calls a reduction, and most are reduced once a token.
     def address(self, children):
+        self._grow(children[0])
         return self._address(children[0])
 
     def symbol(self, children):
         tok = children[0]
+        self._grow(tok)
         return SymbolRef(str(tok), self._token_pos(tok))
 
     def signed_number(self, children):
@@ -247,11 +279,13 @@ class _ToAst(Transformer):
         return Const(-const.value, self._pos(sign)) if str(sign) == "-" else Const(const.value, self._pos(sign), hex=const.hex)
 
     def _const(self, tok: Token) -> Const:
+        self._grow(tok)
         return Const(self._num(tok), self._token_pos(tok), hex=tok.type == "HEX")
 
     def call(self, children):
         name, arg = children
         arg = self._atomize(arg)
+        self._grow(name)
         func = str(name).upper()
         if func not in _CALLS:
             return self._fail(LadderError(self._pos(name), f"unknown function {name}() in an expression; "
@@ -270,6 +304,7 @@ class _ToAst(Transformer):
     def bit_not(self, children):
         keyword, operand = children
         operand = self._atomize(operand)
+        self._grow(keyword)
         return UnaryOp("NOT", operand, self._pos(keyword))
 
     def binop(self, children):
@@ -278,6 +313,7 @@ class _ToAst(Transformer):
         if operator == "/":
             operator = "|"  # PLC-5 writes division as |
         left = self._atomize(left)
+        self._grow(op)
         return BinOp(operator, left, self._atomize(right), left.pos)
 
     def _atomize(self, item):
@@ -288,11 +324,14 @@ class _ToAst(Transformer):
     # neutral text -----------------------------------------------------------------
     def nt_instruction(self, items):
         name = items[0]
+        self._grow(name)
         operands = [self._atomize(i) for i in items[1:]]
         return Instruction(str(name).upper(), operands, self._pos(name))
 
     def nt_branch(self, items):
         legs = [i for i in items if not isinstance(i, Token)]
+        self.size += len(legs)  # "[", each ",", "]": one each, with the one below
+        self._grow(items[0])
         return Branch(legs, self._pos(items[0]))
 
     def nt_series(self, items):
@@ -325,6 +364,9 @@ class _ToAst(Transformer):
         if line_offset or column_offset:
             line, column = line + line_offset, column + column_offset if line == 1 else column
         pos = _new_tuple(Pos, (source, line, column))
+        self.size += 1
+        if self.size > self.size_limit:
+            raise _deepest_first(run, LadderError(pos, rung_size_message()))
         if kind == "ADDRESS":
             address = self.addresses.get(text)
             operand = self._address_at(text, pos) if address is None else AddressRef(address, pos)
@@ -349,7 +391,11 @@ class _ToAst(Transformer):
         elif kind == "SYMBOL_MEMBER":  # PollTimer/DN: never a mnemonic, so an operand at once
             run.operand(SymbolRef(text, pos))
         elif kind == "STRING":
-            run.operand(Text(_unquote(text), pos))
+            problem = literal_problem(text)
+            if problem is None:
+                run.operand(Text(_unquote(text), pos))
+            elif run.problem is None:
+                run.fail(LadderError(pos, problem))
         else:  # BST, NXB, BND
             run.marker(kind, pos)
         return run
@@ -358,11 +404,13 @@ class _ToAst(Transformer):
         # [run, COMMENT?, _NL] or ["SOR", run?, "EOR", COMMENT?, _NL]
         first = items[0]
         if type(first) is _MnemonicRun:
+            first.size = self.size
             if len(items) == 2:  # no comment: most rungs
                 return _RungDraft(first.pos, run=first)
             run = first
         else:  # SOR
             run = items[1] if type(items[1]) is _MnemonicRun else _MnemonicRun(self._pos(first))
+            run.size = self.size
         comment = _tokens(items, "COMMENT")
         return _RungDraft(run.pos if run is first else self._pos(first), run=run,
                           comment=comment[0][2:].strip() if comment else None)
@@ -384,6 +432,9 @@ class _ToAst(Transformer):
         for v in items[3:]:
             if isinstance(v, Token):
                 if v.type == "STRING":
+                    problem = literal_problem(str(v))
+                    if problem is not None:
+                        return self._fail(LadderError(self._pos(v), f"DATA {name}: {problem}"), None)
                     values.append(_unquote(str(v)))
             elif v.hex and 0x8000 <= v.value <= 0xFFFF and str(name)[:1].upper() in ("N", "B", "O", "I", "S"):
                 values.append(v.value - 0x10000)  # a hex bit pattern for a 16-bit word file: 0xFFFF is -1
@@ -401,6 +452,7 @@ class _ToAst(Transformer):
         """[], [line], [lines so far] or [lines so far, line] (the newline
         between is filtered out): one list grown left to right. A line is
         an item, or None for a header or declaration already reported."""
+        self.size = 0
         if not children:
             return []
         if len(children) == 2:
@@ -412,6 +464,16 @@ class _ToAst(Transformer):
 
     def start(self, items):
         return items[0] if items else []
+
+
+def _deepest_first(run: _MnemonicRun, problem: LadderError) -> LadderError:
+    """A rung past the size limit may have had branches nested past their
+    limit before that point: the earlier problem is the one reported."""
+    if run.deepest > MAX_BRANCH_DEPTH and run.problem is None:
+        deep = limit_problem(run.root)
+        if deep is not None and deep[0].pos < problem.pos:
+            return LadderError(deep[0].pos, deep[1])
+    return problem
 
 
 def _unquote(text: str) -> str:

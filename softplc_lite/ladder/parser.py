@@ -42,8 +42,11 @@ from .lalr_driver import FastLalr, LarkOnly, NotFastPath, fast_parser
 from .limits import (
     MAX_BRANCH_DEPTH,
     MAX_EXPRESSION_DEPTH,
+    MAX_RUNG_ELEMENTS,
     expression_depth,
+    expression_size,
     limit_problem,
+    rung_size_message,
 )
 from .parse_actions import (
     _Comment,
@@ -124,8 +127,10 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
     builder = parser.options.transformer
     # an expression parse happens inside a program parse
     saved = builder.context, builder.problems, builder.addresses, builder.instructions, builder.mnemonics
+    sizes = builder.size, builder.size_limit
     builder.context = (source, line_offset, column_offset)
     builder.problems = problems
+    builder.new_parse(counted=start == "start")
     if start == "start":
         if instructions is None:
             from .instructions import BUILTIN as instructions
@@ -144,6 +149,7 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
         raise
     finally:
         builder.context, builder.problems, builder.addresses, builder.instructions, builder.mnemonics = saved
+        builder.size, builder.size_limit = sizes
     return result
 
 
@@ -168,6 +174,7 @@ def _parse_fast_or_lark(parser: Lark, text: str, start: str, problems: list[Ladd
     except (NotFastPath, LadderError):
         if problems is not None:
             del problems[found:]
+        parser.options.transformer.new_parse(counted=start == "start")
         return parser.parse(text, start=start)
 
 
@@ -333,13 +340,18 @@ def _finish(run: _MnemonicRun, instructions) -> tuple[list[Element], bool]:
     limit, or an expression: nothing else in a mnemonic rung can be over a
     limit). Its first problem is raised here, in the order of its tokens."""
     expression = False
+    size = run.size
     for instruction, index in run.texts:
         if _takes_expression(instruction, index, instructions):
             # CPT "N7:1 + 5": the quoted text is an expression; parse it
             # so both rung syntaxes give the same tree.
             operands = instruction.operands
-            operands[index] = parse_expression(operands[index].value, operands[index].pos)
+            text = operands[index]
+            operands[index] = parse_expression(text.value, text.pos)
             expression = True
+            size += expression_size(operands[index]) - 1  # its elements, as neutral text counts them
+            if size > MAX_RUNG_ELEMENTS:
+                raise LadderError(text.pos, rung_size_message())
     if run.problem is not None:
         raise run.problem
     if run.branches:

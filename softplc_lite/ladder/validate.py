@@ -40,7 +40,7 @@ from .ast import (
 )
 from .errors import LadderError, ProgramErrors
 from .instructions import BUILTIN, MAX_PARAMETERS, InstructionSet, K
-from .limits import MAX_BRANCH_DEPTH, MAX_EXPRESSION_DEPTH, expression_depth, limit_problem
+from .limits import MAX_BRANCH_DEPTH, MAX_EXPRESSION_DEPTH, expression_depth, limit_problem, short_quote
 from .parser import parse_expression
 from .symbols import SymbolIndex, resolve_name, symbol_base
 
@@ -606,7 +606,7 @@ def _describe(operand: Operand) -> str:
     if isinstance(operand, Const):
         return f"the constant {operand.value}"
     if isinstance(operand, Text):
-        return f'the string "{operand.value}"'
+        return f"the string {short_quote(operand.value)}"
     return "an expression"
 
 
