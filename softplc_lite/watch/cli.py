@@ -37,17 +37,19 @@ def watch_command(args) -> int:
         print("softplc watch: error: --scans N needs --snapshot FILE (the view starts at scan 0; "
               "press n to step or r to run)", file=sys.stderr)
         return EXIT_USAGE
-    if not snapshot and not (sys.stdin.isatty() and sys.stdout.isatty()):
-        print("softplc watch: needs a terminal (standard input and output are not one here); "
-              "render the view to a file instead: softplc watch APP --scans N --snapshot view.txt "
-              "(or view.svg)", file=sys.stderr)
-        return EXIT_USAGE
     scans = scans or 0
     problem = size_problem(args.width, args.height) or (scans < 0 and "--scans: expected 0 or more")
     if problem:  # the parser checks these: for callers that build ``args`` themselves
         print(f"softplc watch: error: {problem}", file=sys.stderr)
         return EXIT_USAGE
+    # The app first: a missing app or a program with errors is the problem to fix, whatever the terminal
+    # (the same error and exit code as softplc run's).
     app = load_app(args.app, args.state)
+    if not snapshot and not (sys.stdin.isatty() and sys.stdout.isatty()):
+        print("softplc watch: needs a terminal (standard input and output are not one here); "
+              "render the view to a file instead: softplc watch APP --scans N --snapshot view.txt "
+              "(or view.svg)", file=sys.stderr)
+        return EXIT_USAGE
     watch = list(args.watch)
     if args.watch_file:
         watch += read_watch_file(args.watch_file, app.program.symbols, room=max(0, WATCH_MAX - len(watch)))

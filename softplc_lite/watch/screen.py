@@ -6,6 +6,8 @@ up)."""
 
 from __future__ import annotations
 
+import textwrap
+
 from rich.cells import cell_len
 from rich.console import Console, ConsoleOptions, Group, RenderResult
 from rich.layout import Layout
@@ -35,29 +37,52 @@ KEY_LINES = ("n step  r run  p pause  +/- speed  ↑↓ rung  g go to  f file  b
 
 
 class HelpOverlay:
-    """Every key and what it does (the ``?`` key; any key closes it):
-    ``keys`` is terminal.py's table of (key label, help text). In two
-    columns (or more) when one does not fit the height: 80x24 takes two."""
+    """Every key and what it does (the ``?`` key): ``keys`` is terminal.py's
+    table of (key label, help text), one key a line in one column, a text
+    too long for the width wrapped under itself (never cut). When the keys
+    need more lines than the height, they are shown in pages (``page``,
+    from 0): ``pages`` says how many after a render. Space or PgDn shows the
+    next page, PgUp the one before; any other key closes the list."""
 
-    def __init__(self, keys) -> None:
+    def __init__(self, keys, page: int = 0) -> None:
         self.keys = keys
+        self.page = page
+        self.pages = 1
+
+    def entries(self, width: int) -> list[list[Text]]:
+        """Each key's lines at ``width``."""
+        label_w = max(cell_len(label) for label, _ in self.keys)
+        indent = 2 + label_w + 2
+        room = max(10, width - indent)
+        out = []
+        for label, text in self.keys:
+            wrapped = textwrap.wrap(text, room) or [""]
+            first = Text(no_wrap=True)
+            first.append(f"  {label.ljust(label_w)}  ", style="bold")
+            first.append(wrapped[0])
+            out.append([first] + [Text(" " * indent + more, no_wrap=True) for more in wrapped[1:]])
+        return out
+
+    def paged(self, width: int, height: int) -> list[list[Text]]:
+        """The entries in pages of at most ``height`` lines (a key's lines never split)."""
+        pages: list[list[Text]] = [[]]
+        for lines in self.entries(width):
+            if pages[-1] and len(pages[-1]) + len(lines) > height:
+                pages.append([])
+            pages[-1].extend(lines)
+        return pages
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
-        yield Text(" keys (any key closes this)", style="bold underline")
-        height = (options.height or console.height) - 1
-        columns = max(1, -(-len(self.keys) // max(1, height)))  # as many as the height needs
-        rows = -(-len(self.keys) // columns)
-        width = options.max_width // columns
-        label_w = max(cell_len(label) for label, _ in self.keys)
-        for row in range(rows):
-            line = Text(no_wrap=True, overflow="ellipsis")
-            for label, text in self.keys[row::rows]:
-                entry = Text(no_wrap=True, overflow="ellipsis")
-                entry.append(f"  {label.ljust(label_w)}  ", style="bold")
-                entry.append(text)
-                entry.truncate(width, overflow="ellipsis", pad=True)
-                line.append_text(entry)
-            yield line
+        height = max(1, (options.height or console.height) - 1)
+        pages = self.paged(options.max_width, height)
+        self.pages = len(pages)
+        page = min(max(0, self.page), len(pages) - 1)
+        if len(pages) == 1:
+            yield Text(" keys (any key closes this)", style="bold underline")
+        else:
+            yield Text(f" keys, page {page + 1} of {len(pages)} (space: more, PgUp: back; other keys close this)",
+                       style="bold underline", no_wrap=True, overflow="ellipsis")
+        yield from pages[page]
 
 
 class EditErrors:
@@ -207,6 +232,8 @@ class WatchScreen:
         self.forces = ForcesView(session)
         self.prompt = prompt
         self.help = None  # the key table while the help overlay is shown
+        self.help_page = 0  # the help overlay's page shown
+        self.help_pages = 1  # its pages at the size it was last drawn (the Controller pages through them)
 
     def side(self) -> Group:
         parts = [self.session.watch, self.forces]
@@ -229,7 +256,7 @@ class WatchScreen:
             bottom = Text(f" {keys}", style="dim", no_wrap=True, overflow="ellipsis")
         root.split_column(Layout(self.status, size=2), Layout(name="body"), Layout(bottom, size=1))
         body = root["body"]
-        overlay = HelpOverlay(self.help) if self.help else None  # the help wins over the rest
+        overlay = HelpOverlay(self.help, self.help_page) if self.help else None  # the help wins over the rest
         if overlay is None and self.session.edit_report is not None:
             overlay = EditErrors(self.session.edit_report)
         if overlay is None and self.session.grid is not None:  # the data-file monitor: the body until Esc
@@ -237,6 +264,8 @@ class WatchScreen:
         if overlay is not None:
             body.update(overlay)
             yield from root.__rich_console__(console, options.update(height=height))
+            if isinstance(overlay, HelpOverlay):
+                self.help_pages = overlay.pages
             return
         side = self.side()
         if width >= WIDE:

@@ -93,8 +93,16 @@ class WatchSession:
             self.watch.sample(self.engine.table, trend=False)
             return None
         engine = self.engine
+        before = engine.scans
         engine.scan()
-        self.history.record(engine.scans, engine.clock.now_ms)
+        if engine.scans != before:
+            self.history.record(engine.scans, engine.clock.now_ms)
+        else:
+            # PROGRAM mode: the I/O update ran, the ladder did not, so no scan is counted and none
+            # recorded (a frame of its own would be "scan N of N" in the history, not a scan); what
+            # the update changed belongs to the newest scan's frame, as an edit does.
+            self.history.amend()
+            self.message = "PROGRAM mode: the ladder does not run (inputs and outputs updated; M run to run it)"
         if self.watch.items:
             self.watch.sample(engine.table)
         hit = self.breaks.after_scan()

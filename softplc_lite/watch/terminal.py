@@ -74,7 +74,7 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("R", ("R",), "radix", "the grid's radix: decimal, hex, binary, ASCII (cycles)"),
     Binding("Esc", ("esc",), "close", "close the data-file grid, then the find list"),
     Binding("E", ("E",), "edit_errors", "every error of the last rejected online program edit"),
-    Binding("?", ("?",), "help", "show every key and what it does (any key closes the list)"),
+    Binding("?", ("?",), "help", "show every key and what it does (pages: space; any other key closes it)"),
     Binding("q", ("q",), "quit", "quit (saves the retentive data table)"),
 )
 # (key label, help text) of every key: for ``softplc watch --help``.
@@ -135,10 +135,17 @@ class Controller:
         self.buffer = ""
         self.done = False
         self.help = False  # the help overlay is shown
+        self.help_page = 0  # its page shown
+        self.help_pages = 1  # its pages, as last drawn (ViewLoop tells)
 
     def key(self, k: str) -> None:
-        if self.help:  # any key (Esc too) closes the help, and does nothing else
-            self.help = False
+        if self.help:  # space/PgDn and PgUp page it; any other key (Esc too) closes it, and does nothing else
+            if k in (" ", "pgdown") and self.help_page + 1 < self.help_pages:
+                self.help_page += 1
+            elif k == "pgup" and self.help_page > 0:
+                self.help_page -= 1
+            else:
+                self.help, self.help_page = False, 0
             return
         if self.session.edit_report is not None:  # the same for the online edit's errors (E)
             self.session.edit_report = None
@@ -306,7 +313,9 @@ class ViewLoop:
         if k is not None or (self.dirty and now - self.last_draw >= self.interval):
             self.screen.prompt = self.control.prompt
             self.screen.help = KEYS if self.control.help else None
+            self.screen.help_page = self.control.help_page
             self.draw(self.screen)
+            self.control.help_pages = self.screen.help_pages
             drawn = time.monotonic()
             # Drawing takes at most DRAW_SHARE of the time while running: a
             # big screen redraws less often rather than slowing the scans.

@@ -113,9 +113,18 @@ class Use:
     def describe(self) -> str:
         """One line: where (instruction and operand numbered from 1, as the
         rung shows them left to right), what and how."""
-        how = "indirect " + self.access.value if self.indirect else self.access.value
         return (f"file {self.file} rung {self.rung}  instruction {self.instruction + 1} {self.mnemonic}  "
-                f"operand {self.operand + 1} {self.address}  {how}")
+                f"operand {self.operand + 1} {self.address}  {self.how}")
+
+    @property
+    def how(self) -> str:
+        """``read``, ``write``, ``read/write``, or one of them ``indirect``."""
+        return "indirect " + self.access.value if self.indirect else self.access.value
+
+    def brief(self) -> str:
+        """Where, short, for a narrow list (the how goes first there):
+        ``file 2 rung 3  OTL B3/0``."""
+        return f"file {self.file} rung {self.rung}  {self.mnemonic} {self.address}"
 
 
 class _Target:
@@ -302,20 +311,29 @@ class XrefPanel:
             head.append("not used in any rung", style="yellow")
             yield head
             return
-        head.append(f"{len(uses)} use{'s' if len(uses) != 1 else ''}, {len(f.writers)} writing")
-        if f.current >= 0:
-            head.append(f"  ({f.current + 1} of {len(uses)}; x next, X previous)", style="dim")
+        counts = f"{len(uses)} use{'s' if len(uses) != 1 else ''}, {len(f.writers)} writing"
+        where = f"  ({f.current + 1} of {len(uses)}; x next, X previous)" if f.current >= 0 else ""
+        if where and head.cell_len + len(counts) + len(where) > options.max_width:
+            where = f"  ({f.current + 1} of {len(uses)})"  # the keys are on the ? list
+            if head.cell_len + len(counts) + len(where) > options.max_width:  # the side panel: shorter still
+                counts, where = f"use {f.current + 1} of {len(uses)}, {len(f.writers)} writing", ""
+        head.append(counts)
+        head.append(where, style="dim")
         yield head
         height = self.height or options.height or len(uses) + 1
         rows = max(1, height - 1)
         first = 0
         if len(uses) > rows:
             first = min(max(0, f.current - rows // 2), len(uses) - rows)
-        for k in range(first, min(len(uses), first + rows)):
-            use = uses[k]
+        shown = uses[first:first + rows]
+        # Where a whole line does not fit (the 46-column side panel), read or write goes first, in a
+        # column of its own, and the line says where more briefly: what was cut is never the access.
+        brief = any(2 + len(use.describe()) > options.max_width for use in shown)
+        how_w = max(len(use.how) for use in shown)
+        for k, use in enumerate(shown, first):
             line = Text(no_wrap=True, overflow="ellipsis")
             mark = k == f.current
             line.append("▶ " if mark else "  ", style="bold")
-            line.append(use.describe(), style="reverse" if mark else
-                        "red" if use.access is not Access.READ else None)
+            text = f"{use.how.ljust(how_w)}  {use.brief()}" if brief else use.describe()
+            line.append(text, style="reverse" if mark else "red" if use.access is not Access.READ else None)
             yield line
