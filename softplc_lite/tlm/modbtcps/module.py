@@ -270,7 +270,8 @@ class ModbTcpServer(TLM):
         if self.failed is None:
             self.failed = why
             if self.port is None:
-                self.log(f"{why} ({WHERE}); clients are not served (the scan goes on)")
+                where = f" ({WHERE})" if why.startswith("cannot listen") else ""
+                self.log(f"{why}{where}; clients are not served (the scan goes on)")
             else:
                 self.log(f"{why}; clients are no longer served (the scan goes on)")
         if self._from_server >= 0:

@@ -124,12 +124,11 @@ def main() -> int:
     logging.getLogger("pymodbus").setLevel(logging.CRITICAL)  # this module says what matters, counted
     out_fd, image_fd = int(sys.argv[1]), int(sys.argv[2])
 
-    def fail(why: str) -> int:  # said in one line, to the runtime if it still waits for READY; no traceback
-        print(f"MODBTCPS: {why}", file=sys.stderr, flush=True)
+    def fail(why: str) -> int:  # one line, no traceback: the runtime says it; if it is gone, this process does
         try:
             os.write(out_fd, msg.failed(why))
         except OSError:
-            pass
+            print(f"MODBTCPS: {why}", file=sys.stderr, flush=True)
         return 1
 
     try:
