@@ -34,7 +34,7 @@ def test_find_a_symbol_and_jump_between_its_rungs(tmux, tmp_path):
                width=120, height=40)
     tmux.wait_for("PAUSED")
     tmux.keys("/", "Tripped", "Enter")
-    screen = tmux.wait_for("find Tripped (B3/0): 5 uses, 2 writing")
+    screen = tmux.wait_for("find Tripped (B3/0): use 1 of 5, 2 writing")  # the side panel's short form
     assert "Tripped (B3/0) 1 of 5: file 2 rung 0  instruction 4 XIO  operand 1 B3/0  read" in screen
     assert "rung 0 of 7" in screen
     tmux.keys("x")
