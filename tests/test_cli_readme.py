@@ -1,6 +1,7 @@
-"""issue 18, section 2: every line of the README's "Try it" block works in
-the order written, each in the state the lines before it left (a temp copy
-of programs/, so the tree's own state is not touched). A ``softplc watch``
+"""Every line of the README's "Try it" block works in the order written,
+each in the state the lines before it left (a temp copy of programs/, so the
+tree's own state is not touched, whose Modbus TCP server listens on a port
+found free, so a PLC running here does not stand in the way). A ``softplc watch``
 line runs in a real terminal (tmux), is quit with q once its view is up;
 every other line is bounded (--scans, a --replay trace, or check/fmt) and
 has a timeout."""
@@ -9,13 +10,13 @@ from __future__ import annotations
 
 import re
 import shlex
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 from cli_tmux import SOFTPLC, open_terminal
+from shipped_apps import copy_programs
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -42,7 +43,7 @@ def test_the_try_it_block_is_what_this_test_runs():
 
 
 def test_every_try_it_line_works_in_order(tmp_path, terminal):
-    shutil.copytree(ROOT / "programs", tmp_path / "programs", ignore=shutil.ignore_patterns(".softplc"))
+    copy_programs(tmp_path)
     for k, line in enumerate(try_it_lines()):
         argv = shlex.split(line, comments=True)
         if argv[1] == "watch":

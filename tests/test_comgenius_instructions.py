@@ -167,8 +167,8 @@ def test_the_strings_example_program(executor):
     from softplc_lite.app import load_app
     from softplc_lite.runner import RunOptions, Runner
 
-    app = load_app(Path(__file__).resolve().parent.parent / "programs" / "strings", state_dir=None)
-    app.state_dir = None
+    app = load_app(Path(__file__).resolve().parent.parent / "programs" / "strings", use_cache=False)
+    app.state_dir = None  # nothing written in the repository: no code cache, no snapshot
     r = Runner(app, RunOptions(fresh=True, executor=executor, sets=("NewReading=1",)))
     r.run(2)
     assert r.table.read("ST9:1") == "Ticket 0042: 1234.5 kg"

@@ -262,7 +262,7 @@ def test_a_write_ends_the_quiet_and_the_frame_end_is_due():
 def test_the_app_on_a_silent_slave_still_times_out():
     """Nothing ever arrives (the slave is id 3): the wire is quiet from the
     query's end on, and the COMSCANs' 250 ms timeout still fires."""
-    app = load_app(REPO_APP, state_dir=None)
+    app = load_app(REPO_APP, use_cache=False)
     app.state_dir = None
     r = Runner(app, RunOptions(fresh=True, ports=("0=sim://modbus?device=modbus&id=3&registers=200",)),
                log=lambda msg: None)

@@ -41,7 +41,7 @@ def _app_run(scans: int, sets: tuple[str, ...], device: str, every_scan: bool) -
     """The shipped app for ``scans`` scans; with ``every_scan`` its port
     reads the link at every scan and the link pumps its device at every read
     (no quiet time, a device that cannot tell), as before the shortcuts."""
-    app = load_app(REPO_APP, state_dir=None)
+    app = load_app(REPO_APP, use_cache=False)
     app.state_dir = None
     r = Runner(app, RunOptions(fresh=True, sets=sets, ports=(f"0={device}",)), log=lambda msg: None)
     try:

@@ -1,17 +1,25 @@
 """The examples in docs/ and the README are run: ``>>>`` lines as doctests,
 ``$ softplc ...`` lines in ```console blocks as real commands whose output
-must match what the page shows."""
+must match what the page shows.
+
+They run in a copy of programs/ and docs/examples/ in the test's temporary
+directory (so the apps' state is written there, not in the repository),
+where programs/hmi_server serves on a free port that stands for the page's
+5020, and a page's /tmp/ paths stand for the temporary directory."""
 
 from __future__ import annotations
 
 import doctest
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+
+from shipped_apps import SHIPPED_PORT, copy_programs
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = sorted((ROOT / "docs").glob("*.md"))
@@ -40,25 +48,40 @@ CONSOLE = [
 ]
 
 
+@pytest.fixture
+def here(tmp_path, monkeypatch):
+    """The working directory the examples run in; ``here(text)`` is a page's
+    text as it reads there (its server port and /tmp/ paths replaced)."""
+    ports = copy_programs(tmp_path)
+    shutil.copytree(ROOT / "docs" / "examples", tmp_path / "docs" / "examples")
+    monkeypatch.chdir(tmp_path)
+
+    def as_here(text: str) -> str:
+        return re.sub(rf"\b{SHIPPED_PORT}\b", str(ports["hmi_server"]), text).replace("/tmp/", f"{tmp_path}/")
+    return as_here
+
+
 @pytest.mark.parametrize("page", [p for p in DOCS if ">>>" in p.read_text()], ids=lambda p: p.name)
-def test_doctests_in_docs(page: Path):
-    result = doctest.testfile(
-        str(page), module_relative=False, optionflags=doctest.ELLIPSIS, verbose=False
-    )
+def test_doctests_in_docs(page: Path, here):
+    test = doctest.DocTestParser().get_doctest(here(page.read_text(encoding="utf-8")), {"__name__": "__main__"},
+                                               page.name, str(page), 0)
+    runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS, verbose=False)
+    runner.run(test)
+    result = runner.summarize(verbose=False)
     assert result.attempted > 0
     assert result.failed == 0, f"{result.failed} doctest(s) failed in {page.name}"
 
 
 @pytest.mark.parametrize("command,expected", CONSOLE)
-def test_console_examples(command: str, expected: list[str]):
-    argv = shlex.split(command)
+def test_console_examples(command: str, expected: list[str], here, tmp_path):
+    argv = shlex.split(here(command))
     assert argv[0] == "softplc", "console examples run the softplc command"
     proc = subprocess.run(
         [sys.executable, "-m", "softplc_lite", *argv[1:]],
-        cwd=ROOT, capture_output=True, text=True, timeout=60,
+        cwd=tmp_path, capture_output=True, text=True, timeout=60,
     )
     assert proc.returncode == 0, proc.stderr
-    assert proc.stdout.splitlines() == expected
+    assert proc.stdout.splitlines() == [here(line) for line in expected]
 
 
 def test_every_doc_page_has_a_tested_example():

@@ -14,8 +14,8 @@ PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
 
 
 def runner(name: str, executor: str = "compiled", sets=()) -> Runner:
-    app = load_app(PROGRAMS / name, state_dir=None)
-    app.state_dir = None  # tests never touch the app's snapshot
+    app = load_app(PROGRAMS / name, use_cache=False)  # no code cache written in the repository
+    app.state_dir = None  # nor a snapshot
     return Runner(app, RunOptions(fresh=True, executor=executor, sets=tuple(sets)))
 
 

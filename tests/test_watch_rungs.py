@@ -18,6 +18,8 @@ from softplc_lite.runner import Runner, RunOptions
 from softplc_lite.watch.power import rung_power
 from softplc_lite.watch.rungs import ENERGIZED, FAULT, ProgramFileView, RungView
 
+from shipped_apps import copy_app
+
 ROOT = Path(__file__).resolve().parent.parent
 PROGRAMS = ROOT / "programs"
 
@@ -173,7 +175,7 @@ def test_true_instructions_and_energized_wires_are_highlighted():
 def modbus():
     """programs/modbus_master after 121 scans: the first reply has just been
     matched (R6:1 EN DN, LEN 255, POS 2)."""
-    app = load_app(PROGRAMS / "modbus_master", state_dir=None)
+    app = load_app(PROGRAMS / "modbus_master", use_cache=False)
     app.state_dir = None
     runner = Runner(app, RunOptions(fresh=True), log=lambda msg: None)
     runner.run(121)
@@ -283,9 +285,8 @@ def test_program_file_view_draws_a_window_of_rungs(modbus):
 
 
 @pytest.mark.parametrize("app_dir", sorted(p.name for p in PROGRAMS.iterdir() if (p / "main.lad").exists()))
-def test_every_example_program_renders_at_80_and_120(app_dir):
-    app = load_app(PROGRAMS / app_dir, state_dir=None)
-    app.state_dir = None
+def test_every_example_program_renders_at_80_and_120(app_dir, tmp_path):
+    app = load_app(copy_app(app_dir, tmp_path))  # its server, if it has one, on a free port
     runner = Runner(app, RunOptions(fresh=True), log=lambda msg: None)
     try:
         runner.run(5)
