@@ -1,7 +1,9 @@
-"""Reading the text files a user hands softplc: program, config, data.
+"""Reading the files a user hands softplc (program, config, data, traces)
+and its own state files (the retentive snapshot, the code cache).
 
-Every reader goes through :func:`read_text` (or :func:`decode_text` for
-bytes it read itself), so every file kind gives the same answer:
+Every reader goes through :func:`read_text` or :func:`read_bytes` (or
+:func:`decode_text` for text it has as bytes), so every file kind gives the
+same answer:
 
 * a byte-order mark is honoured, as Windows editors write one: UTF-8 with a
   BOM (Notepad's "UTF-8 with BOM"), UTF-16 LE or BE with a BOM (Notepad's
@@ -17,7 +19,7 @@ bytes it read itself), so every file kind gives the same answer:
   (docs/cli.md, "Input file limits"): a FIFO, a device (a link to
   ``/dev/zero``), a socket or a directory is refused without waiting or
   reading ("cannot read PATH: not a regular file (a FIFO)"), and so is a
-  file over the limit ("cannot read PATH: 20.0 GiB, over the 16 MiB limit
+  file over the limit ("cannot read PATH: 20 GiB, over the 16 MiB limit
   for a program file"), before any of it is read. At most limit + 1 bytes
   are ever read, so a file that grows while it is read is refused too.
   The refusal is a :class:`FileRefused`, a FileAccessError.
@@ -64,14 +66,14 @@ class FileRefused(FileAccessError):
 
 
 def size_text(n: float) -> str:
-    """``n`` bytes the way a person reads it: 512 bytes, 1.5 KiB, 16 MiB, 20.0 GiB."""
+    """``n`` bytes the way a person reads it: 512 bytes, 1.5 KiB, 16 MiB, 20 GiB."""
     if n < 1024:
         return f"{int(n)} byte{'s' if n != 1 else ''}"
     for unit in ("KiB", "MiB", "GiB", "TiB"):
         n /= 1024
-        if n < 1024 or unit == "TiB":
+        if round(n, 1) < 1024 or unit == "TiB":
             break
-    return f"{int(n)} {unit}" if n == int(n) else f"{n:.1f} {unit}"
+    return f"{n:.1f}".removesuffix(".0") + f" {unit}"
 
 
 _NOT_REGULAR = ((stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a character device"),
@@ -87,10 +89,11 @@ def _refusal(path: str, st: os.stat_result, limit: Limit) -> FileAccessError | N
         return FileRefused(path, f"not a regular file ({kind})")
     if st.st_size > limit.size:
         size, cap = size_text(st.st_size), size_text(limit.size)
-        if size.split()[1:] == cap.split()[1:] and float(size.split()[0]) == float(cap.split()[0]):
-            size = f"{st.st_size:,} bytes"  # just over: "256.0 MiB, over the 256 MiB limit" would say nothing
+        if size == cap:  # just over: "256 MiB, over the 256 MiB limit" would say nothing
+            size = f"{st.st_size:,} bytes"
         return FileRefused(path, f"{size}, over the {cap} limit for {limit.what}", too_large=True)
     return None
+
 
 # BOM -> codec; UTF-8's first (a UTF-16 LE BOM is a prefix of no UTF-8 BOM, but keep the longest first).
 BOMS = ((codecs.BOM_UTF8, "utf-8"), (codecs.BOM_UTF16_LE, "utf-16-le"), (codecs.BOM_UTF16_BE, "utf-16-be"))
