@@ -1,6 +1,6 @@
 """The code cache is checked before it is trusted: a PLC never runs logic
-other than its program. Every bit position of a real cache flipped in turn,
-every truncation, a padded file: each is refused before anything in it is
+other than its program. Every byte of a real cache flipped in turn (one bit
+of it, every bit position met, then all eight), truncations, padding: each is refused before anything in it is
 unmarshalled, the program is compiled from its text, runs exactly as it
 does without a cache, and the cache is rewritten (docs/engine.md, "The code
 cache")."""
@@ -75,7 +75,7 @@ def unmarshalled(monkeypatch):
     return seen
 
 
-def test_every_flipped_bit_of_a_real_cache_is_refused_before_anything_is_unmarshalled(blinker, unmarshalled):
+def test_every_flipped_byte_of_a_real_cache_is_refused_before_anything_is_unmarshalled(blinker, unmarshalled):
     app, key, good, _ = blinker
     path = app / ".softplc" / codecache.CACHE_FILE
     cache = CodeCache(path.parent)
@@ -85,14 +85,15 @@ def test_every_flipped_bit_of_a_real_cache_is_refused_before_anything_is_unmarsh
     fd = os.open(path, os.O_RDWR)  # each byte changed in place and put back: quicker than a file a byte
     try:
         for i in range(len(good)):
-            os.pwrite(fd, flipped(good, i)[i:i + 1], i)
-            if cache.load(key) is not None:
-                used.append(i)
-            os.pwrite(fd, good[i:i + 1], i)
-            if cache.problem is None:
-                quiet.append(i)
-            else:
-                said.add(cache.problem)
+            for bad in (flipped(good, i)[i], good[i] ^ 0xFF):  # one bit, then the whole byte
+                os.pwrite(fd, bytes([bad]), i)
+                if cache.load(key) is not None:
+                    used.append(i)
+                os.pwrite(fd, good[i:i + 1], i)
+                if cache.problem is None:
+                    quiet.append(i)
+                else:
+                    said.add(cache.problem)
     finally:
         os.close(fd)
     assert used == [], f"{len(used)} of {len(good)} damaged caches were used, the first at byte {used[0]}"
