@@ -166,7 +166,7 @@ def make_durable(path: str | os.PathLike[str]) -> None:
     rename comes before the fsync, so a save's rename, all a killed process
     needs, never waits for the disk.)"""
     path = Path(path)
-    fd = os.open(path, os.O_RDONLY)
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)  # never waits, whatever took the name since the rename
     try:
         os.fsync(fd)
     finally:
