@@ -67,6 +67,7 @@ def int_in(valid: range, what: str):
 
 def _cmd_address(args: argparse.Namespace) -> int:
     status = EXIT_OK
+    print("address\tcanonical\tkind\taccess")  # the columns, tab-separated as the rows
     for text in args.text:
         try:
             a = parse_address(text)

@@ -28,7 +28,7 @@ def test_help_and_version():
 def test_bad_address_exit_1_with_caret_and_no_traceback():
     proc = softplc("address", "N7:0", "T4:0.FOO")
     assert proc.returncode == 1
-    assert proc.stdout == "N7:0\tN7:0\tword\tdirect\n"
+    assert proc.stdout == "address\tcanonical\tkind\taccess\nN7:0\tN7:0\tword\tdirect\n"  # a header names the columns
     assert "bad address 'T4:0.FOO': 'FOO' is not a member" in proc.stderr
     assert "  T4:0.FOO\n       ^" in proc.stderr
     assert "Traceback" not in proc.stderr
