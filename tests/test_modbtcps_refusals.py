@@ -79,10 +79,12 @@ def mapped(plc) -> dict:
 
 
 def then_a_write_lands(plc, client) -> None:
-    """A write answered once applied: whatever came before it has reached the scan, or never will."""
+    """A write answered once applied: whatever came before it has reached the scan, or never will
+    (N7:19 is put back as it was)."""
+    was = plc.read("N7:19")
     assert not client.write_register(19, 4321, device_id=1).isError()
     assert plc.read("N7:19") == 4321
-    plc.engine.table.write("N7:19", 0)
+    plc.engine.table.write("N7:19", was)
 
 
 def wait_counted(plc, word: int, value: int) -> None:
@@ -227,6 +229,64 @@ def test_every_exception_03_is_counted_in_the_status_words_and_the_watch_view(pl
         wait_counted(plc, S.W_REFUSALS, k)
     assert f"exception 03 {len(ODD_BODIES)}" in " ".join(shown(plc.engine).split())
     assert plc.status(S.W_WRITES_APPLIED) == 0
+
+
+# -- fuzz: whatever the request, an exception answer means nothing was written ----------------------
+
+EDGES = [0, 1, 18, 19, 20, 36, 39, 40, 50, 54, 99, 100, 103, 110, 199, 200, 201, 282, 283, 365, 399, 400, 481,
+         1000, 65534, 65535]
+VALUES = [0, 1, 82, 83, 0x7FFF, 0x8000, 0xFF00, 0xFFFF]
+
+
+def random_write(rnd) -> bytes:
+    """A write request near the map's edges and the functions' limits, its
+    quantities, byte counts and length sometimes wrong."""
+    f = rnd.choice([5, 6, 15, 16, 22, 23])
+    address = rnd.choice(EDGES) if rnd.random() < 0.8 else rnd.randrange(65536)
+    value = lambda: rnd.choice(VALUES) if rnd.random() < 0.7 else rnd.randrange(65536)  # noqa: E731
+    if f in (5, 6):
+        body = struct.pack(">HH", address, value())
+    elif f == 22:
+        body = struct.pack(">HHH", address, value(), value())
+    elif f == 15:
+        count = rnd.choice([1, 8, 9, 40, 1968, 1969, 0]) if rnd.random() < 0.7 else rnd.randrange(2100)
+        byte_count = (count + 7) // 8 if rnd.random() < 0.7 else rnd.randrange(256)
+        body = struct.pack(">HHB", address, count, byte_count & 0xFF) + bytes(rnd.randrange(256)
+                                                                             for _ in range(min(byte_count, 240)))
+    else:
+        count = rnd.choice([1, 2, 83, 121, 122, 123, 124, 0]) if rnd.random() < 0.7 else rnd.randrange(130)
+        byte_count = 2 * count if rnd.random() < 0.7 else rnd.randrange(256)
+        data = b"".join(struct.pack(">H", value()) for _ in range(min(byte_count, 240) // 2))
+        if f == 16:
+            body = struct.pack(">HHB", address, count, byte_count & 0xFF) + data
+        else:
+            read = rnd.choice(EDGES), rnd.choice([1, 2, 20, 125, 126, 0])
+            body = struct.pack(">HHHHB", *read, address, count, byte_count & 0xFF) + data
+    if rnd.random() < 0.1:
+        body = body[:-1] if rnd.random() < 0.5 else body + b"\0"
+    return bytes([f]) + body[:252]
+
+
+def test_fuzz_a_write_answered_with_an_exception_changes_nothing(tcp_apps):
+    import random
+
+    plc = tcp_apps.start(server_xml(maxRequestsPerSecond=100000))
+    rnd = random.Random(27)
+    with ModbusTcpClient("127.0.0.1", port=plc.port, timeout=LIMIT_S, retries=0) as client:
+        refused = 0
+        for _ in range(300):
+            pdu = random_write(rnd)
+            before = mapped(plc)
+            reply = ask(plc.port, pdu)
+            if reply[0] & 0x80:
+                refused += 1
+                then_a_write_lands(plc, client)
+                after = mapped(plc)
+                changed = [(k, i, before[k][i], after[k][i]) for k in before for i in range(len(before[k]))
+                           if before[k][i] != after[k][i]]
+                assert not changed, f"request {pdu.hex()} answered {reply.hex()} wrote {changed}"
+        assert refused > 100  # most of them are refused: the edges are where the rules are
+    wait_counted(plc, S.W_REFUSALS, refused)
 
 
 # -- 7. a program only compiled or drawn starts no server ---------------------------------------------
