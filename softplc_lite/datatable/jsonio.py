@@ -170,13 +170,29 @@ def json_limit_problem(text: str) -> str | None:
     return None
 
 
+def json_kind(value: Any) -> str:
+    """What a JSON value is, in JSON's words: "a number", "text", "an
+    object"; never a Python type name."""
+    if isinstance(value, bool):
+        return "true or false"
+    if isinstance(value, (int, float)):
+        return f"a number ({value})"
+    if isinstance(value, str):
+        return "text"
+    if isinstance(value, dict):
+        return "an object"
+    if isinstance(value, list):
+        return "a list"
+    return "null" if value is None else "a value of another kind"
+
+
 def loads(text: str, source: str = "<json>") -> dict[str, Any]:
     """Parse JSON text, reporting a syntax error with source, line and column."""
     doc = parse_json(text, source)
     if not isinstance(doc, dict):
         raise DataTableJSONError(
             f"{source}: expected an object of files such as {{\"N7\": [1, 2]}}, "
-            f"got {type(doc).__name__}"
+            f"got {json_kind(doc)}"
         )
     return doc
 
@@ -240,7 +256,7 @@ def _apply(table: DataTable, doc: dict[str, Any], source: str) -> None:
         ftype, number = _file_key(key, source)
         where = f"{source}: {key}"
         if not isinstance(values, list):
-            raise DataTableJSONError(f"{where}: expected a list of elements, got {type(values).__name__}")
+            raise DataTableJSONError(f"{where}: expected a list of elements, got {json_kind(values)}")
         if len(values) > MAX_ELEMENTS:
             raise DataTableJSONError(f"{where}: {len(values)} elements; a file holds at most {MAX_ELEMENTS}")
         try:
