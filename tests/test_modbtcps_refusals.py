@@ -330,8 +330,9 @@ def test_compiling_or_drawing_hmi_server_starts_no_server_even_with_its_port_tak
         session = WatchSession(load_app(hmi_copy(tmp_path / "w", port), state_dir=None),
                                WatchOptions(run=RunOptions(fresh=True)))
         try:
-            text = render(session, 130, 30).export_text()
-            assert "not started" in text and server_processes() == []
+            assert "not started" in render(session, 130, 30).export_text() and server_processes() == []
+            panel = " ".join(shown(session.engine, 46).split())
+            assert "MODBTCPS 127.0.0.1:" in panel and "not started" in panel and "down" not in panel
         finally:
             session.quit()
         check = subprocess.run([sys.executable, "-m", "softplc_lite", "check", str(tmp_path / "hmi_server")],

@@ -29,13 +29,16 @@ def refusals_text(server) -> str:
 
 
 def _where(name: str, server) -> Text:
-    """``MODBTCPS 127.0.0.1:502 up``, or ``MODBTCPS down`` and why, in red."""
+    """``MODBTCPS 127.0.0.1:502 up``, ``MODBTCPS down`` and why, in red, or
+    where it will listen while it is not started yet."""
     text = Text()
     text.append(name, style="bold")
     text.append(" ")
     if server.up:
         text.append(f"{server.listening} ")
         text.append("up", style="green")
+    elif getattr(server, "pending", False):  # not started yet, or starting: neither up nor failed
+        text.append(server.listening, style="dim")
     else:
         text.append("down", style="bold red")
         text.append(f" {server.listening}", style="red")  # what the module says went wrong

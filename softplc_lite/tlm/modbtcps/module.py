@@ -287,7 +287,7 @@ class ModbTcpServer(TLM):
         up = self.failed is None and self.port is not None
         return C.ServerStatus(self.failed or self.listening, up, counters[C.CONNECTED],
                               self.rate, counters[C.REQUESTS], self._writes_applied, sum(refused.values()),
-                              refused)
+                              refused, pending=self.failed is None and self.port is None)
 
     def network_servers(self) -> list:
         status = self.server_status()

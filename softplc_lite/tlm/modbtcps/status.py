@@ -80,3 +80,4 @@ class ServerStatus:
     writes: int = 0
     refusals: int = 0
     refused: dict[str, int] | None = None  # by kind, only those not zero
+    pending: bool = False  # not started yet, or starting: neither up nor failed
