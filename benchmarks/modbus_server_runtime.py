@@ -157,6 +157,10 @@ def main() -> int:
     runner = Runner(app, RunOptions(realtime=True, fresh=True, save_state=False))
     engine = runner.engine
     module = next(m for m in engine.modules if m.name == "MODBTCPS")
+    engine.scan()  # the first scan starts the server (docs/modbtcps.md): measured with it listening
+    if module.wait_until_listening() is None:
+        print(f"MODBTCPS: {module.failed}", file=sys.stderr)
+        return 1
     hot = hot_scans(engine, module, HOT_SCANS)
     records = ScanRecords()
     instrument(runner, module, records)
