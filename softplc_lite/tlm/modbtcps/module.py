@@ -143,14 +143,24 @@ class ModbTcpServer(TLM):
             self._read_server(None)
 
     def wait_until_listening(self, timeout: float = START_TIMEOUT_S) -> int | None:
-        """For a caller beside the scan (a test, an example): the port, once
-        the server listens; None if it failed or did not start in time."""
+        """For a caller beside the scan (a test, an example, a benchmark),
+        scanning or not: the port, once the server listens; None if it
+        failed, ended, or did not listen in time. Reads only the shared
+        image and the process's state, never the scan's pipe."""
         deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            if self.port is not None or self.failed is not None:
-                break
+        while time.monotonic() < deadline and self.failed is None:
+            image, process = self.image, self.process
+            if image is not None:
+                try:
+                    counters = image.counters()
+                except ValueError:  # closed meanwhile: the run ended
+                    return None
+                if counters[C.LISTENING]:
+                    return counters[C.PORT]
+            if process is not None and process.poll() is not None:
+                return None
             time.sleep(0.01)
-        return self.port if self.failed is None else None
+        return None
 
     @property
     def listening(self) -> str:

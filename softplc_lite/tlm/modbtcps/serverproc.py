@@ -65,6 +65,7 @@ async def serve(init: dict, image, out_fd: int) -> None:
 
     server = Server(config, layout, image, out_fd, (config.host, config.port))
     port = await server.start()
+    image.set(C.PORT, port)
     image.set(C.LISTENING, 1)
     server.log(1, f"listening on {config.host}:{port}")
     os.set_blocking(out_fd, False)

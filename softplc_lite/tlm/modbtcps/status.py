@@ -26,6 +26,7 @@ MALFORMED = 10  # connections closed: a frame that is not Modbus TCP
 IDLE = 11  # connections closed: no whole request for idleTimeout
 WRITES = 12  # write requests passed to the scan
 LISTENING = 13  # 1 while the server listens
+PORT = 14  # the port it listens on
 COUNTERS = 16
 
 # Status words (offsets in the status block).
