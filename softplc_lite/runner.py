@@ -37,7 +37,9 @@ def apply_assignment(table: DataTable, text: str, symbols=None) -> None:
     """``--set TEXT`` into ``table``; any problem is a DataTableError that
     names the option as typed: ``--set StopOk=abc: I:0/1 holds a bit (0 or
     1), got abc``."""
-    shown = text if len(text) <= 60 else f"{text[:40]}... ({len(text)} characters)"
+    name = text.partition("=")[0].strip()
+    # as typed, or, too long to quote, the address it sets (the message says where in the value)
+    shown = text if len(text) <= 60 else name if len(name) <= 60 else f"{text[:40]}... ({len(text)} characters)"
     try:
         addr, value = parse_assignment(text, symbols)
         table.write(addr, value)
