@@ -10,7 +10,11 @@ while ``run`` or ``watch`` scans ends the run cleanly, exit 0).
 
 from __future__ import annotations
 
-import argparse
+from .interrupt import loaded, quit_while_loading
+
+_LOADING = quit_while_loading()  # Ctrl-C while the modules below load: exit 130, no traceback (interrupt.py)
+
+import argparse  # noqa: E402 (after the Ctrl-C handling)
 import signal
 import sys
 import threading
@@ -34,6 +38,9 @@ from .ladder.fmt import STYLES
 from .ladder.symbols import SymbolIndex, is_symbol_text, resolve_name
 from .runner import RunOptions, Runner
 from .errors import FileAccessError, LocatedError, file_error
+
+if _LOADING:  # imported, not run by python -m (whose __main__ leaves it to main()): Ctrl-C is the importer's again
+    loaded()
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT, EXIT_INTERNAL = 0, 1, 2, 3, 4
 EXIT_REPLAY = 5  # --replay: the program wrote bytes other than the recording's
@@ -187,20 +194,19 @@ def _scan_until_the_end(runner: Runner, app, args: argparse.Namespace) -> None:
     """Scan until --scans, the end of a --replay trace, a major fault, or
     Ctrl-C/SIGTERM: either signal ends the run after the scan under way, so
     the final save holds a whole scan (a second one stops at once). Then
-    SIGTERM is ignored: a service manager that sends it again must not cut
-    the final save short."""
+    both are ignored (main() restores them for a caller in the same
+    process): a service manager that sends SIGTERM again must not cut the
+    final save or the exit short."""
     def stop(signum, frame) -> None:
         if runner.stop_requested:
             raise KeyboardInterrupt
         runner.request_stop()
 
-    previous = _handle_signals({signal.SIGINT: stop, signal.SIGTERM: stop})
+    _handle_signals({signal.SIGINT: stop, signal.SIGTERM: stop})
     try:
         _run_with_status(runner, app, args.scans, unbounded=args.scans is None and args.replay is None)
     finally:
-        _handle_signals({signal.SIGTERM: signal.SIG_IGN})
-        if signal.SIGINT in previous:
-            _handle_signals({signal.SIGINT: previous[signal.SIGINT]})
+        _handle_signals({signal.SIGTERM: signal.SIG_IGN, signal.SIGINT: signal.SIG_IGN})
 
 
 def address_problems(option: str, table: DataTable, texts: list[str], symbols=None) -> list[str]:
@@ -425,11 +431,30 @@ def _handle_signals(handlers: dict) -> dict:
 
 
 def _stop_as_interrupt(signum, frame) -> None:
-    """SIGTERM does what Ctrl-C does."""
+    """SIGTERM does what Ctrl-C does, once: a second one (a service manager
+    sending it twice) is ignored, so it cannot cut the quitting short."""
+    _handle_signals({signal.SIGTERM: signal.SIG_IGN})
     raise KeyboardInterrupt
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """The softplc command. With ``argv`` None (the process's own command
+    line: the console script, python -m) it owns the process's signals to
+    the end: once the command is done, Ctrl-C and SIGTERM are ignored until
+    the process exits, so no signal turns a finished command's exit status
+    into a signal's. With ``argv`` (a program or a test calling it), the
+    caller's handlers are restored at the end."""
+    try:
+        loaded()  # Ctrl-C is a KeyboardInterrupt from here on, caught below
+        return _main(argv)
+    except KeyboardInterrupt:  # while the arguments are read (the commands catch their own)
+        return EXIT_INTERRUPTED
+    finally:
+        if argv is None:
+            _handle_signals({signal.SIGINT: signal.SIG_IGN, signal.SIGTERM: signal.SIG_IGN})
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
@@ -440,10 +465,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     previous = {}
     if args.command in ("run", "watch"):  # they end cleanly on Ctrl-C: SIGTERM (kill, systemd) too
         previous = _handle_signals({signal.SIGTERM: _stop_as_interrupt})
+        sigint = signal.getsignal(signal.SIGINT)
+        if sigint is not None and previous:  # None: not installed from Python, left alone
+            previous[signal.SIGINT] = sigint  # the run ignores it once its scanning ends
     try:
         return _dispatch(args)
     finally:
-        _handle_signals(previous)
+        if argv is not None:
+            _handle_signals({sig: handler for sig, handler in previous.items() if handler is not None})
 
 
 def _dispatch(args: argparse.Namespace) -> int:

@@ -1,0 +1,46 @@
+"""Ctrl-C while the ``softplc`` command starts (docs/cli.md, "Signals").
+
+Loading softplc's modules takes the first 0.2 s or so of every command; a
+KeyboardInterrupt there would escape as a Python traceback, before main()
+can catch anything. The entry modules (``__main__`` and ``cli``) call
+``quit_while_loading`` before their first heavy import: until main() calls
+``loaded``, Ctrl-C ends the process quietly with exit status 130, what an
+interrupted command exits with. Only Python's own default handler is
+replaced, and only in the main thread, so a program that imports softplc
+with its own SIGINT handling keeps it.
+
+This module imports nothing but ``os``, ``signal`` and ``threading``, so
+that it is in place within a few milliseconds of softplc's first line.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import threading
+
+EXIT_INTERRUPTED = 130
+
+
+def _quit(signum, frame) -> None:
+    # Nothing has been written or started while modules load, so nothing
+    # is lost by ending at once; and an exception raised here can be lost:
+    # the handler may run inside compile() (a module's source compiled on
+    # import), which does not always pass it on.
+    os._exit(EXIT_INTERRUPTED)
+
+
+def quit_while_loading() -> bool:
+    """From now until ``loaded``: Ctrl-C exits 130, quietly. Whether this
+    call changed anything (not when an entry module's call already did)."""
+    if threading.current_thread() is threading.main_thread() and \
+            signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        signal.signal(signal.SIGINT, _quit)
+        return True
+    return False
+
+
+def loaded() -> None:
+    """Ctrl-C is a KeyboardInterrupt again (the caller catches it)."""
+    if threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGINT) is _quit:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
