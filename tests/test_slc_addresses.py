@@ -102,8 +102,9 @@ def test_the_io_file_grows_to_the_slot_words_a_program_names():
 def test_softplc_address_prints_the_slc_form(capsys):
     assert main(["address", "I:1.0/3", "O:2.1"]) == 0
     out = capsys.readouterr().out.splitlines()
-    assert out[0].split("\t")[:3] == ["I:1.0/3", "I:1.0/3", "bit"]
-    assert out[1].split("\t")[:3] == ["O:2.1", "O:2.1", "word"]
+    assert out[0] == "address\tcanonical\tkind\taccess"
+    assert out[1].split("\t")[:3] == ["I:1.0/3", "I:1.0/3", "bit"]
+    assert out[2].split("\t")[:3] == ["O:2.1", "O:2.1", "word"]
 
 
 def test_a_decimal_bit_in_the_plc5_form_suggests_the_slc_form():
