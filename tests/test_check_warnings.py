@@ -40,6 +40,15 @@ def test_an_input_after_an_output_on_one_line_names_both_ways_to_end_a_rung():
 def test_a_sor_rung_spans_lines_on_purpose_so_no_semicolon_is_suggested():
     found = warnings("SOR XIC B3/0 OTE O:0/0\n    XIC B3/1 OTE O:0/1 EOR\n")
     assert found == [f"w.lad:2:5: XIC after OTE at w.lad:1:14 {SERIES}"]
+    found = warnings("SOR\nXIC B3/0 OTE O:0/0\nXIC B3/2 OTE O:0/1 EOR\n")
+    assert found == [f"w.lad:3:1: XIC after OTE at w.lad:2:10 {SERIES}"]
+
+
+def test_a_neutral_rung_that_opens_with_a_branch_or_is_indented_gets_the_semicolon_hint():
+    for text, where in [("[XIC(B3/0),XIC(B3/1)]OTE(O:0/0)\nXIC(B3/2)OTE(O:0/1);\n", "w.lad:2:1: XIC after OTE at w.lad:1:22"),
+                        ("  XIC(B3/0)OTE(O:0/0) // note\n  XIC(B3/2)OTE(O:0/1);\n", "w.lad:2:3: XIC after OTE at w.lad:1:12")]:
+        assert warnings(text) == [f"{where} {SERIES} (a ';' missing after the OTE on line 1 would join two rungs "
+                                  "into this one)"]
 
 
 @pytest.mark.parametrize("rung", [
