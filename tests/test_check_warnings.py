@@ -45,8 +45,10 @@ def test_a_sor_rung_spans_lines_on_purpose_so_no_semicolon_is_suggested():
 
 
 def test_a_neutral_rung_that_opens_with_a_branch_or_is_indented_gets_the_semicolon_hint():
-    for text, where in [("[XIC(B3/0),XIC(B3/1)]OTE(O:0/0)\nXIC(B3/2)OTE(O:0/1);\n", "w.lad:2:1: XIC after OTE at w.lad:1:22"),
-                        ("  XIC(B3/0)OTE(O:0/0) // note\n  XIC(B3/2)OTE(O:0/1);\n", "w.lad:2:3: XIC after OTE at w.lad:1:12")]:
+    for text, where in [
+        ("[XIC(B3/0),XIC(B3/1)]OTE(O:0/0)\nXIC(B3/2)OTE(O:0/1);\n", "w.lad:2:1: XIC after OTE at w.lad:1:22"),
+        ("  XIC(B3/0)OTE(O:0/0) // note\n  XIC(B3/2)OTE(O:0/1);\n", "w.lad:2:3: XIC after OTE at w.lad:1:12"),
+    ]:
         assert warnings(text) == [f"{where} {SERIES} (a ';' missing after the OTE on line 1 would join two rungs "
                                   "into this one)"]
 

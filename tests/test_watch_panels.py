@@ -141,5 +141,6 @@ def test_watch_of_a_missing_app_says_so_before_asking_for_a_terminal(tmp_path):
                        stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=60)
     run = subprocess.run([sys.executable, "-m", "softplc_lite", "run", "nosuch"], cwd=tmp_path,
                          capture_output=True, text=True, timeout=60)
-    assert (p.returncode, p.stderr) == (run.returncode, run.stderr) == (1, "nosuch: no such app directory or .lad file\n")
+    missing = (1, "nosuch: no such app directory or .lad file\n")
+    assert (p.returncode, p.stderr) == (run.returncode, run.stderr) == missing
     assert p.stdout == ""

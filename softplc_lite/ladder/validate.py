@@ -184,7 +184,8 @@ class _Checker:
         if kind is K.FILE_MODE:
             return self.file_mode(instr, index, operand)
         def where() -> str:
-            return f"{instr.mnemonic} operand {index + 1} ({self.instructions.lookup(instr.mnemonic).operand_at(index).name})"
+            name = self.instructions.lookup(instr.mnemonic).operand_at(index).name
+            return f"{instr.mnemonic} operand {index + 1} ({name})"
 
         if kind is K.EXPRESSION:
             return self.expression(operand, instr.mnemonic, where)
@@ -296,7 +297,8 @@ class _Checker:
                 raise _OverLimit  # before anything walks it recursively
         plan = self.plan(instr.mnemonic)
         if plan is None:
-            self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}{self.instructions.hint(instr.mnemonic, at_end)}")
+            hint = self.instructions.hint(instr.mnemonic, at_end)
+            self.error(instr.pos, f"unknown instruction {instr.mnemonic!r}{hint}")
             return instr
         spec = plan.spec
         n = len(given)
