@@ -162,12 +162,22 @@ class ModbTcpServer(TLM):
             time.sleep(0.01)
         return None
 
+    def _bound_port(self) -> int | None:
+        """The port listened on: from READY, or from the image when the
+        server listens and the scan has not read READY yet."""
+        if self.port is None and self.image is not None and self.failed is None:
+            counters = self.image.counters()
+            if counters[C.LISTENING]:
+                return counters[C.PORT]
+        return self.port
+
     @property
     def listening(self) -> str:
-        where = f"{self.config.host}:{self.port if self.port is not None else self.config.port}"
+        port = self._bound_port()
+        where = f"{self.config.host}:{port if port is not None else self.config.port}"
         if not self.started:
             return f"{where}, not started (the first scan starts it)"
-        return where if self.port is not None else f"{where}, starting"
+        return where if port is not None else f"{where}, starting"
 
     # -- each scan ---------------------------------------------------------------------------
     def on_input(self, engine) -> None:
@@ -294,10 +304,10 @@ class ModbTcpServer(TLM):
             return None
         counters = self.image.counters() if self.image is not None else ZERO_COUNTERS
         refused = {name: counters[c] for name, c in C.REFUSAL_NAMES if counters[c]}
-        up = self.failed is None and self.port is not None
-        return C.ServerStatus(self.failed or self.listening, up, counters[C.CONNECTED],
+        bound = self.failed is None and self._bound_port() is not None
+        return C.ServerStatus(self.failed or self.listening, bound, counters[C.CONNECTED],
                               self.rate, counters[C.REQUESTS], self._writes_applied, sum(refused.values()),
-                              refused, pending=self.failed is None and self.port is None)
+                              refused, pending=self.failed is None and not bound)
 
     def network_servers(self) -> list:
         status = self.server_status()
