@@ -36,12 +36,12 @@ from .ast import (
     Text,
     UnaryOp,
     leaves,
-    walk,
 )
 from .errors import LadderError, ProgramErrors
 from .instructions import BUILTIN, MAX_PARAMETERS, InstructionSet, K
-from .limits import MAX_BRANCH_DEPTH, MAX_EXPRESSION_DEPTH, expression_depth, limit_problem, short_quote
+from .limits import MAX_BRANCH_DEPTH, MAX_EXPRESSION_DEPTH, expression_depth, limit_problem
 from .parser import parse_expression
+from .subroutine_check import SubroutineChecks, describe as _describe, pos_of as _pos
 from .symbols import SymbolIndex, resolve_name, symbol_base
 
 _NUMERIC = (ValueKind.WORD, ValueKind.FLOAT, ValueKind.LONG)  # LONG: SLC/MicroLogix L elements
@@ -94,7 +94,7 @@ class _Plan:
         self.unindexed = tuple(kind in _FILE_KINDS for kind in self.kinds)
 
 
-class _Checker:
+class _Checker(SubroutineChecks):
     def __init__(self, program: Program, instructions: InstructionSet = BUILTIN) -> None:
         self.program = program
         self.instructions = instructions
@@ -366,53 +366,6 @@ class _Checker:
             return instr  # already in validated form, the spec's mnemonic string included: kept
         return instr.copy_with(plan.mnemonic, operands)
 
-    def jsr_parameters(self, instr: Instruction, operands: list, target: int) -> None:
-        """A JSR's parameters against its subroutine: as many inputs as the
-        target's SBR receives, return parameters that are addresses, and as
-        many of them as each RET with values in the target returns."""
-        count = operands[1] if len(operands) > 1 else Const(0, instr.pos)  # JSR file: no parameters
-        if not (isinstance(count, Const) and isinstance(count.value, int) and 0 <= count.value <= MAX_PARAMETERS):
-            return  # a count already reported
-        inputs, params = count.value, operands[2:]
-        if inputs > len(params):
-            self.error(_pos(count), f"JSR passes {inputs} input parameter{_s(inputs)} but lists "
-                       f"{len(params)} parameter{_s(len(params))}")
-            return
-        returns = params[inputs:]
-        if len(returns) > MAX_PARAMETERS:
-            self.error(_pos(returns[MAX_PARAMETERS]), f"JSR takes at most {MAX_PARAMETERS} return parameters, "
-                       f"got {len(returns)}")
-        for k, ret in enumerate(returns):
-            if isinstance(ret, Const):
-                self.error(_pos(ret), f"JSR operand {inputs + 3 + k} (return parameter) must be a word or float "
-                           f"address, not {_describe(ret)}")
-        sbr, rets = self.subroutine_shape(target)
-        received = len(sbr.operands) if sbr is not None else 0
-        if received != inputs:
-            where = f"its SBR at {sbr.pos} receives {received}" if sbr is not None else "it has no SBR with parameters"
-            self.error(_pos(count), f"JSR passes {inputs} input parameter{_s(inputs)} to program file "
-                       f"{target}, but {where}")
-        if returns:
-            if not rets:
-                self.error(instr.pos, f"JSR expects {len(returns)} return parameter{_s(len(returns))} from program "
-                           f"file {target}, which has no RET with values")
-            for ret in rets:
-                if len(ret.operands) != len(returns):
-                    self.error(instr.pos, f"JSR expects {len(returns)} return parameter{_s(len(returns))} from "
-                               f"program file {target}, but the RET at {ret.pos} returns {len(ret.operands)}")
-
-    def subroutine_shape(self, number: int) -> tuple[Instruction | None, list[Instruction]]:
-        """Program file ``number``'s SBR with parameters (the first instruction
-        of its first rung) and its RETs with values, from the parsed text."""
-        shape = self._shapes.get(number)  # every JSR to a file asks: walk it once
-        if shape is None:
-            rungs = self.program.files[number].rungs
-            first = rungs[0].elements[0] if rungs and rungs[0].elements else None
-            sbr = first if isinstance(first, Instruction) and first.mnemonic == "SBR" and first.operands else None
-            rets = [ins for rung in rungs for ins in walk(rung.elements) if ins.mnemonic == "RET" and ins.operands]
-            shape = self._shapes[number] = (sbr, rets)
-        return shape
-
     def series(self, elements: list[Element], file_number: int, labels: set[int], first: bool,
                depth: int = 0, tail: bool = True) -> tuple[Element, ...]:
         """The validated series (``depth``: branches around it). Raises
@@ -589,27 +542,9 @@ def _has_compare(expr) -> bool:
     return False
 
 
-def _s(n: int) -> str:
-    return "" if n == 1 else "s"
-
-
-def _pos(operand):
-    return getattr(operand, "pos")
-
-
 def _a(kind: str) -> str:
     """An operand kind with its article: "a bit address", "an integer constant"."""
     return f"{'an' if kind[0] in 'aeiou' else 'a'} {kind}"
-
-
-def _describe(operand: Operand) -> str:
-    if isinstance(operand, AddressRef):
-        return f"{operand.address} (a {operand.address.kind.value})"
-    if isinstance(operand, Const):
-        return f"the constant {operand.value}"
-    if isinstance(operand, Text):
-        return f"the string {short_quote(operand.value)}"
-    return "an expression"
 
 
 def check(program: Program, instructions: InstructionSet = BUILTIN) -> tuple[Program, list[LadderError]]:
