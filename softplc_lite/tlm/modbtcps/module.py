@@ -38,7 +38,6 @@ from pathlib import Path
 from typing import Mapping
 
 from ..api import TLM
-from ..errors import ModuleError
 from . import messages as msg
 from . import status as C
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config
@@ -114,7 +113,7 @@ class ModbTcpServer(TLM):
             return
         self._ready_by = time.monotonic() + START_TIMEOUT_S
         if not engine.clock.realtime:  # simulated time: every scan of the run sees it listening
-            self._wait_ready()
+            self._wait_ready(engine.table)
 
     def _spawn(self) -> None:
         read_fd, write_fd = os.pipe()
@@ -136,11 +135,12 @@ class ModbTcpServer(TLM):
         except OSError:
             pass  # the process died at once: the end of its pipe says so
 
-    def _wait_ready(self) -> None:
-        """Block until the server listens or cannot (simulated time only)."""
+    def _wait_ready(self, table) -> None:
+        """Block until the server listens or cannot (simulated time only);
+        a write that comes with its READY is applied to ``table``."""
         while self._ready_by is not None and self._from_server >= 0:
             select.select([self._from_server], [], [], 0.05)
-            self._read_server(None)
+            self._read_server(table)
 
     def wait_until_listening(self, timeout: float = START_TIMEOUT_S) -> int | None:
         """For a caller beside the scan (a test, an example, a benchmark),
@@ -188,7 +188,7 @@ class ModbTcpServer(TLM):
 
     def _read_server(self, table) -> None:
         """What the server sent: READY, FAILED, and the clients' writes,
-        applied to ``table`` (None: before the first write can come)."""
+        applied to ``table``."""
         try:
             data = os.read(self._from_server, 1 << 20)
         except BlockingIOError:
@@ -207,7 +207,7 @@ class ModbTcpServer(TLM):
             elif m[0] == msg.FAILED:  # the end of the pipe follows
                 self._lost(m[1])
                 return
-            elif table is not None:
+            else:
                 self._apply(m, table)
 
     def _apply(self, m: tuple, table) -> None:
