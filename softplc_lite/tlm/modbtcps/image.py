@@ -126,7 +126,10 @@ class SharedImage:
         remove_stale(directory)
         size = max(IMAGE_START + image_bytes, IMAGE_START)
         fd, path = create_named(size, directory)
-        os.unlink(path)
+        try:
+            os.unlink(path)
+        except FileNotFoundError:  # removed by another runtime's clean-up meanwhile: the open file serves
+            pass
         try:
             return cls(fd, size)
         except BaseException:
