@@ -144,3 +144,24 @@ def test_watch_of_a_missing_app_says_so_before_asking_for_a_terminal(tmp_path):
     missing = (1, "nosuch: no such app directory or .lad file\n")
     assert (p.returncode, p.stderr) == (run.returncode, run.stderr) == missing
     assert p.stdout == ""
+
+
+def test_the_view_loop_pages_the_key_list_at_the_size_it_draws(open_app):
+    from softplc_lite.watch.terminal import ViewLoop
+
+    session = open_app("motor")
+    console = Console(width=80, height=24, color_system=None, file=io.StringIO(), legacy_windows=False)
+    drawn = []
+
+    def draw(screen):
+        with console.capture() as cap:
+            console.print(screen)
+        drawn.append(cap.get())
+
+    loop = ViewLoop(session, WatchScreen(session, rung_view, measured=False), draw)
+    loop.tick("?")
+    assert "keys, page 1 of 2" in drawn[-1]
+    loop.tick(" ")
+    assert "keys, page 2 of 2" in drawn[-1] and "quit (saves the retentive data table)" in drawn[-1]
+    loop.tick(" ")  # past the last page: closed, and nothing else done
+    assert "keys," not in drawn[-1] and "Rung 0" in drawn[-1] and session.engine.scans == 0
