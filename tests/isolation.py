@@ -5,7 +5,9 @@ checkout beside a user's running PLC and on several workers at once.
 * Hypothesis keeps its example database and caches in one temporary
   directory per run (its default is ``.hypothesis/`` in the working
   directory), handed to xdist workers and to pytest runs the tests start
-  through ``HYPOTHESIS_STORAGE_DIRECTORY``.
+  through ``HYPOTHESIS_STORAGE_DIRECTORY``. Its per-example deadline is
+  off suite-wide (profile "softplc"): on cores shared with another worker
+  it would time the machine's load, not the code.
 * The session hooks list the repository tree before and after the run and
   fail the run, naming each path, when anything appeared in it. They act in
   the process that runs the session: the xdist controller, whose session
@@ -27,6 +29,7 @@ import tempfile
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
 from hypothesis.configuration import set_hypothesis_home_dir
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -34,13 +37,15 @@ SKIPPED = {".git", "__pycache__"}
 SOURCES = (".py", ".md")
 
 
-def hypothesis_home() -> None:
+def hypothesis_setup() -> None:
     home = os.environ.get("HYPOTHESIS_STORAGE_DIRECTORY")
     if not home:
         home = tempfile.mkdtemp(prefix="softplc-hypothesis-")
         os.environ["HYPOTHESIS_STORAGE_DIRECTORY"] = home
         atexit.register(shutil.rmtree, home, ignore_errors=True)
     set_hypothesis_home_dir(home)
+    settings.register_profile("softplc", deadline=None)
+    settings.load_profile("softplc")  # --hypothesis-profile, applied later, still wins
 
 
 def repo_listing(root: Path = ROOT) -> set[str]:
