@@ -64,6 +64,7 @@ def late_scans(stderr: str) -> tuple[int, int]:
     return int(m.group(1)), int(m.group(2))
 
 
+@pytest.mark.alone  # counts late real-time scans (docs/testing.md)
 def test_20_clients_write_counters_for_10_seconds_every_write_lands_and_no_scan_is_late(tmp_path):
     port = free_tcp_port()
     units = '<Unit id="1"><HoldingRegisters start="0" count="20" address="N7:0" writable="yes"/></Unit>\n'

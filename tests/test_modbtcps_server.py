@@ -89,7 +89,9 @@ def test_read_floats_in_both_word_orders(plc, client):
 
 def test_read_input_registers_words_and_a_float(plc, client):
     plc.engine.table.write("F8:20", 0.1)
-    plc.wait_for(lambda: client.read_input_registers(0, count=1, device_id=1).registers[0] > 3, "scans counted")
+    counted = plc.read("N11:0")  # a scan that counts past the next has published the write
+    plc.wait_for(lambda: client.read_input_registers(0, count=1, device_id=1).registers[0] >= counted + 2,
+                 "scans counted")
     regs = client.read_input_registers(20, count=2, device_id=1).registers
     assert client.convert_from_registers(regs, client.DATATYPE.FLOAT32) == pytest.approx(0.1, rel=1e-7)
 

@@ -478,6 +478,7 @@ def run_and_kill(app: Path, state: Path, server: socket.socket, rng: random.Rand
     return {"last": received[-1], "first": received[0], "tmp_left": tmp_left}
 
 
+@pytest.mark.alone  # scans lost to a kill, in wall-clock ms (docs/testing.md)
 def test_sigkill_loses_at_most_save_ms_of_scans_and_never_half_a_scan(tmp_path):
     """SIGKILL `softplc run --realtime --scan-ms 5` 15 times: at random
     moments (small table), and (after a first random one) the moment a save
