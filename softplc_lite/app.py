@@ -18,7 +18,7 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from .datatable import DataTable, DataTableError, jsonio
-from .errors import FileAccessError, LocatedError
+from .errors import FileAccessError, LocatedError, shown_path
 from .display import Display, display_names, parse_display
 from .ladder.ast import Pos, Program, walk
 from .ladder.errors import LadderError
@@ -75,7 +75,15 @@ class App:
 
     @property
     def name(self) -> str:
-        return self.path.stem if not self.is_dir else self.path.name
+        """The app as messages name it: its directory's name (that of the
+        directory it stands for when given as "." or ".."), or its file's
+        stem."""
+        if not self.is_dir:
+            return shown_path(self.path.stem)
+        name = self.path.name
+        if name in ("", ".", ".."):
+            name = self.path.resolve().name or str(self.path.resolve())  # "/" has no name
+        return shown_path(name)
 
     @property
     def snapshot_path(self) -> Path | None:
@@ -116,9 +124,9 @@ def parse_files(files: list[Path], base: Path, instructions: InstructionSet = BU
 
 def _display(f: Path, base: Path) -> str:
     try:
-        return str(f.relative_to(Path.cwd()))
+        return shown_path(f.relative_to(Path.cwd()))
     except ValueError:
-        return str(f)
+        return shown_path(f)
 
 
 def read_settings_file(path: Path) -> dict:
@@ -301,13 +309,13 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
     the state directory (ladder/codecache.py; check passes False)."""
     path = Path(path)
     if not path.exists():
-        raise AppError(f"{path}: no such app directory or .lad file")
+        raise AppError(f"{shown_path(path)}: no such app directory or .lad file")
     is_dir = path.is_dir()
     files = lad_files(path)
     if is_dir and not files:
-        raise AppError(f"{path}: the app directory has no .lad program files")
+        raise AppError(f"{shown_path(path)}: the app directory has no .lad program files")
     if not is_dir and path.suffix.lower() != ".lad":
-        raise AppError(f"{path}: expected an app directory or a .lad file")
+        raise AppError(f"{shown_path(path)}: expected an app directory or a .lad file")
     module_dir = path if is_dir else path.parent
     try:
         modules, _ = load_modules(module_dir, configure=False)

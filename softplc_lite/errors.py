@@ -9,12 +9,30 @@ a traceback.
 ``file_error(e, path, action)`` turns an OSError met opening, reading or
 writing a user's file into a sentence ("cannot read app/softplc.toml:
 permission denied"), never Python's ``[Errno 13] Permission denied: '...'``.
+
+``shown_path(path)`` is a path as every message and the watch view show
+it: printable on any output, whatever bytes the file name holds.
 """
 
 from __future__ import annotations
 
 import errno
 import os
+
+
+def shown_path(path: str | bytes | os.PathLike) -> str:
+    """``path`` as text that any output can print. Linux lets a file name
+    hold bytes that are not UTF-8 (b"\\xff.lad"); Python gives them as
+    surrogate escapes, which a UTF-8 output refuses. Such bytes are shown as
+    backslash escapes (``\\xff.lad``), so the name still says which bytes
+    it has; any other name is unchanged."""
+    name = os.fsdecode(os.fspath(path))
+    if name.isascii():
+        return name
+    try:
+        return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    except UnicodeEncodeError:  # a surrogate that is no escaped byte
+        return name.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 class LocatedError(Exception):
@@ -28,7 +46,7 @@ class LocatedError(Exception):
         super().__init__(self.report())
 
     def report(self) -> str:
-        where = self.path or ""
+        where = shown_path(self.path) if self.path else ""
         if self.line:
             where += f":{self.line}"
             if self.column:
@@ -84,5 +102,5 @@ def file_error(e: OSError, path: str | os.PathLike[str] | None = None, action: s
     create, save...); ``path`` defaults to the file the OSError names."""
     name = os.fspath(path) if path is not None else (e.filename if e.filename is not None else "")
     name = os.fsdecode(name) if isinstance(name, bytes) else str(name)
-    where = f" {name}" if name else ""
+    where = f" {shown_path(name)}" if name else ""
     return FileAccessError(f"cannot {action}{where}: {os_error_words(e)}", name or None, e)
