@@ -56,6 +56,7 @@ def verify(program: Program, instructions: InstructionSet = BUILTIN, parsed: Pro
     ``shown``: names used outside the rungs (softplc.toml's [display]), which
     count as uses. ``overflow`` is the app's math setting."""
     found: list[LadderError] = []
+    roles = {m: spec.output for m, spec in instructions.table.items()}  # mnemonic -> is an output
     outputs: dict[str, list[Instruction]] = defaultdict(list)
     elements: dict[str, list[Instruction]] = defaultdict(list)
     for pfile in program.files.values():
@@ -75,7 +76,7 @@ def verify(program: Program, instructions: InstructionSet = BUILTIN, parsed: Pro
                         elements[str(op.address)].append(ins)
                 if ins.mnemonic in _STORES:
                     found += _constant_warnings(ins, overflow)
-            found += _input_after_output(rung, instructions)
+            found += _input_after_output(rung, roles)
             if rung.elements and not has_output and not only_markers:
                 found.append(LadderError(rung.pos, "rung has no output instruction: its conditions "
                                          "are evaluated and nothing is done with them"))
@@ -99,11 +100,12 @@ def verify(program: Program, instructions: InstructionSet = BUILTIN, parsed: Pro
     return sorted(found, key=lambda e: (e.pos.source, e.pos.line, e.pos.column))
 
 
-def _input_after_output(rung: Rung, instructions: InstructionSet) -> list[LadderError]:
+def _input_after_output(rung: Rung, roles: dict[str, bool]) -> list[LadderError]:
     """The first input instruction of ``rung`` that an output instruction
     precedes in series (on the rung, or inside a branch leg, or after a
     branch one of whose legs ends in an output); outputs in parallel legs,
-    each last in its leg, are the way to have several."""
+    each last in its leg, are the way to have several. ``roles``: mnemonic
+    -> whether it is an output instruction (unknown ones are skipped)."""
     first: list[tuple[Instruction, Instruction]] = []
 
     def series(elements, before: Instruction | None) -> Instruction | None:
@@ -115,12 +117,10 @@ def _input_after_output(rung: Rung, instructions: InstructionSet) -> list[Ladder
                 after = [series(leg, before) for leg in el.legs]
                 before = next((o for o in after if o is not None), None)
                 continue
-            spec = instructions.lookup(el.mnemonic)
-            if spec is None:
-                continue
-            if spec.output:
+            output = roles.get(el.mnemonic)
+            if output:
                 before = el
-            elif before is not None:
+            elif output is not None and before is not None:
                 first.append((el, before))
         return before
 
