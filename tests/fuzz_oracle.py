@@ -304,6 +304,8 @@ def check_case(case: Case, root: Path, timeout: float = 20.0, runner=run_main,
     """Write ``case`` under ``root``, run it, apply every property."""
     root = Path(root)
     case.write(root)
+    if case.driver:
+        return DRIVERS[case.driver](case, root, timeout, runner)
     d = str(root)
     findings: list[Finding] = []
     results: list[Result] = []
@@ -343,6 +345,24 @@ def check_case(case: Case, root: Path, timeout: float = 20.0, runner=run_main,
         for style in fmt_styles:
             fmt_roundtrip(root / rel, style, do, findings, case)
     return findings, results
+
+
+def _drivers() -> dict:
+    import fuzz_files
+    import fuzz_protocol
+    import fuzz_signals
+
+    return {"files": fuzz_files.run_files_case, "signals": fuzz_signals.run_signals_case,
+            "modbus_tcp": fuzz_protocol.run_modbus_case}
+
+
+class _Drivers(dict):
+    def __missing__(self, key):
+        self.update(_drivers())
+        return dict.__getitem__(self, key)
+
+
+DRIVERS = _Drivers()
 
 
 def dump_roundtrip(first: Result, root: Path, do, findings: list[Finding], case: Case) -> None:

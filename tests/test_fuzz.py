@@ -4,7 +4,7 @@ The generators are tests/fuzz_inputs.py, the oracle tests/fuzz_oracle.py;
 tools/fuzz.py runs the same for minutes in several processes
 (docs/fuzzing.md). Here every input kind gets a bounded, derandomized run
 (the same inputs on every machine, no example database), with the profile
-``MUST_PASS``: input classes still being fixed (none now; issue 15 listed fifteen) are
+``MUST_PASS``: input classes still being fixed (``fuzz_inputs.KNOWN_OPEN``) are
 left out, so a failure here is a new regression, not a known bug. The
 campaign (``tools/fuzz.py``, profile ``all``) is where the open classes
 show.
@@ -32,6 +32,9 @@ EXAMPLES = {
     "ladder": 45, "toml": 30, "datatable_json": 30, "load_json": 30, "modules_lst": 25, "comgenius_lst": 35,
     "modbmast_xml": 20, "cli_args": 40, "trace": 20, "snapshot_file": 40, "snapshot_app": 25, "address": 40,
     "watch": 25,
+    # Files that are not what their name promises, damaged state, signals, a live Modbus TCP server:
+    # together about 20 s (a signals case is a real run of 1-2 s, a modbus_tcp case a few hundred requests).
+    "special_files": 20, "state_damage": 12, "signals": 3, "modbus_tcp": 2,
 }
 
 # Findings the product still has for inputs the MUST_PASS profile draws,
@@ -142,6 +145,53 @@ def test_run_main_catches_what_escapes_and_usage_exits(monkeypatch):
     assert fo.run_main(["check", "programs/blinker"]).code == 0
 
 
+def _files_case(name: str, spec: str) -> Case:
+    import random
+
+    import fuzz_files
+
+    return fuzz_files.special_case(name, spec, random.Random(0), fi.EVERYTHING)
+
+
+def test_files_oracle_wants_a_special_input_refused_and_named(tmp_path):
+    """A stand-in softplc that accepts a FIFO main.lad, then one that refuses it without naming it."""
+    case = _files_case("main.lad", "fifo")
+    accepts = lambda argv, timeout: fo.Result(argv, 0)  # noqa: E731
+    findings, _ = fo.check_case(case, tmp_path / "a", runner=accepts)
+    assert {f.cls for f in findings} == {"not-refused"}
+    unnamed = lambda argv, timeout: fo.Result(argv, 1, err="error: cannot read a file: No such file or directory")  # noqa: E731
+    findings, _ = fo.check_case(case, tmp_path / "b", runner=unnamed)
+    assert {f.cls for f in findings} == {"unnamed", "raw-errno"}
+    findings, _ = fo.check_case(case, tmp_path / "c")  # the real one
+    assert findings == []
+
+
+def test_files_oracle_sees_a_code_cache_that_changes_the_logic(tmp_path):
+    """A stand-in for a run that loads a damaged cache: its table is not the one the run without a cache makes."""
+    case = _files_case("codecache.bin", "empty")
+    runs = []
+
+    def runner(argv, timeout):
+        r = fo.run_main(argv, timeout)
+        runs.append(argv)
+        if len(runs) == 3:  # prepare, reference, then the run on the damaged cache
+            Path(argv[argv.index("--dump") + 1]).write_text('{"N7": [1]}')
+        return r
+
+    findings, _ = fo.check_case(case, tmp_path, runner=runner)
+    assert {f.cls for f in findings} == {"cache-other-logic"}
+
+
+def test_special_files_cover_every_file_softplc_reads_and_every_special():
+    import fuzz_files
+
+    assert set(fuzz_files.SPECIALS) == {"fifo", "devzero", "dangling", "loop", "dir", "sparse", "empty"}
+    targets = {t[1].split("/")[-1] for t in fuzz_files.TARGETS.values()}
+    assert {"main.lad", "softplc.toml", "MODULES.LST", "COMGENIUS.LST", "MODBMAST.XML", "MODBTCPS.XML", "datatable.json",
+            "load.json", "replay.trace", "t.snap", "t.json", "watch.txt", "datatable.snap", "datatable.snap.prev",
+            "codecache.bin"} <= targets
+
+
 def test_fmt_property_sees_text_that_does_not_parse_back(tmp_path):
     """fmt_roundtrip on a stand-in for fmt whose output never parses."""
     lad = tmp_path / "app" / "main.lad"
@@ -187,3 +237,14 @@ def test_small_int_numbers_stay_under_the_digit_limit(n):
         text = fi.interesting_number(rnd, fi.SMALL_INTS)
         assert len(text) <= 4302, text[:40]
         assert "e999" not in text
+
+
+def test_the_campaign_lists_every_kind():
+    """tools/fuzz.py --help names every kind --kinds takes."""
+    import subprocess
+    import sys
+
+    tool = Path(__file__).resolve().parents[1] / "tools" / "fuzz.py"
+    text = " ".join(subprocess.run([sys.executable, str(tool), "--help"], capture_output=True, text=True,
+                                   check=True).stdout.split())
+    assert all(kind in text for kind in KINDS), [k for k in KINDS if k not in text]

@@ -12,6 +12,14 @@ cases it also runs one case through the real ``softplc`` command. The parent
 restarts a worker that stops answering (a hang the watchdog could not break)
 or dies (a crash, or the memory limit), and records that case as a finding.
 
+Four kinds are run by a driver of the oracle rather than command by command:
+``special_files`` and ``state_damage`` change a file between commands (a FIFO,
+a link to /dev/zero, a sparse 20 GiB file... in place of each file softplc
+reads; flipped bytes in a real snapshot or code cache), ``signals`` sends
+SIGINT/SIGTERM to a real ``softplc run`` at a random moment, ``modbus_tcp``
+sends hostile requests to a live MODBTCPS server. Their ``repro.sh`` replays
+the whole case.
+
 A finding is saved once per signature (class, command, exception type and
 last frame, or normalised message) under OUT/CLASS/HASH/: ``files/`` (the
 case's files), ``case.json``, ``finding.txt`` (the command, its output and
@@ -78,9 +86,14 @@ def save_finding(out: Path, finding, case, root: str) -> bool:
             text += ["--- traceback", r.traceback]
     (target / "finding.txt").write_text("\n".join(text).replace(root, "{d}") + "\n", encoding="utf-8",
                                         errors="backslashreplace")
-    repro = ["#!/bin/sh", "# The command of this finding, on the files next to this script.",
-             'D="$(cd "$(dirname "$0")/files" && pwd)"',
-             "softplc " + " ".join(shlex.quote(a).replace("{d}", "'\"$D\"'") for a in argv), ""]
+    if case.driver:  # the files change between commands, or a process is signalled, or a server is sent requests
+        repro = ["#!/bin/sh", f"# A {case.kind} case: its driver ({case.driver}) does more than one command on the files,",
+                 "# so the whole case is replayed, in-process (add --real for the softplc command).",
+                 f'python "{Path(__file__).resolve()}" --replay "$(dirname "$0")"', ""]
+    else:
+        repro = ["#!/bin/sh", "# The command of this finding, on the files next to this script.",
+                 'D="$(cd "$(dirname "$0")/files" && pwd)"',
+                 "softplc " + " ".join(shlex.quote(a).replace("{d}", "'\"$D\"'") for a in argv), ""]
     (target / "repro.sh").write_bytes("\n".join(repro).encode("utf-8", "surrogateescape"))
     (target / "finding.json").write_text(json.dumps({"class": finding.cls, "signature": finding.signature,
                                                      "argv": argv, "detail": finding.detail}, indent=1))
@@ -338,7 +351,9 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=0, help="base seed: the same seed draws the same inputs (default 0)")
     p.add_argument("--out", default=str(ROOT / "fuzz-findings"), help="where findings are saved (default fuzz-findings/)")
     p.add_argument("--jobs", type=int, default=2, help="worker processes (default 2)")
-    p.add_argument("--kinds", help="comma-separated input kinds (default all)")
+    p.add_argument("--kinds", help="comma-separated input kinds (default all): ladder, toml, datatable_json, load_json, "
+                                   "modules_lst, comgenius_lst, modbmast_xml, cli_args, trace, snapshot_file, "
+                                   "snapshot_app, address, watch, special_files, state_damage, signals, modbus_tcp")
     p.add_argument("--profile", choices=("all", "must-pass"), default="all",
                    help="all: every feature, the known-open classes too (default); must-pass: what the test suite uses")
     p.add_argument("--timeout", type=float, default=20.0, help="seconds per command before it counts as a hang (default 20)")
