@@ -18,6 +18,10 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 BLINKER = ROOT / "programs" / "blinker" / "main.lad"
+# The two ways the command starts: python -m, and the console script pip
+# installed beside this interpreter (which imports softplc_lite.cli itself).
+ENTRIES = {"python -m": [sys.executable, "-m", "softplc_lite"],
+           "console script": [sys.executable, str(Path(sys.executable).parent / "softplc")]}
 
 
 @pytest.fixture(name="app")
@@ -28,11 +32,10 @@ def fixture_app(tmp_path) -> Path:
     return app
 
 
-def start(app: Path, *args: str, env: dict | None = None) -> subprocess.Popen:
+def start(app: Path, *args: str, env: dict | None = None, entry: str = "python -m") -> subprocess.Popen:
     """``softplc run APP`` on the wall clock, until stopped."""
-    return subprocess.Popen([sys.executable, "-m", "softplc_lite", "run", str(app), "--fresh",
-                             "--print", "C5:0.ACC", *args], cwd=app.parent, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env)
+    return subprocess.Popen([*ENTRIES[entry], "run", str(app), "--fresh", "--print", "C5:0.ACC", *args],
+                            cwd=app.parent, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
 
 
 def finish(proc: subprocess.Popen) -> tuple[int, str, str]:
@@ -45,13 +48,13 @@ def finish(proc: subprocess.Popen) -> tuple[int, str, str]:
     return proc.returncode, out, err
 
 
-def softplc_loading(app: Path) -> subprocess.Popen:
+def softplc_loading(app: Path, entry: str) -> subprocess.Popen:
     """A run whose standard error says, line by line, each module Python
     has finished importing (PYTHONPROFILEIMPORTTIME), read up to the first
     of softplc's own modules after softplc_lite.interrupt: from there on
     softplc's code handles Ctrl-C."""
     env = dict(os.environ, PYTHONPROFILEIMPORTTIME="1")
-    proc = start(app, "--state", str(app / "state"), env=env)
+    proc = start(app, "--state", str(app / "state"), env=env, entry=entry)
     deadline = time.monotonic() + 30
     while time.monotonic() < deadline:
         line = proc.stderr.readline()
@@ -62,9 +65,10 @@ def softplc_loading(app: Path) -> subprocess.Popen:
     pytest.fail("softplc's modules never loaded")
 
 
+@pytest.mark.parametrize("entry", ENTRIES)
 @pytest.mark.parametrize("delay", [0, 0.005, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3])
-def test_ctrl_c_while_softplc_loads_exits_130_without_a_traceback(app, delay):
-    proc = softplc_loading(app)
+def test_ctrl_c_while_softplc_loads_exits_130_without_a_traceback(app, delay, entry):
+    proc = softplc_loading(app, entry)
     time.sleep(delay)
     proc.send_signal(signal.SIGINT)
     code, out, err = finish(proc)
