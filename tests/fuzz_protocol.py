@@ -23,6 +23,7 @@ exception code in its own word.
 
 from __future__ import annotations
 
+import json
 import random
 import socket
 import struct
@@ -170,13 +171,23 @@ def _table(engine) -> dict:
     return {k: v for k, v in export_table(engine.table).items() if k not in SKIPPED_FILES}
 
 
+def _fname(function: int) -> str:
+    """A function for a signature: each served one by its number, the others as one."""
+    return f"f{function}" if function in SERVED else "f-other"
+
+
+def _same(a, b) -> bool:
+    """Equal, a NaN equal to a NaN (a float word holding one is unchanged)."""
+    return json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
+
+
 def _diff(before: dict, after: dict) -> list[str]:
     out = []
     for k in sorted(set(before) | set(after)):
         a, b = before.get(k), after.get(k)
-        if a != b:
+        if not _same(a, b):
             if isinstance(a, list) and isinstance(b, list) and len(a) == len(b):
-                out += [f"{k}:{i} {x!r} -> {y!r}" for i, (x, y) in enumerate(zip(a, b)) if x != y]
+                out += [f"{k}:{i} {x!r} -> {y!r}" for i, (x, y) in enumerate(zip(a, b)) if not _same(x, y)]
             else:
                 out.append(f"{k}: {str(a)[:40]} -> {str(b)[:40]}")
     return out
@@ -215,7 +226,7 @@ def run_modbus_case(case, root: Path, timeout: float, runner):
                 conn.close()
                 if malformed:
                     continue  # a length past the bytes sent: the server waits for the rest; not counted yet
-                add("no-answer", f"f{frame[7]}", f"no answer in 5 s to {frame.hex()}")
+                add("no-answer", f"{_fname(frame[7])}", f"no answer in 5 s to {frame.hex()}")
                 continue
             lines.append(f"{frame.hex()} -> {reply.hex() if reply else 'closed'}")
             if reply is None:
@@ -223,20 +234,20 @@ def run_modbus_case(case, root: Path, timeout: float, runner):
                     expected["refusals"] += 1
                     expected["W_MALFORMED"] += 1
                 else:
-                    add("no-answer", f"closed:f{frame[7]}", f"the connection closed on a well-formed {frame.hex()}")
+                    add("no-answer", f"closed:{_fname(frame[7])}", f"the connection closed on a well-formed {frame.hex()}")
                     continue
             elif malformed:
-                add("malformed-answered", f"f{frame[7]}", f"{frame.hex()} answered {reply.hex()}")
+                add("malformed-answered", f"{_fname(frame[7])}", f"{frame.hex()} answered {reply.hex()}")
                 continue
             elif reply[:2] != frame[:2] or reply[6] != frame[6] or reply[7] not in (frame[7], frame[7] | 0x80):
-                add("wrong-reply", f"f{frame[7]}", f"{frame.hex()} answered {reply.hex()}")
+                add("wrong-reply", f"{_fname(frame[7])}", f"{frame.hex()} answered {reply.hex()}")
                 continue
             elif reply[7] == frame[7] and frame[7] < 0x80:
                 continue  # answered normally: what it wrote is the client's right
             else:
                 code = reply[8] if len(reply) > 8 else -1
                 if code not in EXCEPTION_WORDS:
-                    add("exception-code", f"f{frame[7]}:{code}", f"{frame.hex()} answered exception {code}")
+                    add("exception-code", f"{_fname(frame[7])}:{code}", f"{frame.hex()} answered exception {code}")
                     continue
                 expected["refusals"] += 1
                 expected[EXCEPTION_WORDS[code]] += 1
@@ -248,7 +259,7 @@ def run_modbus_case(case, root: Path, timeout: float, runner):
                 conn.close()
             changed = _diff(before, _table(plc.engine))
             if changed:
-                add("changed-by-refusal", f"f{frame[7]}:{'malformed' if malformed else reply[8]}",
+                add("changed-by-refusal", f"{_fname(frame[7])}:{'malformed' if malformed else reply[8]}",
                     f"{frame.hex()} answered {reply.hex() if reply else 'closed'} and changed {changed[:6]}")
         conn.close()
         words = {"refusals": S.W_REFUSALS, **{w: getattr(S, w) for w in list(EXCEPTION_WORDS.values()) + ["W_MALFORMED"]}}
