@@ -149,3 +149,13 @@ def test_a_program_of_many_large_rungs_compiles_in_blocks_of_bounded_size(tmp_pa
                                                   "--set", "B3/0=1", "--print", "B3/1")
     assert code == 0 and out == "B3/1 = 1\n", err[-2000:]
     assert peak_mb < 300, peak_mb
+
+
+def test_a_ten_megabyte_string_in_a_data_table_json_file_is_refused_in_bounded_memory(tmp_path):
+    # The same per-character cost in the JSON reader's scan for long numbers
+    # and deep nesting (datatable/jsonio.py): 1.2 GB for this file, unbounded.
+    (tmp_path / "big.json").write_text('{"N7": [1, 2], "ST9": ["' + "A" * TEN_MB + '"]}')
+    code, _, err, peak_mb, seconds = softplc_measured(tmp_path, "datatable", "big.json", "--print", "N7:1")
+    assert code == 1 and err == (f"error: big.json: ST9[0]: a {TEN_MB}-character string does not fit ST9:0: "
+                                 "at most 82 characters\n"), err[-2000:]
+    assert peak_mb < PEAK_BOUND_MB and seconds < 60, (peak_mb, seconds)
