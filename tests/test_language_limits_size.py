@@ -1,6 +1,7 @@
 """The size limits of docs/language.md ("Limits"): a quoted string of at
 most MAX_LITERAL_CHARS characters and a rung of at most MAX_RUNG_ELEMENTS
-elements, checked while the text is parsed. A 10 MB literal or rung is
+elements, checked while the text is parsed, and nesting (MAX_NESTING,
+MAX_SIGNS) checked on the text before it is parsed. A 10 MB literal or rung is
 refused promptly, located, quoted short, in bounded memory (the real
 ``softplc`` in a subprocess, its peak memory read from the kernel); one
 just within the limits checks and runs."""
@@ -16,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from softplc_lite.ladder.limits import MAX_LITERAL_CHARS, MAX_RUNG_ELEMENTS
+from softplc_lite.ladder.limits import MAX_LITERAL_CHARS, MAX_NESTING, MAX_RUNG_ELEMENTS
 
 ROOT = Path(__file__).resolve().parent.parent
 TEN_MB = 10_000_000
@@ -79,7 +80,16 @@ RUNG_TOO_LARGE = f"more than {MAX_RUNG_ELEMENTS:,} elements"
     ("CPT(N7:0," + "N7:1+" * (TEN_MB // 5) + "1);\n", "main.lad:1:",
      RUNG_TOO_LARGE),
     ("DATA N7 10 = " + "1 " * (TEN_MB // 2) + "\n", "main.lad:1:", RUNG_TOO_LARGE),
-], ids=["DATA string", "CPT expression", "mnemonic rung", "neutral rung", "neutral expression", "DATA values"])
+    # nesting the parser would hold on its stack before any limit could look at it
+    # (CPT's own "(" is the first one open)
+    ("CPT(N7:0," + "(" * (TEN_MB // 2) + "N7:1" + ")" * (TEN_MB // 2) + ");\n", f"main.lad:1:{9 + MAX_NESTING}:",
+     f"parentheses and brackets nested more than {MAX_NESTING:,} deep"),
+    ("XIC(B3/0)" + "[" * (TEN_MB // 2) + "OTE(B3/1)" + "]" * (TEN_MB // 2) + ";\n",
+     f"main.lad:1:{10 + MAX_NESTING}:", f"parentheses and brackets nested more than {MAX_NESTING:,} deep"),
+    ("CPT(N7:0," + "-" * TEN_MB + "N7:1);\n", "main.lad:1:10:",
+     f"{TEN_MB:,} signs or NOTs in a row: an expression nested more than 64 levels deep"),
+], ids=["DATA string", "CPT expression", "mnemonic rung", "neutral rung", "neutral expression", "DATA values",
+        "parentheses", "brackets", "signs"])
 def test_ten_megabytes_in_one_literal_or_rung_are_refused_promptly_in_bounded_memory(tmp_path, text, where, says):
     app = app_with(tmp_path, text)
     for command in (("check", str(app)), ("run", str(app), "--fresh", "--scans", "1")):

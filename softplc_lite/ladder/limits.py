@@ -17,6 +17,8 @@ first 10,000 elements do (tests/test_language_limits_size.py).
 
 from __future__ import annotations
 
+import re
+
 from .ast import BinOp, Branch, Call, Instruction, UnaryOp
 
 MAX_BRANCH_DEPTH = 32  # branches inside branches
@@ -32,6 +34,14 @@ MAX_RUNG_ELEMENTS = 10_000
 # CPT/CMP expression in mnemonic form): an ST element holds 82, and the
 # longest expression the depth limit lets through is well under 4,096.
 MAX_LITERAL_CHARS = 4096
+# Parentheses and brackets open at once, and signs (or NOTs) in a row: what
+# the parser holds on its stack before any rule is reduced, so a rung of
+# millions of "(" or "-" would cost gigabytes before MAX_RUNG_ELEMENTS or
+# the depth limits could look at it. Checked on the text first
+# (nesting_problem). Redundant parentheses add no expression level, hence
+# the generous figure; a run of signs always does.
+MAX_NESTING = 5000
+MAX_SIGNS = 100
 
 _EXPRESSION_NODES = (BinOp, UnaryOp, Call)
 
@@ -55,6 +65,36 @@ def expression_depth(node) -> int:
         else:
             stack.append((node.arg, depth))
     return deepest
+
+
+_STRING = r'"[^"\\\n]*+(?:\\.[^"\\\n]*+)*+"'
+_SIGNS = rf"(?:[-+][ \t]*+){{{MAX_SIGNS},}}+|(?i:(?:\bNOT\b[ \t]*+){{{MAX_SIGNS},}}+)"
+_NESTING_SCAN = re.compile(rf"{_STRING}|//[^\n]*+|[(\[\])]|{_SIGNS}")
+_MAYBE_SIGNS = re.compile(_SIGNS)
+
+
+def nesting_problem(text: str) -> tuple[int, str] | None:
+    """(offset, what is wrong) for the first place a text nests
+    parentheses and brackets deeper than MAX_NESTING or has MAX_SIGNS signs
+    or NOTs in a row (outside strings and comments), else None. A text with
+    fewer brackets than the limit and no such run is not scanned."""
+    if text.count("(") + text.count("[") <= MAX_NESTING and _MAYBE_SIGNS.search(text) is None:
+        return None
+    depth = 0
+    for m in _NESTING_SCAN.finditer(text):
+        first = m.group()[0]
+        if first in "([":
+            depth += 1
+            if depth > MAX_NESTING:
+                return m.start(), f"parentheses and brackets nested more than {MAX_NESTING:,} deep"
+        elif first in ")]":
+            depth = max(0, depth - 1)
+        elif first not in "\"/":
+            run = m.group()
+            signs = run.count("-") + run.count("+") + run.upper().count("NOT")
+            return m.start(), (f"{signs:,} signs or NOTs in a row: an expression nested more than "
+                               f"{MAX_EXPRESSION_DEPTH} levels deep")
+    return None
 
 
 def rung_size_message() -> str:

@@ -46,6 +46,7 @@ from .limits import (
     expression_depth,
     expression_size,
     limit_problem,
+    nesting_problem,
     rung_size_message,
 )
 from .parse_actions import (
@@ -217,6 +218,11 @@ def parse_program(
         from .instructions import BUILTIN as instructions
     if text and not text.endswith("\n"):
         text += "\n"
+    nested = nesting_problem(text)  # before the parser holds millions of "(" on its stack
+    if nested is not None:
+        offset, message = nested
+        raise LadderError(Pos(source, text.count("\n", 0, offset) + 1 + line_offset,
+                              offset - text.rfind("\n", 0, offset)), message)
     items = _parse_tree(text, source, "start", line_offset, problems=problems, instructions=instructions)
     program = program if program is not None else Program()
     current: ProgramFile | None = None
