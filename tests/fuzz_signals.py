@@ -10,9 +10,8 @@ The oracle (docs/cli.md "Signals" and "Exit codes"): no ``Traceback`` in the
 output through softplc's code (Python's own start is Python's: docs/cli.md);
 an exit status of 0 (a run ended by either signal saves and ends normally) or
 130 (stopped outside the scan loop, while loading: the run handles Ctrl-C and
-SIGTERM alike), or death by
-SIGTERM before softplc said anything (SIGTERM while Python itself starts,
-before any handler can exist: nothing has been written); no process of its
+SIGTERM alike), or death by the signal before softplc said anything (while
+Python itself starts, before any handler can exist: nothing has been written); no process of its
 session left behind; no ``datatable.snap.tmp`` left; and the retentive state
 loads: a following ``softplc run APP --scans 1`` without ``--fresh`` says
 nothing about the snapshot and exits 0.
@@ -138,8 +137,8 @@ def run_signals_case(case, root: Path, timeout: float, runner):
         add("exception", f"signals:{what}:{r.exception.split(':', 1)[0]}", r.exception)
     else:
         allowed = {0, 130}  # 130: stopped while loading, SIGTERM as Ctrl-C ("handles Ctrl-C and SIGTERM alike")
-        if "SIGTERM" in p["signals"] and not (r.out or r.err):
-            allowed.add(-signal.SIGTERM)  # SIGTERM before any handler: nothing started, nothing written
+        if not (r.out or r.err):  # killed by a signal before any handler (Python starting): nothing written
+            allowed |= {-SIGNALS[name] for name in p["signals"]}
         if pythons_start:
             allowed |= {1, -signal.SIGINT}  # Python's own ending of a KeyboardInterrupt in its start
         if sent and r.code not in allowed:
