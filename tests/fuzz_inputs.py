@@ -18,6 +18,11 @@ the apps in ``programs/``, the documented examples) and breaks them:
 * shapes the language allows but nobody types: branches hundreds deep,
   CPT expressions of thousands of terms, DATA/FILE/SYMBOL at the edges.
 
+Four kinds are generated and run by modules of their own, with a driver of
+the oracle: ``special_files`` and ``state_damage`` (``fuzz_files``: files that
+are not regular files or not of a sane size, damaged real state),
+``signals`` (``fuzz_signals``), ``modbus_tcp`` (``fuzz_protocol``).
+
 A :class:`Profile` says which *features* a draw may use. Features are the
 input classes known to break the product while it is being fixed
 (``KNOWN_OPEN``); the default suite leaves them out, the campaign uses

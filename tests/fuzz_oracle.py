@@ -30,6 +30,11 @@ class                     what the oracle saw
                           load back to the same table
 ========================  ==============================================================
 
+A case with a ``driver`` (``DRIVERS``: files changed between commands,
+signals to a real run, requests to a live Modbus TCP server) is run by it
+instead, with the classes of its module (``fuzz_files``, ``fuzz_signals``,
+``fuzz_protocol``) besides these.
+
 A finding's ``signature`` (command, class, exception type and last frame,
 or a normalised message) is what ``tools/fuzz.py`` de-duplicates on.
 """
