@@ -42,6 +42,10 @@ from softplc_lite.ports.modbus_slave import (
     with_crc,
 )
 
+# The pymodbus comparison writes to one module-wide peer and twin, and later
+# tests read what earlier ones wrote: with xdist, the module keeps to one
+# worker, in order (--dist loadgroup in pyproject.toml).
+pytestmark = pytest.mark.xdist_group("modbus_slave")
 
 CHAR = 260_417  # one character at 38400 8N1, ns
 GAP = 911_460  # 3.5 characters

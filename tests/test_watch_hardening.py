@@ -107,6 +107,7 @@ def app(tmp_path: Path, text: str, name: str = "app") -> Path:
 
 
 @pytest.mark.timeout(60)
+@pytest.mark.alone  # compares timings: another worker's load skews the ratio (docs/testing.md)
 @pytest.mark.parametrize("width", [64, 100])
 @pytest.mark.parametrize("second_leg", [True, False])
 def test_deep_rung_layout_grows_linearly(width, second_leg):
