@@ -15,7 +15,11 @@ checkout beside a user's running PLC and on several workers at once.
   sees every test of every worker once. Bytecode caches (``__pycache__``)
   are the interpreter's, not a test's, and are not counted; nor is a new
   source file (.py, .md) in a directory that was there: that is a
-  developer's edit made while the suite ran, and no test writes either.
+  developer's edit made while the suite ran, and no test writes either;
+  nor a new file in an app's state directory (``.softplc/``) that was
+  there: a PLC running from the checkout saves its snapshot there every
+  100 ms (the suite runs beside it), and a test that writes an app's state
+  in place makes that directory in a fresh checkout.
 
 conftest.py imports the hooks, which pytest finds there by name.
 """
@@ -35,6 +39,7 @@ from hypothesis.configuration import set_hypothesis_home_dir
 ROOT = Path(__file__).resolve().parent.parent
 SKIPPED = {".git", "__pycache__"}
 SOURCES = (".py", ".md")
+STATE_DIR = ".softplc"
 
 
 def hypothesis_setup() -> None:
@@ -78,11 +83,13 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     before = session.config.stash.get(_BEFORE, None)
     if before is None:
         return
-    def edited(path: str) -> bool:
+    def elsewhere(path: str) -> bool:
+        """A developer's new source file, or a running PLC's save."""
         parent = path.rpartition("/")[0]
-        return path.endswith(SOURCES) and (not parent or f"{parent}/" in before)
+        known = not parent or f"{parent}/" in before
+        return known and (path.endswith(SOURCES) or f"/{STATE_DIR}/" in f"/{path}")
 
-    appeared = sorted(p for p in repo_listing() - before if not edited(p))
+    appeared = sorted(p for p in repo_listing() - before if not elsewhere(p))
     if appeared:
         session.config.stash[_APPEARED] = appeared
         if session.exitstatus == pytest.ExitCode.OK:
