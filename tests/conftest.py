@@ -113,3 +113,21 @@ def tcp_apps(tmp_path):
     apps = Apps(tmp_path)
     yield apps
     apps.close()
+
+
+@pytest.fixture
+def tcp_plc(tcp_apps):
+    """A MODBTCPS runtime of tests/modbtcps_apps.UNIT_1 on a free port."""
+    return tcp_apps.start()
+
+
+@pytest.fixture
+def tcp_client(tcp_plc):
+    """pymodbus's real client, connected to ``tcp_plc``."""
+    from modbtcps_apps import LIMIT_S
+    from pymodbus.client import ModbusTcpClient
+
+    c = ModbusTcpClient("127.0.0.1", port=tcp_plc.port, timeout=LIMIT_S, retries=0)
+    assert c.connect()
+    yield c
+    c.close()

@@ -27,16 +27,13 @@ pytestmark = pytest.mark.timeout(120)
 
 
 @pytest.fixture
-def plc(tcp_apps):
-    return tcp_apps.start()
+def plc(tcp_plc):
+    return tcp_plc
 
 
 @pytest.fixture
-def client(plc):
-    c = ModbusTcpClient("127.0.0.1", port=plc.port, timeout=LIMIT_S, retries=0)
-    assert c.connect()
-    yield c
-    c.close()
+def client(tcp_client):
+    return tcp_client
 
 
 def exception_code(response) -> int | None:
