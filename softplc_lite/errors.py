@@ -54,29 +54,69 @@ class LocatedError(Exception):
         return f"{where}: {self.message}" if where else self.message
 
 
-# errno -> what a person is told; anything else: the OS's own words, in lower case.
+# errno -> what a person is told (a softplc_lite choice: never the C library's
+# own text, which reads "Is a directory" or "[Errno 21]" in the middle of a sentence).
 _WORDS = {
     errno.ENOENT: "no such file or directory",
     errno.EACCES: "permission denied",
     errno.EPERM: "permission denied",
     errno.EISDIR: "it is a directory",
     errno.ENOTDIR: "a part of the path is not a directory",
-    errno.ENOSPC: "no space left on the device",
+    errno.ENOSPC: "no space left on the device (disk full)",
+    errno.EDQUOT: "the disk quota is used up",
+    errno.EFBIG: "the file would be larger than the system allows (file too large)",
     errno.EROFS: "the file system is read-only",
     errno.EEXIST: "it already exists",
     errno.ENAMETOOLONG: "the name is too long",
-    errno.ELOOP: "too many symbolic links",
+    errno.ELOOP: "too many symbolic links (a link loop)",
     errno.EMFILE: "too many open files",
+    errno.ENFILE: "too many open files on the system",
     errno.EBUSY: "the file is busy",
+    errno.ETXTBSY: "the file is busy",
+    errno.EAGAIN: "the file is busy",
+    errno.EIO: "an input/output error on the device",
+    errno.ENXIO: "no such device (or a FIFO nobody reads)",
+    errno.ENODEV: "no such device",
+    errno.EXDEV: "it is on another file system",
+    errno.ENOTEMPTY: "the directory is not empty",
+    errno.ENOMEM: "out of memory",
+    errno.EINTR: "interrupted by a signal",
+    errno.EINVAL: "the file system does not allow it",
+    errno.EOPNOTSUPP: "the file system does not support it",
+    errno.ESTALE: "the network file system lost the file",
 }
 
 
-def os_error_words(e: OSError) -> str:
-    """What went wrong, in words: 'permission denied', 'it is a directory'."""
-    if e.errno in _WORDS:
-        return _WORDS[e.errno]
-    text = e.strerror or str(e) or type(e).__name__
-    return text[:1].lower() + text[1:]
+def os_error_words(e: BaseException) -> str:
+    """What went wrong, in words: 'permission denied', 'it is a directory'.
+    The one place an OSError becomes words: an errno not listed is said
+    generically with its number; an OSError without an errno carries
+    softplc's own words (FileRefused) and keeps them; anything else is an
+    unexpected error, never a Python type name."""
+    if isinstance(e, FileAccessError):  # already said, maybe better than its errno says it
+        return e.words
+    number = getattr(e, "errno", None) if isinstance(e, OSError) else None
+    if number in _WORDS:
+        return _WORDS[number]
+    if number is not None:
+        return f"the operating system refused it (error {number})"
+    if isinstance(e, OSError) and e.strerror:
+        return e.strerror
+    return "an unexpected error"
+
+
+def describe_os_error(e: BaseException, path: str | os.PathLike | None = None) -> str:
+    """``os_error_words(e)``, with the file the error concerns in
+    parentheses when it is not ``path``, the file the message names (a
+    save that failed on ``NAME.tmp``), nor the target of a rename onto
+    ``path``."""
+    words = os_error_words(e)
+    if not isinstance(e, OSError) or e.filename is None:
+        return words
+    names = [os.fsdecode(os.fspath(n)) for n in (e.filename, e.filename2) if n is not None]
+    if path is None or os.fsdecode(os.fspath(path)) not in names:  # a rename onto path: path is the one
+        words += f" ({shown_path(e.filename)})"
+    return words
 
 
 class FileAccessError(OSError):

@@ -34,6 +34,7 @@ from typing import Callable
 
 from .datatable import DataTable, DataTableError, snapshot
 from .datatable.errors import SnapshotError
+from .errors import describe_os_error
 from .ladder import status as S
 
 DURABLE_EVERY_S = 5.0  # one periodic save in this many seconds is fsynced (and becomes NAME.prev)
@@ -70,14 +71,6 @@ def restore_snapshot(table: DataTable, path: Path) -> snapshot.Restored:
                                 f"{os.sep} does not fit the program ({reason}); run with --fresh to start from "
                                 "the program's initial data (the first save replaces it)") from None
     return restored
-
-
-def describe_os_error(e: BaseException) -> str:
-    """``strerror`` and the file it concerns, for a message that names the path."""
-    if isinstance(e, OSError) and e.strerror:
-        where = f" ({e.filename})" if e.filename else ""
-        return f"{e.strerror}{where}"
-    return f"{type(e).__name__}: {e}"
 
 
 class StorageFaults:
@@ -225,13 +218,13 @@ class SnapshotWriter:
             try:
                 snapshot.write(job.data, self.path, False)
             except Exception as e:  # noqa: BLE001 - reported as a minor fault; the thread must live on
-                error = describe_os_error(e)
+                error = describe_os_error(e, self.path)
             renamed_at = time.monotonic()
             if job.durable and error is None:
                 try:
                     snapshot.make_durable(self.path)
                 except Exception as e:  # noqa: BLE001
-                    durable_error = describe_os_error(e)
+                    durable_error = describe_os_error(e, self.path)
             self.result = WriteResult(job.seq, job.taken_at, renamed_at, job.durable, error, durable_error)
             if not self._woken and self._latest is job:  # nothing new: the interval goes back
                 _handover.end(self)
@@ -334,7 +327,7 @@ class Retentive:
         try:
             snapshot.write(snapshot.encode(table), self.path, True)
         except Exception as e:  # noqa: BLE001 - reported, the run's output still printed
-            reason = describe_os_error(e)
+            reason = describe_os_error(e, self.path)
             self._failed(reason, log=False)
             return f"cannot save the retentive snapshot {self.path} at the end of the run: {reason}"
         self.faults.ok("save", f"the retentive snapshot {self.path} is saved again")

@@ -14,7 +14,9 @@ same answer:
   bad byte and what was expected, never a ``UnicodeDecodeError`` (a reader
   of DOS-era files may ask for a ``fallback`` codec instead, latin-1);
 * an OSError becomes errors.FileAccessError, still an OSError, whose
-  text is a sentence: "cannot read PATH: permission denied";
+  text is a sentence: "cannot read PATH: permission denied" (a link to
+  nothing: "cannot read PATH: a symbolic link to TARGET, which does not
+  exist");
 * only a regular file is read, and no more than its kind's :class:`Limit`
   (docs/cli.md, "Input file limits"): a FIFO, a device (a link to
   ``/dev/zero``), a socket or a directory is refused without waiting or
@@ -33,7 +35,7 @@ import os
 import stat
 from dataclasses import dataclass
 
-from .errors import FileAccessError, LocatedError, file_error
+from .errors import FileAccessError, LocatedError, file_error, shown_path
 
 
 @dataclass(frozen=True)
@@ -61,7 +63,7 @@ class FileRefused(FileAccessError):
     size (over its kind's Limit); ``str(e)`` is "cannot read PATH: WHY"."""
 
     def __init__(self, path: str, why: str, too_large: bool = False) -> None:
-        super().__init__(f"cannot read {path}: {why}", path, OSError(None, why))
+        super().__init__(f"cannot read {shown_path(path)}: {why}", path, OSError(None, why))
         self.too_large = too_large  # else: not a regular file
 
 
@@ -93,6 +95,22 @@ def _refusal(path: str, st: os.stat_result, limit: Limit) -> FileAccessError | N
             size = f"{st.st_size:,} bytes"
         return FileRefused(path, f"{size}, over the {cap} limit for {limit.what}", too_large=True)
     return None
+
+
+def _dangling(path: str) -> FileAccessError | None:
+    """A link at ``path`` whose target does not exist, said so ("cannot
+    read PATH: a symbolic link to TARGET, which does not exist"), or None:
+    "no such file" would deny the name the user sees in a listing. Still
+    ENOENT, so a reader of an optional file that asks for its errno treats
+    it as missing only if it means to."""
+    try:
+        target = os.readlink(path)
+    except OSError:  # not a link (a missing file), or gone meanwhile
+        return None
+    why = f"a symbolic link to {shown_path(target)}, which does not exist"
+    error = FileAccessError(f"cannot read {shown_path(path)}: {why}", path, OSError(errno.ENOENT, why))
+    error.words = why
+    return error
 
 
 # BOM -> codec; UTF-8's first (a UTF-16 LE BOM is a prefix of no UTF-8 BOM, but keep the longest first).
@@ -155,7 +173,7 @@ def read_bytes(path: str | os.PathLike[str], limit: Limit = CONFIG) -> bytes:
     except FileAccessError:
         raise
     except OSError as e:
-        raise file_error(e, name) from None
+        raise (_dangling(name) if e.errno == errno.ENOENT else None) or file_error(e, name) from None
     try:
         st = os.fstat(fd)
         refused = _refusal(name, st, limit)

@@ -214,7 +214,8 @@ def test_an_unwritable_trace_stops_the_start_and_nothing_is_written(tmp_path):
                           str(tmp_path / "s"), "--scans", "20", "--record", str(tmp_path / "no-dir" / "x.trace")],
                          cwd=root, capture_output=True, text=True, timeout=60)
     assert run.returncode == 1 and "Traceback" not in run.stderr
-    assert run.stderr.strip() == f"error: --record: cannot write {tmp_path / 'no-dir' / 'x.trace'}: No such file or directory"
+    assert run.stderr.strip() == (f"error: --record: cannot write {tmp_path / 'no-dir' / 'x.trace'}: "
+                                  "no such file or directory")
 
 
 def test_a_recorder_that_never_opened_closes_quietly(tmp_path):

@@ -109,11 +109,11 @@ def test_storage_faults_set_s17_bit_4_and_s102_and_log_once_per_reason():
     logged: list[str] = []
     faults = StorageFaults(s, logged.append)
     for _ in range(3):
-        faults.failed("save", S.MINOR_CODE_SAVE, "cannot save X: No space left on device")
+        faults.failed("save", S.MINOR_CODE_SAVE, "cannot save X: no space left on the device (disk full)")
     assert s[S.MINOR_FAULT_BITS] == STORAGE and s[S.MINOR_FAULT_CODE] == 9
     assert s[S.MINOR_FAULT_FILE] == 0 and s[S.MINOR_FAULT_RUNG] == 0
     faults.failed("save", S.MINOR_CODE_SAVE, "cannot save X: Read-only file system")
-    faults.failed("record", S.MINOR_CODE_RECORD, "--record: cannot write T: No space left on device")
+    faults.failed("record", S.MINOR_CODE_RECORD, "--record: cannot write T: no space left on the device (disk full)")
     assert s[S.MINOR_FAULT_CODE] == 10
     assert len(logged) == 3 and all(m.startswith("warning: ") for m in logged)
     faults.ok("save", "saved again")
@@ -210,7 +210,7 @@ def test_a_durable_step_that_fails_is_told_once_while_the_saves_go_on(tmp_path):
         assert snapshot.load(path).read("N7:0") == 6 and not (tmp_path / "datatable.snap.prev").exists()
         assert s[S.MINOR_FAULT_BITS] == STORAGE and s[S.MINOR_FAULT_CODE] == S.MINOR_CODE_SAVE
         assert len(logged) == 1 and logged[0].startswith(f"warning: cannot put the retentive snapshot {path} on disk "
-                                                         f"(fsync, datatable.snap.prev): Is a directory")
+                                                         f"(fsync, datatable.snap.prev): it is a directory")
         (tmp_path / "datatable.snap.prev.tmp").rmdir()
         t.write("N7:0", 7)
         ret.tick(t, time.monotonic())
@@ -279,7 +279,7 @@ def test_disk_full_is_a_minor_fault_retried_until_saving_works_again(tmp_path):
     assert "datatable.snap.tmp" not in full["files"], full["files"]  # a failed write removes its temp file
     assert len(full["logged"]) == 1, full["logged"]  # once, not every period
     assert full["logged"][0].startswith(f"warning: cannot save the retentive snapshot {state / 'datatable.snap'}: "
-                                        "File too large")
+                                        "the file would be larger than the system allows (file too large)")
     assert "minor fault S:17/4, code 9" in full["logged"][0]
     assert not space["bits"] & STORAGE and space["code"] == S.MINOR_CODE_SAVE
     assert space["logged"][1:] == [f"the retentive snapshot {state / 'datatable.snap'} is saved again"]
@@ -301,10 +301,11 @@ def test_an_unusable_state_directory_keeps_the_plc_running_and_exits_1(tmp_path)
     assert dump.exists() and "Traceback" not in p.stderr
     snap = state / "datatable.snap"
     warnings = [line for line in p.stderr.splitlines() if line.startswith("warning:")]
-    assert warnings == [(f"warning: cannot save the retentive snapshot {snap}: Not a directory ({snap}.tmp); the "
-                         f"PLC keeps running and tries again every 100 ms (minor fault S:17/4, code 9)")]
+    assert warnings == [(f"warning: cannot save the retentive snapshot {snap}: a part of the path is not a "
+                         f"directory ({snap}.tmp); the PLC keeps running and tries again every 100 ms (minor fault "
+                         "S:17/4, code 9)")]
     assert p.stderr.splitlines()[-1] == (f"error: cannot save the retentive snapshot {snap} at the end of the run: "
-                                         f"Not a directory ({snap}.tmp)")
+                                         f"a part of the path is not a directory ({snap}.tmp)")
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root writes into a read-only directory anyway (CI runs as root)")
@@ -330,9 +331,10 @@ def test_record_to_a_full_device_is_a_minor_fault_and_the_run_goes_on(tmp_path):
     assert "C5:1.ACC = 2" in p.stdout and "S:17 = 16\nS:102 = 10\n" in p.stdout
     warnings = [line for line in p.stderr.splitlines() if line.startswith("warning:")]
     assert len(warnings) == 1 and warnings[0].startswith(
-        "warning: --record: cannot write /dev/full: No space left on device; the run goes on")
+        "warning: --record: cannot write /dev/full: no space left on the device (disk full); the run goes on")
     assert p.stderr.splitlines()[-1].startswith(
-        "error: --record: the trace /dev/full is incomplete: cannot write /dev/full: No space left on device")
+        "error: --record: the trace /dev/full is incomplete: cannot write /dev/full: no space left on the device "
+        "(disk full)")
 
 
 class _Port:
@@ -375,7 +377,8 @@ def test_a_trace_that_could_not_be_written_for_a_while_says_what_it_lost(tmp_pat
     port.record("0", "TX", b"\xff")
     rec.flush()
     rec.close()
-    assert reports[0] == f"cannot write {tmp_path / 't.trace'}: No space left on device" and reports[-1] is None
+    assert reports[0] == f"cannot write {tmp_path / 't.trace'}: no space left on the device (disk full)"
+    assert reports[-1] is None
     text = (tmp_path / "t.trace").read_text()
     events = parse_trace(text)
     kept = [e.data[0] for e in events]

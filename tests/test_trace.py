@@ -81,7 +81,7 @@ def test_read_trace_missing_or_binary_file(tmp_path: Path):
     with pytest.raises(TraceError) as info:
         read_trace(tmp_path / "missing.trace")
     assert info.value.path == str(tmp_path / "missing.trace")
-    assert "cannot read trace file: No such file or directory" in str(info.value)
+    assert "cannot read trace file: no such file or directory" in str(info.value)
     binary = tmp_path / "bin.trace"
     binary.write_bytes(b"# softplc_lite port trace 1\n\xff\xfe\x00")
     with pytest.raises(TraceError, match=r"bin.trace:2:1: byte 0xff is not UTF-8 text"):

@@ -44,7 +44,7 @@ import re
 from dataclasses import dataclass, field
 from typing import IO, Sequence
 
-from ..errors import LocatedError
+from ..errors import LocatedError, os_error_words
 from ..textfile import TRACE, read_text
 from .errors import PortError
 
@@ -153,7 +153,7 @@ def read_trace(path: str | os.PathLike) -> list[TraceEvent]:
     except LocatedError as e:
         raise TraceError(e.message, name, e.line, e.column) from None
     except OSError as e:  # errors.FileAccessError: "cannot read PATH: not a regular file (a FIFO)"
-        raise TraceError(f"cannot read trace file: {e.strerror or e}", name) from e
+        raise TraceError(f"cannot read trace file: {os_error_words(e)}", name) from None
     return parse_trace(text, name)
 
 
