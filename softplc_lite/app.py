@@ -12,6 +12,7 @@ An app directory holds:
 
 from __future__ import annotations
 
+import os
 import re
 import tomllib
 from dataclasses import dataclass, field, fields
@@ -91,11 +92,12 @@ class App:
 
 
 def lad_files(path: Path) -> list[Path]:
-    """The program files of an app: every ``*.lad`` entry of the directory
-    but a directory (a FIFO, a device or a dangling link among them is a
-    program file that cannot be read, reported as such, never left out)."""
+    """The program files of an app: every ``*.lad`` entry of the directory.
+    One that cannot be a program file (a directory, a FIFO, a device, a
+    dangling link) is still one: parse_files reports it by name, where
+    leaving it out would leave its rungs or subroutine missing unexplained."""
     if path.is_dir():
-        return sorted(p for p in path.glob("*.lad") if not p.is_dir())
+        return sorted(path.glob("*.lad"))
     return [path]
 
 
@@ -111,7 +113,10 @@ def parse_files(files: list[Path], base: Path, instructions: InstructionSet = BU
             errors.append(LadderError(Pos(_display(f, base), e.line, e.column), e.message))
             continue
         except FileAccessError as e:
-            errors.append(LadderError(Pos(_display(f, base), 1, 1), f"cannot read the file: {e.words}"))
+            if f.is_dir():
+                errors.append(_whole_file_error(_display(f, base), "a directory, not a program file"))
+            else:
+                errors.append(LadderError(Pos(_display(f, base), 1, 1), f"cannot read the file: {e.words}"))
             continue
         problems: list[LadderError] = []
         try:
@@ -120,6 +125,14 @@ def parse_files(files: list[Path], base: Path, instructions: InstructionSet = BU
         except LadderError as e:  # a syntax error: list every problem, resuming after each
             errors.extend(syntax_problems(text, _display(f, base), instructions=instructions) or [e])
     return program, errors
+
+
+def _whole_file_error(source: str, message: str) -> LadderError:
+    """A problem of a program file as a whole, reported as ``FILE: message``
+    (no line: a directory has none); sorted with the file's others."""
+    error = LadderError(Pos(source, 0, 0), message)
+    error.args = (f"{source}: {message}",)
+    return error
 
 
 def _display(f: Path, base: Path) -> str:
@@ -131,8 +144,10 @@ def _display(f: Path, base: Path) -> str:
 
 def read_settings_file(path: Path) -> dict:
     """softplc.toml as a dict ({} when the app has none); a syntax error
-    names the file, line and column."""
-    if not path.exists():
+    names the file, line and column. A name that is there but cannot be read
+    (a dangling or looping link, a directory) is reported, not taken for no
+    file: the user meant settings to be read."""
+    if not os.path.lexists(path):
         return {}
     try:
         text = read_text(path)
@@ -376,7 +391,7 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
                 settings_problems += display_problems(display, table, path / SETTINGS_FILE, settings_doc)
         except AppError as e:
             settings_problems += e.errors or [LocatedError(str(e))]
-    table_json = path / DATATABLE_FILE if is_dir and (path / DATATABLE_FILE).exists() else None
+    table_json = path / DATATABLE_FILE if is_dir and os.path.lexists(path / DATATABLE_FILE) else None
     if table_json is not None and not errors:
         try:  # what a run without a snapshot loads: check it as well
             jsonio.load_file(table, str(table_json))
@@ -417,7 +432,7 @@ def _cache_parts(files: list[Path], path: Path, modules) -> list[tuple[str, byte
     base = path if path.is_dir() else path.parent
     parts = [(_display(f, base), read_bytes(f, PROGRAM)) for f in files]
     settings = base / SETTINGS_FILE
-    parts.append((SETTINGS_FILE, read_bytes(settings) if settings.exists() else b""))
+    parts.append((SETTINGS_FILE, read_bytes(settings) if os.path.lexists(settings) else b""))
     for m in modules:
         config = base / m.config_file if getattr(m, "config_file", None) else None
         parts.append((f"module {m.name} {getattr(m, 'version', '')} {type(m).__module__}",

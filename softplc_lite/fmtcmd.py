@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import IO, Sequence
 
 from .app import AppError, app_instructions, lad_files
-from .errors import LocatedError, file_error
+from .errors import LocatedError, file_error, shown_path
 from .ladder.errors import LadderError
 from .ladder.fmt import STYLES, format_source, unprintable
 from .ladder.ast import Program
@@ -87,14 +87,17 @@ def _sources(paths: Sequence[str], stdin: IO[bytes]) -> tuple[list[tuple[str, Pa
             found.append(("<stdin>", None, stdin.read(), Path.cwd()))
             continue
         path = Path(given)
-        if not path.exists():
-            problems.append(LocatedError(f"{given}: no such file or directory (expected a .lad file or an app "
-                                         "directory)"))
+        if not os.path.lexists(path):
+            problems.append(LocatedError(f"{shown_path(given)}: no such file or directory (expected a .lad file "
+                                         "or an app directory)"))
             continue
         files = lad_files(path)
         if path.is_dir() and not files:
-            problems.append(LocatedError(f"{given}: the directory has no .lad program files"))
+            problems.append(LocatedError(f"{shown_path(given)}: the directory has no .lad program files"))
         for f in files:
+            if f.is_dir():
+                problems.append(LocatedError(f"{shown_path(f)}: a directory, not a program file"))
+                continue
             try:
                 found.append((str(f), f, read_bytes(f, PROGRAM), path if path.is_dir() else path.parent))
             except OSError as e:
@@ -161,7 +164,7 @@ def fmt_command(paths: Sequence[str], style: str = "mnemonic", check: bool = Fal
     if check:
         changed = [r for r in results if r.changed]
         for r in changed:
-            print(f"would reformat {r.name}", file=stderr)
+            print(f"would reformat {shown_path(r.name)}", file=stderr)
         return EXIT_ERROR if changed else EXIT_OK
     if write:
         status = EXIT_OK
@@ -175,10 +178,10 @@ def fmt_command(paths: Sequence[str], style: str = "mnemonic", check: bool = Fal
                     print(file_error(e, r.path, "write").report(), file=stderr)
                     status = EXIT_ERROR
                     continue
-                print(f"reformatted {r.name}", file=stderr)
+                print(f"reformatted {shown_path(r.name)}", file=stderr)
         return status
     for k, r in enumerate(results):
         if len(results) > 1:
-            stdout.write(("\n" if k else "") + f"// ==> {r.name} <==\n")
+            stdout.write(("\n" if k else "") + f"// ==> {shown_path(r.name)} <==\n")
         stdout.write(r.after)
     return EXIT_OK
