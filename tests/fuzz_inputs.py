@@ -72,22 +72,12 @@ FEATURES = {
     "check_run": "programs check accepts and run may refuse: a number beside a file of another type, "
                  "astral characters in DATA strings, [display] addresses past their file",
     "byte_mutation": "random byte and token mutations (may produce any of the above by chance)",
-    "optional_file_link": "softplc.toml or datatable.json as a dangling or looping link (read as no file, silently)",
-    "lad_dir": "a directory named like a program file (main.lad/, sbr063_crc.lad/): left out, not reported",
-    "errno_text": "a --replay trace that is a dangling link, a link loop or a directory, a directory in place of "
-                  "datatable.snap: the message ends in the system's error text",
 }
 
 # Classes still being fixed: left out of the default suite (the campaign
-# draws them all). Every class issue 15 listed is fixed; these remain of the file kinds.
-KNOWN_OPEN: frozenset[str] = frozenset({
-    # Found by the special_files kind; reported, not yet fixed: each is read as "no such file" or
-    # "not a program file" where docs/cli.md ("Input file limits") says a file that is not a
-    # regular file is reported.
-    "optional_file_link", "lad_dir",
-    # "cannot read trace file: No such file or directory", "... the end of the run: Is a directory".
-    "errno_text",
-})
+# draws them all). None is open: a class found open goes here, with a
+# FEATURES entry, until it is fixed.
+KNOWN_OPEN: frozenset[str] = frozenset()
 
 
 @dataclass(frozen=True)
