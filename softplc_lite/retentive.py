@@ -34,7 +34,7 @@ from typing import Callable
 
 from .datatable import DataTable, DataTableError, snapshot
 from .datatable.errors import SnapshotError
-from .errors import describe_os_error
+from .errors import describe_os_error, shown_path
 from .ladder import status as S
 
 DURABLE_EVERY_S = 5.0  # one periodic save in this many seconds is fsynced (and becomes NAME.prev)
@@ -242,6 +242,7 @@ class Retentive:
     def __init__(self, path: Path, save_ms: int, faults: StorageFaults,
                  durable_every_s: float = DURABLE_EVERY_S) -> None:
         self.path = Path(path)
+        self.shown = shown_path(self.path)  # as messages name it
         self.save_s = save_ms / 1000
         self.durable_every_s = durable_every_s
         self.faults = faults
@@ -292,21 +293,21 @@ class Retentive:
         self._latencies.append(result.renamed_at - result.taken_at)
         if result.error is None:
             self.saves += 1
-            self.faults.ok("save", f"the retentive snapshot {self.path} is saved again")
+            self.faults.ok("save", f"the retentive snapshot {self.shown} is saved again")
         else:
             self._failed(result.error, f"; the PLC keeps running and tries again every "
                                        f"{round(self.save_s * 1000)} ms")
         if result.durable_error is not None:
             # Its own source: the saves themselves work, so this is told once, not every 5 s.
-            self.faults.failed("durable", S.MINOR_CODE_SAVE, f"cannot put the retentive snapshot {self.path} on "
-                               f"disk (fsync, {self.path.name}.prev): {result.durable_error}",
+            self.faults.failed("durable", S.MINOR_CODE_SAVE, f"cannot put the retentive snapshot {self.shown} on "
+                               f"disk (fsync, {shown_path(self.path.name)}.prev): {result.durable_error}",
                                f"; it is saved, but may not survive a power loss; tried again every "
                                f"{self.durable_every_s:.0f} s")
         elif result.durable and result.error is None:
-            self.faults.ok("durable", f"the retentive snapshot {self.path} is put on disk again")
+            self.faults.ok("durable", f"the retentive snapshot {self.shown} is put on disk again")
 
     def _failed(self, reason: str, advice: str = "", log: bool = True) -> None:
-        self.faults.failed("save", S.MINOR_CODE_SAVE, f"cannot save the retentive snapshot {self.path}: {reason}",
+        self.faults.failed("save", S.MINOR_CODE_SAVE, f"cannot save the retentive snapshot {self.shown}: {reason}",
                            advice, log)
 
     def finish(self, table: DataTable) -> str | None:
@@ -323,13 +324,13 @@ class Retentive:
             if not finished:
                 reason = f"a save is still being written after {WRITER_JOIN_S:.0f} s; the final save is not made"
                 self._failed(reason, log=False)
-                return f"cannot save the retentive snapshot {self.path}: {reason}"
+                return f"cannot save the retentive snapshot {self.shown}: {reason}"
         try:
             snapshot.write(snapshot.encode(table), self.path, True)
         except Exception as e:  # noqa: BLE001 - reported, the run's output still printed
             reason = describe_os_error(e, self.path)
             self._failed(reason, log=False)
-            return f"cannot save the retentive snapshot {self.path} at the end of the run: {reason}"
-        self.faults.ok("save", f"the retentive snapshot {self.path} is saved again")
-        self.faults.ok("durable", f"the retentive snapshot {self.path} is put on disk again")
+            return f"cannot save the retentive snapshot {self.shown} at the end of the run: {reason}"
+        self.faults.ok("save", f"the retentive snapshot {self.shown} is saved again")
+        self.faults.ok("durable", f"the retentive snapshot {self.shown} is put on disk again")
         return None

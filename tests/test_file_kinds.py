@@ -169,3 +169,19 @@ def test_fmt_names_a_non_utf8_file_name_with_escapes(tmp_path):
     written = softplc(tmp_path, "fmt", "--write", "app")
     assert written.returncode == 0 and written.stderr == "reformatted app/\\xff.lad\n", written.stderr
     assert (app / name).read_text() == "XIC B3/0 OTE O:0/0\n"
+
+
+def test_the_snapshot_and_record_messages_name_a_non_utf8_path_with_escapes(tmp_path):
+    app = tmp_path / os.fsdecode(b"\xff")
+    shutil.copytree(ROOT / "programs" / "blinker", app, ignore=shutil.ignore_patterns(".softplc"))
+    (app / ".softplc" / "datatable.snap").mkdir(parents=True)
+    result = softplc(tmp_path, "run", os.fsdecode(b"\xff"), "--scans", "5", "--fresh")
+    assert result.returncode == 1
+    assert result.stderr.splitlines()[-1] == ("error: cannot save the retentive snapshot \\xff/.softplc/datatable.snap "
+                                              "at the end of the run: it is a directory"), result.stderr
+    copy_app(tmp_path, "loopback")
+    (tmp_path / os.fsdecode(b"\xfe.trace")).mkdir()
+    result = softplc(tmp_path, "run", "app", "--fresh", "--state", "state", "--scans", "5",
+                     "--record", os.fsdecode(b"\xfe.trace"))
+    assert result.returncode == 1
+    assert result.stderr.strip() == "error: --record: cannot write \\xfe.trace: it is a directory", result.stderr

@@ -25,7 +25,7 @@ import os
 import time
 from typing import Callable
 
-from ..errors import os_error_words
+from ..errors import os_error_words, shown_path
 from .errors import PortError
 from .trace import TraceWriter
 
@@ -74,7 +74,7 @@ class Recorder:
         try:
             self._fd = os.open(self.path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
         except OSError as e:
-            raise PortError(f"--record: cannot write {self.path}: {os_error_words(e)}") from None
+            raise PortError(f"--record: cannot write {shown_path(self.path)}: {os_error_words(e)}") from None
         self._text = io.StringIO()
         self._writer = TraceWriter(self._text, self._comments)
         self._take_text()  # written with the first events
@@ -122,7 +122,7 @@ class Recorder:
             while self._pending:
                 del self._pending[:os.write(self._fd, self._pending)]
         except OSError as e:
-            self.problem = f"cannot write {self.path}: {os_error_words(e)}"
+            self.problem = f"cannot write {shown_path(self.path)}: {os_error_words(e)}"
             self._retry_at = time.monotonic() + RETRY_S
             if self.on_problem is not None:
                 self.on_problem(self.problem)
@@ -155,5 +155,5 @@ class Recorder:
         try:
             os.close(self._fd)
         except OSError as e:  # e.g. a network file system reporting a late write error
-            self.problem = self.problem or f"cannot write {self.path}: {os_error_words(e)}"
+            self.problem = self.problem or f"cannot write {shown_path(self.path)}: {os_error_words(e)}"
         self._fd = None
