@@ -9,6 +9,7 @@ import json
 import time
 from dataclasses import dataclass, field
 
+from ..errors import shown_path
 from ..app import App
 from ..datatable import DataTableError, ValueKind
 from ..datatable.display import format_read
@@ -323,7 +324,10 @@ class WatchSession:
         if edit.accepted:
             self.message = f"{edit.summary()} (at scan {self.engine.scans}){extra}"
         else:
-            self.message = f"{edit.summary()}  (E: every error)"
+            # the key first and the app's own path off the file names: a status line
+            # cut at the terminal's width must still say how to see the rest
+            where = shown_path(self.app.path) + "/"
+            self.message = f"(E: every error) {edit.summary().replace(where, '')}"
 
     def _program_replaced(self, changes) -> str:
         """The view follows the new program: files, the selected rung (where
