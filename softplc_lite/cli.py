@@ -10,7 +10,7 @@ while ``run`` or ``watch`` scans ends the run cleanly, exit 0).
 
 from __future__ import annotations
 
-from .interrupt import loaded, quit_while_loading
+from .interrupt import loaded, quit_until_handled, quit_while_loading, stop_as_interrupt
 
 _LOADING = quit_while_loading()  # Ctrl-C while the modules below load: exit 130, no traceback (interrupt.py)
 
@@ -430,13 +430,6 @@ def _handle_signals(handlers: dict) -> dict:
     return {sig: signal.signal(sig, handler) for sig, handler in handlers.items()}
 
 
-def _stop_as_interrupt(signum, frame) -> None:
-    """SIGTERM does what Ctrl-C does, once: a second one (a service manager
-    sending it twice) is ignored, so it cannot cut the quitting short."""
-    _handle_signals({signal.SIGTERM: signal.SIG_IGN})
-    raise KeyboardInterrupt
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """The softplc command. With ``argv`` None (the process's own command
     line: the console script, python -m) it owns the process's signals to
@@ -445,7 +438,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     into a signal's. With ``argv`` (a program or a test calling it), the
     caller's handlers are restored at the end."""
     try:
-        loaded()  # Ctrl-C is a KeyboardInterrupt from here on, caught below
+        if argv is None:  # the process's own command: Ctrl-C or SIGTERM end it at once until it
+            quit_until_handled()  # takes them over (a run once it scans, the view once it opens)
+        else:
+            loaded()  # the caller's process: Ctrl-C is a KeyboardInterrupt, caught below
         return _main(argv)
     except KeyboardInterrupt:  # while the arguments are read (the commands catch their own)
         return EXIT_INTERRUPTED
@@ -464,7 +460,7 @@ def _main(argv: Sequence[str] | None) -> int:
         return EXIT_USAGE
     previous = {}
     if args.command in ("run", "watch"):  # they end cleanly on Ctrl-C: SIGTERM (kill, systemd) too
-        previous = _handle_signals({signal.SIGTERM: _stop_as_interrupt})
+        previous = _handle_signals({signal.SIGTERM: stop_as_interrupt}) if argv is not None else {}
         sigint = signal.getsignal(signal.SIGINT)
         if sigint is not None and previous:  # None: not installed from Python, left alone
             previous[signal.SIGINT] = sigint  # the run ignores it once its scanning ends

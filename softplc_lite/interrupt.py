@@ -44,3 +44,36 @@ def loaded() -> None:
     """Ctrl-C is a KeyboardInterrupt again (the caller catches it)."""
     if threading.current_thread() is threading.main_thread() and signal.getsignal(signal.SIGINT) is _quit:
         signal.signal(signal.SIGINT, signal.default_int_handler)
+
+
+def quit_until_handled() -> None:
+    """The command owns the process (the console script, python -m): until
+    it takes the signals over itself (``raise_on_interrupt``, or a run's own
+    handlers once it scans), Ctrl-C and SIGTERM end it at once with 130.
+    Loading an app writes nothing a signal could cut short (the code cache
+    is written aside and renamed), and a KeyboardInterrupt raised anywhere
+    in that code could land in a finalizer, which swallows it: the command
+    would then go on as if no one had asked it to stop."""
+    if threading.current_thread() is threading.main_thread():
+        if signal.getsignal(signal.SIGINT) in (signal.default_int_handler, _quit):
+            signal.signal(signal.SIGINT, _quit)
+        if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, _quit):
+            signal.signal(signal.SIGTERM, _quit)
+
+
+def stop_as_interrupt(signum, frame) -> None:
+    """SIGTERM does what Ctrl-C does, once: a second one (a service manager
+    sending it twice) is ignored, so it cannot cut the quitting short."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    raise KeyboardInterrupt
+
+
+def raise_on_interrupt() -> None:
+    """From here on Ctrl-C and SIGTERM raise KeyboardInterrupt, for a
+    command that ends cleanly on it (the watch view quits as q does)."""
+    if threading.current_thread() is threading.main_thread():
+        if signal.getsignal(signal.SIGINT) is _quit:
+            signal.signal(signal.SIGINT, signal.default_int_handler)
+        if signal.getsignal(signal.SIGTERM) is _quit:
+            signal.signal(signal.SIGTERM, stop_as_interrupt)

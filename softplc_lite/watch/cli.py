@@ -17,6 +17,7 @@ import sys
 from rich.console import Console
 
 from ..app import load_app
+from ..interrupt import raise_on_interrupt
 from ..cli import (
     EXIT_ERROR,
     EXIT_USAGE,
@@ -67,6 +68,7 @@ def watch_command(args) -> int:
         for problem in problems:
             print(f"error: {problem}", file=sys.stderr)
         return EXIT_ERROR
+    raise_on_interrupt()  # from here Ctrl-C and SIGTERM quit as q does, saving
     try:
         if snapshot:
             for _ in range(scans):
