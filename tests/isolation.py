@@ -27,8 +27,10 @@ conftest.py imports the hooks, which pytest finds there by name.
 from __future__ import annotations
 
 import atexit
+import hashlib
 import os
 import shutil
+import sys
 import tempfile
 from pathlib import Path
 
@@ -51,6 +53,34 @@ def hypothesis_setup() -> None:
     set_hypothesis_home_dir(home)
     settings.register_profile("softplc", deadline=None)
     settings.load_profile("softplc")  # --hypothesis-profile, applied later, still wins
+
+
+def bytecode_setup() -> None:
+    """Compiled modules are cached outside the repository, in one directory
+    of this user's for this checkout, handed to workers and to every
+    ``softplc`` the tests start through ``PYTHONPYCACHEPREFIX``: the suite
+    starts the real command hundreds of times, and an environment that says
+    PYTHONDONTWRITEBYTECODE would make each start compile the whole package
+    again (about 0.2 s each) and every run rewrite each test module's
+    asserts again. Python checks a cached module against its source, so a
+    stale cache costs a compile, never a wrong result; a directory another
+    user owns is never used (its bytecode would run as ours)."""
+    prefix = os.environ.get("PYTHONPYCACHEPREFIX")
+    if not prefix:
+        key = hashlib.sha256(f"{ROOT}|{sys.version}".encode()).hexdigest()[:12]
+        prefix = os.path.join(tempfile.gettempdir(), f"softplc-pycache-{os.getuid()}-{key}")
+        try:
+            os.makedirs(prefix, mode=0o700, exist_ok=True)
+            mine = os.stat(prefix).st_uid == os.getuid() and not os.path.islink(prefix)
+        except OSError:
+            mine = False
+        if not mine:
+            prefix = tempfile.mkdtemp(prefix="softplc-pycache-")
+            atexit.register(shutil.rmtree, prefix, ignore_errors=True)
+        os.environ["PYTHONPYCACHEPREFIX"] = prefix
+    os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+    sys.pycache_prefix = prefix
+    sys.dont_write_bytecode = False
 
 
 def repo_listing(root: Path = ROOT) -> set[str]:
