@@ -9,7 +9,6 @@ just within the limits checks and runs."""
 from __future__ import annotations
 
 import os
-import resource
 import subprocess
 import sys
 import time
@@ -29,8 +28,12 @@ PEAK_BOUND_MB = 250
 AS_CAP = 3 << 30
 
 
-def _cap_memory() -> None:
-    resource.setrlimit(resource.RLIMIT_AS, (AS_CAP, AS_CAP))
+# A small Python caps the address space, then becomes softplc (exec): the peak
+# (ru_maxrss, which exec keeps) starts from its few MB. A preexec_fn would fork
+# the test's own process, whose resident memory (hundreds of MB in a long
+# pytest worker) the child's peak would count from.
+CAPPED = ("import os, resource, sys; resource.setrlimit(resource.RLIMIT_AS, ({cap}, {cap})); "
+          "os.execv(sys.executable, [sys.executable, '-m', 'softplc_lite', *sys.argv[1:]])").format(cap=AS_CAP)
 
 
 def softplc_measured(tmp_path: Path, *args: str, timeout: float = 120) -> tuple[int, str, str, float, float]:
@@ -38,8 +41,7 @@ def softplc_measured(tmp_path: Path, *args: str, timeout: float = 120) -> tuple[
     out, err = tmp_path / "out.txt", tmp_path / "err.txt"
     start = time.monotonic()
     with out.open("wb") as o, err.open("wb") as e:
-        proc = subprocess.Popen([sys.executable, "-m", "softplc_lite", *args], cwd=tmp_path, stdout=o, stderr=e,
-                                preexec_fn=_cap_memory)
+        proc = subprocess.Popen([sys.executable, "-c", CAPPED, *args], cwd=tmp_path, stdout=o, stderr=e)
         deadline = start + timeout
         while True:
             pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
