@@ -344,15 +344,13 @@ def build_parser() -> argparse.ArgumentParser:
                    "comment, else the last recorded byte); exit 5 if the output differed")
     r.set_defaults(func=_cmd_run)
 
-    from .watch.keys import keys_help
-
     w = sub.add_parser(
         "watch", help="step scans in a terminal view: rungs, power flow, values, ports",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description="The online view of a running PLC in the terminal (docs/watch.md), or with --snapshot "
                     "one rendering of it to a file.",
-        epilog=f"keys in the view:\n{keys_help()}\n\nCtrl-C or SIGTERM quit as q does (exit 0). See "
-               f"docs/watch.md and {DOCS}.")
+)
+    _keys_in_the_epilog(w)
     w.add_argument("app", metavar="APP", help="app directory or .lad file")
     w.add_argument("--watch", action="append", default=[], metavar="ADDR",
                    help="add ADDR (address or symbol) to the watch list (repeatable; checked before scan 0)")
@@ -420,6 +418,23 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--save", metavar="SNAPSHOT", help="save the table as a retentive snapshot")
     d.set_defaults(func=_cmd_datatable, parser=d)
     return p
+
+
+def _keys_in_the_epilog(parser: argparse.ArgumentParser) -> None:
+    """``softplc watch --help`` ends with the view's keys, made when the help
+    is printed: the key table comes from the view's terminal module (rich,
+    termios), which every other command would otherwise load for nothing
+    (50 ms a start)."""
+    format_help = parser.format_help
+
+    def with_keys() -> str:
+        from .watch.keys import keys_help
+
+        parser.epilog = (f"keys in the view:\n{keys_help()}\n\nCtrl-C or SIGTERM quit as q does (exit 0). "
+                         f"See docs/watch.md and {DOCS}.")
+        return format_help()
+
+    parser.format_help = with_keys
 
 
 def _handle_signals(handlers: dict) -> dict:
