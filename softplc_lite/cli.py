@@ -10,6 +10,19 @@ while ``run`` or ``watch`` scans ends the run cleanly, exit 0).
 
 from __future__ import annotations
 
+import signal as _signal  # built in, loaded with the interpreter: no wait
+
+
+def _quit_at_once(signum, frame) -> None:  # Ctrl-C before interrupt.py is loaded (it takes over)
+    import os
+
+    os._exit(130)
+
+
+_quit_at_once.ends_softplc = True
+if _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler:
+    _signal.signal(_signal.SIGINT, _quit_at_once)
+
 from .interrupt import loaded, quit_until_handled, quit_while_loading, stop_as_interrupt
 
 _LOADING = quit_while_loading()  # Ctrl-C while the modules below load: exit 130, no traceback (interrupt.py)

@@ -33,8 +33,10 @@ def _quit(signum, frame) -> None:
 def quit_while_loading() -> bool:
     """From now until ``loaded``: Ctrl-C exits 130, quietly. Whether this
     call changed anything (not when an entry module's call already did)."""
+    handler = signal.getsignal(signal.SIGINT)
+    # an entry module's first lines may have set a stand-in (ends_softplc) while this module loaded
     if threading.current_thread() is threading.main_thread() and \
-            signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            (handler is signal.default_int_handler or getattr(handler, "ends_softplc", False)):
         signal.signal(signal.SIGINT, _quit)
         return True
     return False

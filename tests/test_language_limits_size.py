@@ -9,6 +9,7 @@ just within the limits checks and runs."""
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -28,33 +29,39 @@ PEAK_BOUND_MB = 250
 AS_CAP = 3 << 30
 
 
-# A small Python caps the address space, then becomes softplc (exec): the peak
-# (ru_maxrss, which exec keeps) starts from its few MB. A preexec_fn would fork
-# the test's own process, whose resident memory (hundreds of MB in a long
-# pytest worker) the child's peak would count from.
-CAPPED = ("import os, resource, sys; resource.setrlimit(resource.RLIMIT_AS, ({cap}, {cap})); "
-          "os.execv(sys.executable, [sys.executable, '-m', 'softplc_lite', *sys.argv[1:]])").format(cap=AS_CAP)
+# A small Python caps the address space and starts softplc as its own child,
+# then writes the child's peak (ru_maxrss) to a file. Linux counts a new
+# process's peak from the memory of the process that started it (fork copies
+# it; exec records the old image's peak), so softplc started straight from a
+# long pytest worker would count the worker's hundreds of MB as its own.
+CAPPED = """
+import os, resource, sys
+resource.setrlimit(resource.RLIMIT_AS, ({cap}, {cap}))
+pid = os.posix_spawn(sys.executable, [sys.executable, "-m", "softplc_lite", *sys.argv[2:]], os.environ)
+_, status, usage = os.wait4(pid, 0)
+with open(sys.argv[1], "w") as f:
+    f.write(str(usage.ru_maxrss))
+code = os.waitstatus_to_exitcode(status)
+sys.exit(code if code >= 0 else 128 - code)
+""".format(cap=AS_CAP)
 
 
 def softplc_measured(tmp_path: Path, *args: str, timeout: float = 120) -> tuple[int, str, str, float, float]:
     """Run softplc; (exit status, stdout, stderr, peak memory in MB, seconds)."""
-    out, err = tmp_path / "out.txt", tmp_path / "err.txt"
+    out, err, peak = tmp_path / "out.txt", tmp_path / "err.txt", tmp_path / "peak.txt"
     start = time.monotonic()
     with out.open("wb") as o, err.open("wb") as e:
-        proc = subprocess.Popen([sys.executable, "-c", CAPPED, *args], cwd=tmp_path, stdout=o, stderr=e)
-        deadline = start + timeout
-        while True:
-            pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
-            if pid:
-                break
-            if time.monotonic() > deadline:
-                proc.kill()
-                os.wait4(proc.pid, 0)
-                pytest.fail(f"softplc {' '.join(args)} took more than {timeout} s")
-            time.sleep(0.05)
-    proc.returncode = os.waitstatus_to_exitcode(status)
+        proc = subprocess.Popen([sys.executable, "-c", CAPPED, str(peak), *args], cwd=tmp_path, stdout=o, stderr=e,
+                                start_new_session=True)
+        try:
+            proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+            pytest.fail(f"softplc {' '.join(args)} took more than {timeout} s")
     seconds = time.monotonic() - start
-    return (proc.returncode, out.read_text(), err.read_text(errors="replace"), usage.ru_maxrss / 1024, seconds)
+    return (proc.returncode, out.read_text(), err.read_text(errors="replace"), int(peak.read_text()) / 1024,
+            seconds)
 
 
 def app_with(tmp_path: Path, text: str) -> Path:
