@@ -30,6 +30,7 @@ import atexit
 import hashlib
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 from pathlib import Path
@@ -95,6 +96,39 @@ def repo_listing(root: Path = ROOT) -> set[str]:
     return found
 
 
+# The ports a PLC on the same machine would hold: programs/hmi_server's
+# 127.0.0.1:5020, and 44818 (EtherNet/IP). The whole run happens while
+# another process listens on them, so a test that binds one of them (or
+# runs a shipped app on its own port) fails here, not on a user's machine.
+HELD_PORTS = (5020, 44818)
+HOLDER_ENV = "SOFTPLC_TEST_PORT_HOLDER"
+HOLDER = """
+import socket, sys
+held = []
+for port in map(int, sys.argv[1:]):
+    s = socket.socket()
+    try:
+        s.bind(("127.0.0.1", port))
+        s.listen()
+        held.append(s)
+    except OSError:  # already taken (a PLC running on this machine): held either way
+        s.close()
+print("holding", flush=True)
+sys.stdin.read()  # until the run closes it, or ends
+"""
+
+
+def hold_ports() -> subprocess.Popen:
+    """A process that listens on HELD_PORTS (where free) until its standard
+    input closes; its pid in HOLDER_ENV for the workers and the check."""
+    holder = subprocess.Popen([sys.executable, "-c", HOLDER, *map(str, HELD_PORTS)], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True)
+    if holder.stdout.readline() != "holding\n":
+        raise RuntimeError("the process holding ports 5020 and 44818 for the run did not start")
+    os.environ[HOLDER_ENV] = str(holder.pid)
+    return holder
+
+
 def _controller(session: pytest.Session) -> bool:
     return not hasattr(session.config, "workerinput")
 
@@ -103,13 +137,22 @@ _BEFORE = pytest.StashKey[set]()
 _APPEARED = pytest.StashKey[list]()
 
 
+_HOLDER = pytest.StashKey[subprocess.Popen]()
+
+
+@pytest.hookimpl(tryfirst=True)
 def pytest_sessionstart(session: pytest.Session) -> None:
     if _controller(session):
         session.config.stash[_BEFORE] = repo_listing()
+        session.config.stash[_HOLDER] = hold_ports()  # before any worker starts
 
 
 @pytest.hookimpl(trylast=True)
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    holder = session.config.stash.get(_HOLDER, None)
+    if holder is not None:
+        holder.stdin.close()
+        holder.wait(30)
     before = session.config.stash.get(_BEFORE, None)
     if before is None:
         return
