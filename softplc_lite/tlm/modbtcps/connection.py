@@ -212,6 +212,7 @@ class Connection(ConnectionBase):
                     self.serving = True
                     response = await self._serve(item)
                     self.serving = False
+                    self._rearm()  # a client that waited for its answer has a whole idleTimeout after it
                 else:
                     response = item
                 if self.is_open:
