@@ -1,6 +1,6 @@
 """``python -m softplc_lite``: the softplc command (cli.main)."""
 
-import signal as _signal  # built in, loaded with the interpreter: no wait
+import _signal  # the C module, loaded with the interpreter (signal.py is not: it builds enums)
 
 
 def _quit_at_once(signum, frame) -> None:  # Ctrl-C before interrupt.py is loaded (it takes over)

@@ -10,7 +10,7 @@ while ``run`` or ``watch`` scans ends the run cleanly, exit 0).
 
 from __future__ import annotations
 
-import signal as _signal  # built in, loaded with the interpreter: no wait
+import _signal  # the C module, loaded with the interpreter (signal.py is not: it builds enums)
 
 
 def _quit_at_once(signum, frame) -> None:  # Ctrl-C before interrupt.py is loaded (it takes over)
