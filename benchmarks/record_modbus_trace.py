@@ -100,7 +100,7 @@ OUTCOMES = ("good", "exceptions", "timeouts", "garbage")
 
 def master(sets=(), **options) -> Runner:
     """The modbus_master app in a Runner (the app's snapshot untouched)."""
-    app = load_app(APP, state_dir=None)
+    app = load_app(APP, state_dir=None, use_cache=False)  # writes nothing beside the app
     app.state_dir = None
     return Runner(app, RunOptions(fresh=True, sets=tuple(sets), **options), log=lambda msg: None)
 
