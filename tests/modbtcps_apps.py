@@ -5,6 +5,8 @@ after the test."""
 
 from __future__ import annotations
 
+import socket
+import struct
 import threading
 import time
 from pathlib import Path
@@ -48,6 +50,21 @@ def write_app(directory: Path, xml: str, ladder: str = "ADD N11:0 1 N11:0\n", mo
     for name, text in (extra or {}).items():
         (directory / name).write_text(text)
     return directory
+
+
+
+def raw_request(port: int, pdu: bytes, unit: int = 1) -> bytes:
+    """One request as bytes on a new socket (what pymodbus's client refuses
+    to send); the reply's PDU. The transaction id must come back."""
+    with socket.create_connection(("127.0.0.1", port), timeout=LIMIT_S) as s:
+        s.sendall(struct.pack(">HHHB", 7, 0, len(pdu) + 1, unit) + pdu)
+        reply = b""
+        while len(reply) < 6 or len(reply) < 6 + struct.unpack(">H", reply[4:6])[0]:
+            chunk = s.recv(512)
+            assert chunk, "the server closed the connection"
+            reply += chunk
+    assert reply[:2] == b"\x00\x07", "the transaction id comes back"
+    return reply[7:]
 
 
 class Running:

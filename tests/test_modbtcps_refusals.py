@@ -33,7 +33,7 @@ from softplc_lite.watch.cli import render
 from softplc_lite.watch.serversview import ServersView
 from softplc_lite.watch.session import WatchOptions, WatchSession
 
-from modbtcps_apps import LIMIT_S, server_xml, write_app
+from modbtcps_apps import LIMIT_S, raw_request, server_xml, write_app
 from modbus_peer import free_tcp_port, wait_for_tcp
 
 pytestmark = pytest.mark.timeout(180)
@@ -52,19 +52,6 @@ def plc(tcp_plc):
 @pytest.fixture
 def client(tcp_client):
     return tcp_client
-
-
-def ask(port: int, pdu: bytes, unit: int = 1) -> bytes:
-    """One request on a new socket; the reply's PDU."""
-    with socket.create_connection(("127.0.0.1", port), timeout=LIMIT_S) as s:
-        s.sendall(struct.pack(">HHHB", 7, 0, len(pdu) + 1, unit) + pdu)
-        reply = b""
-        while len(reply) < 6 or len(reply) < 6 + struct.unpack(">H", reply[4:6])[0]:
-            chunk = s.recv(512)
-            assert chunk, "the server closed the connection"
-            reply += chunk
-    assert reply[:2] == b"\x00\x07", "the transaction id comes back"
-    return reply[7:]
 
 
 def mapped(plc) -> dict:
@@ -100,7 +87,7 @@ def shown(engine, width: int = 100) -> str:
 @pytest.mark.parametrize("value", [0x1234, 0x0001, 0x00FF, 0xFFFF, 0xFF01, 0x8000])
 def test_write_single_coil_with_another_value_is_exception_03_and_changes_nothing(plc, client, value):
     before = mapped(plc)
-    assert ask(plc.port, struct.pack(">BHH", 5, 0, value)) == bytes([0x85, 3])
+    assert raw_request(plc.port, struct.pack(">BHH", 5, 0, value)) == bytes([0x85, 3])
     then_a_write_lands(plc, client)
     assert mapped(plc) == before and plc.read("B3/0") == 0
     wait_counted(plc, S.W_EXCEPTION_03, 1)
@@ -108,9 +95,9 @@ def test_write_single_coil_with_another_value_is_exception_03_and_changes_nothin
 
 
 def test_write_single_coil_on_and_off_still_work(plc):
-    assert ask(plc.port, struct.pack(">BHH", 5, 3, 0xFF00)) == struct.pack(">BHH", 5, 3, 0xFF00)
+    assert raw_request(plc.port, struct.pack(">BHH", 5, 3, 0xFF00)) == struct.pack(">BHH", 5, 3, 0xFF00)
     assert plc.read("B3/3") == 1
-    assert ask(plc.port, struct.pack(">BHH", 5, 3, 0x0000)) == struct.pack(">BHH", 5, 3, 0x0000)
+    assert raw_request(plc.port, struct.pack(">BHH", 5, 3, 0x0000)) == struct.pack(">BHH", 5, 3, 0x0000)
     assert plc.read("B3/3") == 0
 
 
@@ -196,7 +183,7 @@ def test_every_write_function_answered_with_an_exception_writes_nothing(plc, cli
     before = mapped(plc)
     expected = {2: 0, 3: 0}
     for pdu, code in REFUSED_WRITES[function]:
-        assert ask(plc.port, pdu) == bytes([0x80 | function, code]), pdu.hex()
+        assert raw_request(plc.port, pdu) == bytes([0x80 | function, code]), pdu.hex()
         expected[code] += 1
     then_a_write_lands(plc, client)
     assert mapped(plc) == before
@@ -221,7 +208,7 @@ ODD_BODIES = [
 
 def test_every_exception_03_is_counted_in_the_status_words_and_the_watch_view(plc):
     for k, pdu in enumerate(ODD_BODIES, 1):
-        assert ask(plc.port, pdu) == bytes([0x80 | pdu[0], 3]), pdu.hex()
+        assert raw_request(plc.port, pdu) == bytes([0x80 | pdu[0], 3]), pdu.hex()
         wait_counted(plc, S.W_EXCEPTION_03, k)
         wait_counted(plc, S.W_REFUSALS, k)
     assert f"exception 03 {len(ODD_BODIES)}" in " ".join(shown(plc.engine).split())
@@ -274,7 +261,7 @@ def test_fuzz_a_write_answered_with_an_exception_changes_nothing(tcp_apps):
         for _ in range(300):
             pdu = random_write(rnd)
             before = mapped(plc)
-            reply = ask(plc.port, pdu)
+            reply = raw_request(plc.port, pdu)
             if reply[0] & 0x80:
                 refused += 1
                 then_a_write_lands(plc, client)

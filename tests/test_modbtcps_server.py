@@ -21,7 +21,7 @@ from softplc_lite.ladder.engine import Mode
 from softplc_lite.tlm.modbtcps import status as S
 from softplc_lite.watch.forces import Forces, parse_force
 
-from modbtcps_apps import LIMIT_S, server_xml
+from modbtcps_apps import LIMIT_S, raw_request, server_xml
 
 pytestmark = pytest.mark.timeout(120)
 
@@ -203,18 +203,6 @@ def test_a_unit_with_no_writable_region_refuses_the_function(tcp_apps):
         assert exception_code(c.write_register(0, 1, device_id=3)) == 1
         assert c.read_holding_registers(0, count=4, device_id=3).registers == [0, 0, 0, 0]
     plc.wait_for(lambda: plc.status(S.W_EXCEPTION_01) == 1, "exception 01 counted")
-
-
-def raw_request(port: int, pdu: bytes, unit: int = 1) -> bytes:
-    """One request as bytes on a socket (what pymodbus's client refuses to send), the reply's PDU."""
-    with socket.create_connection(("127.0.0.1", port), timeout=LIMIT_S) as s:
-        s.sendall(struct.pack(">HHHB", 1, 0, len(pdu) + 1, unit) + pdu)
-        reply = b""
-        while len(reply) < 6 or len(reply) < 6 + struct.unpack(">H", reply[4:6])[0]:
-            chunk = s.recv(512)
-            assert chunk, "the server closed the connection"
-            reply += chunk
-    return reply[7:]
 
 
 def test_bad_counts_and_string_lengths_are_exception_03(plc, client):
