@@ -268,21 +268,15 @@ def apply_change_unlinked(root: Path, target: str, change: dict) -> None:
 def run_files_case(case, root: Path, timeout: float, runner):
     """The ``files`` driver: prepare, a reference run where the role needs one,
     the change, the case's commands, and the role's oracle."""
-    from fuzz_oracle import Finding, _first_error, judge
+    from fuzz_oracle import CaseRun, Finding, _first_error
 
     d = str(root)
     p = case.params
     target, role, change = p["target"], p["role"], p["change"]
     spec = change.get("special", "bytes")
     name = Path(target).name
-    findings: list = []
-    results: list = []
-
-    def do(argv: list[str]):
-        r = runner([a.replace("{d}", d) for a in argv], timeout)
-        results.append(r)
-        findings.extend(judge(r, case, d, False))
-        return r
+    run = CaseRun(case, d, timeout, runner)
+    findings, results, do = run.findings, run.results, run.do
 
     def add(cls: str, sig: str, r, detail: str) -> None:
         findings.append(Finding(cls, f"{cls}:{r.argv[0] if r.argv else '?'}:{sig}", r.argv, detail, case.kind, r))

@@ -252,6 +252,23 @@ def _first_error(err: str) -> str:
     return err.strip()[:200]
 
 
+class CaseRun:
+    """The commands of one case, run on its directory ``{d}`` by ``runner``:
+    each result kept, and judged by the common oracle (without the location
+    property: these kinds judge their own files)."""
+
+    def __init__(self, case: Case, root: str, timeout: float, runner) -> None:
+        self.case, self.root, self.timeout, self.runner = case, root, timeout, runner
+        self.findings: list[Finding] = []
+        self.results: list[Result] = []
+
+    def do(self, argv: list[str]) -> Result:
+        r = self.runner([a.replace("{d}", self.root) for a in argv], self.timeout)
+        self.results.append(r)
+        self.findings.extend(judge(r, self.case, self.root, False))
+        return r
+
+
 def judge(r: Result, case: Case, root: str, check_location: bool = True) -> list[Finding]:
     """Findings about one command's result: (a), (b), (e), fault 255, (f)."""
     cmd = r.argv[0] if r.argv else "?"

@@ -74,20 +74,14 @@ def _group_alive(pgid: int) -> bool:
 
 
 def run_signals_case(case, root: Path, timeout: float, runner):
-    from fuzz_oracle import Finding, Result, _first_error, judge, softplc_command
+    from fuzz_oracle import CaseRun, Finding, Result, _first_error, softplc_command
 
     d = str(root)
     p = case.params
     app = root / "app"
     _free_port_xml(app)
-    findings: list = []
-    results: list = []
-
-    def do(argv: list[str]):
-        r = runner([a.replace("{d}", d) for a in argv], timeout)
-        results.append(r)
-        findings.extend(judge(r, case, d, False))
-        return r
+    run = CaseRun(case, d, timeout, runner)
+    findings, results, do = run.findings, run.results, run.do
 
     do(["run", "{d}/app", "--scans", "5", "--fresh"])  # a snapshot to keep or damage
     argv = ["run", str(app), *p["args"]]
