@@ -24,7 +24,6 @@ numbers ("0"), MODBMAST's "MODBMAST:1".
 from __future__ import annotations
 
 import errno
-import os
 import re
 import time
 from collections import deque
@@ -33,6 +32,7 @@ from typing import Callable
 
 import serial
 
+from ..errors import os_error_words
 from .transports import Transport, transport_for
 from .wire import char_time_ns
 
@@ -336,6 +336,5 @@ def reason(e: BaseException) -> str:
     if number is not None:
         if number in _DEVICE_WORDS:
             return _DEVICE_WORDS[number]
-        words = os.strerror(number)
-        return words[:1].lower() + words[1:]
+        return os_error_words(OSError(number, ""))  # the common words, never the C library's text
     return text or "the device refused it"

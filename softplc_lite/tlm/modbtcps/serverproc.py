@@ -30,6 +30,7 @@ import signal
 import socket
 import sys
 
+from ...errors import os_error_words
 from . import messages as msg
 from . import status as C
 
@@ -50,7 +51,7 @@ def _bind_problem(host: str, port: int) -> str | None:
         try:
             probe.bind(sockaddr)
         except OSError as e:
-            why = _WHY.get(e.errno, f"the system refused it ({errno.errorcode.get(e.errno, e.errno)})")
+            why = _WHY.get(e.errno) or os_error_words(e)  # a listen's own words first, then the common ones
             return f"cannot listen on {host}:{port}: {why}"
     return None
 
