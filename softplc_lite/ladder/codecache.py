@@ -43,7 +43,7 @@ import sys
 from pathlib import Path
 
 from ..datatable.snapshot import write as write_atomically
-from ..errors import FileAccessError
+from ..errors import FileAccessError, os_error_words
 from ..gcpause import gc_paused
 from ..textfile import CODE_CACHE, read_bytes
 from . import treecodec
@@ -282,7 +282,7 @@ class CodeCache:
             write_atomically(blob, self.path, durable=False)  # a cache: a lost write costs a compile
             return True
         except Exception as e:  # unwritable state directory, a tree the codec does not take: no cache
-            self.problem = f"{self.path}: code cache not written ({type(e).__name__}: {e})"
+            self.problem = f"{self.path}: code cache not written ({os_error_words(e)})"
             return False
 
 
