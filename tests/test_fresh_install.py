@@ -29,6 +29,10 @@ ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "README.md"
 INSTALL = "pip install -e ."  # what the README's first command does first; the fixture does exactly that
 
+# One worker runs this file's tests, so the one that does not build the
+# environment does not sit idle on the lock while another worker builds it.
+pytestmark = pytest.mark.xdist_group("fresh_install")
+
 
 def first_command() -> tuple[str, list[str]]:
     """The README's first command, split at ``&&``: its install part and the softplc command after it."""
@@ -65,7 +69,8 @@ def fresh_venv(tmp_path_factory) -> Path:
 def _clean_env() -> dict[str, str]:
     """The environment a user's shell would give: nothing of this test run's Python path."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
-    env["PYTHONDONTWRITEBYTECODE"] = "1"  # nothing written into the repository's source tree
+    # Byte code goes to the run's PYTHONPYCACHEPREFIX (tests/isolation.py), never into the repository,
+    # and is reused by every command after the first.
     return env
 
 

@@ -325,8 +325,7 @@ def test_a_module_whose_library_is_missing_says_which_in_one_located_line(case, 
     site = tmp_path / "site"
     _install(site, "NEEDY", source, "needy:Lib", requires)
     app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="; the test module\nneedy\n")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")]),
-               PYTHONDONTWRITEBYTECODE="1")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")]))
     for command in (["run", str(app), "--fresh", "--scans", "3"], ["check", str(app)]):
         proc = subprocess.run([sys.executable, "-m", "softplc_lite", *command], capture_output=True, text=True,
                               env=env, timeout=60, cwd=tmp_path)
@@ -349,8 +348,7 @@ def test_modbtcps_in_an_install_without_pymodbus_says_so_at_load(tmp_path):
     app = tmp_path / "hmi_server"
     shutil.copytree(Path(__file__).resolve().parent.parent / "programs" / "hmi_server", app,
                     ignore=shutil.ignore_patterns(".softplc"))
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(hide), os.environ.get("PYTHONPATH", "")]),
-               PYTHONDONTWRITEBYTECODE="1")
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(hide), os.environ.get("PYTHONPATH", "")]))
     proc = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(app), "--fresh", "--scans", "100",
                            "--print", "Level"], capture_output=True, text=True, env=env, timeout=60, cwd=tmp_path)
     assert proc.returncode == 1, proc.stderr
