@@ -142,6 +142,18 @@ def test_installed_modules_come_from_entry_points(demo_path):
     assert names["DEMO"].value == "demo_tlm:Demo"
 
 
+def test_a_module_installed_or_removed_while_the_process_lives_is_seen_at_the_next_look(tmp_path, monkeypatch):
+    # installed() keeps its answer while the import path and its directories are unchanged
+    site = tmp_path / "site"
+    site.mkdir()
+    monkeypatch.syspath_prepend(str(site))
+    assert "LATE" not in installed()
+    _install(site, "LATE", "from softplc_lite.tlm import TLM\nclass Late(TLM):\n    pass\n", "late:Late")
+    assert installed()["LATE"].value == "late:Late"
+    shutil.rmtree(site / "late-1.0.dist-info")
+    assert "LATE" not in installed() and "COMGENIUS" in installed()
+
+
 @pytest.mark.parametrize("executor", ["compiled", "reference"])
 def test_a_third_party_module_runs_through_the_same_door(demo_path, tmp_path, executor):
     app = load_app(make_app(tmp_path, PROGRAM, **{"DEMO.LST": "3\n"}))

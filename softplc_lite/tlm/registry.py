@@ -24,8 +24,10 @@ find.
 
 from __future__ import annotations
 
+import os
 import re
 import shlex
+import sys
 from dataclasses import dataclass
 from importlib.metadata import EntryPoint, PackageNotFoundError, entry_points, packages_distributions, version
 from importlib.util import find_spec
@@ -40,11 +42,35 @@ MODULES_FILE = "MODULES.LST"
 
 
 def installed() -> dict[str, EntryPoint]:
-    """Installed modules by upper-case name, in sorted order."""
-    found: dict[str, EntryPoint] = {}
-    for ep in sorted(entry_points(group=GROUP), key=lambda e: (e.name.upper(), e.value)):
-        found.setdefault(ep.name.upper(), ep)
-    return found
+    """Installed modules by upper-case name, in sorted order.
+
+    Reading every installed distribution's metadata costs milliseconds, and
+    a load asks several times, so the answer is kept while the import path
+    and the modification times of its directories stay the same: installing
+    or removing a distribution adds or removes a directory, which changes
+    its parent's time (the rule Python's own import system uses for its
+    directory caches)."""
+    global _installed
+    state = _import_path_state()
+    if _installed is None or _installed[0] != state:
+        found: dict[str, EntryPoint] = {}
+        for ep in sorted(entry_points(group=GROUP), key=lambda e: (e.name.upper(), e.value)):
+            found.setdefault(ep.name.upper(), ep)
+        _installed = (state, found)
+    return dict(_installed[1])
+
+
+_installed: tuple[tuple, dict[str, EntryPoint]] | None = None
+
+
+def _import_path_state() -> tuple:
+    state = []
+    for entry in sys.path:
+        try:
+            state.append((entry, os.stat(entry or ".").st_mtime_ns))
+        except OSError:
+            state.append((entry, None))
+    return tuple(state)
 
 
 def _package(ep: EntryPoint) -> str:
