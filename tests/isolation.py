@@ -2,6 +2,9 @@
 test run does may land inside the repository, so the suite can run from a
 checkout beside a user's running PLC and on several workers at once.
 
+* softplc's cache (``SOFTPLC_CACHE_DIR``, docs/cli.md "Cache") is kept
+  beside the run's bytecode cache, outside the repository and the user's
+  home.
 * Hypothesis keeps its example database and caches in one temporary
   directory per run (its default is ``.hypothesis/`` in the working
   directory), handed to xdist workers and to pytest runs the tests start
@@ -82,6 +85,8 @@ def bytecode_setup() -> None:
     os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
     sys.pycache_prefix = prefix
     sys.dont_write_bytecode = False
+    # softplc's own cache (the parser's tables, usercache.py) beside it, never the user's ~/.cache
+    os.environ.setdefault("SOFTPLC_CACHE_DIR", os.path.join(prefix, "softplc-cache"))
 
 
 def repo_listing(root: Path = ROOT) -> set[str]:

@@ -17,6 +17,7 @@ program parses about 2.5x faster).
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterator
 from functools import lru_cache
 from types import MappingProxyType
@@ -25,6 +26,7 @@ from lark import Lark, Token
 from lark.exceptions import UnexpectedInput, VisitError
 
 from ..gcpause import gc_paused
+from ..usercache import cached_file
 from .ast import (
     MAIN_FILE,
     DataDecl,
@@ -107,17 +109,20 @@ def _ast_parser() -> Lark:
 
 
 def _lark(transformer) -> Lark:
-    return Lark.open_from_package(
-        "softplc_lite.ladder",
-        "ladder.lark",
-        parser="lalr",
-        lexer="contextual",
-        postlex=LadderPostLex(),
-        propagate_positions=False,
-        maybe_placeholders=False,
-        start=["start", "expr"],
-        transformer=transformer,
-    )
+    """The grammar's LALR parser. Building its tables takes about 60 ms,
+    a fifth of a short ``softplc check``; lark keeps them in the user's
+    cache (usercache.py) and loads them in a tenth of that when the grammar,
+    lark and Python are unchanged (lark checks a digest of all three and of
+    the options, the file's path among them)."""
+
+    # lark loads the file only when its digest matches, and rebuilds and
+    # rewrites it otherwise (cut short, made for another version, or being
+    # written by another softplc starting at the same moment).
+    cached = cached_file(f"ladder-parser-{sys.version_info[0]}.{sys.version_info[1]}.lark")
+    return Lark.open_from_package("softplc_lite.ladder", "ladder.lark", parser="lalr", lexer="contextual",
+                                  postlex=LadderPostLex(), propagate_positions=False, maybe_placeholders=False,
+                                  start=["start", "expr"], transformer=transformer,
+                                  cache=False if cached is None else str(cached))
 
 
 # -- errors ---------------------------------------------------------------------------
