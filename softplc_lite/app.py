@@ -474,11 +474,26 @@ def _module_checks(program: Program, modules: list[TLM]) -> list[LadderError]:
     return sorted(found, key=lambda e: (e.pos.source, e.pos.line, e.pos.column))
 
 
+# The files of an app directory that are softplc's own, never a module's config.
+_OWN_FILES = {"MODULES.LST", "SOFTPLC.TOML", "DATATABLE.JSON"}
+
+
+def _maybe_config_files(app_dir: Path) -> bool:
+    """Whether ``app_dir`` holds any entry that could be a module's config file."""
+    try:
+        return any(not p.name.upper().endswith(".LAD") and p.name.upper() not in _OWN_FILES and not p.is_dir()
+                   for p in app_dir.iterdir())
+    except OSError:
+        return True  # the modules' own lookups meet the error and say it
+
+
 def _unused_configs(app_dir: Path, modules: list[TLM]) -> list[str]:
     """A module config file in the app directory whose module MODULES.LST
     does not enable: likely a forgotten line."""
     enabled = {m.name for m in modules}
-    out = []
+    out: list[str] = []
+    if not _maybe_config_files(app_dir):
+        return out  # spares loading every installed module's code to learn its config file's name
     for name in installed():
         if name in enabled:
             continue

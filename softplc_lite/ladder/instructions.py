@@ -8,6 +8,8 @@ this order. Plug-in modules (TLMs) add their instructions through an
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from .ab_mnemonics import ab_instruction
 from .instr import BOUND as _BOUND
 from .spelling import closest
@@ -92,17 +94,25 @@ class InstructionSet:
 
     ``unavailable`` maps mnemonics of installed but not enabled modules to
     their module name, so an unknown-instruction error can say what to add
-    to MODULES.LST."""
+    to MODULES.LST: a dict, or a function that makes it, called only when an
+    error needs it (finding it loads every installed module's code, which
+    a program without an unknown instruction never needs)."""
 
-    def __init__(self, extra=(), unavailable: dict[str, str] | None = None) -> None:
+    def __init__(self, extra=(), unavailable: dict[str, str] | Callable[[], dict[str, str]] | None = None) -> None:
         self.table: dict[str, InstructionSpec] = dict(_BUILTIN_TABLE)
-        self.unavailable = dict(unavailable or {})
+        self._unavailable = unavailable if callable(unavailable) else dict(unavailable or {})
         for spec in extra:
             existing = self.table.get(spec.mnemonic)
             if existing is not None and existing != spec:
                 owner = f"module {existing.module}" if existing.module else "the built-in instruction set"
                 raise ValueError(f"{spec.mnemonic} of module {spec.module} is already an instruction of {owner}")
             self.table[spec.mnemonic] = spec
+
+    @property
+    def unavailable(self) -> dict[str, str]:
+        if callable(self._unavailable):
+            self._unavailable = dict(self._unavailable())
+        return self._unavailable
 
     def lookup(self, mnemonic: str) -> InstructionSpec | None:
         return self.table.get(mnemonic.upper())

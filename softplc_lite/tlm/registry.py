@@ -271,18 +271,21 @@ def instruction_set(modules: list[TLM], hints: bool = False) -> InstructionSet:
             if spec.module != module.name:
                 raise ModuleError(f"module {module.name} declares {spec.mnemonic} as belonging to {spec.module}")
             extra.append(spec)
-    unavailable: dict[str, str] = {}
-    if hints:
-        enabled = {m.name for m in modules}
+    enabled = {m.name for m in modules}
+
+    def unavailable() -> dict[str, str]:
+        found: dict[str, str] = {}
         for name in installed():
             if name in enabled:
                 continue
             try:
                 other = load_module(name)
-                unavailable.update({s.mnemonic: name for s in other.instructions()})
+                found.update({s.mnemonic: name for s in other.instructions()})
             except ModuleError:
                 continue  # a broken module that is not enabled gives no hint
+        return found
+
     try:
-        return InstructionSet(extra, unavailable)
+        return InstructionSet(extra, unavailable if hints else None)
     except ValueError as e:
         raise ModuleError(str(e)) from None
