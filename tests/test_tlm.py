@@ -379,3 +379,11 @@ def test_the_softplc_command_runs_a_third_party_module(demo_path, tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.splitlines() == ["N7:1 = 10", "R6:0.POS = 2"]
     assert "warning: demo says hello" in proc.stderr
+
+
+def test_a_config_file_of_a_module_not_enabled_is_pointed_out(tmp_path):
+    app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules=None, **{"comgenius.lst": "not read\n", "notes.txt": ""})
+    assert load_app(app).warnings == [f"{app / 'comgenius.lst'}: COMGENIUS is not enabled (add COMGENIUS to "
+                                      "MODULES.LST), so this file is not read"]
+    (app / "comgenius.lst").unlink()
+    assert load_app(app).warnings == []
