@@ -19,6 +19,7 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import os
 import socket
 import subprocess
 import sys
@@ -32,8 +33,40 @@ from pymodbus.simulator import DataType, SimData, SimDevice
 logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
 
 
+def _ephemeral_low() -> int:
+    try:
+        return int(Path("/proc/sys/net/ipv4/ip_local_port_range").read_text().split()[0])
+    except (OSError, ValueError, IndexError):
+        return 32768  # Linux's default
+
+
+# A port found free is handed to a server that binds it a moment later. A
+# port the kernel picked (bind to port 0) is from the ephemeral range, which
+# every client connection of every test also draws its own port from: one
+# could take it in that moment. So ports come from below that range, each
+# xdist worker from its own block, never twice in one process, and only
+# ones nothing listens on now (a user's running PLC keeps its own).
+_BLOCK = 1500
+_FIRST = 10000
+_handed: set[int] = set()
+
+
 def free_tcp_port() -> int:
-    with socket.socket() as s:
+    blocks = max(1, (_ephemeral_low() - _FIRST) // _BLOCK)
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
+    index = int(worker[2:]) if worker[2:].isdigit() else 0
+    start = _FIRST + (index % blocks) * _BLOCK
+    for port in range(start, start + _BLOCK):
+        if port in _handed:
+            continue
+        with socket.socket() as s:
+            try:
+                s.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+        _handed.add(port)
+        return port
+    with socket.socket() as s:  # a whole block used: the kernel's pick
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
 
