@@ -22,10 +22,11 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Iterable
+from typing import TYPE_CHECKING, Iterable
 
-from rich.console import Console, ConsoleOptions, RenderResult
-from rich.text import Text
+if TYPE_CHECKING:
+    from rich.console import Console, ConsoleOptions, RenderResult
+    from rich.text import Text
 
 from .datatable import DataTable, DataTableError
 from .datatable.address import Address
@@ -158,6 +159,8 @@ class StatusLine:
         self._last = (wall_s, scans, now_ms)
 
     def text(self) -> Text:
+        from rich.text import Text  # here: only a status line drawn in a terminal needs rich
+
         t = Text()
         t.append(self.name, style="bold")
         clock = "real" if self.realtime else "simulated"

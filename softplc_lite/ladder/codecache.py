@@ -58,12 +58,11 @@ _DIGEST = 32  # SHA-256, after _HEAD
 
 
 def softplc_version() -> str:
-    try:
-        from importlib.metadata import version
+    # The package's own version (the same as pyproject.toml's, tests/test_cli_usage.py),
+    # not the installed distribution's metadata: reading that costs 10 ms a start.
+    from .. import __version__
 
-        return version("softplc_lite")
-    except Exception:  # an uninstalled tree: the package's own files decide
-        return "unknown"
+    return __version__
 
 
 def cache_key(parts) -> str:

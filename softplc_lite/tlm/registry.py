@@ -29,13 +29,16 @@ import re
 import shlex
 import sys
 from dataclasses import dataclass
-from importlib.metadata import EntryPoint, PackageNotFoundError, entry_points, packages_distributions, version
 from importlib.util import find_spec
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..ladder.instructions import InstructionSet
 from .api import TLM, find_file, read_module_file
 from .errors import ModuleError, ModuleErrors
+
+if TYPE_CHECKING:
+    from importlib.metadata import EntryPoint
 
 GROUP = "softplc_lite.tlms"
 MODULES_FILE = "MODULES.LST"
@@ -53,6 +56,8 @@ def installed() -> dict[str, EntryPoint]:
     global _installed
     state = _import_path_state()
     if _installed is None or _installed[0] != state:
+        from importlib.metadata import entry_points  # here: an app that enables no module never needs it (15 ms)
+
         found: dict[str, EntryPoint] = {}
         for ep in sorted(entry_points(group=GROUP), key=lambda e: (e.name.upper(), e.value)):
             found.setdefault(ep.name.upper(), ep)
@@ -107,12 +112,16 @@ def _not_installed(ep: EntryPoint, missing: str) -> str:
     if top == missing or find_spec(top) is None:
         return (f"module {ep.name} needs the Python package '{top}', which is not installed "
                 f"({pip or 'install it into the Python that runs softplc'})")
+    from importlib.metadata import packages_distributions
+
     have = ", ".join(f"{d} {_version(d)}" for d in packages_distributions().get(top, [])) or top
     return (f"module {ep.name} needs '{missing}', which the installed {have} does not have "
             f"({pip or 'the module may be written for another version of it'})")
 
 
 def _version(dist: str) -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
     try:
         return version(dist)
     except PackageNotFoundError:  # pragma: no cover - listed a moment ago
