@@ -5,10 +5,10 @@ checkout beside a user's running PLC and on several workers at once.
 * softplc's cache (``SOFTPLC_CACHE_DIR``, docs/cli.md "Cache") is kept
   beside the run's bytecode cache, outside the repository and the user's
   home.
-* Hypothesis keeps its example database and caches in one temporary
-  directory per run (its default is ``.hypothesis/`` in the working
-  directory), handed to xdist workers and to pytest runs the tests start
-  through ``HYPOTHESIS_STORAGE_DIRECTORY``. Its per-example deadline is
+* Hypothesis keeps its caches beside the bytecode cache (its default is
+  ``.hypothesis/`` in the working directory), handed to xdist workers and
+  to pytest runs the tests start through ``HYPOTHESIS_STORAGE_DIRECTORY``,
+  with no example database. Its per-example deadline is
   off suite-wide (profile "softplc"): on cores shared with another worker
   it would time the machine's load, not the code.
 * The session hooks list the repository tree before and after the run and
@@ -49,13 +49,18 @@ STATE_DIR = ".softplc"
 
 
 def hypothesis_setup() -> None:
+    """After bytecode_setup: hypothesis's directory is kept beside the
+    bytecode cache, so the constants it reads out of every test module's
+    source at collection (1.5 s a process) are read once per change, not
+    in every worker of every run. Its example database is off: a test runs
+    once a run, so a failing example saved for a replay would only be
+    replayed by a later run, which should find its own."""
     home = os.environ.get("HYPOTHESIS_STORAGE_DIRECTORY")
     if not home:
-        home = tempfile.mkdtemp(prefix="softplc-hypothesis-")
+        home = os.path.join(os.environ["PYTHONPYCACHEPREFIX"], "hypothesis")
         os.environ["HYPOTHESIS_STORAGE_DIRECTORY"] = home
-        atexit.register(shutil.rmtree, home, ignore_errors=True)
     set_hypothesis_home_dir(home)
-    settings.register_profile("softplc", deadline=None)
+    settings.register_profile("softplc", deadline=None, database=None)
     settings.load_profile("softplc")  # --hypothesis-profile, applied later, still wins
 
 
