@@ -15,11 +15,12 @@ from softplc_lite.datatable import DataTable
 from softplc_lite.datatable.filetypes import FILE_TYPES
 
 from clocks import Clock
-from isolation import bytecode_setup, hypothesis_setup, pytest_sessionfinish, pytest_sessionstart, pytest_terminal_summary  # noqa: F401
+from isolation import bytecode_setup, hypothesis_setup, signals_setup, pytest_sessionfinish, pytest_sessionstart, pytest_terminal_summary  # noqa: F401
 from tmux_helpers import tmux  # noqa: F401  (the fixture of the terminal tests)
 
 bytecode_setup()  # one bytecode cache for the run, outside the repository (tests/isolation.py)
 hypothesis_setup()  # nothing of hypothesis's in the repository, no deadline (tests/isolation.py)
+signals_setup()  # Ctrl-C heard by the processes tests start, however the run was started (tests/isolation.py)
 
 
 def pytest_collection_finish(session):

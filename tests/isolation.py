@@ -33,6 +33,7 @@ import atexit
 import hashlib
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -92,6 +93,16 @@ def bytecode_setup() -> None:
     sys.dont_write_bytecode = False
     # softplc's own cache (the parser's tables, usercache.py) beside it, never the user's ~/.cache
     os.environ.setdefault("SOFTPLC_CACHE_DIR", os.path.join(prefix, "softplc-cache"))
+
+
+def signals_setup() -> None:
+    """Ctrl-C as a terminal gives it. A run started in the background of a
+    non-interactive shell, or under nohup, begins with SIGINT ignored, and
+    every process it starts would inherit that: the signal tests would wait
+    for softplc processes that cannot hear their Ctrl-C. A Python handler,
+    unlike an ignored signal, is not inherited across exec."""
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def repo_listing(root: Path = ROOT) -> set[str]:
