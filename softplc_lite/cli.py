@@ -10,24 +10,7 @@ while ``run`` or ``watch`` scans ends the run cleanly, exit 0).
 
 from __future__ import annotations
 
-import _signal  # the C module, loaded with the interpreter (signal.py is not: it builds enums)
-
-
-def _quit_at_once(signum, frame) -> None:  # Ctrl-C before interrupt.py is loaded (it takes over)
-    import os
-
-    os._exit(130)
-
-
-_quit_at_once.ends_softplc = True
-if _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler:
-    _signal.signal(_signal.SIGINT, _quit_at_once)
-
-from .interrupt import loaded, quit_until_handled, quit_while_loading, stop_as_interrupt
-
-_LOADING = quit_while_loading()  # Ctrl-C while the modules below load: exit 130, no traceback (interrupt.py)
-
-import argparse  # noqa: E402 (after the Ctrl-C handling)
+import argparse
 import signal
 import sys
 import threading
@@ -48,9 +31,7 @@ from .ladder.fmt import STYLES
 from .ladder.symbols import SymbolIndex, is_symbol_text, resolve_name
 from .runner import RunOptions, Runner
 from .errors import FileAccessError, LocatedError, file_error
-
-if _LOADING:  # imported, not run by python -m (whose __main__ leaves it to main()): Ctrl-C is the importer's again
-    loaded()
+from .interrupt import loaded, quit_until_handled, stop_as_interrupt
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT, EXIT_INTERNAL = 0, 1, 2, 3, 4
 EXIT_REPLAY = 5  # --replay: the program wrote bytes other than the recording's

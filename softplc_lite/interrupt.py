@@ -2,10 +2,10 @@
 
 Loading softplc's modules takes the first 0.2 s or so of every command; a
 KeyboardInterrupt there would escape as a Python traceback, before main()
-can catch anything. The entry modules (``__main__`` and ``cli``) call
-``quit_while_loading`` before their first heavy import: until main() calls
-``loaded``, Ctrl-C ends the process quietly with exit status 130, what an
-interrupted command exits with. Only Python's own default handler is
+can catch anything. The entry module (``console``, which the console script
+and ``python -m`` load first) calls ``quit_while_loading`` before its first
+heavy import: until main() takes the signals over, Ctrl-C ends the process
+quietly with exit status 130, what an interrupted command exits with. Only Python's own default handler is
 replaced, and only in the main thread, so a program that imports softplc
 with its own SIGINT handling keeps it.
 
@@ -34,7 +34,7 @@ def quit_while_loading() -> bool:
     """From now until ``loaded``: Ctrl-C exits 130, quietly. Whether this
     call changed anything (not when an entry module's call already did)."""
     handler = signal.getsignal(signal.SIGINT)
-    # an entry module's first lines may have set a stand-in (ends_softplc) while this module loaded
+    # the entry module's first lines may have set a stand-in (ends_softplc) while this module loaded
     if threading.current_thread() is threading.main_thread() and \
             (handler is signal.default_int_handler or getattr(handler, "ends_softplc", False)):
         signal.signal(signal.SIGINT, _quit)
