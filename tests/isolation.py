@@ -36,6 +36,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import sysconfig
 import tempfile
 from pathlib import Path
 
@@ -88,11 +89,66 @@ def bytecode_setup() -> None:
             prefix = tempfile.mkdtemp(prefix="softplc-pycache-")
             atexit.register(shutil.rmtree, prefix, ignore_errors=True)
         os.environ["PYTHONPYCACHEPREFIX"] = prefix
+        _seed(prefix)
     os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
     sys.pycache_prefix = prefix
     sys.dont_write_bytecode = False
     # softplc's own cache (the parser's tables, usercache.py) beside it, never the user's ~/.cache
     os.environ.setdefault("SOFTPLC_CACHE_DIR", os.path.join(prefix, "softplc-cache"))
+
+
+def _seed(prefix: str) -> None:
+    """A new cache starts with the byte code the standard library and the
+    test tools were installed with (their ``__pycache__``), which a cache
+    prefix makes Python ignore: without it each worker of a first run
+    compiled all of them again, 9 s of a worker's start. Once per cache
+    (the file SEEDED); a file that cannot be linked or copied is left for
+    Python to compile."""
+    marker = os.path.join(prefix, "SEEDED")
+    if os.path.exists(marker):
+        return
+    tag = sys.implementation.cache_tag
+    for pyc in _installed_byte_code(tag):
+        cached = pyc.parent.parent / pyc.name.replace(f".{tag}.pyc", ".py")  # its source file's path
+        target = os.path.join(prefix, str(cached.parent).lstrip(os.sep), pyc.name)
+        try:
+            os.makedirs(os.path.dirname(target), exist_ok=True)
+            if not os.path.exists(target):
+                shutil.copyfile(pyc, target)
+        except OSError:
+            continue
+    Path(marker).write_text("")
+
+
+def _installed_byte_code(tag: str) -> list[Path]:
+    """The byte code files of the standard library and of the distributions
+    the test extra brings (softplc_lite[test] and what they require)."""
+    from importlib.metadata import PackageNotFoundError, distribution
+    from packaging.requirements import Requirement
+
+    found: list[Path] = []
+    stdlib = sysconfig.get_paths()["stdlib"]
+    for root, dirs, files in os.walk(stdlib):
+        dirs[:] = [d for d in dirs if d != "site-packages"]
+        if os.path.basename(root) == "__pycache__":
+            found += [Path(root, f) for f in files if f.endswith(f".{tag}.pyc")]
+    seen: set[str] = set()
+    todo = [("softplc_lite", "test")]
+    while todo:
+        name, extra = todo.pop()
+        try:
+            dist = distribution(name)
+        except PackageNotFoundError:
+            continue
+        if dist.metadata["Name"].lower() in seen:
+            continue
+        seen.add(dist.metadata["Name"].lower())
+        found += [Path(f.locate()) for f in dist.files or () if f.name.endswith(f".{tag}.pyc")]
+        for text in dist.requires or ():
+            req = Requirement(text)
+            if req.marker is None or req.marker.evaluate({"extra": extra}):
+                todo.append((req.name, ""))
+    return found
 
 
 def signals_setup() -> None:
