@@ -235,6 +235,7 @@ class ModbTcpServer(TLM):
                 self._status_words(ZERO_COUNTERS)
             return
         self._publish()
+        self._update_status()  # before the answers: a client that has its answer has its write counted
         if self._applied != self._acked and self.process is not None:
             self._acked = self._applied
             refused, self._refused = self._refused, []
@@ -243,6 +244,9 @@ class ModbTcpServer(TLM):
                 self.process.stdin.flush()
             except (OSError, ValueError):
                 self._lost("the server process ended")
+                self._update_status()  # its failed bit in this scan's words
+
+    def _update_status(self) -> None:
         if self._status is not None:
             counters = self.image.counters()
             self._measure_rate(counters[C.REQUESTS])
