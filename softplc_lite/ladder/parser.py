@@ -110,7 +110,7 @@ def _ast_parser() -> Lark:
 
 def _lark(transformer) -> Lark:
     """The grammar's LALR parser. Building its tables takes about 60 ms,
-    a fifth of a short ``softplc check``; lark keeps them in the user's
+    a third of a short ``softplc check``; lark keeps them in the user's
     cache (usercache.py) and loads them in a tenth of that when the grammar,
     lark and Python are unchanged (lark checks a digest of all three and of
     the options, the file's path among them)."""
