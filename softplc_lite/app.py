@@ -34,7 +34,7 @@ from .ports import claim_conflicts
 from .ports.urlhandler.protocol_sim import url_problem as sim_url_problem
 from .tlm.api import TLM, find_file
 from .tlm.errors import ModuleError, ModuleErrors
-from .tlm.registry import configure_modules, installed, instruction_set, load_module, load_modules
+from .tlm.registry import MODULES_FILE, configure_modules, installed, instruction_set, load_module, load_modules
 from .textfile import PROGRAM, read_bytes, read_text
 
 SETTINGS_FILE = "softplc.toml"
@@ -475,7 +475,7 @@ def _module_checks(program: Program, modules: list[TLM]) -> list[LadderError]:
 
 
 # The files of an app directory that are softplc's own, never a module's config.
-_OWN_FILES = {"MODULES.LST", "SOFTPLC.TOML", "DATATABLE.JSON"}
+_OWN_FILES = {name.upper() for name in (MODULES_FILE, SETTINGS_FILE, DATATABLE_FILE)}
 
 
 def _maybe_config_files(app_dir: Path) -> bool:

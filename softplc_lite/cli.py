@@ -345,8 +345,7 @@ def build_parser() -> argparse.ArgumentParser:
         "watch", help="step scans in a terminal view: rungs, power flow, values, ports",
         formatter_class=argparse.RawDescriptionHelpFormatter,
         description="The online view of a running PLC in the terminal (docs/watch.md), or with --snapshot "
-                    "one rendering of it to a file.",
-)
+                    "one rendering of it to a file.")
     _keys_in_the_epilog(w)
     w.add_argument("app", metavar="APP", help="app directory or .lad file")
     w.add_argument("--watch", action="append", default=[], metavar="ADDR",

@@ -5,9 +5,9 @@ KeyboardInterrupt there would escape as a Python traceback, before main()
 can catch anything. The entry module (``console``, which the console script
 and ``python -m`` load first) calls ``quit_while_loading`` before its first
 heavy import: until main() takes the signals over, Ctrl-C ends the process
-quietly with exit status 130, what an interrupted command exits with. Only Python's own default handler is
-replaced, and only in the main thread, so a program that imports softplc
-with its own SIGINT handling keeps it.
+quietly with exit status 130, what an interrupted command exits with. Only
+Python's own default handler is replaced, and only in the main thread, so a
+program that imports softplc with its own SIGINT handling keeps it.
 
 This module imports nothing but ``os``, ``signal`` and ``threading``, so
 that it is in place within a few milliseconds of softplc's first line.
@@ -30,16 +30,13 @@ def _quit(signum, frame) -> None:
     os._exit(EXIT_INTERRUPTED)
 
 
-def quit_while_loading() -> bool:
-    """From now until ``loaded``: Ctrl-C exits 130, quietly. Whether this
-    call changed anything (not when an entry module's call already did)."""
+def quit_while_loading() -> None:
+    """From now until main() takes the signals over: Ctrl-C exits 130, quietly."""
     handler = signal.getsignal(signal.SIGINT)
     # the entry module's first lines may have set a stand-in (ends_softplc) while this module loaded
     if threading.current_thread() is threading.main_thread() and \
             (handler is signal.default_int_handler or getattr(handler, "ends_softplc", False)):
         signal.signal(signal.SIGINT, _quit)
-        return True
-    return False
 
 
 def loaded() -> None:

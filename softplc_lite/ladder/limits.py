@@ -68,10 +68,12 @@ def expression_depth(node) -> int:
 
 
 _STRING = r'"[^"\\\n]*+(?:\\.[^"\\\n]*+)*+"'
-_SIGNS = rf"(?:[-+][ \t]*+){{{MAX_SIGNS},}}+|(?i:(?:\bNOT\b[ \t]*+){{{MAX_SIGNS},}}+)"
-_NESTING_SCAN = re.compile(rf"{_STRING}|//[^\n]*+|[(\[\])]|{_SIGNS}")
-_SIGN_RUN = re.compile(rf"(?:[-+][ \t]*+){{{MAX_SIGNS},}}+")
-_NOT_RUN = re.compile(rf"(?i:(?:\bNOT\b[ \t]*+){{{MAX_SIGNS},}}+)")
+_SKIPPED = rf"{_STRING}|//[^\n]*+"  # strings and comments: no nesting counts inside them
+_SIGN_RUN_TEXT = rf"(?:[-+][ \t]*+){{{MAX_SIGNS},}}+"
+_NOT_RUN_TEXT = rf"(?i:(?:\bNOT\b[ \t]*+){{{MAX_SIGNS},}}+)"
+_NESTING_SCAN = re.compile(rf"{_SKIPPED}|[(\[\])]|{_SIGN_RUN_TEXT}|{_NOT_RUN_TEXT}")
+_SIGN_RUN = re.compile(_SIGN_RUN_TEXT)
+_NOT_RUN = re.compile(_NOT_RUN_TEXT)
 
 
 def _maybe_sign_run(text: str) -> bool:
@@ -80,7 +82,9 @@ def _maybe_sign_run(text: str) -> bool:
     if text.count("-") + text.count("+") >= MAX_SIGNS and _SIGN_RUN.search(text):
         return True
     return text.upper().count("NOT") >= MAX_SIGNS and _NOT_RUN.search(text) is not None
-_STRINGS_AND_COMMENTS = re.compile(rf"{_STRING}|//[^\n]*+")
+
+
+_STRINGS_AND_COMMENTS = re.compile(_SKIPPED)
 _NOT_BRACKETS = re.compile(r"[^()\[\]]++")
 _ONE_KIND = str.maketrans("[]", "()")
 # Passes of the bracket filter below before it leaves the text to the exact
