@@ -78,7 +78,8 @@ def bytecode_setup() -> None:
     stale cache costs a compile, never a wrong result; a directory another
     user owns is never used (its bytecode would run as ours)."""
     prefix = os.environ.get("PYTHONPYCACHEPREFIX")
-    if not prefix:
+    chosen_here = not prefix  # else a worker of this run, or a run this suite started
+    if chosen_here:
         key = hashlib.sha256(f"{ROOT}|{sys.version}".encode()).hexdigest()[:12]
         prefix = os.path.join(tempfile.gettempdir(), f"softplc-pycache-{os.getuid()}-{key}")
         try:
@@ -90,11 +91,11 @@ def bytecode_setup() -> None:
             prefix = tempfile.mkdtemp(prefix="softplc-pycache-")
             atexit.register(shutil.rmtree, prefix, ignore_errors=True)
         os.environ["PYTHONPYCACHEPREFIX"] = prefix
-        sys.pycache_prefix = prefix
-        _seed(prefix)
     os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
     sys.pycache_prefix = prefix
     sys.dont_write_bytecode = False
+    if chosen_here:
+        _seed(prefix)
     # softplc's own cache (the parser's tables, usercache.py) beside it, never the user's ~/.cache
     os.environ.setdefault("SOFTPLC_CACHE_DIR", os.path.join(prefix, "softplc-cache"))
 
@@ -106,14 +107,14 @@ def _seed(prefix: str) -> None:
     without it each worker of a first run, and each command the first tests
     start, compiled all of them again (9 s of a worker's start). Once per
     cache (the file SEEDED); a file that cannot be copied is left for Python
-    to compile. Called with ``sys.pycache_prefix`` already set."""
+    to compile. Called with ``sys.pycache_prefix`` set to ``prefix``."""
     marker = os.path.join(prefix, "SEEDED")
     if os.path.exists(marker):
         return
     tag = sys.implementation.cache_tag
     for pyc in _installed_byte_code(tag):
-        cached = pyc.parent.parent / pyc.name.replace(f".{tag}.pyc", ".py")  # its source file's path
-        target = os.path.join(prefix, str(cached.parent).lstrip(os.sep), pyc.name)
+        # DIR/__pycache__/NAME.TAG.pyc is PREFIX/DIR/NAME.TAG.pyc in the prefix's tree
+        target = os.path.join(prefix, str(pyc.parent.parent).lstrip(os.sep), pyc.name)
         try:
             os.makedirs(os.path.dirname(target), exist_ok=True)
             if not os.path.exists(target):
@@ -121,7 +122,7 @@ def _seed(prefix: str) -> None:
         except OSError:
             continue
     # softplc's own modules too, once, before the workers and the first commands all compile them at once
-    compileall.compile_dir(str(ROOT / "softplc_lite"), quiet=1, workers=0 if (os.cpu_count() or 1) > 1 else 1)
+    compileall.compile_dir(str(ROOT / "softplc_lite"), quiet=1, workers=0)  # 0: one process a core
     Path(marker).write_text("")
 
 
