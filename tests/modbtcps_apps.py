@@ -52,7 +52,6 @@ def write_app(directory: Path, xml: str, ladder: str = "ADD N11:0 1 N11:0\n", mo
     return directory
 
 
-
 def raw_request(port: int, pdu: bytes, unit: int = 1) -> bytes:
     """One request as bytes on a new socket (what pymodbus's client refuses
     to send); the reply's PDU. The transaction id must come back."""

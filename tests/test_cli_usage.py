@@ -157,9 +157,10 @@ def test_the_help_lists_the_keys_the_controller_handles():
     missing = [b.action for b in terminal.BINDINGS if not callable(getattr(terminal.Controller, f"_do_{b.action}", None))]
     assert not missing, missing
 
+
 def test_the_package_version_is_the_distributions():
     # the code cache's key uses the package's __version__ (ladder/codecache.py)
     import tomllib
 
-    pyproject = tomllib.loads((Path(__file__).resolve().parent.parent / "pyproject.toml").read_text())
+    pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text())
     assert pyproject["project"]["version"] == __version__

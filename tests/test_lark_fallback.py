@@ -9,7 +9,6 @@ the lark objects the simulations alter are shared by the whole process."""
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import sys
 import textwrap
