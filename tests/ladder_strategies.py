@@ -20,6 +20,7 @@ trees), so ``parse_program(format_program(p, style)) == p`` can be checked.
 
 from __future__ import annotations
 
+import functools
 import random
 
 from hypothesis import strategies as st
@@ -74,6 +75,19 @@ IDX = [f"N9:{k}" for k in range(4)]  # index words (N9:4 is the file selector)
 ADDRESS_SPACE = ["B3:3", "N7:9", "F8:3", "T4:3", "C5:3", "N9:4"]
 
 
+# Strategies made once: hypothesis validates each new strategy object and
+# works out its properties, which cost more than the draw itself when a
+# program takes a thousand draws.
+@functools.cache
+def _integers(lo: int, hi: int) -> st.SearchStrategy[int]:
+    return st.integers(lo, hi)
+
+
+@functools.cache
+def _indexes(n: int) -> st.SearchStrategy[int]:
+    return st.sampled_from(range(n))
+
+
 class Gen:
     """Draws one program procedurally: every choice is one small hypothesis
     draw, so generation is cheap and shrinks well (towards the first
@@ -87,7 +101,7 @@ class Gen:
 
     # -- primitive choices ------------------------------------------------------------
     def int(self, lo: int, hi: int) -> int:
-        return self._draw(st.integers(lo, hi))
+        return self._draw(_integers(lo, hi))
 
     def kind(self, n: int) -> int:
         """One of n cases, 0..n-1, uniformly."""
@@ -97,8 +111,10 @@ class Gen:
         return self.kind(one_in) == 0
 
     def pick(self, options: list):
-        # sampled_from is uniform (integers() favours the ends of its range).
-        return self._draw(st.sampled_from(options))
+        # sampled_from is uniform (integers() favours the ends of its range);
+        # an index into the options, so that one strategy serves every
+        # choice of that many options
+        return options[self._draw(_indexes(len(options)))]
 
     def weighted(self, *pairs):
         """pairs of (weight, value); returns a value."""
