@@ -13,12 +13,11 @@ import doctest
 import re
 import shlex
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from helpers.cli import softplc_here
 from shipped_apps import SHIPPED_PORT, copy_programs
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -76,10 +75,7 @@ def test_doctests_in_docs(page: Path, here):
 def test_console_examples(command: str, expected: list[str], here, tmp_path):
     argv = shlex.split(here(command))
     assert argv[0] == "softplc", "console examples run the softplc command"
-    proc = subprocess.run(
-        [sys.executable, "-m", "softplc_lite", *argv[1:]],
-        cwd=tmp_path, capture_output=True, text=True, timeout=60,
-    )
+    proc = softplc_here(*argv[1:], cwd=tmp_path)  # the text it prints; test_cli_readme runs the command itself
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.splitlines() == [here(line) for line in expected]
 
