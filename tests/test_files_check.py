@@ -1,21 +1,20 @@
 """softplc check lists every problem of every config file, not the first
 (issue 18): MODULES.LST, COMGENIUS.LST (sim:// options included),
 MODBMAST.XML sim:// devices, softplc.toml; each with file and line, and
-"N problems found". Run as a real subprocess."""
+"N problems found". Each runs the CLI in this process (helpers.cli): the
+test reads only what it prints and returns."""
 
 from __future__ import annotations
 
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+from helpers.cli import ROOT, softplc_here
 
 
-def check(app: Path) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite.cli", "check", str(app)], capture_output=True,
-                          text=True, timeout=60, cwd=ROOT)
+def check(app: Path) -> subprocess.CompletedProcess[str]:
+    return softplc_here("check", str(app))
 
 
 def test_every_problem_of_every_config_file(tmp_path):

@@ -8,8 +8,6 @@ from __future__ import annotations
 
 import codecs
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -18,6 +16,8 @@ from softplc_lite.app import AppError, load_app
 from softplc_lite.datatable import DataTable, jsonio
 from softplc_lite.errors import LocatedError
 from softplc_lite.textfile import decode_text
+
+from helpers.cli import softplc_here
 
 ROOT = Path(__file__).resolve().parent.parent
 ENCODINGS = {
@@ -70,8 +70,7 @@ def test_modules_lst_with_a_bom_no_longer_names_the_bom_as_a_module(tmp_path):
     app_dir = tmp_path / "app"
     shutil.copytree(ROOT / "programs" / "loopback", app_dir)
     reencode(app_dir / "MODULES.LST", "utf-8-bom")
-    result = subprocess.run([sys.executable, "-m", "softplc_lite.cli", "check", str(app_dir)],
-                            capture_output=True, text=True, timeout=60)
+    result = softplc_here("check", str(app_dir))
     assert result.returncode == 0, result.stderr
     assert "ï»¿" not in result.stderr and "module COMGENIUS" in result.stdout
 

@@ -11,9 +11,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
@@ -24,12 +21,7 @@ from softplc_lite.errors import FileAccessError, file_error
 from softplc_lite.retentive import restore_snapshot
 from softplc_lite.textfile import read_text
 
-ROOT = Path(__file__).resolve().parent.parent
-
-
-def softplc(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite.cli", *args], capture_output=True, text=True,
-                          timeout=60, cwd=ROOT)
+from helpers.cli import ROOT, softplc_here
 
 
 def test_the_helper_says_the_error_in_words(tmp_path):
@@ -52,7 +44,7 @@ def test_app_config_files_that_cannot_be_read_are_said_in_words(tmp_path):
     shutil.copytree(ROOT / "programs" / "loopback", app)
     (app / "softplc.toml").mkdir()
     (app / "datatable.json").mkdir()
-    result = softplc("check", str(app))
+    result = softplc_here("check", str(app))
     assert result.returncode == 1
     assert result.stderr.splitlines() == [f"cannot read {app / 'softplc.toml'}: it is a directory",
                                           f"cannot read {app / 'datatable.json'}: it is a directory",
@@ -61,10 +53,10 @@ def test_app_config_files_that_cannot_be_read_are_said_in_words(tmp_path):
 
 
 def test_load_and_snapshot_files_that_cannot_be_read_are_said_in_words(tmp_path):
-    result = softplc("run", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"), "--scans", "1",
+    result = softplc_here("run", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"), "--scans", "1",
                      "--load", str(tmp_path))
     assert result.returncode == 1 and result.stderr == f"error: cannot read {tmp_path}: it is a directory\n"
-    result = softplc("datatable", str(tmp_path))
+    result = softplc_here("datatable", str(tmp_path))
     assert result.returncode == 1 and result.stderr == f"error: cannot read {tmp_path}: it is a directory\n"
 
 
@@ -75,7 +67,7 @@ def test_an_unreadable_settings_file_is_permission_denied_in_words(tmp_path):
     (app / "softplc.toml").write_text("[scan]\nscan_ms = 10\n")
     (app / "softplc.toml").chmod(0)
     try:
-        result = softplc("check", str(app))
+        result = softplc_here("check", str(app))
     finally:
         (app / "softplc.toml").chmod(0o644)
     assert result.returncode == 1
@@ -120,9 +112,8 @@ def test_a_snapshot_that_cannot_be_read_suggests_fresh(tmp_path):
 def test_dump_into_a_directory_is_said_in_words_and_exits_1(tmp_path):
     """--dump to a path that is a directory: the run still ends cleanly, the
     error is a sentence, and the exit status says something failed."""
-    out = subprocess.run([sys.executable, "-m", "softplc_lite", "run", "programs/motor", "--fresh", "--scans", "2",
-                          "--state", str(tmp_path / "state"), "--dump", str(tmp_path)],
-                         capture_output=True, text=True, timeout=60, cwd=Path(__file__).resolve().parent.parent)
+    out = softplc_here("run", "programs/motor", "--fresh", "--scans", "2", "--state", str(tmp_path / "state"),
+                  "--dump", str(tmp_path))
     assert out.returncode == 1
     assert f"error: --dump: cannot write {tmp_path}: it is a directory" in out.stderr
     assert "Errno" not in out.stderr and "Traceback" not in out.stderr
