@@ -3,8 +3,10 @@ limits"): a name that is there but cannot be read is reported by name, in
 words, never taken for no file nor left out, and never with the C library's
 text ("No such file or directory", "Is a directory").
 
-Each test runs the real CLI in a subprocess on an app copied to tmp_path,
-from tmp_path, so messages name files as ``app/...``."""
+Each test runs the CLI on an app copied to tmp_path, from tmp_path, so
+messages name files as ``app/...``: in this process (helpers.cli), but for
+names that are not UTF-8 on the command line, which a process of its own
+receives as bytes."""
 
 from __future__ import annotations
 
@@ -12,23 +14,15 @@ import errno
 import os
 import re
 import shutil
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
 from softplc_lite.errors import describe_os_error, os_error_words
 
-ROOT = Path(__file__).resolve().parent.parent
+from helpers.cli import ROOT, softplc, softplc_here
 # What the C library says (strerror) and Python's own "[Errno N]": never in a message.
 RAW = re.compile(r"\[Errno \d+\]|No such file or directory|Is a directory|Not a directory|Too many levels of "
                  r"symbolic links|File too large|No space left on device|Permission denied|Traceback")
-
-
-def softplc(cwd: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite.cli", *args], capture_output=True, text=True,
-                          timeout=120, cwd=cwd)
 
 
 def copy_app(tmp_path: Path, name: str) -> Path:
@@ -66,9 +60,9 @@ def test_an_optional_file_that_is_a_broken_link_is_reported_not_taken_for_no_fil
     app = copy_app(tmp_path, base)
     make(app / name, kind)
     said = f"cannot read app/{name}: {WORDS[kind]}"
-    check = softplc(tmp_path, "check", "app")
+    check = softplc_here("check", "app", cwd=tmp_path)
     assert check.returncode == 1 and check.stderr.splitlines() == [said, "1 problem found"], check.stderr
-    run = softplc(tmp_path, "run", "app", "--scans", "2", "--fresh", "--state", "state")
+    run = softplc_here("run", "app", "--scans", "2", "--fresh", "--state", "state", cwd=tmp_path)
     assert run.returncode == 1 and said in run.stderr.splitlines() and not RAW.search(run.stderr), run.stderr
     assert run.stdout == "" and not (tmp_path / "state").exists()  # refused before any scan
 
@@ -76,7 +70,7 @@ def test_an_optional_file_that_is_a_broken_link_is_reported_not_taken_for_no_fil
 def test_an_optional_file_that_is_not_there_is_still_no_file(tmp_path):
     copy_app(tmp_path, "blinker")  # neither softplc.toml nor datatable.json
     assert not (tmp_path / "app" / "datatable.json").exists()
-    result = softplc(tmp_path, "check", "app")
+    result = softplc_here("check", "app", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
 
 
@@ -86,7 +80,7 @@ def test_a_directory_named_like_the_only_program_file_is_named(tmp_path):
     app = copy_app(tmp_path, "blinker")
     make(app / "main.lad", "dir")
     for argv in (["check", "app"], ["run", "app", "--scans", "2", "--fresh", "--state", "state"]):
-        result = softplc(tmp_path, *argv)
+        result = softplc_here(*argv, cwd=tmp_path)
         assert result.returncode == 1, result.stderr
         assert "app/main.lad: a directory, not a program file" in result.stderr.splitlines(), result.stderr
         assert "no .lad program files" not in result.stderr and not RAW.search(result.stderr)
@@ -95,10 +89,10 @@ def test_a_directory_named_like_the_only_program_file_is_named(tmp_path):
 def test_a_directory_named_like_a_subroutine_file_is_named_with_the_jsr_it_breaks(tmp_path):
     app = copy_app(tmp_path, "modbus_slave")
     make(app / "sbr063_crc.lad", "dir")
-    check = softplc(tmp_path, "check", "app")
+    check = softplc_here("check", "app", cwd=tmp_path)
     lines = check.stderr.splitlines()
     assert check.returncode == 1 and "app/sbr063_crc.lad: a directory, not a program file" in lines, check.stderr
-    fmt = softplc(tmp_path, "fmt", "app")
+    fmt = softplc_here("fmt", "app", cwd=tmp_path)
     assert fmt.returncode == 1 and "app/sbr063_crc.lad: a directory, not a program file" in fmt.stderr.splitlines()
     assert not RAW.search(check.stderr + fmt.stderr)
 
@@ -109,7 +103,8 @@ def test_a_directory_named_like_a_subroutine_file_is_named_with_the_jsr_it_break
 def test_a_replay_trace_that_cannot_be_read_is_said_in_words(tmp_path, kind):
     copy_app(tmp_path, "modbus_master")
     make(tmp_path / "t.trace", kind)
-    result = softplc(tmp_path, "run", "app", "--fresh", "--state", "state", "--replay", "t.trace", "--scans", "20")
+    result = softplc_here("run", "app", "--fresh", "--state", "state", "--replay", "t.trace", "--scans", "20",
+                          cwd=tmp_path)
     assert result.returncode == 1, result.stderr
     assert f"replay: t.trace: cannot read trace file: {WORDS[kind]} " in result.stderr, result.stderr
     assert not RAW.search(result.stderr), result.stderr
@@ -117,11 +112,11 @@ def test_a_replay_trace_that_cannot_be_read_is_said_in_words(tmp_path, kind):
 
 def test_a_directory_in_place_of_the_snapshot_is_said_in_words(tmp_path):
     app = copy_app(tmp_path, "blinker")
-    first = softplc(tmp_path, "run", "app", "--scans", "5", "--fresh")
+    first = softplc_here("run", "app", "--scans", "5", "--fresh", cwd=tmp_path)
     assert first.returncode == 0, first.stderr
     snap = app / ".softplc" / "datatable.snap"
     make(snap, "dir")
-    result = softplc(tmp_path, "run", "app", "--scans", "5")
+    result = softplc_here("run", "app", "--scans", "5", cwd=tmp_path)
     lines = result.stderr.splitlines()
     assert result.returncode == 1, result.stderr
     assert "warning: cannot read app/.softplc/datatable.snap: it is a directory" in lines[0], lines
@@ -133,7 +128,8 @@ def test_a_directory_in_place_of_the_snapshot_is_said_in_words(tmp_path):
 def test_a_record_trace_that_is_a_directory_is_said_in_words(tmp_path):
     copy_app(tmp_path, "loopback")
     (tmp_path / "out.trace").mkdir()
-    result = softplc(tmp_path, "run", "app", "--fresh", "--state", "state", "--scans", "5", "--record", "out.trace")
+    result = softplc_here("run", "app", "--fresh", "--state", "state", "--scans", "5", "--record", "out.trace",
+                          cwd=tmp_path)
     assert result.returncode == 1
     assert result.stderr.strip() == "error: --record: cannot write out.trace: it is a directory", result.stderr
 
@@ -164,24 +160,25 @@ def test_fmt_names_a_non_utf8_file_name_with_escapes(tmp_path):
     app.mkdir()
     name = os.fsdecode(b"\xff.lad")
     (app / name).write_text("XIC   B3/0    OTE O:0/0\n")
-    checked = softplc(tmp_path, "fmt", "--check", "app")
+    checked = softplc_here("fmt", "--check", "app", cwd=tmp_path)
     assert checked.returncode == 1 and checked.stderr == "would reformat app/\\xff.lad\n", checked.stderr
-    written = softplc(tmp_path, "fmt", "--write", "app")
+    written = softplc_here("fmt", "--write", "app", cwd=tmp_path)
     assert written.returncode == 0 and written.stderr == "reformatted app/\\xff.lad\n", written.stderr
     assert (app / name).read_text() == "XIC B3/0 OTE O:0/0\n"
 
 
 def test_the_snapshot_and_record_messages_name_a_non_utf8_path_with_escapes(tmp_path):
+    # Processes: the names reach the command as bytes that are not UTF-8, as a shell passes them.
     app = tmp_path / os.fsdecode(b"\xff")
     shutil.copytree(ROOT / "programs" / "blinker", app, ignore=shutil.ignore_patterns(".softplc"))
     (app / ".softplc" / "datatable.snap").mkdir(parents=True)
-    result = softplc(tmp_path, "run", os.fsdecode(b"\xff"), "--scans", "5", "--fresh")
+    result = softplc("run", os.fsdecode(b"\xff"), "--scans", "5", "--fresh", cwd=tmp_path)
     assert result.returncode == 1
     assert result.stderr.splitlines()[-1] == ("error: cannot save the retentive snapshot \\xff/.softplc/datatable.snap "
                                               "at the end of the run: it is a directory"), result.stderr
     copy_app(tmp_path, "loopback")
     (tmp_path / os.fsdecode(b"\xfe.trace")).mkdir()
-    result = softplc(tmp_path, "run", "app", "--fresh", "--state", "state", "--scans", "5",
-                     "--record", os.fsdecode(b"\xfe.trace"))
+    result = softplc("run", "app", "--fresh", "--state", "state", "--scans", "5",
+                     "--record", os.fsdecode(b"\xfe.trace"), cwd=tmp_path)
     assert result.returncode == 1
     assert result.stderr.strip() == "error: --record: cannot write \\xfe.trace: it is a directory", result.stderr
