@@ -14,12 +14,14 @@ import errno
 import os
 import re
 import shutil
+from pathlib import Path
 
 import pytest
 
 from softplc_lite.errors import describe_os_error, os_error_words
 
 from helpers.cli import ROOT, softplc, softplc_here
+
 # What the C library says (strerror) and Python's own "[Errno N]": never in a message.
 RAW = re.compile(r"\[Errno \d+\]|No such file or directory|Is a directory|Not a directory|Too many levels of "
                  r"symbolic links|File too large|No space left on device|Permission denied|Traceback")
