@@ -5,8 +5,6 @@ point (``softplc_lite.cli.main``) in-process, and a few run the real
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -15,7 +13,7 @@ from softplc_lite import cli
 from softplc_lite.ladder.limits import MAX_BRANCH_DEPTH, MAX_EXPRESSION_DEPTH
 from softplc_lite.ladder.semantics import MAX_JSR_DEPTH
 
-ROOT = Path(__file__).resolve().parent.parent
+from helpers.cli import softplc
 
 
 def short(value) -> str:
@@ -44,11 +42,6 @@ def make_app(root: Path, lad: str | bytes, **files: str | bytes) -> Path:
         path = app / name.replace("_", ".") if name != "main.lad" else app / name
         path.write_bytes(text if isinstance(text, bytes) else text.encode())
     return app
-
-
-def softplc(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=timeout)
 
 
 HUGE = "9" * 5000
@@ -280,6 +273,7 @@ def test_printf_render_stops_at_its_limit():
 
 def test_the_real_command_reports_without_a_traceback(tmp_path):
     app = make_app(tmp_path, f"MOV {HUGE} N7:0\n" + _branches(600) + "\n")
+    # A process: a fresh interpreter, with Python's own limits on digits and recursion, and its real stderr.
     p = softplc("check", str(app))
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert "main.lad:1:5: number" in p.stderr and "main.lad:2:" in p.stderr
