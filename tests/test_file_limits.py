@@ -29,6 +29,8 @@ from softplc_lite.runner import RunOptions, Runner
 from softplc_lite.textfile import FileRefused, Limit, read_bytes, read_text, size_text
 from softplc_lite.watch.watchlist import read_watch_file
 
+from helpers.cli import softplc
+
 PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
 GiB = 1 << 30
 PROMPT_S = 30  # a refusal comes at once; a command that waits on a FIFO never ends, and is stopped after this
@@ -80,15 +82,16 @@ def unblocked(path: Path, after: float = 2.0):
         thread.join()
 
 
-def softplc(*args: str, cwd: Path, timeout: float = PROMPT_S) -> subprocess.CompletedProcess[str]:
-    """The real CLI in a process of its own, limited to 1.5 GiB of address
-    space (a reader that reads /dev/zero or 20 GiB whole fails at once
-    instead of taking the machine's memory) and to ``timeout`` seconds."""
-    def limit() -> None:
-        resource.setrlimit(resource.RLIMIT_AS, (3 * GiB // 2, resource.RLIM_INFINITY))
+def limit_memory() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (3 * GiB // 2, resource.RLIM_INFINITY))
 
-    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=timeout, preexec_fn=limit)
+
+def softplc_capped(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """The real CLI in a process of its own, never in-process: limited to
+    1.5 GiB of address space (a reader that reads /dev/zero or 20 GiB whole
+    fails at once instead of taking the machine's memory) and to PROMPT_S
+    seconds (one that waits on a FIFO is stopped)."""
+    return softplc(*args, cwd=cwd, timeout=PROMPT_S, preexec_fn=limit_memory)
 
 
 # -- the reader itself --------------------------------------------------------------------------------------
@@ -269,7 +272,7 @@ def test_the_cli_refuses_a_special_or_huge_input_promptly_and_says_where(tmp_pat
     app = copy_app(tmp_path, app_name)
     (app / name).unlink(missing_ok=True)
     make(app / name)
-    p = softplc(*args, cwd=tmp_path)
+    p = softplc_capped(*args, cwd=tmp_path)
     assert p.returncode == 1, (p.returncode, p.stderr)
     assert said in p.stderr, p.stderr
     assert "Traceback" not in p.stderr and "internal error" not in p.stderr
@@ -291,8 +294,8 @@ def run_in_process(app: Path, scans: int = 100, fresh: bool = False) -> tuple[di
 
 
 def run_blinker(tmp_path: Path, *extra: str) -> subprocess.CompletedProcess[str]:
-    return softplc("run", "blinker", "--scans", "100", "--print", "C5:0.ACC", "--print", "T4:0.ACC", *extra,
-                   cwd=tmp_path)
+    return softplc_capped("run", "blinker", "--scans", "100", "--print", "C5:0.ACC", "--print", "T4:0.ACC", *extra,
+                          cwd=tmp_path)
 
 
 ONE_BLINK = {"C5:0.ACC": 1, "T4:0.ACC": 50}  # the blinker after 100 scans from its start
