@@ -1,7 +1,8 @@
-"""issue 18, section 2: which clock ``softplc run`` follows, SIGTERM handled
-as Ctrl-C (``run`` and ``watch``), and the status line of an unbounded run
-in a terminal. Real subprocesses and a real terminal (tmux); every process
-is bounded by a timeout and ended by its own pid."""
+"""Which clock ``softplc run`` follows, SIGTERM handled as Ctrl-C (``run``
+and ``watch``), and the status line of an unbounded run in a terminal.
+What ends by SIGTERM or Ctrl-C is a real process (in a real terminal, tmux,
+for the status line), bounded by a timeout and ended by its own pid; a
+bounded command whose output is all a test checks runs in-process."""
 
 from __future__ import annotations
 
@@ -17,7 +18,7 @@ from pathlib import Path
 import pytest
 from cli_tmux import SOFTPLC, open_terminal
 
-ROOT = Path(__file__).resolve().parent.parent
+from helpers.cli import ROOT, softplc_here
 
 
 @pytest.fixture(name="terminal")
@@ -26,14 +27,10 @@ def fixture_terminal(request):
 BLINKER = ROOT / "programs" / "blinker" / "main.lad"  # C5:0.ACC counts blinks: one a second of PLC time
 
 
-def softplc(*args: str, timeout: float = 60) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=ROOT, capture_output=True,
-                          text=True, timeout=timeout, check=False)
-
-
 def run_then_sigterm(args: list[str], state: Path, seconds: float) -> subprocess.CompletedProcess:
     """Start ``softplc run``, let it scan ``seconds`` of wall time after its
     first retentive save, then SIGTERM it; (returncode, stdout, stderr)."""
+    # a process: it ends by SIGTERM
     proc = subprocess.Popen([sys.executable, "-m", "softplc_lite", "run", *args, "--state", str(state)],
                             cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
@@ -62,7 +59,7 @@ def test_an_unbounded_run_follows_the_wall_clock_and_sigterm_ends_it_like_ctrl_c
     assert 1 <= blinks <= 4, p.stdout  # about 2.5 s of PLC time: the wall clock, not simulated time
     assert json.loads(dump.read_text())["C5"][0]["ACC"] == blinks  # --dump written at the SIGTERM
     # the final save holds the last scan: a fresh-less run starts from it
-    again = softplc("run", str(BLINKER), "--state", str(tmp_path / "state"), "--scans", "0",
+    again = softplc_here("run", str(BLINKER), "--state", str(tmp_path / "state"), "--scans", "0",
                     "--print", "C5:0.ACC")
     assert again.returncode == 0 and again.stdout == f"C5:0.ACC = {blinks}\n", again
 
@@ -81,7 +78,7 @@ def test_a_bounded_run_is_on_simulated_time_unless_realtime(tmp_path, clock, exp
     app.mkdir()
     (app / "main.lad").write_text(BLINKER.read_text())
     (app / "softplc.toml").write_text('[display]\nsummary = { blinks = "C5:0.ACC" }\n')
-    p = softplc("run", str(app), "--fresh", "--scans", "20", *clock)
+    p = softplc_here("run", str(app), "--fresh", "--scans", "20", *clock)
     assert p.returncode == 0, p.stderr
     first = p.stdout.splitlines()[0]
     assert re.fullmatch(rf"app: 20 scans, [\d.]+ s {expected} time", first), p.stdout
@@ -92,7 +89,7 @@ def test_a_bounded_run_is_on_simulated_time_unless_realtime(tmp_path, clock, exp
 
 
 def test_realtime_and_simulated_together_are_a_usage_error():
-    p = softplc("run", str(BLINKER), "--realtime", "--simulated", "--scans", "1")
+    p = softplc_here("run", str(BLINKER), "--realtime", "--simulated", "--scans", "1")
     assert p.returncode == 2
     assert p.stderr.splitlines()[-1] == "softplc run: error: argument --simulated: not allowed with argument --realtime"
 
@@ -115,6 +112,6 @@ def test_sigterm_quits_watch_as_q_does(terminal, tmp_path):
     os.kill(terminal.command_pid(), signal.SIGTERM)  # the softplc process the pane's shell started
     assert terminal.exit_status() == 0
     # the final save holds the newest scan: the OFF timer as after 3 scans of softplc run
-    p = softplc("datatable", str(tmp_path / "datatable.snap"), "--print", "T4:0.ACC")
-    three = softplc("run", str(BLINKER), "--scans", "3", "--print", "T4:0.ACC")
+    p = softplc_here("datatable", str(tmp_path / "datatable.snap"), "--print", "T4:0.ACC")
+    three = softplc_here("run", str(BLINKER), "--scans", "3", "--print", "T4:0.ACC")
     assert p.returncode == 0 and p.stdout == three.stdout == "T4:0.ACC = 2\n", (p, three)
