@@ -60,7 +60,7 @@ def test_an_unbounded_run_follows_the_wall_clock_and_sigterm_ends_it_like_ctrl_c
     assert json.loads(dump.read_text())["C5"][0]["ACC"] == blinks  # --dump written at the SIGTERM
     # the final save holds the last scan: a fresh-less run starts from it
     again = softplc_here("run", str(BLINKER), "--state", str(tmp_path / "state"), "--scans", "0",
-                    "--print", "C5:0.ACC")
+                         "--print", "C5:0.ACC")
     assert again.returncode == 0 and again.stdout == f"C5:0.ACC = {blinks}\n", again
 
 

@@ -41,7 +41,7 @@ def test_datatable_json_then_load_then_set(app, tmp_path):
     extra.write_text('{"N7": [null, null, 3]}')
     dump = tmp_path / "out.json"
     p = softplc_here("run", str(app), "--fresh", "--scans", "1", "--load", str(extra), "--set", "N7:3=9",
-                "--set", "F8:0=2.5", "--dump", str(dump), "--print", "N7:0", "--print", "N7:2", "--print", "N7:3")
+                     "--set", "F8:0=2.5", "--dump", str(dump), "--print", "N7:0", "--print", "N7:2", "--print", "N7:3")
     assert p.returncode == 0, p.stderr
     assert p.stdout.splitlines() == ["N7:0 = 101", "N7:2 = 3", "N7:3 = 9"]
     doc = json.loads(dump.read_text())
