@@ -2,30 +2,23 @@
 addresses are checked before scan 0 (exit 1, nothing run or saved), the
 help texts, --version, softplc alone, softplc datatable alone, and the
 CLI-level watch fixes (--snapshot leaves the retentive state alone unless
---save; --scans needs --snapshot). Real subprocesses and real files."""
+--save; --scans needs --snapshot). The command run by cli.main in the
+test's process, on real files: each test checks what it prints, returns and
+writes."""
 
 from __future__ import annotations
 
 import re
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from helpers.cli import ROOT, softplc_here
 from softplc_lite import __version__
 from softplc_lite.cli import build_parser
 from softplc_lite.watch import terminal
 from softplc_lite.watch.keys import key_rows
-
-ROOT = Path(__file__).resolve().parent.parent
-
-
-def softplc(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=60, check=False)
-
 
 def motor(tmp_path: Path) -> Path:
     app = tmp_path / "motor"
@@ -44,26 +37,26 @@ def motor(tmp_path: Path) -> Path:
      "softplc run: error: argument --simulated: not allowed with argument --realtime"),
 ])
 def test_usage_errors_name_only_the_rule_broken(args, message):
-    p = softplc(*args)
+    p = softplc_here(*args)
     assert p.returncode == 2
     assert p.stderr.splitlines()[-1] == message  # one rule, on the last line under the usage
     assert "Traceback" not in p.stderr and p.stdout == ""
 
 
 def test_softplc_alone_prints_usage_and_exits_2():
-    p = softplc()
+    p = softplc_here()
     assert p.returncode == 2 and p.stdout == ""
     assert p.stderr.startswith("usage: softplc ")
     assert "a COMMAND is needed: run, watch, check, fmt, address or datatable" in p.stderr
 
 
 def test_version():
-    p = softplc("--version")
+    p = softplc_here("--version")
     assert (p.returncode, p.stdout) == (0, f"softplc_lite {__version__}\n")
 
 
 def test_datatable_alone_explains_itself():
-    p = softplc("datatable")
+    p = softplc_here("datatable")
     assert p.returncode == 2
     assert p.stderr.startswith("usage: softplc datatable")
     assert "expected FILEs to load" in p.stderr and "softplc datatable docs/examples/datatable.json" in p.stderr
@@ -73,7 +66,7 @@ def test_datatable_alone_explains_itself():
 
 def test_a_bad_print_address_stops_before_scan_0(tmp_path):
     app = motor(tmp_path)
-    p = softplc("run", str(app), "--scans", "5", "--print", "Motor", "--print", "N7:999", "--print", "Nope")
+    p = softplc_here("run", str(app), "--scans", "5", "--print", "Motor", "--print", "N7:999", "--print", "Nope")
     assert p.returncode == 1 and p.stdout == ""
     assert p.stderr.splitlines() == [
         "error: --print N7:999: element 999 is past the end of N7 (1 element)",
@@ -85,7 +78,7 @@ def test_a_bad_print_address_stops_before_scan_0(tmp_path):
 def test_a_bad_watch_address_stops_before_scan_0(tmp_path):
     app = motor(tmp_path)
     out = tmp_path / "view.txt"
-    p = softplc("watch", str(app), "--watch", "N99:0", "--scans", "3", "--snapshot", str(out), "--save")
+    p = softplc_here("watch", str(app), "--watch", "N99:0", "--scans", "3", "--snapshot", str(out), "--save")
     assert p.returncode == 1
     assert p.stderr == "error: --watch N99:0: there is no data file N99\n"
     assert not out.exists() and not (app / ".softplc" / "datatable.snap").exists()
@@ -94,7 +87,7 @@ def test_a_bad_watch_address_stops_before_scan_0(tmp_path):
 def test_a_bad_display_address_stops_before_scan_0_with_its_line(tmp_path):
     app = motor(tmp_path)
     (app / "softplc.toml").write_text('# shown by softplc run\n[display]\nsummary = { far = "N7:50" }\n')
-    p = softplc("run", str(app), "--scans", "5")
+    p = softplc_here("run", str(app), "--scans", "5")
     assert p.returncode == 1 and p.stdout == ""
     assert re.search(r"softplc.toml:3: \[display\] summary 'far': .*past the end of N7", p.stderr), p.stderr
     assert not (app / ".softplc" / "datatable.snap").exists()
@@ -105,19 +98,19 @@ def test_a_bad_display_address_stops_before_scan_0_with_its_line(tmp_path):
 def test_watch_snapshot_leaves_the_retentive_state_unless_save(tmp_path):
     app = motor(tmp_path)
     snap = app / ".softplc" / "datatable.snap"
-    assert softplc("run", str(app), "--scans", "1", "--set", "N7:0=5").returncode == 0
+    assert softplc_here("run", str(app), "--scans", "1", "--set", "N7:0=5").returncode == 0
     before = snap.read_bytes()
     view = tmp_path / "view.txt"
-    p = softplc("watch", str(app), "--scans", "3", "--set", "N7:0=77", "--snapshot", str(view))
+    p = softplc_here("watch", str(app), "--scans", "3", "--set", "N7:0=77", "--snapshot", str(view))
     assert p.returncode == 0 and view.exists(), p.stderr
     assert snap.read_bytes() == before  # read at start, not written
-    p = softplc("watch", str(app), "--scans", "3", "--set", "N7:0=77", "--snapshot", str(view), "--save")
+    p = softplc_here("watch", str(app), "--scans", "3", "--set", "N7:0=77", "--snapshot", str(view), "--save")
     assert p.returncode == 0, p.stderr
-    assert softplc("run", str(app), "--scans", "0", "--print", "N7:0").stdout == "N7:0 = 77\n"
+    assert softplc_here("run", str(app), "--scans", "0", "--print", "N7:0").stdout == "N7:0 = 77\n"
 
 
 def test_watch_scans_without_snapshot_is_refused():
-    p = softplc("watch", "programs/motor", "--scans", "10")
+    p = softplc_here("watch", "programs/motor", "--scans", "10")
     assert p.returncode == 2
     assert p.stderr == ("softplc watch: error: --scans N needs --snapshot FILE (the view starts at scan 0; "
                         "press n to step or r to run)\n")
@@ -137,13 +130,13 @@ def test_every_argument_has_help_and_every_help_points_to_docs():
         for action in sub._actions:
             assert action.help, f"{name} {action.option_strings or action.dest} has no help text"
     for name in ("run", "watch", "check", "address", "datatable"):
-        p = softplc(name, "--help")
+        p = softplc_here(name, "--help")
         assert p.returncode == 0 and re.search(r"docs/\w+\.md", p.stdout), (name, p.stdout)
-    assert "docs/cli.md" in softplc("--help").stdout
+    assert "docs/cli.md" in softplc_here("--help").stdout
 
 
 def test_watch_help_lists_every_key_of_the_table():
-    text = softplc("watch", "--help").stdout
+    text = softplc_here("watch", "--help").stdout
     assert "keys in the view:" in text
     rows = key_rows()
     assert len(rows) == len(terminal.BINDINGS) >= 20
