@@ -7,25 +7,17 @@ from __future__ import annotations
 
 import re
 import shutil
-import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
+from helpers.cli import ROOT, softplc_here
 from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions
 from softplc_lite.watch.session import WatchOptions, WatchSession
 from softplc_lite.watch.terminal import Controller
 
-ROOT = Path(__file__).resolve().parent.parent
 # Python's words that must not reach a user
 LEAKS = re.compile(r"\((str|int|float|dict|list|bool|NoneType)\)|\bdict\b|ValueError|TypeError|\[Errno|Traceback")
-
-
-def softplc(cwd: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=60)
 
 
 @pytest.fixture
@@ -36,7 +28,7 @@ def apps(tmp_path):
 
 
 def test_set_a_bit_to_text_names_the_option_the_bit_and_what_was_typed(apps):
-    p = softplc(apps, "run", "motor", "--fresh", "--scans", "1", "--set", "StopOk=abc")
+    p = softplc_here("run", "motor", "--fresh", "--scans", "1", "--set", "StopOk=abc", cwd=apps)
     assert p.returncode == 1 and p.stdout == ""
     assert p.stderr == "error: --set StopOk=abc: I:0/1 holds a bit (0 or 1), got abc\n"
 
@@ -54,7 +46,7 @@ def test_set_a_bit_to_text_names_the_option_the_bit_and_what_was_typed(apps):
     ("N7:0", "--set N7:0: expected ADDR=VALUE, e.g. N7:0=5"),
 ])
 def test_every_set_refusal_is_said_in_words(apps, item, said):
-    p = softplc(apps, "run", "motor", "--fresh", "--scans", "1", "--set", item)
+    p = softplc_here("run", "motor", "--fresh", "--scans", "1", "--set", item, cwd=apps)
     assert p.returncode == 1
     assert p.stderr == f"error: {said}\n"
     assert not LEAKS.search(p.stderr)
@@ -62,11 +54,11 @@ def test_every_set_refusal_is_said_in_words(apps, item, said):
 
 def test_a_missing_device_for_port_names_the_option_and_says_no_such_device(apps):
     missing = apps / "no-such-tty"
-    p = softplc(apps, "run", "loopback", "--fresh", "--scans", "1", "--port", f"0={missing}")
+    p = softplc_here("run", "loopback", "--fresh", "--scans", "1", "--port", f"0={missing}", cwd=apps)
     assert p.returncode == 1
     assert p.stderr == (f"error: --port 0={missing}: cannot open {missing}: no such device "
                         "(set PORT_ERRORS=RETRY in [DRIVER] to run on without it)\n")
-    p = softplc(apps, "run", "modbus_scada", "--fresh", "--scans", "1", "--port", f"1={missing}")
+    p = softplc_here("run", "modbus_scada", "--fresh", "--scans", "1", "--port", f"1={missing}", cwd=apps)
     assert p.returncode == 1
     assert p.stderr.startswith(f"error: --port MODBMAST:1={missing}: cannot open {missing}: no such device ")
 
@@ -74,7 +66,7 @@ def test_a_missing_device_for_port_names_the_option_and_says_no_such_device(apps
 @pytest.mark.parametrize("device, words", [(".", "it is a directory, not a device"),
                                            ("motor/main.lad", "not a serial device")])
 def test_a_device_that_is_no_serial_port_is_said_in_words(apps, device, words):
-    p = softplc(apps, "run", "loopback", "--fresh", "--scans", "1", "--port", f"0={device}")
+    p = softplc_here("run", "loopback", "--fresh", "--scans", "1", "--port", f"0={device}", cwd=apps)
     assert p.returncode == 1 and f"cannot open {device}: {words} " in p.stderr
     assert not LEAKS.search(p.stderr)
 
