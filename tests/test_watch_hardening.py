@@ -1,15 +1,14 @@
 """The watch view against sizes that once hung or crashed it (issue 15):
 deep, wide and long rungs, huge snapshot sizes, an app with no rungs,
 watch files too big or not text, expressions nested too deep. Layout is
-checked through the library, the command line through the real
-``softplc`` command (a subprocess with a timeout)."""
+checked through the library, the command line through ``softplc``'s
+main() in this process (tests/helpers/cli.py)."""
 
 from __future__ import annotations
 
 import gc
 import io
 import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -27,6 +26,7 @@ from softplc_lite.watch import cells, layout as layout_module
 from softplc_lite.watch.power import rung_power
 from softplc_lite.watch.rungs import RungView
 
+from helpers.cli import softplc_here
 from ladder_strategies import programs
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -89,11 +89,6 @@ def best_time(fn, repeat: int = 5, number: int = 3) -> float:
     finally:
         gc.enable()
     return best
-
-
-def softplc(*args: str, timeout: float = 60, **kw) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=timeout, check=False, stdin=subprocess.DEVNULL, **kw)
 
 
 def app(tmp_path: Path, text: str, name: str = "app") -> Path:
@@ -249,8 +244,8 @@ def test_every_rung_line_is_exactly_the_width(program, width):
 def test_snapshot_size_and_scans_out_of_range_are_usage_errors(tmp_path, args, message):
     # --width 100000 --height 100000 used to render ten billion cells: it never finished
     out = tmp_path / "view.txt"
-    proc = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
-                   "--snapshot", str(out), *args, timeout=30)
+    proc = softplc_here("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                        "--snapshot", str(out), *args)
     assert proc.returncode == 2, proc.stderr
     assert proc.stderr.startswith("usage: softplc watch")
     assert f"softplc watch: error: {message}" in proc.stderr
@@ -262,8 +257,8 @@ def test_snapshot_size_and_scans_out_of_range_are_usage_errors(tmp_path, args, m
 def test_snapshots_at_the_ends_of_the_size_range(tmp_path, width, height):
     out = tmp_path / "view.txt"
     start = time.monotonic()
-    proc = softplc("watch", "programs/modbus_master", "--fresh", "--state", str(tmp_path / "state"), "--scans", "20",
-                   "--snapshot", str(out), "--width", str(width), "--height", str(height))
+    proc = softplc_here("watch", "programs/modbus_master", "--fresh", "--state", str(tmp_path / "state"),
+                        "--scans", "20", "--snapshot", str(out), "--width", str(width), "--height", str(height))
     assert proc.returncode == 0, proc.stderr
     assert time.monotonic() - start < 30
     lines = out.read_text(encoding="utf-8").splitlines()
@@ -271,7 +266,7 @@ def test_snapshots_at_the_ends_of_the_size_range(tmp_path, width, height):
 
 
 def test_help_gives_the_size_ranges():
-    proc = softplc("watch", "--help")
+    proc = softplc_here("watch", "--help")
     assert proc.returncode == 0
     text = " ".join(proc.stdout.split())
     assert "--width COLS --snapshot width, 40..1000 (default 100)" in text
@@ -304,7 +299,8 @@ def test_snapshot_of_a_program_with_no_rungs(tmp_path, scans):
     # IndexError before: the session took the first of no program files
     empty = app(tmp_path, "// nothing\n", "empty")
     out = tmp_path / "view.txt"
-    proc = softplc("watch", str(empty), "--state", str(tmp_path / "state"), "--scans", scans, "--snapshot", str(out))
+    proc = softplc_here("watch", str(empty), "--state", str(tmp_path / "state"), "--scans", scans,
+                        "--snapshot", str(out))
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr
     text = out.read_text(encoding="utf-8")
@@ -370,8 +366,8 @@ def test_a_watch_file_of_100000_lines_is_refused_at_the_line_past_the_limit(tmp_
     watch = tmp_path / "big.watch"
     watch.write_text("# N7 words\n" + "".join(f"N7:{k % 1000}\n" for k in range(100_000)), encoding="utf-8")
     start = time.monotonic()
-    proc = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
-                   "--watch-file", str(watch), "--snapshot", str(tmp_path / "view.txt"))
+    proc = softplc_here("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                        "--watch-file", str(watch), "--snapshot", str(tmp_path / "view.txt"))
     assert time.monotonic() - start < 30
     assert proc.returncode == 1
     assert proc.stderr.strip() == (f"error: {watch}:{WATCH_MAX + 2}:1: one address too many: the watch list holds "
@@ -382,8 +378,8 @@ def test_watch_file_problems_are_located(tmp_path):
     def run(raw: bytes, *extra: str) -> subprocess.CompletedProcess:
         watch = tmp_path / "list.watch"
         watch.write_bytes(raw)
-        return softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"), *extra,
-                       "--watch-file", str(watch), "--snapshot", str(tmp_path / "view.txt"))
+        return softplc_here("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"), *extra,
+                            "--watch-file", str(watch), "--snapshot", str(tmp_path / "view.txt"))
 
     where = tmp_path / "list.watch"
     binary = run(b"N7:0\nC5:0.ACC  # counts\n\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR")
@@ -406,16 +402,16 @@ def test_watch_file_problems_are_located(tmp_path):
 
 
 def test_too_many_watch_addresses_and_long_arguments_give_short_errors(tmp_path):
-    many = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
-                   *[a for k in range(300) for a in ("--watch", f"N7:{k}")], "--snapshot", str(tmp_path / "v.txt"))
+    many = softplc_here("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                        *[a for k in range(300) for a in ("--watch", f"N7:{k}")], "--snapshot", str(tmp_path / "v.txt"))
     assert many.returncode == 1
     assert many.stderr.strip() == "error: --watch: 300 addresses; the watch list holds at most 256"
-    long = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
-                   "--break-when", "N7:0 + " * 10_000 + "1 > 2", "--snapshot", str(tmp_path / "v.txt"))
+    long = softplc_here("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                        "--break-when", "N7:0 + " * 10_000 + "1 > 2", "--snapshot", str(tmp_path / "v.txt"))
     assert long.returncode == 1 and "Traceback" not in long.stderr
     assert len(long.stderr) < 400, long.stderr[:400]
-    force = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
-                    "--force", "B3/0=" + "1" * 50_000, "--snapshot", str(tmp_path / "v.txt"))
+    force = softplc_here("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
+                         "--force", "B3/0=" + "1" * 50_000, "--snapshot", str(tmp_path / "v.txt"))
     assert force.returncode == 1 and len(force.stderr) < 400, force.stderr[:400]
 
 
@@ -534,7 +530,7 @@ def test_thousands_of_forces_are_counted_not_listed(tmp_path):
 def test_a_break_condition_on_a_string_or_a_whole_timer_is_refused_at_start(tmp_path, condition, message):
     # a TypeError at the first scan before (an internal error, exit 4)
     strings = app(tmp_path, "SYMBOL Reading ST9:0\nDATA ST9 1 = \"WT: 12\"\nXIC B3/0 TON T4:0 0.01 5 0\n")
-    proc = softplc("watch", str(strings), "--fresh", "--state", str(tmp_path / "state"), "--scans", "2",
-                   "--break-when", condition, "--snapshot", str(tmp_path / "view.txt"))
+    proc = softplc_here("watch", str(strings), "--fresh", "--state", str(tmp_path / "state"), "--scans", "2",
+                        "--break-when", condition, "--snapshot", str(tmp_path / "view.txt"))
     assert proc.returncode == 1
     assert proc.stderr.strip() == f"error: --break-when {condition!r}: {message}"
