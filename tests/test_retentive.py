@@ -26,15 +26,11 @@ from softplc_lite.ports import recorder as recorder_module
 from softplc_lite.retentive import Retentive, StorageFaults
 from softplc_lite.runner import RunOptions, Runner
 
-ROOT = Path(__file__).resolve().parent.parent
+from helpers.cli import ROOT, softplc_here
+
 STORAGE = 1 << S.MINOR_STORAGE_BIT
 
 COUNTER = "ADD N7:0 1 N7:0\nMOV -1 N7:2\nMOV N7:0 N7:1\nMOV 0 N7:2\n"
-
-
-def softplc(*args: str, timeout: float = 60) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=ROOT,
-                          capture_output=True, text=True, timeout=timeout)
 
 
 def make_app(directory: Path, ladder: str = COUNTER, **files: str) -> Path:
@@ -268,6 +264,7 @@ def test_disk_full_is_a_minor_fault_retried_until_saving_works_again(tmp_path):
     app = make_app(tmp_path / "app")
     state = tmp_path / "state"
     state.mkdir()
+    # a process: the write limit (RLIMIT_FSIZE) is the whole process's
     p = subprocess.run([sys.executable, "-c", DISK_FULL_CHILD, str(app), str(state), str(FULL_AT)],
                        capture_output=True, text=True, timeout=60, cwd=tmp_path)
     assert p.returncode == 0, p.stderr
@@ -294,8 +291,8 @@ def test_an_unusable_state_directory_keeps_the_plc_running_and_exits_1(tmp_path)
     (tmp_path / "a-file").write_text("not a directory")
     state = tmp_path / "a-file" / "state"
     dump = tmp_path / "dump.json"
-    p = softplc("run", str(app), "--state", str(state), "--realtime", "--scan-ms", "5", "--scans", "100",
-                "--print", "N7:0", "--print", "S:17", "--print", "S:102", "--dump", str(dump))
+    p = softplc_here("run", str(app), "--state", str(state), "--realtime", "--scan-ms", "5", "--scans", "100",
+                     "--print", "N7:0", "--print", "S:17", "--print", "S:102", "--dump", str(dump))
     assert p.returncode == 1, p.stderr
     assert p.stdout == "N7:0 = 100\nS:17 = 16\nS:102 = 9\n"  # all the scans, the fault in the table
     assert dump.exists() and "Traceback" not in p.stderr
@@ -315,8 +312,8 @@ def test_a_read_only_state_directory_is_a_minor_fault(tmp_path):
     state.mkdir()
     state.chmod(0o555)
     try:
-        p = softplc("run", str(app), "--state", str(state), "--realtime", "--scan-ms", "5", "--scans", "60",
-                    "--print", "N7:0", "--print", "S:17", "--print", "S:102")
+        p = softplc_here("run", str(app), "--state", str(state), "--realtime", "--scan-ms", "5", "--scans", "60",
+                         "--print", "N7:0", "--print", "S:17", "--print", "S:102")
     finally:
         state.chmod(0o755)
     assert p.returncode == 1 and p.stdout == "N7:0 = 60\nS:17 = 16\nS:102 = 9\n", p.stderr
@@ -324,8 +321,9 @@ def test_a_read_only_state_directory_is_a_minor_fault(tmp_path):
 
 
 def test_record_to_a_full_device_is_a_minor_fault_and_the_run_goes_on(tmp_path):
-    p = softplc("run", "programs/modbus_master", "--fresh", "--state", str(tmp_path / "state"), "--scans", "3000",
-                "--record", "/dev/full", "--print", "C5:1.ACC", "--print", "S:17", "--print", "S:102")
+    p = softplc_here("run", "programs/modbus_master", "--fresh", "--state", str(tmp_path / "state"),
+                     "--scans", "3000", "--record", "/dev/full", "--print", "C5:1.ACC", "--print", "S:17",
+                     "--print", "S:102")
     assert p.returncode == 1, p.stderr
     assert "modbus_master: 3000 scans" in p.stdout  # not the major fault 255 of before
     assert "C5:1.ACC = 2" in p.stdout and "S:17 = 16\nS:102 = 10\n" in p.stdout
@@ -436,6 +434,7 @@ def run_and_kill(app: Path, state: Path, server: socket.socket, rng: random.Rand
     as soon as a save's temp file appears), read what it sent until the
     connection closes. Returns the last count received and the files left."""
     port = server.getsockname()[1]
+    # a process: it ends by SIGKILL
     proc = subprocess.Popen([sys.executable, "-m", "softplc_lite", "run", str(app), "--state", str(state),
                              "--realtime", "--scan-ms", str(SCAN_MS), "--port", f"0=socket://127.0.0.1:{port}"],
                             cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
