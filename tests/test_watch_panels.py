@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import io
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -21,6 +19,8 @@ from softplc_lite.watch.portsview import ports_of
 from softplc_lite.watch.screen import WatchScreen, rung_view
 from softplc_lite.watch.session import WatchOptions, WatchSession
 from softplc_lite.watch.terminal import KEYS, Controller
+
+from helpers.cli import softplc_here
 
 ROOT = Path(__file__).resolve().parent.parent
 SIZES = [(120, 40), (100, 40), (80, 24)]
@@ -137,10 +137,8 @@ def test_a_step_in_program_mode_records_no_scan_and_history_stays_scans(open_app
 
 
 def test_watch_of_a_missing_app_says_so_before_asking_for_a_terminal(tmp_path):
-    p = subprocess.run([sys.executable, "-m", "softplc_lite", "watch", "nosuch"], cwd=tmp_path,
-                       stdin=subprocess.DEVNULL, capture_output=True, text=True, timeout=60)
-    run = subprocess.run([sys.executable, "-m", "softplc_lite", "run", "nosuch"], cwd=tmp_path,
-                         capture_output=True, text=True, timeout=60)
+    p = softplc_here("watch", "nosuch", cwd=tmp_path)  # its standard input and output are not a terminal
+    run = softplc_here("run", "nosuch", cwd=tmp_path)
     missing = (1, "nosuch: no such app directory or .lad file\n")
     assert (p.returncode, p.stderr) == (run.returncode, run.stderr) == missing
     assert p.stdout == ""

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import os
 import subprocess
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,6 +33,8 @@ from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions
 from softplc_lite.watch.cli import render, write_snapshot
 from softplc_lite.watch.session import WatchOptions, WatchSession
+
+from helpers.cli import softplc, softplc_here
 
 ROOT = Path(__file__).resolve().parent.parent
 PROGRAMS = ROOT / "programs"
@@ -165,17 +166,12 @@ def test_the_doc_pictures_are_current(case: Case, width: int, height: int, image
     assert svg == path.read_text(encoding="utf-8"), f"{path.relative_to(ROOT)} is out of date: UPDATE_GOLDENS=1"
 
 
-def _softplc(*args: str, **kw) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", "watch", *args], cwd=ROOT, capture_output=True,
-                          text=True, timeout=60, check=False, **kw)
-
-
 def test_cli_snapshot_writes_the_golden_view(tmp_path):
     case = CASES[0]
     out = tmp_path / "view.txt"
-    proc = _softplc(f"programs/{case.program}", "--fresh", "--state", str(tmp_path / "state"), "--scans",
-                    str(case.scans), *case.cli, "--snapshot", str(out), "--width", "80", "--height", "24",
-                    stdin=subprocess.DEVNULL)
+    proc = softplc_here("watch", f"programs/{case.program}", "--fresh", "--state", str(tmp_path / "state"),
+                        "--scans", str(case.scans), *case.cli, "--snapshot", str(out), "--width", "80", "--height",
+                        "24")
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout == ""
     _compare(GOLDENS / f"{case.name}-80x24.txt", out.read_text(encoding="utf-8"))
@@ -183,8 +179,8 @@ def test_cli_snapshot_writes_the_golden_view(tmp_path):
 
 def test_cli_snapshot_svg(tmp_path):
     out = tmp_path / "view.svg"
-    proc = _softplc("programs/blinker", "--fresh", "--state", str(tmp_path / "state"), "--scans", "60",
-                    "--snapshot", str(out), "--width", "80", "--height", "24", stdin=subprocess.DEVNULL)
+    proc = softplc_here("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"), "--scans", "60",
+                        "--snapshot", str(out), "--width", "80", "--height", "24")
     assert proc.returncode == 0, proc.stderr
     svg = out.read_text(encoding="utf-8")
     assert svg.startswith("<svg") and svg.rstrip().endswith("</svg>")
@@ -192,7 +188,8 @@ def test_cli_snapshot_svg(tmp_path):
 
 
 def test_cli_without_a_terminal_says_so_and_suggests_a_snapshot(tmp_path):
-    proc = _softplc("programs/blinker", "--fresh", "--state", str(tmp_path), stdin=subprocess.DEVNULL)
+    # a process, its standard input /dev/null: what "not a terminal" is to a user
+    proc = softplc("watch", "programs/blinker", "--fresh", "--state", str(tmp_path), stdin=subprocess.DEVNULL)
     assert proc.returncode == 2
     assert "needs a terminal" in proc.stderr and "--snapshot" in proc.stderr
     assert proc.stdout == ""
