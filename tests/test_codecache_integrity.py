@@ -10,8 +10,6 @@ from __future__ import annotations
 import marshal
 import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -21,6 +19,8 @@ from softplc_lite.app import load_app
 from softplc_lite.ladder import codecache
 from softplc_lite.ladder.codecache import CodeCache
 from softplc_lite.runner import RunOptions, Runner
+
+from helpers.cli import softplc_here
 
 PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
 SCANS = 200  # the blinker: two blinks on simulated time
@@ -138,17 +138,14 @@ def test_a_damaged_cache_runs_the_real_program_as_without_a_cache_and_is_rewritt
 def test_the_cli_runs_the_real_program_from_a_damaged_cache_and_rewrites_it(tmp_path):
     shutil.copytree(PROGRAMS / "blinker", tmp_path / "blinker", ignore=shutil.ignore_patterns(".softplc"))
 
-    def softplc() -> subprocess.CompletedProcess[str]:
-        return subprocess.run([sys.executable, "-m", "softplc_lite", "run", "blinker", "--fresh", "--scans", "1000",
-                               "--print", "Lamp", "--print", "C5:0.ACC", "--print", "T4:1.ACC"],
-                              cwd=tmp_path, capture_output=True, text=True, timeout=60)
-
-    first = softplc()
+    args = ("run", "blinker", "--fresh", "--scans", "1000", "--print", "Lamp", "--print", "C5:0.ACC",
+            "--print", "T4:1.ACC")
+    first = softplc_here(*args, cwd=tmp_path)
     assert first.returncode == 0 and first.stdout == "Lamp (O:0/0) = 1\nC5:0.ACC = 10\nT4:1.ACC = 31\n", first
     path = tmp_path / "blinker" / ".softplc" / codecache.CACHE_FILE
     good = path.read_bytes()
     path.write_bytes(flipped(good, len(good) * 2 // 3))  # in the compiled code
-    damaged = softplc()
+    damaged = softplc_here(*args, cwd=tmp_path)
     assert damaged.returncode == 0, damaged.stderr
     assert damaged.stdout == first.stdout
     assert damaged.stderr == ("warning: blinker/.softplc/codecache.bin: damaged code cache (its digest does not "
