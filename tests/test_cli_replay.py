@@ -1,26 +1,25 @@
 """issue 18, section 2: ``--replay`` as a CI gate. Output differences exit
 5; a trace says how many scans it covers (``# scans: N``) and a replay
 without --scans stops at the end of the trace. Real runs of the shipped
-Modbus master against its shipped recording."""
+Modbus master against its shipped recording, by cli.main in the test's
+process: each test checks what the run prints and returns."""
 
 from __future__ import annotations
 
 import subprocess
-import sys
 from pathlib import Path
 
+from helpers.cli import ROOT, softplc_here
 from softplc_lite.cli import EXIT_REPLAY
 from softplc_lite.ports.trace import covered_scans, read_trace, scans_in
 
-ROOT = Path(__file__).resolve().parent.parent
 APP = ROOT / "programs" / "modbus_master"
 SHIPPED = APP / "pymodbus-session.trace"
 SUMMARY = "modbus_master: 1195 scans, 1.20 s simulated time\npolls (C5:0.ACC) = 13\ngood (C5:1.ACC) = 8\n"
 
 
-def replay(trace: Path, state: Path, *extra: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(APP), "--fresh", "--state", str(state),
-                           "--replay", str(trace), *extra], cwd=ROOT, capture_output=True, text=True, timeout=120, check=False)
+def replay(trace: Path, state: Path, *extra: str) -> subprocess.CompletedProcess[str]:
+    return softplc_here("run", str(APP), "--fresh", "--state", str(state), "--replay", str(trace), *extra)
 
 
 def test_the_shipped_trace_says_how_many_scans_it_covers():
