@@ -4,10 +4,6 @@ configuration, --port / --record / --replay, and the one-owner rule."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
-from pathlib import Path
-
 import pytest
 
 from softplc_lite.app import AppError, load_app
@@ -16,9 +12,8 @@ from softplc_lite.ladder.engine import Mode
 from softplc_lite.ports.modbus_slave import find_slave
 from softplc_lite.tlm.modbmast.status import NO_REPLY
 
+from helpers.cli import softplc_here
 from modbmast_apps import Apps, link, modbmast, scans, serial_xml, status, write_app
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture
@@ -161,11 +156,6 @@ def test_a_bad_file_at_reload_faults_the_plc_and_keeps_the_old_configuration(app
 
 # -- the command line ---------------------------------------------------------------------------
 
-def softplc(*args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=ROOT, capture_output=True, text=True,
-                          timeout=60)
-
-
 COMGENIUS_LST = "[DRIVER]\nDEBUG=0\n[PORTS]\n1, {device}, ISO-8859-1, 38400, 8, N, 1, 50\n[STRINGS]\n\"x\"\n"
 
 
@@ -173,10 +163,10 @@ def test_port_overrides_name_the_module_when_both_have_the_port(tmp_path):
     d = write_app(tmp_path / "app", three_slaves("cli-a"), "MBR_GETSTATUS #N9:0 1 1 1\n",
                   modules="COMGENIUS\nMODBMAST\n", extra={"COMGENIUS.LST": COMGENIUS_LST.format(device="loop://")})
     args = ("run", str(d), "--fresh", "--scans", "20", "--print", "N10:11")
-    both = softplc(*args, "--port", "1=sim://x?device=modbus&id=1")
+    both = softplc_here(*args, "--port", "1=sim://x?device=modbus&id=1")
     assert both.returncode == 1 and "COMGENIUS and MODBMAST both have a port 1; say which: " \
         "--port COMGENIUS:1=... or --port MODBMAST:1=..." in both.stderr
-    ok = softplc(*args, "--port", "MODBMAST:1=sim://cli-b?device=modbus&id=1&values=index")
+    ok = softplc_here(*args, "--port", "MODBMAST:1=sim://cli-b?device=modbus&id=1&values=index")
     assert ok.returncode == 0, ok.stderr
     assert ok.stdout.strip() == "N10:11 = 1"  # holding register 1 with values=index
 
@@ -187,7 +177,7 @@ def test_two_modules_may_not_open_one_device(tmp_path):
     xml = serial_xml(f'<Port num="2" baudrate="9600" device="{tty}"/>')
     d = write_app(tmp_path / "app", xml, "XIC B3/0 OTE B3/1\n", modules="COMGENIUS\nMODBMAST\n",
                   extra={"COMGENIUS.LST": COMGENIUS_LST.format(device=tty)})
-    result = softplc("check", str(d))
+    result = softplc_here("check", str(d))
     assert result.returncode == 1
     assert f"MODBMAST.XML:2: MODBMAST port 2 would open {tty}, which COMGENIUS port 1 opens (" in result.stderr
     assert "COMGENIUS.LST:4); a serial device has one owner" in result.stderr
@@ -197,11 +187,11 @@ def test_record_then_replay_gives_the_same_data_table(tmp_path):
     d = write_app(tmp_path / "app", three_slaves("rec"), MNEMONIC)
     trace = tmp_path / "run.trace"
     args = ("run", str(d), "--fresh", "--scans", "40", "--print", "N10:11", "--print", "N9:6")
-    first = softplc(*args, "--record", str(trace))
+    first = softplc_here(*args, "--record", str(trace))
     assert first.returncode == 0, first.stderr
     text = trace.read_text()
     assert "MODBMAST:1 TX 01 03 00 00 00 02 C4 0B" in text and "MODBMAST:1 RX 01 03 04" in text
-    again = softplc(*args, "--replay", str(trace))
+    again = softplc_here(*args, "--replay", str(trace))
     assert again.returncode == 0, again.stderr
     assert again.stdout == first.stdout and "output matched" in again.stderr
 
@@ -210,7 +200,7 @@ def test_check_lists_the_config_files_problems_and_the_programs_together(tmp_pat
     xml = serial_xml('<Port num="40" baudrate="9600"><Slave id="0"/></Port>', 'debug="7"')
     d = write_app(tmp_path / "app", xml, "XIC B3/0 OTE B3/1\nMOV 1 N7:0 N7:1\n",
                   modules="COMGENIUS\nMODBMAST\n", extra={"COMGENIUS.LST": "[DRIVER]\nDEBUG=5\n"})
-    result = softplc("check", str(d))
+    result = softplc_here("check", str(d))
     lines = result.stderr.splitlines()
     assert result.returncode == 1 and lines[-1] == "5 problems found"
     assert lines[0].endswith("COMGENIUS.LST:2: [DRIVER]: DEBUG must be 0, 1 or 2, not '5'")
