@@ -1,19 +1,20 @@
 """Every shipped app is as ``softplc fmt`` prints it: ``softplc fmt --check``
 passes on each (a CI gate a user's own apps can copy), so the examples
-teach the canonical form. fmt --check writes nothing; it runs in-process on
-the app as shipped, and once as the real command on copies."""
+teach the canonical form. fmt --check writes nothing; it runs on each app
+as shipped, and once through the whole command (its arguments, its exit
+status) on copies, both in this process."""
 
 from __future__ import annotations
 
 import io
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from softplc_lite.fmtcmd import fmt_command
+
+from helpers.cli import softplc_here
 
 ROOT = Path(__file__).resolve().parent.parent
 APPS = sorted(p.name for p in (ROOT / "programs").iterdir() if p.is_dir() and any(p.glob("*.lad")))
@@ -29,7 +30,6 @@ def test_each_shipped_app_passes_fmt_check(name):
 def test_the_command_agrees_on_copies(tmp_path):
     for name in APPS:
         shutil.copytree(ROOT / "programs" / name, tmp_path / name, ignore=shutil.ignore_patterns(".softplc"))
-    p = subprocess.run([sys.executable, "-m", "softplc_lite", "fmt", "--check", *APPS], cwd=tmp_path,
-                       capture_output=True, text=True, timeout=120)
+    p = softplc_here("fmt", "--check", *APPS, cwd=tmp_path)
     assert (p.returncode, p.stdout, p.stderr) == (0, "", "")
     assert len(APPS) >= 10

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import math
 import struct
-import subprocess
-import sys
 from fractions import Fraction
 
 import pytest
@@ -23,6 +21,8 @@ from softplc_lite.datatable.jsonio import load_text as load_json
 from softplc_lite.ladder import Engine, Mode, Settings, load_text, run_text
 from softplc_lite.ladder import status as S
 from softplc_lite.ladder.rounding import FLOAT32_MAX, round_half_even
+
+from helpers.cli import softplc_here
 
 EXECUTORS = ("compiled", "reference")
 
@@ -250,8 +250,7 @@ def test_a_real_app_rounds_a_set_float_half_to_even(tmp_path):
     app.mkdir()
     (app / "main.lad").write_text("MOV F8:0 N7:0\nCPT N7:1 \"F8:0 * 3\"\nSCP F8:0 0.0 1.0 0.0 -1.0 N7:2\n")
     for executor in EXECUTORS:
-        out = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(app), "--fresh", "--scans", "1",
-                              "--executor", executor, "--set", "F8:0=2.5", "--print", "N7:0", "--print", "N7:1",
-                              "--print", "N7:2"], capture_output=True, text=True, timeout=120, cwd=tmp_path)
+        out = softplc_here("run", str(app), "--fresh", "--scans", "1", "--executor", executor, "--set", "F8:0=2.5",
+                           "--print", "N7:0", "--print", "N7:1", "--print", "N7:2", cwd=tmp_path)
         assert out.returncode == 0, out.stderr
         assert out.stdout.splitlines()[-3:] == ["N7:0 = 2", "N7:1 = 8", "N7:2 = -2"], out.stdout
