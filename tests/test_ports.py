@@ -14,6 +14,7 @@ from softplc_lite.ports.port import LineSettings, SerialPort
 from softplc_lite.ports.trace import parse_trace
 
 from clocks import Clock
+from helpers.cli import softplc_here
 
 CHAR = 260_417  # one character at 38400 8N1, ns
 
@@ -205,14 +206,8 @@ def test_a_port_that_cannot_be_opened_is_down_with_the_reason(clock):
 def test_an_unwritable_trace_stops_the_start_and_nothing_is_written(tmp_path):
     """--record to a place that cannot be written: refused before the first
     scan (exit 1, the path named), not a fault in the middle of the run."""
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    root = Path(__file__).resolve().parent.parent
-    run = subprocess.run([sys.executable, "-m", "softplc_lite", "run", "programs/loopback", "--fresh", "--state",
-                          str(tmp_path / "s"), "--scans", "20", "--record", str(tmp_path / "no-dir" / "x.trace")],
-                         cwd=root, capture_output=True, text=True, timeout=60)
+    run = softplc_here("run", "programs/loopback", "--fresh", "--state", str(tmp_path / "s"), "--scans", "20",
+                       "--record", str(tmp_path / "no-dir" / "x.trace"))
     assert run.returncode == 1 and "Traceback" not in run.stderr
     assert run.stderr.strip() == (f"error: --record: cannot write {tmp_path / 'no-dir' / 'x.trace'}: "
                                   "no such file or directory")
