@@ -4,17 +4,15 @@ and in neutral text a forgotten ';' joins two rungs in just that way."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from helpers.cli import softplc_here
 from softplc_lite.ladder.parser import parse_program
 from softplc_lite.ladder.validate import check
 from softplc_lite.ladder.verify import verify
 
-ROOT = Path(__file__).resolve().parent.parent
 SERIES = "in series: an output instruction ends its rung or branch leg"
 
 
@@ -84,8 +82,7 @@ def test_check_warns_of_the_joined_rungs_and_exits_0(tmp_path):
     app = tmp_path / "joined"
     app.mkdir()
     (app / "main.lad").write_text("XIC(B3/0)OTE(O:0/0)\nXIC(B3/1)OTE(O:0/1);\n")
-    p = subprocess.run([sys.executable, "-m", "softplc_lite", "check", "joined"], cwd=tmp_path,
-                       capture_output=True, text=True, timeout=60)
+    p = softplc_here("check", "joined", cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     main = Path("joined", "main.lad")
     assert p.stderr.splitlines() == [

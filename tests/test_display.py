@@ -3,19 +3,15 @@
 from __future__ import annotations
 
 import re
-
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 from rich.console import Console
 
+from helpers.cli import softplc_here
 from softplc_lite.app import AppError, load_app
 from softplc_lite.datatable import DataTable
 from softplc_lite.display import StatusLine, parse_display
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def app_dir(tmp_path: Path, display: str) -> Path:
@@ -28,8 +24,7 @@ def app_dir(tmp_path: Path, display: str) -> Path:
 
 def test_summary_after_a_bounded_run(tmp_path):
     d = app_dir(tmp_path, 'status = { count = "Count", "first" = "N11:0" }\nsummary = { block = "#N11:0 3" }\n')
-    out = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(d), "--fresh", "--scans", "40"],
-                         capture_output=True, text=True, timeout=60, cwd=ROOT)
+    out = softplc_here("run", str(d), "--fresh", "--scans", "40")
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines() == [
         "counting: 40 scans, 0.20 s simulated time",
