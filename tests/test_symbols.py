@@ -5,12 +5,11 @@ an address is taken (--set, --print, --watch, --watch-file, --force,
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
+from helpers.cli import softplc_here
 from softplc_lite.app import load_app
 from softplc_lite.datatable import DataTableError, parse_address
 from softplc_lite.display import parse_item
@@ -28,7 +27,6 @@ from softplc_lite.watch.forces import parse_force
 from softplc_lite.watch.session import WatchOptions, WatchSession
 from softplc_lite.watch.watchlist import WatchItem, read_watch_file
 
-ROOT = Path(__file__).resolve().parent.parent
 EXECUTORS = ("compiled", "reference")
 
 DECLS = """SYMBOL PollTimer T4:0
@@ -225,9 +223,8 @@ def test_watch_file_takes_symbol_members_and_locates_a_bad_one(app, tmp_path):
 
 
 def test_run_print_and_set_take_symbol_members(app):
-    p = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(app), "--scans", "3", "--set", "start=1",
-                        "--set", "PollTimer.PRE=500", "--print", "PollTimer.PRE", "--print", "Flags/3",
-                        "--print", "N7:0"], cwd=ROOT, capture_output=True, text=True, timeout=60)
+    p = softplc_here("run", str(app), "--scans", "3", "--set", "start=1", "--set", "PollTimer.PRE=500",
+                     "--print", "PollTimer.PRE", "--print", "Flags/3", "--print", "N7:0")
     assert p.returncode == 0, p.stderr
     assert p.stdout.splitlines()[-3:] == ["PollTimer.PRE (T4:0.PRE) = 500", "Flags/3 (B3/35) = 0", "N7:0 = 0"]
 
