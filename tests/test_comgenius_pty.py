@@ -22,13 +22,12 @@ report of a missing device. Every test ends its engines and socat.
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
 
+from helpers.cli import softplc_here
 from ptypair import PtyPair, require_socat, socat_processes
 from softplc_lite.datatable import DataTable
 from softplc_lite.ladder import Engine, Mode, load_text
@@ -40,7 +39,6 @@ from softplc_lite.tlm.comgenius.ports import RX_BUFFER_CHARS
 from softplc_lite.tlm.errors import ModuleError
 from softplc_lite.tlm.registry import instruction_set
 
-ROOT = Path(__file__).resolve().parent.parent
 
 STRINGS = r"""[STRINGS]
 1 "Rack no: %3o has %2d modules.\r\n"
@@ -546,15 +544,10 @@ def make_app(tmp_path: Path, device: str, driver: str = "") -> Path:
     return app
 
 
-def softplc(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, "-m", "softplc_lite", *args], cwd=ROOT, capture_output=True,
-                          text=True, timeout=60)
-
-
 def test_cli_reports_a_missing_device_without_a_traceback(tmp_path):
     missing = tmp_path / "no-such-tty"
     app = make_app(tmp_path, str(missing))
-    p = softplc("run", str(app), "--scans", "5", "--fresh")
+    p = softplc_here("run", str(app), "--scans", "5", "--fresh")
     assert p.returncode == 1, (p.stdout, p.stderr)
     line = ports_line((app / "COMGENIUS.LST").read_text())
     assert f"{app / 'COMGENIUS.LST'}:{line}: [PORTS]: port 0: cannot open {missing}" in p.stderr
@@ -565,7 +558,7 @@ def test_cli_reports_a_missing_device_without_a_traceback(tmp_path):
 def test_cli_with_retry_runs_on_without_the_device(tmp_path):
     missing = tmp_path / "no-such-tty"
     app = make_app(tmp_path, str(missing), driver="PORT_ERRORS=RETRY\nRETRY_MS=50")
-    p = softplc("run", str(app), "--scans", "5", "--fresh", "--set", "B3/0=1", "--print", "R6:0")
+    p = softplc_here("run", str(app), "--scans", "5", "--fresh", "--set", "B3/0=1", "--print", "R6:0")
     assert p.returncode == 0, (p.stdout, p.stderr)
     line = ports_line((app / "COMGENIUS.LST").read_text())
     assert line == 6
@@ -580,8 +573,8 @@ def test_cli_port_override_sends_over_the_pty(tmp_path, pty):
     app = make_app(tmp_path, str(tmp_path / "no-such-tty"))
     reader = serial.Serial(pty.b, 38400, timeout=0)
     try:
-        p = softplc("run", str(app), "--scans", "3", "--fresh", "--set", "B3/0=1", "--port", f"0={pty.a}",
-                    "--print", "R6:0")
+        p = softplc_here("run", str(app), "--scans", "3", "--fresh", "--set", "B3/0=1", "--port", f"0={pty.a}",
+                         "--print", "R6:0")
         assert p.returncode == 0, (p.stdout, p.stderr)
         assert "DN=1" in p.stdout and "ER=0" in p.stdout and "LEN=5" in p.stdout
         got = b""
