@@ -1,6 +1,6 @@
-"""`softplc run --online` end to end (issue 18): a realtime run whose
-program file is edited mid-run, first badly, then well. The flag is wired
-into the CLI by the lead (see /tmp/h18/online_wiring.md)."""
+"""`softplc run --online` end to end: a realtime run whose program file is
+edited mid-run, first badly, then well. A real process: the run has no end
+of its own, Ctrl-C (SIGINT) ends it."""
 
 from __future__ import annotations
 
