@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import subprocess
 import sys
 import textwrap
 from pathlib import Path
@@ -20,6 +19,8 @@ from softplc_lite.ladder import Mode
 from softplc_lite.ladder.engine import Engine
 from softplc_lite.ladder.fmt import format_program
 from softplc_lite.tlm import ModuleError, installed, load_modules
+
+from helpers.cli import softplc, softplc_here
 
 DEMO_MODULE = '''
 """A third-party TLM for the tests: PULSE and TWICE, a config file, hooks."""
@@ -337,10 +338,10 @@ def test_a_module_whose_library_is_missing_says_which_in_one_located_line(case, 
     site = tmp_path / "site"
     _install(site, "NEEDY", source, "needy:Lib", requires)
     app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="; the test module\nneedy\n")
+    # a process: the module comes in at the start of a fresh interpreter, from PYTHONPATH, as a user's does
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")]))
     for command in (["run", str(app), "--fresh", "--scans", "3"], ["check", str(app)]):
-        proc = subprocess.run([sys.executable, "-m", "softplc_lite", *command], capture_output=True, text=True,
-                              env=env, timeout=60, cwd=tmp_path)
+        proc = softplc(*command, env=env, cwd=tmp_path)
         assert proc.returncode == 1, proc.stderr
         assert "Traceback" not in proc.stderr and proc.stdout == ""
         lines = proc.stderr.splitlines()
@@ -361,8 +362,7 @@ def test_modbtcps_in_an_install_without_pymodbus_says_so_at_load(tmp_path):
     shutil.copytree(Path(__file__).resolve().parent.parent / "programs" / "hmi_server", app,
                     ignore=shutil.ignore_patterns(".softplc"))
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(hide), os.environ.get("PYTHONPATH", "")]))
-    proc = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(app), "--fresh", "--scans", "100",
-                           "--print", "Level"], capture_output=True, text=True, env=env, timeout=60, cwd=tmp_path)
+    proc = softplc("run", str(app), "--fresh", "--scans", "100", "--print", "Level", env=env, cwd=tmp_path)
     assert proc.returncode == 1, proc.stderr
     assert proc.stderr.splitlines() == [
         f"{app / 'MODULES.LST'}:2: module MODBTCPS needs the Python package 'pymodbus', which is not installed "
@@ -372,10 +372,8 @@ def test_modbtcps_in_an_install_without_pymodbus_says_so_at_load(tmp_path):
 
 def test_the_softplc_command_runs_a_third_party_module(demo_path, tmp_path):
     app = make_app(tmp_path, PROGRAM)
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(demo_path), os.environ.get("PYTHONPATH", "")]))
-    proc = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(app), "--fresh", "--scans", "3",
-                           "--set", "N7:0=5", "--set", "B3/0=1", "--print", "N7:1", "--print", "R6:0.POS"],
-                          capture_output=True, text=True, env=env, timeout=60)
+    proc = softplc_here("run", str(app), "--fresh", "--scans", "3", "--set", "N7:0=5", "--set", "B3/0=1",
+                        "--print", "N7:1", "--print", "R6:0.POS")  # demo_path: DEMO on this process's import path
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.splitlines() == ["N7:1 = 10", "R6:0.POS = 2"]
     assert "warning: demo says hello" in proc.stderr
