@@ -3,8 +3,6 @@ located file:line:col, none of them an error (exit code 0)."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -12,6 +10,8 @@ import pytest
 from softplc_lite.ladder.parser import parse_program
 from softplc_lite.ladder.validate import check
 from softplc_lite.ladder.verify import verify
+
+from helpers.cli import softplc_here
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -99,8 +99,7 @@ def test_check_prints_the_warnings_located_and_exits_0(tmp_path):
     app = tmp_path / "warned"
     app.mkdir()
     (app / "main.lad").write_text("SYMBOL Spare B3/9\nXIC B3/0 OTE O:0/1\nXIC B3/1 OTE O:0/1\nXIC B3/2\n")
-    p = subprocess.run([sys.executable, "-m", "softplc_lite", "check", str(app)], cwd=ROOT, capture_output=True,
-                       text=True, timeout=60)
+    p = softplc_here("check", str(app))
     assert p.returncode == 0, p.stderr
     main = app / "main.lad"
     assert p.stderr.splitlines() == [
@@ -114,8 +113,7 @@ def test_check_prints_the_warnings_located_and_exits_0(tmp_path):
 
 @pytest.mark.parametrize("name", sorted(p.name for p in (ROOT / "programs").iterdir() if p.is_dir()))
 def test_shipped_programs_have_no_warnings(name):
-    p = subprocess.run([sys.executable, "-m", "softplc_lite", "check", str(ROOT / "programs" / name)], cwd=ROOT,
-                       capture_output=True, text=True, timeout=120)
+    p = softplc_here("check", str(ROOT / "programs" / name))
     assert p.returncode == 0 and "warning" not in p.stderr, p.stderr
 
 
