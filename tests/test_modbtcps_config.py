@@ -15,7 +15,6 @@ from __future__ import annotations
 import ipaddress
 import re
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -40,6 +39,7 @@ from softplc_lite.tlm.modbtcps.config import (
 )
 from softplc_lite.tlm.xmlcheck import MAX_PROBLEMS
 
+from helpers.cli import softplc_here
 from located import locate, where
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -757,15 +757,14 @@ def test_item_address_is_the_bit_k_places_on(first_bit, k):
     assert item_address(r, k) == parse_address(f"B3/{first_bit + k}")
 
 
-# -- 12. softplc check reports it all (a real subprocess, the module registered by its entry point) -------
+# -- 12. softplc check reports it all (its main(), the module registered by its entry point) -------------
 
 def check_app(tmp_path: Path, xml: str | None) -> subprocess.CompletedProcess:
     (tmp_path / "MODULES.LST").write_text("MODBTCPS\n")
     (tmp_path / "main.lad").write_text("ADD N11:0 1 N11:0\n")
     if xml is not None:
         (tmp_path / CONFIG_FILE).write_text(xml)
-    return subprocess.run([sys.executable, "-m", "softplc_lite", "check", str(tmp_path)], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=60)
+    return softplc_here("check", str(tmp_path), cwd=tmp_path)
 
 
 def test_check_reports_every_problem_with_file_line_and_column(tmp_path):
