@@ -29,8 +29,6 @@ import re
 import selectors
 import socket
 import struct
-import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
@@ -43,6 +41,7 @@ from softplc_lite.ports import modbus_slave
 from softplc_lite.ports.modbus_slave import initial_value, with_crc
 from softplc_lite.ports.trace import read_trace
 
+from helpers.cli import softplc_here
 from ptypair import PtyPair, require_socat, socat_processes
 
 pytest.importorskip("pymodbus", minversion="3.16.1")
@@ -546,8 +545,7 @@ def test_the_shipped_trace_replays_with_the_command_in_its_header(tmp_path):
     m = re.search(r"^# replay: softplc run (.*)$", text, re.M)
     assert m, "no '# replay:' comment"
     args = m.group(1).split() + ["--state", str(tmp_path)]
-    p = subprocess.run([sys.executable, "-m", "softplc_lite", "run", *args], cwd=ROOT, check=False,
-                       capture_output=True, text=True, timeout=60)
+    p = softplc_here("run", *args)
     assert p.returncode == 0, p.stderr
     expected = trace_outcomes(SHIPPED_TRACE)
     for name, addr in COUNTERS.items():
