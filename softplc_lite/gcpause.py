@@ -7,6 +7,11 @@ allocation burst triggers collections that walk every object alive, so on a
 nothing. Load stages run with it paused; a stage nested in another leaves
 it paused, and the outermost one turns it back on.
 
+The collector is one per process, so the pause is too: it holds while any
+thread is inside a load stage (a count under a lock), and the last stage to
+end restores the state the first one found (a collector the embedding
+program had turned off stays off).
+
 Turning it back on is not free either: the next allocation would start a
 collection of the youngest generation, which then holds every object the
 load made (about 0.1 s of a 10,000-rung load, to free nothing again). So
@@ -16,12 +21,20 @@ list splices in CPython, nothing stays frozen). A cycle among them is
 still collected, by the next full collection instead of the next young
 one (softplc choice; small loads, such as most tests make, are left to
 the collector as before).
+
+``gc.unfreeze()`` releases every frozen object, not only the ones just
+frozen; so when the process already holds frozen objects (an embedding
+program called ``gc.freeze()``, e.g. before forking workers), the move is
+skipped and its frozen set is left exactly as it was: the load's objects
+are then left to the collector (slower, never a change to the embedder's
+memory).
 """
 
 from __future__ import annotations
 
 import functools
 import gc
+import threading
 from contextlib import contextmanager
 from typing import Callable, Iterator, TypeVar
 
@@ -31,19 +44,29 @@ F = TypeVar("F", bound=Callable)
 # oldest generation when it ends: about what a 300-rung program makes.
 LARGE_LOAD_OBJECTS = 50_000
 
+_lock = threading.Lock()
+_active = 0  # load stages running now, in every thread
+_was_enabled = False  # the collector's state when the first of them began
+
 
 @contextmanager
 def paused_gc() -> Iterator[None]:
-    was_enabled = gc.isenabled()
-    gc.disable()
+    global _active, _was_enabled
+    with _lock:
+        if _active == 0:
+            _was_enabled = gc.isenabled()
+            gc.disable()
+        _active += 1
     try:
         yield
     finally:
-        if was_enabled:
-            if gc.get_count()[0] > LARGE_LOAD_OBJECTS:
-                gc.freeze()
-                gc.unfreeze()
-            gc.enable()
+        with _lock:
+            _active -= 1
+            if _active == 0 and _was_enabled:
+                if gc.get_count()[0] > LARGE_LOAD_OBJECTS and gc.get_freeze_count() == 0:
+                    gc.freeze()
+                    gc.unfreeze()
+                gc.enable()
 
 
 def gc_paused(func: F) -> F:
