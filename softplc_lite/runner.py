@@ -31,6 +31,7 @@ from .ports import parse_port_overrides
 from .ports.recorder import MAX_PENDING
 from .ports.trace import covered_scans
 from .retentive import Retentive, StorageFaults, restore_snapshot
+from .tlm.api import attach_options
 
 
 def apply_assignment(table: DataTable, text: str, symbols=None) -> None:
@@ -85,6 +86,20 @@ class RunOptions:
         return {"ports": parse_port_overrides(self.ports), "record": self.record, "replay": self.replay}
 
 
+def module_engine(program, table: DataTable | None = None, settings=None, clock=None, *, modules=(),
+                  module_options: dict | None = None, **engine_args) -> Engine:
+    """An Engine whose modules attach with the run's options (``module_options``:
+    "ports", "record", "replay", as RunOptions.module_options gives them): the
+    --port overrides go to the module that has each port (ModuleError when
+    none or two do, or two ports would share a device), and a --record trace
+    gets a recorder the modules' ports share, which the engine opens once
+    they have attached and closes after them."""
+    modules = list(modules)
+    per_module, recorder = attach_options(modules, module_options or {})
+    return Engine(program, table, settings, clock, modules=modules, module_options=per_module,
+                  recorder=recorder, **engine_args)
+
+
 class Runner:
     def __init__(self, app: App, options: RunOptions | None = None, log: Callable[[str], None] | None = None) -> None:
         self.app = app
@@ -95,8 +110,8 @@ class Runner:
             settings.scan_ms = options.scan_ms
         clock = RealClock() if options.realtime else SimulatedClock(settings.scan_ms)
         self.table = DataTable()
-        self.engine = Engine(app.program, self.table, settings, clock, executor=options.executor,
-                             modules=app.modules, module_options=options.module_options(), code=app.code)
+        self.engine = module_engine(app.program, self.table, settings, clock, executor=options.executor,
+                                    modules=app.modules, module_options=options.module_options(), code=app.code)
         if options.executor == "compiled":
             save_code_cache(app, self.engine)  # before a table is restored into it: the program's own layout
         for warning in self.engine.module_warnings:

@@ -19,6 +19,7 @@ from softplc_lite.ladder.engine import SimulatedClock
 from softplc_lite.tlm.comgenius import ComGenius
 from softplc_lite.tlm.comgenius.config import parse_config
 from softplc_lite.ports import OverrideError
+from softplc_lite.runner import module_engine
 from softplc_lite.tlm.comgenius.ports import RX_BUFFER_CHARS, TX_BUFFER_BYTES, port_url
 from softplc_lite.tlm.errors import ModuleError
 from softplc_lite.tlm.registry import instruction_set
@@ -59,8 +60,8 @@ def plc(request, engines):
         module = ComGenius(parse_config(config_text(ports, driver) if ports else config_text(driver=driver)))
         program_ = load_text(program, instructions=instruction_set([module]))
         table = DataTable()
-        e = Engine(program_, table, clock=SimulatedClock(scan_ms), executor=request.param, modules=[module],
-                   module_options=options)
+        e = module_engine(program_, table, clock=SimulatedClock(scan_ms), executor=request.param, modules=[module],
+                          module_options=options)
         engines.append(e)
         for addr, value in (values or {}).items():
             e.table.write(addr, value)

@@ -40,12 +40,13 @@ def run_text(
 ) -> Engine:
     """Load a program, write ``values`` (address -> value), put it in RUN and
     run ``scans`` scans on simulated time. Returns the engine. ``modules``:
-    configured TLM instances whose instructions the program may use."""
+    configured plug-in modules (ladder.host.Module) whose instructions the
+    program may use, attached without run options."""
     instructions = None
     if modules:
-        from ..tlm.registry import instruction_set
+        from .instructions import InstructionSet
 
-        instructions = instruction_set(list(modules))
+        instructions = InstructionSet([spec for module in modules for spec in module.instructions()])
     engine = Engine(load_text(text, instructions=instructions), table=table, settings=settings,
                     executor=executor, modules=modules)
     for addr, value in (values or {}).items():

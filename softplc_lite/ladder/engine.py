@@ -12,7 +12,6 @@ Time is injectable: SimulatedClock advances a fixed number of ms per scan
 
 from __future__ import annotations
 
-import enum
 import time
 import traceback
 from dataclasses import dataclass, replace
@@ -26,29 +25,10 @@ from .ast import MAIN_FILE, AddressRef, Const, Instruction, Pos, Program, addres
 from .compiler import RET, EndScan, compile_file, describe
 from .resolvers import address_fault
 from .errors import LadderError
+from .host import TRANSITIONS, Mode, ModeError, overrides
 from .instr import BOUND
 from .interpreter import interpret_file
 from .semantics import EN, STAMP, TT, Machine, MajorFault, Settings, source_units
-
-
-class Mode(enum.Enum):
-    PROGRAM = 0
-    RUN = 1
-    TEST = 2
-    FAULTED = 3
-
-
-# Which mode changes an operator may ask for (FAULTED is entered by faults).
-TRANSITIONS = {
-    Mode.PROGRAM: {Mode.RUN, Mode.TEST},
-    Mode.RUN: {Mode.PROGRAM, Mode.TEST},
-    Mode.TEST: {Mode.PROGRAM, Mode.RUN},
-    Mode.FAULTED: {Mode.PROGRAM},  # clearing the fault
-}
-
-
-class ModeError(Exception):
-    pass
 
 
 class SimulatedClock:
@@ -256,11 +236,18 @@ class Engine:
         modules=(),
         module_options=None,
         code: dict | None = None,
+        recorder=None,
     ) -> None:
-        """``code``: the program files' compiled code from the code cache
-        (ladder/codecache.py), used instead of compiling them."""
+        """``modules``: the plug-in modules the program's instructions may
+        belong to (ladder.host.Module); ``module_options``: module name ->
+        the options its ``attach`` gets (the runner decides them: --port,
+        --record, --replay); ``recorder``: what the modules' ports record
+        into, opened once every module has attached (so an unwritable trace
+        stops the start) and closed after them. ``code``: the program
+        files' compiled code from the code cache (ladder/codecache.py), used
+        instead of compiling them."""
         self.program = program
-        self.modules = list(modules)  # enabled TLMs (softplc_lite.tlm.TLM)
+        self.modules = list(modules)
         self.table = table if table is not None else DataTable()
         self.settings = settings or Settings()
         self.clock = clock or SimulatedClock(self.settings.scan_ms)
@@ -298,7 +285,7 @@ class Engine:
         self._instances: dict[int, object] = {}  # id(instruction) -> its module instance (online edit)
         self._kept_instances: dict[int, object] = {}  # while replace_program builds: instances kept
         self.module_warnings: list[str] = []
-        self.recorder = None  # the --record trace, shared by the modules' ports
+        self.recorder = recorder
         reference_module_blocks(program, self.table, self._owner)
         self._attach_modules(module_options or {})
         self._attach_hooks()
@@ -327,15 +314,12 @@ class Engine:
             return import_file(code["files"][number], program, number, *args)
         return build
 
-    # -- plug-in modules (TLMs) --------------------------------------------------------
-    def _attach_modules(self, options) -> None:
-        from ..tlm.api import attach_options
-
-        per_module, self.recorder = attach_options(self.modules, options)
+    # -- plug-in modules ------------------------------------------------------------------
+    def _attach_modules(self, per_module) -> None:
         attached = []
         try:
             for m in self.modules:
-                self.module_warnings += m.attach(self, per_module[m.name])
+                self.module_warnings += m.attach(self, per_module.get(m.name, {}))
                 attached.append(m)
             if self.recorder is not None:
                 self.recorder.open()  # every port is described now; an unwritable TRACE stops the start
@@ -345,8 +329,6 @@ class Engine:
             raise
 
     def _attach_hooks(self) -> None:
-        from ..tlm.api import overrides
-
         for m in self.modules:
             if overrides(m, "on_input"):
                 self.input_hooks.append(m.on_input)
@@ -363,9 +345,7 @@ class Engine:
             return None
         instance = self._kept_instances.get(id(ins))  # an online edit: the same instruction in an unchanged rung
         if instance is None:
-            from ..tlm.api import InstructionContext
-
-            instance = module.create(ins, InstructionContext(self, ins))
+            instance = module.instance(self, ins)
         self._instances[id(ins)] = instance
         return instance
 

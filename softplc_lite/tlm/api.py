@@ -13,8 +13,8 @@ for that app:
    before running (``softplc check`` prints them with their location);
 4. ``attach(engine, options)`` is called once when an engine takes the
    module, before the first scan: open what it drives (ports). ``options``
-   holds the run's module options, already split between modules by
-   ``attach_options``: "ports" ({N: device} from ``softplc run --port``, only
+   holds the run's module options, which the runner splits between
+   modules with ``attach_options``: "ports" ({N: device} from ``softplc run --port``, only
    this module's ports), "recorder" (a ports.Recorder for ``--record``, or
    None) and "replay" (a trace path for ``--replay``, or None); a module
    ignores keys it does not use. Raise ModuleError to refuse to start. A
@@ -23,13 +23,14 @@ for that app:
    open one device; one that serves a network (MODBTCPS) reports its
    servers in ``network_servers()``, for the watch view;
 5. ``create(instr, ctx)`` makes one instance per instruction in the
-   program. Each scan the engine calls the instance with the rung-in
+   program (the engine asks through ``instance``). Each scan the engine calls the instance with the rung-in
    condition and takes its return value as the rung-out condition;
 6. the driver hooks ``on_input``/``on_output`` run every scan at the
    engine's input and output points, ``on_mode`` on each mode change, and
    ``close`` when the run ends.
 
-The engine has no special case for any module; COMGENIUS uses exactly this.
+The engine has no special case for any module, and knows this package
+only as ladder.host.Module, which TLM extends; COMGENIUS uses exactly this.
 """
 
 from __future__ import annotations
@@ -39,12 +40,13 @@ import sys
 import time
 from array import array
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Mapping
+from typing import TYPE_CHECKING, Mapping
 
 from ..datatable.errors import AddressRangeError
 from ..ladder.ast import AddressRef, Const, Instruction
 from ..ladder.resolvers import address_fault
 from ..ladder.errors import LadderError
+from ..ladder.host import Instance, Module
 from ..ladder.instructions import InstructionSpec
 from ..ladder.semantics import R_DN, R_EM, R_EN, R_ER, Machine
 from ..ports import PortClaim, Recorder, assign_port_overrides, claim_conflicts, physical_url
@@ -52,16 +54,16 @@ from .errors import ModuleError
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..datatable import DataTable
-    from ..ladder.engine import Engine, Mode
-
-Instance = Callable[[bool], bool]
+    from ..ladder.engine import Engine
 
 
-class TLM:
+class TLM(Module):
     """Base class of a plug-in module. Subclasses set ``name`` (as written
-    in MODULES.LST) and override what they need."""
+    in MODULES.LST) and override what they need. What the engine calls
+    (instructions, references, attach, the driver hooks, close) is
+    ladder.host.Module's, documented there; this class adds the loader's
+    and the tools' side, and runs ``create`` for the engine's ``instance``."""
 
-    name: str = ""
     title: str = ""
     config_file: str | None = None  # read from the app directory by configure()
 
@@ -77,24 +79,11 @@ class TLM:
         """Warnings about one (validated) instruction of this module."""
         return []
 
-    def references(self, instr: Instruction) -> list:
-        """Data table addresses one of the module's instructions reaches
-        beyond its operands (the last word of a block operand), so that the
-        engine grows those files as it does for COP."""
-        return []
-
-    def config_references(self) -> list:
-        """Addresses the module's configuration makes exist in the data table
-        when it attaches (MODBMAST's data blocks). ``softplc check`` builds the
-        table a run would start with from these and references()."""
-        return []
-
     def create(self, instr: Instruction, ctx: "InstructionContext") -> Instance:
         raise NotImplementedError(f"module {self.name} cannot run {instr.mnemonic}")
 
-    def attach(self, engine: "Engine", options: Mapping[str, object]) -> list[str]:
-        """An engine takes the module (before its first scan); return warnings."""
-        return []
+    def instance(self, engine: "Engine", instr: Instruction) -> Instance:
+        return self.create(instr, InstructionContext(engine, instr))
 
     def port_claims(self) -> list[PortClaim]:
         """The serial ports the module will open, from its config."""
@@ -109,19 +98,6 @@ class TLM:
         server, with the fields of tlm.modbtcps.status.ServerStatus
         (listening, up, clients, rate, requests, writes, refusals, refused)."""
         return []
-
-    # driver hooks: no-ops unless overridden
-    def on_input(self, engine: "Engine") -> None:
-        pass
-
-    def on_output(self, engine: "Engine", outputs_enabled: bool) -> None:
-        pass
-
-    def on_mode(self, engine: "Engine", old: "Mode", new: "Mode") -> None:
-        pass
-
-    def close(self) -> None:
-        pass
 
     def log(self, message: str) -> None:
         """Diagnostics (a module's DEBUG output): standard error by default."""
@@ -191,11 +167,6 @@ def find_file(directory: Path, name: str) -> Path | None:
             if p.name.upper() == name.upper() and not p.is_dir():
                 return p
     return None
-
-
-def overrides(module: TLM, hook: str) -> bool:
-    """Does ``module`` implement ``hook`` (so the engine must call it)?"""
-    return getattr(type(module), hook) is not getattr(TLM, hook)
 
 
 # -- operands --------------------------------------------------------------------------

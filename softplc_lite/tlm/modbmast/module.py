@@ -29,7 +29,7 @@ import serial
 
 from ...ladder import status as S
 from ...ladder.ast import Instruction
-from ...ladder.engine import Mode
+from ...ladder.host import Mode
 from ...ladder.errors import LadderError
 from ...ladder.instructions import InstructionSpec
 from ...modbus.framing import FRAMERS

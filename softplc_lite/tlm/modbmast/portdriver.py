@@ -28,7 +28,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from ...ladder.engine import Mode
+from ...ladder.host import Mode
 from ...modbus.framing import FRAMERS, FrameError, rtu_intervals_ns
 from ...ports import SerialPort, hexdump
 from .config import PortConfig
