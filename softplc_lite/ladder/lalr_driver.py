@@ -1,4 +1,4 @@
-"""A faster loop over a Lark LALR parser's own tables (issue 17, "Load").
+"""A faster loop over a Lark LALR parser's own tables, for the load time of large programs.
 
 Lark stays the one grammar: this module takes everything from the ``Lark``
 object built from ``ladder.lark`` -- the LALR parse table, the contextual
@@ -22,7 +22,7 @@ lexer and text: it depends on nothing else), and the ``Rule`` attribute
 look-ups of each reduction (precomputed into one table, keyed by plain
 str: lark names rules with Tokens, which compare through Token.__eq__).
 
-Read from the same tables (issue 17, cold load): the steps of a
+Read from the same tables, for the cold load: the steps of a
 left-recursive list rule (``_list_steps``: most tokens of a mnemonic rung
 are one step, no stack traffic and, with a token action, no Token: about
 2 us a token instead of 4 on the 10,000-rung boolean program), and the
@@ -90,9 +90,16 @@ class LarkOnly:
         raise NotFastPath(self.why)
 
 
+# Why the loop is off for the rest of the process (each thread parses with
+# a FastLalr of its own: one that finds lark unlike turns them all off).
+_off: str | None = None
+
+
 def fast_parser(lark: Lark, token_actions: dict | None = None) -> FastLalr | LarkOnly:
     """The fast loop over ``lark``'s tables, or, when they cannot be read
     as lark 1.3 lays them out, a LarkOnly (one debug line says why)."""
+    if _off is not None:
+        return LarkOnly(_off)
     try:
         if _MISSING is not None:
             raise _MISSING
@@ -102,9 +109,12 @@ def fast_parser(lark: Lark, token_actions: dict | None = None) -> FastLalr | Lar
 
 
 def _gave_up(e: Exception) -> str:
+    global _off
     why = f"lark {LARK_VERSION} is not laid out as this loop reads it ({e!r})"
-    _log.debug("the fast parse loop is off for this process: %s; lark's own parser parses", why)
-    return why
+    if _off is None:
+        _log.debug("the fast parse loop is off for this process: %s; lark's own parser parses", why)
+        _off = why
+    return _off
 
 
 class _StateLexer:
@@ -219,7 +229,8 @@ class FastLalr:
         """What ``lark.parse(text, start=start)`` gives, or NotFastPath. A
         failure to read lark's objects (a state's lexer is built on first
         use) turns this loop off for the rest of the process."""
-        if self.off is not None:
+        if self.off is not None or _off is not None:
+            self.off = self.off or _off
             raise NotFastPath(self.off)
         try:
             return self._parse(text, start)

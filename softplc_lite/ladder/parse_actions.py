@@ -5,10 +5,10 @@ assembles them into a Program (mnemonic rungs are grouped into instructions
 here as they are parsed, with the instruction set of the parse, and
 finished there).
 
-Positions come from tokens (see the "!" rules in the grammar). Moved out of
-parser.py for its size (issue 17); the rule actions take lark's child list
-as it is (no v_args wrapper), and ``mn_token`` is ``mn_tokens`` for a token
-given as its fields, which lalr_driver calls without making a Token.
+Positions come from tokens (see the "!" rules in the grammar). The rule
+actions take lark's child list as it is (no v_args wrapper), and
+``mn_token`` is ``mn_tokens`` for a token given as its fields, which
+lalr_driver calls without making a Token.
 """
 
 from __future__ import annotations
@@ -164,10 +164,11 @@ def _tokens(items, *kinds):
 class _ToAst(Transformer):
     """Parse-tree rules to AST nodes, called by Lark during the LALR parse.
 
-    One instance serves every parse; ``context`` holds the current parse's
-    source name and offsets (an expression inside a quoted mnemonic operand
-    is parsed on its own and its positions shifted into the file). Parsing
-    is single-threaded, as Lark's parser objects are.
+    One instance serves every parse of one thread (parser.py gives each
+    thread a parser of its own: the attributes below are the state of the
+    parse under way); ``context`` holds the current parse's source name and
+    offsets (an expression inside a quoted mnemonic operand is parsed on
+    its own and its positions shifted into the file).
     """
 
     def __init__(self) -> None:

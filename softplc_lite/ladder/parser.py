@@ -10,14 +10,21 @@ symbol operand.
 
 The rule actions (the Transformer applied during the parse) are in
 ``parse_actions.py``; ``lalr_driver.py`` runs this Lark parser's own tables
-with less overhead a token, and a text it cannot parse (a syntax error) is
-parsed again by Lark itself for Lark's error (issue 17: a 10,000-rung
-program parses about 2.5x faster).
+with less overhead a token (a 10,000-rung program parses about 2.5x
+faster), and a text it cannot parse (a syntax error) is parsed again by
+Lark itself for Lark's error.
+
+Threads: the rule actions hold the state of the parse under way (its
+source name and offsets, its problem list, its instruction set), so each
+thread parses with a parser of its own (``_ast_parser``), built on its
+first parse (about 6 ms from the cached tables). The online reloader
+parses on a thread of its own while the scan thread may parse too.
 """
 
 from __future__ import annotations
 
 import sys
+import threading
 from collections.abc import Iterator
 from functools import lru_cache
 from types import MappingProxyType
@@ -98,14 +105,21 @@ def get_parser() -> Lark:
     return _lark(None)
 
 
-@lru_cache(maxsize=1)
+# This thread's parser and its fast loop ("lark", "fast"), see the module docstring.
+_per_thread = threading.local()
+
+
 def _ast_parser() -> Lark:
-    """The grammar with the AST built during the parse: Lark calls
+    """This thread's grammar with the AST built during the parse: Lark calls
     ``_ToAst``'s methods as LALR reduces each rule, so no parse tree is built
     and walked a second time (that halved the load of a 10,000-rung
     program). Positions come from tokens (see the "!" rules in the grammar);
     the source name and line offset of each parse are ``_ToAst.context``."""
-    return _lark(_ToAst())
+    try:
+        return _per_thread.lark
+    except AttributeError:
+        lark = _per_thread.lark = _lark(_ToAst())
+        return lark
 
 
 def _lark(transformer) -> Lark:
@@ -159,12 +173,15 @@ def _parse_tree(text: str, source: str, start: str, line_offset: int = 0, column
     return result
 
 
-@lru_cache(maxsize=1)
 def _fast_parser() -> FastLalr | LarkOnly:
-    """lalr_driver's loop over this grammar's tables, or a LarkOnly where
-    this lark's objects are not laid out as that loop reads them."""
-    lark = _ast_parser()
-    return fast_parser(lark, token_actions={"mn_tokens": lark.options.transformer.mn_token})
+    """lalr_driver's loop over this thread's grammar tables, or a LarkOnly
+    where this lark's objects are not laid out as that loop reads them."""
+    try:
+        return _per_thread.fast
+    except AttributeError:
+        lark = _ast_parser()
+        fast = _per_thread.fast = fast_parser(lark, token_actions={"mn_tokens": lark.options.transformer.mn_token})
+        return fast
 
 
 def _parse_fast_or_lark(parser: Lark, text: str, start: str, problems: list[LadderError] | None):
