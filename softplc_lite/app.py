@@ -29,7 +29,7 @@ from .ladder.semantics import MAX_JSR_DEPTH, Settings
 from .ladder.validate import check
 from .ladder.codecache import CodeCache, apply_layout, cache_key, export_engine
 from .ladder.verify import verify
-from .ladder.engine import layout_problems
+from .ladder.layout import layout_problems
 from .ports import claim_conflicts
 from .ports.urlhandler.protocol_sim import url_problem as sim_url_problem
 from .tlm.api import TLM, find_file

@@ -13,8 +13,10 @@ from __future__ import annotations
 
 from ..datatable import DataTable
 from .ast import Program
-from .engine import Engine, FaultInfo, Mode, ModeError, RealClock, SimulatedClock
+from .clocks import RealClock, SimulatedClock
+from .engine import Engine
 from .errors import LadderError, ProgramErrors
+from .host import Mode, ModeError
 from .parser import parse_program
 from .semantics import MajorFault, Settings
 from .validate import check, validate
@@ -57,6 +59,6 @@ def run_text(
 
 
 __all__ = [
-    "Engine", "FaultInfo", "LadderError", "MajorFault", "Mode", "ModeError", "Program", "ProgramErrors",
+    "Engine", "LadderError", "MajorFault", "Mode", "ModeError", "Program", "ProgramErrors",
     "RealClock", "Settings", "SimulatedClock", "check", "load_text", "parse_program", "run_text", "validate",
 ]

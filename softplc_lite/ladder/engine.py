@@ -6,222 +6,39 @@ mode changes. Modes: PROGRAM (no ladder), RUN, TEST (ladder runs, outputs
 stay idle: output hooks are told outputs are disabled), FAULTED (after a
 major fault; clear it to go back to PROGRAM).
 
-Time is injectable: SimulatedClock advances a fixed number of ms per scan
-(deterministic, the default); RealClock reads the wall clock.
+Time is injectable (clocks.py); the table a program lays out before its
+first scan is built by layout.py; what the engine needs of a module is
+host.Module. A major fault is kept as ``engine.fault`` (the MajorFault,
+its code, file, rung, instruction and message) until it is cleared.
 """
 
 from __future__ import annotations
 
 import time
 import traceback
-from dataclasses import dataclass, replace
 from typing import Callable
 
-from ..datatable import DataTable, DataTableError, parse_address
+from ..datatable import DataTable
 from ..datatable.errors import AddressRangeError
 from ..datatable.table import to_signed
 from . import status as S
-from .ast import MAIN_FILE, AddressRef, Const, Instruction, Pos, Program, address_refs, instructions_of, walk
+from .ast import MAIN_FILE, AddressRef, Const, Instruction, Program
+from .clocks import RealClock, SimulatedClock
 from .compiler import RET, EndScan, compile_file, describe
-from .resolvers import address_fault
-from .errors import LadderError
 from .host import TRANSITIONS, Mode, ModeError, overrides
-from .instr import BOUND
 from .interpreter import interpret_file
-from .semantics import EN, STAMP, TT, Machine, MajorFault, Settings, source_units
+from .layout import initial_values, layout_problems, reference_module_blocks, reference_program
+from .resolvers import address_fault
+from .semantics import EN, STAMP, TT, Machine, MajorFault, Settings
 
-
-class SimulatedClock:
-    """Each scan advances exactly ``scan_ms`` milliseconds."""
-
-    realtime = False
-
-    def __init__(self, scan_ms: int = 10) -> None:
-        self.scan_ms = scan_ms
-        self.now_ms = 0
-
-    def advance(self) -> int:
-        self.now_ms += self.scan_ms
-        return self.scan_ms
-
-
-class RealClock:
-    """Milliseconds of wall-clock time since the previous scan."""
-
-    realtime = True
-
-    def __init__(self) -> None:
-        self._last_ns = time.monotonic_ns()
-        self._carry_ns = 0
-        self.now_ms = 0
-
-    def advance(self) -> int:
-        now = time.monotonic_ns()
-        elapsed = now - self._last_ns + self._carry_ns
-        self._last_ns = now
-        ms, self._carry_ns = divmod(elapsed, 1_000_000)
-        self.now_ms += ms
-        return ms
-
-
-@dataclass
-class FaultInfo:
-    code: int
-    file: int | None
-    rung: int | None
-    instruction: str | None
-    message: str
-
-    def __str__(self) -> str:
-        where = ""
-        if self.file is not None:
-            where = f"program file {self.file}, rung {self.rung}"
-            if self.instruction:
-                where += f", {self.instruction}"
-            where += ": "
-        return f"major fault {self.code}: {where}{self.message}"
-
+# Importable from here too: the engine's own names (the modes, the clocks, the layout functions).
+__all__ = ["Engine", "Mode", "ModeError", "RealClock", "SimulatedClock", "initial_values", "layout_problems",
+           "reference_module_blocks", "reference_program"]
 
 _EndScan = EndScan  # TND: end this scan now (defined with RET/TND so both executors let it through)
 
 
 Hook = Callable[["Engine"], None]
-
-
-def reference_program(program: Program, table: DataTable, problems: list | None = None) -> None:
-    """Grow the table to everything the program names (and COP/FLL blocks).
-    With ``problems``, what the table refuses is listed there, located at
-    the declaration or instruction (softplc check), instead of raised."""
-    for decl in program.data:
-        letter = "ST" if decl.file.startswith("ST") else decl.file[:1]
-        with _located(decl.pos, problems):
-            table.create_file(letter, int(decl.file[len(letter):]), decl.size)
-    seen: set[int] = set()  # ids of addresses referenced: the parser makes one Address per text
-    for pfile in program.files.values():
-        for rung in pfile.rungs:
-            for ins in instructions_of(rung.elements):
-                try:
-                    _reference_instruction(ins, table, seen)
-                except DataTableError as e:  # (a try, not a with per instruction: load time)
-                    with _located(ins.pos, problems):
-                        raise e from None
-
-
-def _reference_instruction(ins, table: DataTable, seen: set[int]) -> None:
-    for op in ins.operands:
-        if op.__class__ is AddressRef:
-            refs = (op,)
-        elif op.__class__ is Const:
-            continue
-        else:
-            refs = address_refs(op)
-        for ref in refs:
-            a = ref.address
-            if id(a) not in seen:
-                table.reference(a)
-                seen.add(id(a))
-    bound = BOUND.get(ins.mnemonic)
-    if bound is not None and bound.references is not None:
-        for address in bound.references(ins):
-            table.reference(address)
-    if ins.mnemonic in ("COP", "FLL") and ins.operands[1].address.is_direct:
-        n = ins.operands[2].value
-        dest = ins.operands[1].address
-        for ref in ins.operands[:2]:
-            if isinstance(ref, AddressRef) and ref.address.is_direct:
-                # a COP source in another storage (F vs words) spans the same bytes
-                count = source_units(n, ref.address.ftype, dest.ftype)
-                table.reference(ref.address.with_element(ref.address.element + count - 1))
-
-
-_PRESET = frozenset({"TON", "TOF", "RTO", "CTU", "CTD"})
-
-
-def initial_values(program: Program, table: DataTable, problems: list | None = None) -> None:
-    """What a download sets: DATA initial values, and the preset and
-    accumulator operands of TON/TOF/RTO/CTU/CTD (as RSLogix 5 does)."""
-    for decl in program.data:
-        letter = "ST" if decl.file.startswith("ST") else decl.file[:1]
-        for k, v in enumerate(decl.values):
-            addr = parse_address(f"{decl.file}:0").with_element(k)  # not text: O0 and I1 count in octal
-            with _located(decl.pos, problems, f"DATA {decl.file} value {k + 1}: "):
-                if isinstance(v, int) and letter not in ("F", "L") and v > 32767:
-                    table.write_word(addr, v)
-                else:
-                    table.write(addr, v)
-    for address, value, pos in instruction_writes(program):
-        with _located(pos, problems):
-            table.write(address, value)
-
-
-def instruction_writes(program: Program) -> list[tuple]:
-    """(address, value, pos) that a download writes for the instructions:
-    the preset and accumulator operands of TON/TOF/RTO/CTU/CTD into PRE and
-    ACC, and each bound instruction's ``initial`` (a control's LEN, POS)."""
-    out = []
-    for pfile in program.files.values():
-        for rung in pfile.rungs:
-            for ins in instructions_of(rung.elements):
-                if ins.mnemonic in _PRESET and ins.operands[0].address.is_direct:
-                    pre, acc = ins.operands[-2], ins.operands[-1]
-                    timer = ins.operands[0].address
-                    out.append((replace(timer, member="PRE"), pre.value, ins.pos))
-                    out.append((replace(timer, member="ACC"), acc.value, ins.pos))
-                bound = BOUND.get(ins.mnemonic)
-                if bound is not None and bound.initial is not None:
-                    out += [(address, value, ins.pos) for address, value in bound.initial(ins)]
-    return out
-
-
-def layout_problems(program: Program, modules=()) -> tuple[DataTable, list[LadderError]]:
-    """Build the data table a run would start with (files, sizes, initial
-    values, module blocks) and list, located, everything it refuses: so that
-    ``softplc check`` reports first whatever ``softplc run`` would refuse."""
-    table = DataTable()
-    problems: list[LadderError] = []
-    reference_program(program, table, problems)
-    initial_values(program, table, problems)
-    for module in modules:
-        where = Pos(f"{module.config_file or module.name} ({module.name})", 0, 0)
-        for address in module.config_references():
-            with _located(where, problems):
-                table.reference(address)
-    reference_module_blocks(program, table, {spec.mnemonic: m for m in modules for spec in m.instructions()},
-                            problems)
-    return table, problems
-
-
-def reference_module_blocks(program: Program, table: DataTable, owner: dict, problems: list | None = None) -> None:
-    """Grow the table to what module instructions reach beyond their
-    operands (``owner``: mnemonic -> module); ``problems`` as for
-    reference_program."""
-    if not owner:
-        return
-    for pfile in program.files.values():
-        for rung in pfile.rungs:
-            for ins in walk(rung.elements):
-                module = owner.get(ins.mnemonic)
-                if module is not None:
-                    with _located(ins.pos, problems):
-                        for address in module.references(ins):
-                            table.reference(address)
-
-
-class _located:
-    """Raise a DataTableError as is, or (with a problems list) add it there
-    as a LadderError at ``pos``."""
-
-    def __init__(self, pos, problems: list | None, prefix: str = "") -> None:
-        self.pos, self.problems, self.prefix = pos, problems, prefix
-
-    def __enter__(self) -> None:
-        return None
-
-    def __exit__(self, kind, exc, tb) -> bool:
-        if exc is None or self.problems is None or not isinstance(exc, DataTableError):
-            return False
-        self.problems.append(LadderError(self.pos, f"{self.prefix}{exc}"))
-        return True
 
 
 class Engine:
@@ -270,7 +87,7 @@ class Engine:
         if self.s[S.WATCHDOG_MS] == 0:
             self.s[S.WATCHDOG_MS] = self.settings.watchdog_ms
         self.mode = Mode.PROGRAM
-        self.fault: FaultInfo | None = None
+        self.fault: MajorFault | None = None
         self.scans = 0
         self.input_hooks: list[Hook] = []
         self.output_hooks: list[Callable[["Engine", bool], None]] = []
@@ -365,9 +182,38 @@ class Engine:
         the ProgramChanges; raises EditRefused (nothing changed) if the table
         cannot take the program. What is kept and what is written:
         ladder/online.py, docs/engine.md "Online program edit"."""
-        from .online import replace_program
+        from .online import plan_edit
 
-        return replace_program(self, program, code)
+        return self.apply_edit(plan_edit(self, program, code))
+
+    def apply_edit(self, plan):
+        """Apply an online edit planned by ladder/online.plan_edit against
+        this engine and its table as they still are: the table grows and
+        takes the edit's values, the code is built anew (module
+        instructions of unchanged rungs keep their instances). Returns the
+        plan's ProgramChanges; raises EditRefused if the code cannot be
+        built, the old code then running on in the grown table."""
+        from .online import build_refused
+
+        plan.apply_to(self.table)
+        instances = self._instances
+        kept = {id(new): instances[id(old)] for old, new in plan.kept if id(old) in instances}
+        try:
+            if plan.code is not None and self.executor == "compiled":
+                try:  # bound to the live table, as the code cache's code is
+                    self._rebuild(plan.program, kept, self._cached_build(plan.code))
+                except Exception:  # code that does not fit after all: compile, as without it
+                    self._rebuild(plan.program, kept)
+            else:
+                self._rebuild(plan.program, kept)
+        except Exception as exc:
+            raise build_refused(exc) from exc
+        return plan.changes
+
+    @property
+    def module_owners(self) -> dict:
+        """Mnemonic -> the module whose instruction it is."""
+        return self._owner
 
     def _rebuild(self, program: Program, kept_instances: dict, build=None) -> None:
         """Build the code of ``program`` (with ``build``, else for the
@@ -480,7 +326,7 @@ class Engine:
         except MajorFault as fault:
             self._major(fault)
         except Exception as exc:  # a bug in softplc must not become a traceback for the user
-            self._major(MajorFault(S.FAULT_INTERNAL, f"internal error: {type(exc).__name__}: {exc}"), exc)
+            self._major(MajorFault(S.FAULT_INTERNAL, f"internal error: {type(exc).__name__}: {exc}"))
         elapsed_ms = (time.perf_counter() - start) * 1000
         self.last_scan_ms = elapsed_ms
         self.max_scan_ms = max(self.max_scan_ms, elapsed_ms)
@@ -630,9 +476,11 @@ class Engine:
                 found = (rung, ins)
         return found
 
-    def _major(self, fault: MajorFault, cause: BaseException | None = None) -> None:
+    def _major(self, fault: MajorFault) -> None:
         s = self.s
-        self.fault = FaultInfo(fault.code, fault.file, fault.rung, fault.instruction, fault.message)
+        # kept without its traceback and cause: they hold the frames of the scan that failed
+        self.fault = fault.with_traceback(None)
+        fault.__cause__ = fault.__context__ = None
         bit = S.MAJOR_WATCHDOG_BIT if fault.code == S.FAULT_WATCHDOG else S.MAJOR_RUNTIME_BIT
         s[S.MAJOR_FAULT_BITS] |= 1 << bit
         s[S.MAJOR_FAULT_CODE] = fault.code

@@ -4,10 +4,12 @@ programs, and what an accepted edit writes into the live data table.
 ``program_changes(old, new)`` compares the rungs of each program file by
 their canonical text (fmt.format_rung) with difflib.SequenceMatcher, so an
 inserted rung is one rung added, not every later rung changed; a rung that
-only moved is matched by its text and counted as moved. ``Engine.replace_
-program`` (engine.py) uses the result to carry breakpoints and module
-instruction instances over, and ``edit_writes`` for the preset rule
-(docs/engine.md, "Online program edit").
+only moved is matched by its text and counted as moved. ``plan_edit``
+checks an edit against the live data table without changing anything and
+returns an EditPlan (what the table must gain and take, ``edit_writes``
+for the preset rule, the module instances unchanged rungs keep);
+``Engine.apply_edit`` applies it at a scan boundary (docs/engine.md,
+"Online program edit").
 """
 
 from __future__ import annotations
@@ -19,6 +21,8 @@ from ..datatable import DataTable, parse_address
 from .ast import Pos, Program, walk
 from .errors import LadderError
 from .fmt import format_rung
+from .layout import (data_values, instruction_writes, located, reference_module_blocks, reference_program,
+                     write_data_value)
 
 
 class EditRefused(Exception):
@@ -258,7 +262,6 @@ def precompile(program: Program, settings) -> dict | None:
     scan thread then compiles)."""
     from .codecache import export_file
     from .compiler import compile_file
-    from .engine import reference_program
     from .semantics import Machine
 
     table = DataTable()
@@ -282,28 +285,54 @@ def _stand_in(ins):
     return _no_call
 
 
-def replace_program(engine, program: Program, code: dict | None = None) -> ProgramChanges:
-    """Engine.replace_program: ``program`` (validated) runs from the next
-    scan on, the data table kept. The files and elements it names are
-    created; DATA values go into new elements only; instruction download
-    values as ``edit_writes`` says; the code is built anew for the engine's
-    executor; module instructions of unchanged rungs keep their instances.
-    The mode, S:1/15 and the rest of the table stay. ``code``: the
-    program's code from ``precompile`` (bound here instead of compiled).
-    Raises EditRefused, with nothing changed, when the table cannot take
-    the program."""
-    from .engine import _located, instruction_writes, reference_module_blocks, reference_program
+@dataclass
+class EditPlan:
+    """An accepted online edit, not yet applied (``plan_edit``): the
+    program, what changed, the files and elements the live table has
+    (``sizes``: file number -> elements), what the edit writes into it
+    (address, value, pos), the instructions of unchanged rungs paired with
+    their old selves (they keep their module instances), and the
+    precompiled code if any. ``Engine.apply_edit`` applies it."""
 
+    program: Program
+    changes: ProgramChanges
+    sizes: dict[int, int]
+    writes: list
+    kept: list[tuple]  # (old instruction, new instruction)
+    owners: dict  # mnemonic -> module, as the engine hosts them
+    code: dict | None = None
+
+    def apply_to(self, table: DataTable) -> None:
+        """Grow ``table`` to the new program and write the edit's values
+        (the plan's trial showed the table takes them); ``changes.created``
+        then says what the table gained."""
+        reference_program(self.program, table)
+        reference_module_blocks(self.program, table, self.owners)
+        for address, value, _ in self.writes:
+            write_data_value(table, address, value)
+        self.changes.created = _created(self.sizes, table)
+
+
+def plan_edit(engine, program: Program, code: dict | None = None) -> EditPlan:
+    """What running ``program`` (validated) on ``engine`` from the next scan
+    on, the data table kept, takes; nothing is changed. The files and
+    elements it names are to be created; DATA values go into new elements
+    only; instruction download values as ``edit_writes`` says; module
+    instructions of unchanged rungs keep their instances. ``code``: the
+    program's code from ``precompile``. Raises EditRefused when the table
+    cannot take the program. Call between scans, from the scan thread (the
+    plan reads the live table's layout)."""
     old = engine.program
     changes = program_changes(old, program)
-    # First on a table of the same layout: the live one is changed only when
+    # On a table of the live one's layout: the live one is changed only when
     # everything fits (a file the program needs may exist with another type).
     trial = DataTable()
     for f in engine.table.files():
         trial.create_file(f.ftype.letter, f.number, f.size)
     problems: list[LadderError] = []
+    owners = engine.module_owners
     reference_program(program, trial, problems)
-    reference_module_blocks(program, trial, engine._owner, problems)
+    reference_module_blocks(program, trial, owners, problems)
     if problems:
         raise EditRefused(problems)
     sizes = {f.number: f.size for f in engine.table.files()}
@@ -311,49 +340,22 @@ def replace_program(engine, program: Program, code: dict | None = None) -> Progr
     def is_new(address) -> bool:
         return address.element is not None and address.element >= sizes.get(address.file, 0)
 
-    writes = [(address, value, decl.pos) for decl in program.data for address, value in _data_values(decl)
+    writes = [(address, value, decl.pos) for decl in program.data for address, value in data_values(decl)
               if is_new(address)]  # DATA values of new elements only: the others keep their live values
     writes += edit_writes(instruction_writes(old), instruction_writes(program), is_new)
     for address, value, pos in writes:
-        with _located(pos, problems):
-            _write(trial, address, value)
+        with located(pos, problems):
+            write_data_value(trial, address, value)
     if problems:
         raise EditRefused(problems)
-    # The edit goes in: nothing below can be refused.
-    reference_program(program, engine.table)
-    reference_module_blocks(program, engine.table, engine._owner)
-    for address, value, _ in writes:
-        _write(engine.table, address, value)
-    changes.created = _created(sizes, engine.table)
-    instances = engine._instances
-    kept = {id(new): instances[id(was)] for was, new in kept_instructions(old, program, changes)
-            if id(was) in instances}
-    try:
-        if code is not None and engine.executor == "compiled":
-            try:  # bound to the live table, as the code cache's code is
-                engine._rebuild(program, kept, engine._cached_build(code))
-            except Exception:  # code that does not fit after all: compile, as without it
-                engine._rebuild(program, kept)
-        else:
-            engine._rebuild(program, kept)
-    except Exception as exc:  # a bug in the compiler: the old code runs on (the table only grew)
-        problem = f"internal error building the new program: {type(exc).__name__}: {exc}"
-        raise EditRefused([LadderError(Pos("online edit", 0, 0), problem)]) from exc
-    return changes
+    return EditPlan(program, changes, sizes, writes, list(kept_instructions(old, program, changes)), owners, code)
 
 
-def _data_values(decl):
-    for k, value in enumerate(decl.values):
-        yield parse_address(f"{decl.file}:0").with_element(k), value  # not text: O0 and I1 count in octal
-
-
-def _write(table: DataTable, address, value) -> None:
-    """As a download writes (engine.initial_values): a DATA integer above
-    32767 for a word file is stored as its 16 bits (0xFFFF)."""
-    if isinstance(value, int) and address.type_letter not in ("F", "L") and value > 32767:
-        table.write_word(address, value)
-    else:
-        table.write(address, value)
+def build_refused(exc: Exception) -> EditRefused:
+    """The refusal of an edit whose code could not be built (a bug in the
+    compiler): the old code runs on, in a table that only grew."""
+    problem = f"internal error building the new program: {type(exc).__name__}: {exc}"
+    return EditRefused([LadderError(Pos("online edit", 0, 0), problem)])
 
 
 def _created(sizes: dict[int, int], table: DataTable) -> list[str]:
