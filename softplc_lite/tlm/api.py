@@ -313,7 +313,7 @@ class ControlledInstruction:
         self.busy = False
         # A direct CONTROL address is bound once (BoundOperand): its word and
         # its ControlElement are kept, so a scan's call allocates and looks up
-        # nothing (issue 17). An indirect one is resolved at every call.
+        # nothing. An indirect one is resolved at every call.
         location = getattr(control, "_location", None)  # None: resolved at every call (location())
         self._d = location[0] if location is not None else None
         self._i = location[1] if location is not None else 0
