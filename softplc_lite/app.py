@@ -20,7 +20,7 @@ from pathlib import Path
 
 from .datatable import DataTable, DataTableError, jsonio
 from .errors import FileAccessError, LocatedError, shown_path
-from .display import Display, display_names, parse_display
+from .run_output import Display, display_names, parse_display
 from .ladder.ast import Pos, Program, walk
 from .ladder.errors import LadderError
 from .ladder.instructions import BUILTIN, InstructionSet
@@ -276,7 +276,7 @@ def _short(value: object) -> str:
 
 
 def load_display(path: Path, symbols=None, doc: dict | None = None) -> Display:
-    """The ``[display]`` section of softplc.toml (see display.py)."""
+    """The ``[display]`` section of softplc.toml (see run_output.py)."""
     if doc is None:
         doc = read_settings_file(path)
     if "display" not in doc:

@@ -23,7 +23,7 @@ from .app import SCAN_MS_RANGE, AppError, load_app
 from .datatable import DataTable, DataTableError, parse_address
 from .datatable import jsonio, snapshot
 from .datatable.display import format_read
-from .display import StatusLine
+from .run_output import StatusLine
 from .ladder.engine import Mode
 from .ladder.errors import LadderError
 from .fmtcmd import fmt_command
@@ -136,7 +136,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
             print(f"error: {problem}", file=sys.stderr)
         return EXIT_ERROR
     if args.online:
-        from .online import ProgramWatcher
+        from .program_watcher import ProgramWatcher
 
         watcher = ProgramWatcher(app)
 

@@ -11,7 +11,7 @@ from rich.console import Console
 from helpers.cli import softplc_here
 from softplc_lite.app import AppError, load_app
 from softplc_lite.datatable import DataTable
-from softplc_lite.display import StatusLine, parse_display
+from softplc_lite.run_output import StatusLine, parse_display
 
 
 def app_dir(tmp_path: Path, display: str) -> Path:

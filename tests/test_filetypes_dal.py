@@ -256,7 +256,7 @@ def test_add_and_sub_into_a_long_carry_out_of_bit_31():
 
 
 def test_display_section_shows_d_and_a_text_forms():
-    from softplc_lite.display import parse_item
+    from softplc_lite.run_output import parse_item
 
     t = jsonio.table_from_json('{"D10": ["0042"], "A11": ["OK"]}')
     assert parse_item("bcd", "D10:0", "softplc.toml").read(t) == "66 (BCD 0042)"

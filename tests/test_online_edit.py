@@ -14,7 +14,7 @@ from softplc_lite.ladder import Engine, Mode, load_text
 from softplc_lite.ladder import status as S
 from softplc_lite.ladder.instructions import InstructionSpec, K, OperandSpec
 from softplc_lite.ladder.online import EditRefused, precompile, program_changes
-from softplc_lite.online import ProgramWatcher
+from softplc_lite.program_watcher import ProgramWatcher
 from softplc_lite.tlm import TLM
 from softplc_lite.tlm.registry import instruction_set
 

@@ -120,7 +120,7 @@ def test_a_file_operand_keeps_its_slc_form_through_validation():
 
 def test_display_blocks_of_slc_and_octal_io_words():
     from softplc_lite.datatable import DataTable
-    from softplc_lite.display import parse_item
+    from softplc_lite.run_output import parse_item
 
     t = DataTable()
     t.reference("I:2.1")

@@ -12,7 +12,7 @@ import pytest
 from helpers.cli import softplc_here
 from softplc_lite.app import load_app
 from softplc_lite.datatable import DataTableError, parse_address
-from softplc_lite.display import parse_item
+from softplc_lite.run_output import parse_item
 from softplc_lite.errors import LocatedError
 from softplc_lite.ladder import run_text
 from softplc_lite.ladder.ast import SymbolDecl, address_refs

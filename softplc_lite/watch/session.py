@@ -16,7 +16,7 @@ from ..datatable.display import format_read
 from ..ladder.ast import AddressRef, walk
 from ..ladder.engine import Mode, ModeError
 from ..ladder.symbols import SymbolError, resolve_name
-from ..online import ProgramWatcher
+from ..program_watcher import ProgramWatcher
 from ..runner import Runner, RunOptions
 from .breakpoints import Breakpoints, Hit
 from .datagrid import DataGrid, grid_for, next_radix
