@@ -24,7 +24,7 @@ from softplc_lite.app import load_app
 from softplc_lite.datatable import DataTable
 from softplc_lite.ladder import Engine, Mode, load_text
 from softplc_lite.ladder.engine import SimulatedClock
-from softplc_lite.ports import wire
+from softplc_lite.ports import simlink
 from softplc_lite.runner import RunOptions, Runner
 from softplc_lite.tlm.comgenius import ComGenius
 from softplc_lite.tlm.comgenius.config import parse_config
@@ -209,7 +209,7 @@ def test_a_quiet_device_link_reads_what_an_always_pumped_one_reads(seed):
     urls = [f"sim://t_speed{next(_names)}?device=modbus&id=2&registers=200{fault}" for _ in range(2)]
     ports = [_open(url, clock) for url in urls]
     try:
-        always = wire.device_links(urls[1].split("?")[0][6:])[-1]
+        always = simlink.device_links(urls[1].split("?")[0][6:])[-1]
         always.quiet_from = lambda now: 0  # the pump runs at every read, as before the shortcut
         got = [[], []]
         skipped = 0

@@ -31,7 +31,7 @@ import pytest
 import serial
 
 import softplc_lite.ports.urlhandler  # noqa: F401  (registers sim://)
-from softplc_lite.ports import modbus_slave, simdevices, wire
+from softplc_lite.ports import modbus_slave, simdevices, simlink
 from softplc_lite.ports.modbus_slave import (
     ModbusSlave,
     find_slave,
@@ -405,7 +405,7 @@ def test_bit_packing():
 def no_links_left():
     """Every link a test opened is gone once its ports are closed."""
     yield
-    assert not any(name.startswith("mb_") for name in wire.link_names())
+    assert not any(name.startswith("mb_") for name in simlink.link_names())
 
 
 def test_reply_timing_over_the_wire(opened, clock):
@@ -563,7 +563,7 @@ def test_bad_options(options, message):
     with pytest.raises(serial.SerialException) as info:
         serial.serial_for_url(f"sim://{name}?device=modbus&{options}")
     assert re.search("modbus device: " + message, str(info.value)), str(info.value)
-    assert name not in wire.link_names()
+    assert name not in simlink.link_names()
     with pytest.raises(ValueError, match=message):
         simdevices.create_device("modbus", dict([options.split("=")]))
 

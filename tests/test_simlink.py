@@ -11,7 +11,7 @@ import pytest
 import serial
 
 import softplc_lite.ports.urlhandler as urlhandler
-from softplc_lite.ports import simdevices, wire
+from softplc_lite.ports import simdevices, simlink, wire
 from softplc_lite.ports.simdevices import EchoDevice
 
 from clocks import Clock
@@ -30,7 +30,7 @@ _names = itertools.count()
 def no_links_left():
     """Every link a test opened is gone once its ports are closed."""
     yield
-    assert not any(name.startswith("t_") for name in wire.link_names())
+    assert not any(name.startswith("t_") for name in simlink.link_names())
 
 
 def fresh() -> str:
@@ -178,9 +178,9 @@ def test_third_end_is_rejected_and_name_reusable(opened, clock):
     with pytest.raises(serial.SerialException, match=f"link {name} already has two ends"):
         serial.serial_for_url(f"sim://{name}")
     a.close()
-    assert name in wire.link_names()
+    assert name in simlink.link_names()
     b.close()
-    assert name not in wire.link_names()
+    assert name not in simlink.link_names()
     c, d = opened(f"sim://{name}", clock), opened(f"sim://{name}", clock)
     c.write(b"again")
     clock.now = 10**9
@@ -251,7 +251,7 @@ def test_bad_urls(url, message):
         serial.serial_for_url(url)
     assert "sim://NAME[?device=KIND[&KEY=VALUE...]][&rate=unlimited]" in str(info.value)
     assert re.search(message, str(info.value)), str(info.value)
-    assert "x" not in wire.link_names()
+    assert "x" not in simlink.link_names()
 
 
 def test_device_links_are_per_port_and_apart_from_port_links(opened, clock):
@@ -261,7 +261,7 @@ def test_device_links_are_per_port_and_apart_from_port_links(opened, clock):
     first.write(b"one")
     clock.now += 5_000_000
     assert second.read(10) == b"" and first.read(10) == b"one"
-    assert len(wire.device_links(name)) == 2
+    assert len(simlink.device_links(name)) == 2
     with pytest.raises(serial.SerialException, match="already has two ends"):
         serial.serial_for_url(f"sim://{name}")
     other = fresh()
@@ -270,7 +270,7 @@ def test_device_links_are_per_port_and_apart_from_port_links(opened, clock):
         serial.serial_for_url(f"sim://{other}?device=echo")
     first.close()
     second.close()
-    assert name not in wire.link_names()
+    assert name not in simlink.link_names()
 
 
 def test_echo_timing(opened, clock):
@@ -306,7 +306,7 @@ def test_echo_delay_and_late_polling(opened, clock):
 
 def test_echo_splits_bursts_on_silence(opened, clock):
     device = EchoDevice()
-    end = wire.open_device_end(fresh(), device)
+    end = simlink.open_device_end(fresh(), device)
     try:
         end.configure(38400, 8, "N", 1, False)
         gap = simdevices.silence_ns(CHAR_38400)
@@ -399,19 +399,16 @@ def test_bad_baud_rate_frees_the_link():
     name = fresh()
     with pytest.raises(ValueError, match="invalid baudrate: 0"):
         serial.serial_for_url(f"sim://{name}?device=echo", baudrate=0)
-    assert name not in wire.link_names()
+    assert name not in simlink.link_names()
 
 
 def test_a_port_collected_while_the_registry_is_locked_does_not_deadlock():
-    """Issue 15: a sim:// port left in a reference cycle (a Runner whose
-    start failed) was closed by its finalizer, which took the link
-    registry's lock; when the collection ran inside an allocation made under
-    that lock (opening another link), the process hung. The finalizer now
-    takes no lock and the next registry operation releases the end."""
+    """A sim:// port left in a reference cycle (a Runner whose start failed)
+    is closed by its finalizer, which may run inside an allocation made
+    under the link registry's lock (opening another link): it takes no
+    lock, and the next registry operation releases the end."""
     import gc
     import threading
-
-    from softplc_lite.ports import wire
 
     def body(result: list) -> None:
         port = serial.serial_for_url("sim://collected-under-lock", baudrate=9600)
@@ -421,13 +418,13 @@ def test_a_port_collected_while_the_registry_is_locked_does_not_deadlock():
         del port, cycle
         gc.disable()
         try:
-            with wire._registry_lock:  # where open_device_end stands when an allocation starts a collection
+            with simlink.REGISTRY.lock:  # where open_device_end stands when an allocation starts a collection
                 gc.collect()
         finally:
             gc.enable()
-        result.append(wire.link_names())
+        result.append(simlink.link_names())
         again = serial.serial_for_url("sim://collected-under-lock", baudrate=9600)  # the name is free again
-        result.append(wire.link_names())
+        result.append(simlink.link_names())
         again.close()
 
     result: list = []

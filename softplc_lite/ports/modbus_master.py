@@ -45,7 +45,7 @@ from __future__ import annotations
 from collections import deque
 from collections.abc import Callable
 
-from . import simdevices, wire
+from . import simdevices, simlink
 from .simdevices import SimDevice, check_options, float_option, silence_ns
 from ..modbus.framing import FrameError, RtuFramer
 from ..modbus.pdu import (ILLEGAL_DATA_ADDRESS, ExceptionResponse, ModbusDecodeError, ReadCoilsRequest,
@@ -221,7 +221,7 @@ def find_master(name: str) -> ModbusMaster:
     """The master at the far end of the open ``sim://`` link ``name``
     (the newest, when several ports have opened one of that name);
     LookupError when there is none."""
-    return wire.find_device(name, ModbusMaster, KIND)
+    return simlink.find_device(name, ModbusMaster, KIND)
 
 
 simdevices.register_device(KIND, create)

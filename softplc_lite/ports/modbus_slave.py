@@ -78,7 +78,7 @@ from ..modbus.pdu import (ILLEGAL_DATA_ADDRESS, ExceptionResponse, MaskWriteRegi
                           WriteMultipleCoilsRequest, WriteMultipleCoilsResponse, WriteMultipleRegistersRequest,
                           WriteMultipleRegistersResponse, WriteSingleCoilRequest, WriteSingleCoilResponse,
                           WriteSingleRegisterRequest, WriteSingleRegisterResponse, decode_request)
-from . import simdevices, wire
+from . import simdevices, simlink
 from .simdevices import SimDevice, check_options, float_option, silence_ns
 
 KIND = "modbus"
@@ -316,7 +316,7 @@ def respond(request: bytes, slave: ModbusSlave) -> bytes | None:
     if address == 0:
         return None
     # A master polling the same registers gets the same reply frame while the
-    # values stay the same: framed (and its CRC computed) once (issue 17).
+    # values stay the same: framed (and its CRC computed) once.
     last = slave._last_reply
     if last is not None and last[0] == address and last[1] == replies[0] and last[2] is framer:
         return last[3]
@@ -344,7 +344,7 @@ def _execute(unit: ModbusUnit, pdu: bytes, size: int) -> bytes:
         table = unit.holding_registers if f == 3 else unit.input_registers
         values = tuple(table[request.address:request.address + request.count])
         # the same request on the same values: the reply PDU built (and its
-        # values checked) before (issue 17: a master polls the same block)
+        # values checked) before: a master polls the same block
         last = unit.last_read
         if last is not None and last[0] == pdu and last[1] == values:
             return last[2]
@@ -439,7 +439,7 @@ def find_slave(name: str) -> ModbusSlave:
     """The Modbus slaves at the far end of the open ``sim://`` link ``name``
     (the newest, when several ports have opened one of that name);
     LookupError when there is none."""
-    return wire.find_device(name, ModbusSlave, KIND)
+    return simlink.find_device(name, ModbusSlave, KIND)
 
 
 simdevices.register_device(KIND, create)

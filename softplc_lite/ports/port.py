@@ -96,7 +96,7 @@ class SerialPort:
         self.history: deque[tuple[float, str, bytes]] = deque(maxlen=HISTORY)
         self.record: Callable[..., None] | None = None  # record(label, direction, data, at_ns=None)
         self.clocked = False  # a simulated port on the clock it was given (exact arrival times)
-        # A simulated link's quiet time (wire.Link.quiet_until): a driver
+        # A simulated link's quiet time (simlink.Link.quiet_until): a driver
         # polling at every scan reads nothing before it (see read_at).
         self.quiet = None
 
@@ -194,7 +194,7 @@ class SerialPort:
     def read_at(self, now: int) -> bytes:
         """``read()`` on a clocked port, given its clock's reading ``now``
         (ns): a driver polling at every scan reads the clock once, tests
-        ``quiet`` with it and reads (issue 17). Elsewhere, ``read()``."""
+        ``quiet`` with it and reads. Elsewhere, ``read()``."""
         transport = self.transport
         if transport is None:
             return b""

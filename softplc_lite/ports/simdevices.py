@@ -39,10 +39,11 @@ from __future__ import annotations
 
 import importlib
 import math
+import threading
 from typing import TYPE_CHECKING, Callable, Iterable
 
 if TYPE_CHECKING:
-    from .wire import DeviceEnd
+    from .simlink import DeviceEnd
 
 
 class SimDevice:
@@ -73,7 +74,10 @@ class SimDevice:
 
 
 DeviceFactory = Callable[[dict[str, str]], SimDevice]
+# The device kinds of the process (one, as the sim:// links are: see
+# simlink.py), changed only under _kinds_lock: ports open from any thread.
 DEVICES: dict[str, DeviceFactory] = {}
+_kinds_lock = threading.Lock()
 # Built-in kinds defined in other modules: imported when first created.
 BUILTIN_DEVICES: dict[str, str] = {"modbus": "softplc_lite.ports.modbus_slave:create",
                                    "modbus_master": "softplc_lite.ports.modbus_master:create"}
@@ -85,10 +89,11 @@ def register_device(kind: str, factory: DeviceFactory) -> None:
     kind is a ValueError."""
     if not kind or not kind.replace("_", "").isalnum():
         raise ValueError(f"device kind {kind!r} must be letters, digits and _")
-    known = DEVICES.get(kind)
-    if known is not None and known is not factory:
-        raise ValueError(f"device kind {kind!r} is already registered")
-    DEVICES[kind] = factory
+    with _kinds_lock:
+        known = DEVICES.get(kind)
+        if known is not None and known is not factory:
+            raise ValueError(f"device kind {kind!r} is already registered")
+        DEVICES[kind] = factory
 
 
 def create_device(kind: str, options: dict[str, str]) -> SimDevice:

@@ -11,7 +11,7 @@ importing this package calls it, so after
 "replay://session.trace?port=0")`` open like ``loop://`` or ``socket://``.
 
 - ``protocol_sim``: one end of a simulated link with wire timing, to another
-  port or to a simulated device (wire.py, simdevices.py).
+  port or to a simulated device (simlink.py, wire.py, simdevices.py).
 - ``protocol_replay``: plays back the received side of a trace file
   (trace.py) and checks what the program writes against it.
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 from serial.serialutil import SerialException
 
-from .. import wire
+from ..clocked import Clock, ClockedSerial
 from ..trace import MAX_PORT, TraceError, TraceEvent, port_label, read_trace
 
 FORM = "replay://PATH[?port=N|MODULE:N]"
@@ -88,7 +88,7 @@ def _hex(data: bytes, limit: int = 16) -> str:
     return text + (" ..." if len(data) > limit else "") if data else "nothing"
 
 
-class Serial(wire.ClockedSerial):
+class Serial(ClockedSerial):
     """A port playing back one port of a trace (see the module docstring)."""
 
     def __init__(self, *args, **kwargs) -> None:
@@ -145,7 +145,7 @@ class Serial(wire.ClockedSerial):
     def _configure(self) -> None:
         pass
 
-    def set_clock(self, fn: wire.Clock) -> None:
+    def set_clock(self, fn: Clock) -> None:
         super().set_clock(fn)
         if self.is_open and not self._rebased:
             self._open_ns = fn()

@@ -10,8 +10,8 @@
 
 Two ports opening ``sim://NAME`` are the two ends of link NAME; with
 ``device=KIND`` the other end is a new simulated device. The timing model and
-the links are in wire.py, the devices in simdevices.py, the user's page is
-docs/simulated-wire.md.
+the links in simlink.py, the devices in simdevices.py, the port's clock in
+clocked.py; the user's page is docs/simulated-wire.md.
 """
 
 from __future__ import annotations
@@ -21,7 +21,8 @@ from urllib.parse import parse_qsl
 
 from serial.serialutil import PortNotOpenError, SerialException
 
-from .. import simdevices, wire
+from .. import simdevices, simlink
+from ..clocked import ClockedSerial
 
 FORM = "sim://NAME[?device=KIND[&KEY=VALUE...]][&rate=unlimited]"
 _NAME = re.compile(r"^[A-Za-z0-9_.\-]+$")
@@ -66,11 +67,11 @@ def url_problem(url: str) -> str | None:
     return None
 
 
-class Serial(wire.ClockedSerial):
+class Serial(ClockedSerial):
     """A port on a simulated link (see the module docstring)."""
 
     def __init__(self, *args, **kwargs) -> None:
-        self._end: wire.PortEnd | None = None
+        self._end: simlink.PortEnd | None = None
         self._unlimited = False
         self._device_kind: str | None = None
         super().__init__(*args, **kwargs)
@@ -82,7 +83,7 @@ class Serial(wire.ClockedSerial):
         except ValueError as e:
             raise SerialException(f'expected a string in the form "{FORM}": {e}') from None
         self._device_kind = kind
-        self._end = wire.open_device_end(name, device) if device else wire.open_port_end(name)
+        self._end = simlink.open_device_end(name, device) if device else simlink.open_port_end(name)
 
     def _close_port(self) -> None:
         if self._end is not None:
@@ -123,7 +124,7 @@ class Serial(wire.ClockedSerial):
         return self._end.read_arrived(now)
 
     @property
-    def sim_link(self) -> wire.Link | None:
+    def sim_link(self) -> simlink.Link | None:
         """The link this port is an end of (its ``quiet_until`` says until when
         a read finds nothing); None when closed."""
         return self._end.link if self._end is not None else None
