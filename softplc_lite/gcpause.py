@@ -20,7 +20,7 @@ oldest generation unscanned (``gc.freeze()`` then ``gc.unfreeze()``: two
 list splices in CPython, nothing stays frozen). A cycle among them is
 still collected, by the next full collection instead of the next young
 one (softplc choice; small loads, such as most tests make, are left to
-the collector as before).
+the collector).
 
 ``gc.unfreeze()`` releases every frozen object, not only the ones just
 frozen; so when the process already holds frozen objects (an embedding
