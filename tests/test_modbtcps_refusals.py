@@ -27,7 +27,7 @@ from rich.console import Console
 from softplc_lite.app import load_app
 from softplc_lite.ladder.engine import Engine
 from softplc_lite.runner import RunOptions
-from softplc_lite.tlm.modbtcps import image as shm
+from softplc_lite.tlm.modbtcps.protocol import SEGMENTS as shm
 from softplc_lite.tlm.modbtcps import status as S
 from softplc_lite.watch.cli import render
 from softplc_lite.watch.serversview import ServersView
@@ -360,7 +360,7 @@ def segments_of(pid: int) -> list[str]:
 
 HOLD_A_SEGMENT = """
 import sys, time
-from softplc_lite.tlm.modbtcps import image
+from softplc_lite.tlm.modbtcps.protocol import SEGMENTS as image
 fd, path = image.create_named(4096)   # named, as a runtime's is for a moment
 print(path, flush=True)
 time.sleep(60)

@@ -10,12 +10,12 @@ API (``ModbusTcpServer.serve_forever``/``shutdown``, the PDU classes of
   hooks, ``pdu_send`` (the MBAP framing of a reply), ``close`` and
   ``transport``; asyncio's ``data_received`` is taken over, so pymodbus's
   own receive buffer and request dispatch are never used;
-- ``ModbusTcpServer.callback_new_connection``, ``loop``, ``transport`` (the
+- ``ModbusTcpServer.callback_new_connection``, ``transport`` (the
   listening sockets) and ``trace_packet``/``trace_pdu``/``trace_connect``;
 - ``DecodePDU(True).decode``, the request decoder, and the attributes of
   the request PDUs it returns;
 - a ``ModbusServerContext`` with ``old_simulator`` set, so that the server
-  takes a datastore it never calls (requests are served by serverproc.py).
+  takes a datastore it never calls (requests are served by handler.py).
 
 Nothing else in MODBTCPS imports pymodbus. ``missing()`` says, in one line,
 what an installed pymodbus lacks of this; the server process reports it
@@ -76,33 +76,40 @@ class _NoDatastore(ModbusServerContext):
         self._devices = {}
 
 
-class ConnectionBase(ServerRequestHandler):
-    """pymodbus's object of one client connection, reduced to what the
-    server uses. A subclass implements ``connected()``, ``received(data)``
-    and ``ended()`` (once, however the connection ends), and calls
-    ``reply(response)`` and ``abort()``."""
+class Link(ServerRequestHandler):
+    """pymodbus's object of one client connection, as the network-server
+    layer's Connection uses it (netserver.protocol.Link): pymodbus and
+    asyncio's calls go to the connection, which replies in pymodbus PDUs
+    that ``pdu_send`` frames."""
 
-    def __init__(self, server: "ServerBase") -> None:
-        super().__init__(server, server.trace_packet, server.trace_pdu, server.trace_connect)
+    def __init__(self, listener: "Listener", server) -> None:
+        super().__init__(listener, listener.trace_packet, listener.trace_pdu, listener.trace_connect)
+        self.connection = server.connect(self)
 
-    # pymodbus and asyncio -> the subclass
+    # pymodbus and asyncio -> the connection
     def callback_connected(self) -> None:
-        self.connected()
+        self.connection.connected()
 
     def callback_disconnected(self, exc) -> None:
         super().callback_disconnected(exc)
-        self.ended()
+        self.connection.ended()
 
     def data_received(self, data: bytes) -> None:
         # asyncio's call, taken over: pymodbus's own buffer drops everything when more than 264 bytes
         # arrive at once (pipelined requests) and is cleared by every reply sent.
         if self.transport is not None:
-            self.received(data)
+            self.connection.received(data)
 
     def callback_data(self, data: bytes, addr=None) -> int:
         return len(data)  # not reached: data_received does not pass data on
 
-    # the subclass -> pymodbus
+    def pause_writing(self) -> None:
+        self.connection.pause_writing()
+
+    def resume_writing(self) -> None:
+        self.connection.resume_writing()
+
+    # the connection -> pymodbus
     @property
     def is_open(self) -> bool:
         return self.transport is not None
@@ -130,17 +137,19 @@ class ConnectionBase(ServerRequestHandler):
 
     def close(self, reconnect: bool = False) -> None:
         super().close(reconnect)
-        self.ended()
+        self.connection.ended()
 
 
-class ServerBase(ModbusTcpServer):
-    """pymodbus's TCP server; a subclass implements ``new_connection()``."""
+class Listener(ModbusTcpServer):
+    """pymodbus's TCP server, as the network-server layer's listener
+    (netserver.protocol.Listener): each connection a Link."""
 
-    def __init__(self, address) -> None:
-        super().__init__(_NoDatastore(), address=address)
+    def __init__(self, server) -> None:
+        self.plc_server = server
+        super().__init__(_NoDatastore(), address=(server.settings.host, server.settings.port))
 
     def callback_new_connection(self):
-        return self.new_connection()
+        return Link(self, self.plc_server)
 
     async def start(self) -> int:
         """Listen; the port bound."""

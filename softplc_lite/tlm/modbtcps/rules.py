@@ -13,6 +13,8 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass, field
 
+from ...netserver import Refusal  # noqa: F401 - an exception answer: its code is one of those below
+
 # exception codes (specification section 7)
 ILLEGAL_FUNCTION, ILLEGAL_ADDRESS, ILLEGAL_VALUE, DEVICE_FAILURE, DEVICE_BUSY = 0x01, 0x02, 0x03, 0x04, 0x06
 GATEWAY_NO_RESPONSE = 0x0B
@@ -49,14 +51,6 @@ class Request:
         if self.function == 23:
             what += f", read {self.read_count} from {self.read_address}"
         return f"{what}, {'writes ' + str(self.values) if self.values else f'count {self.count}'}"
-
-
-@dataclass(frozen=True)
-class Refusal:
-    """An exception answer, and why (for the log)."""
-
-    code: int
-    why: str
 
 
 def _range(what: str, value: int, top: int, section: str) -> str | None:

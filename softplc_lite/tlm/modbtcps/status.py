@@ -1,7 +1,8 @@
-"""What the server counts, and the 16 status words the ladder reads.
+"""MODBTCPS's status words: the 16 words the ladder reads, and the
+counters they copy (the server's, netserver/counters.py, and Modbus's own
+exception counts).
 
-The server process counts (in the shared image, image.py); at each output
-point the module copies the counts into the status block named by
+At each output point the server's counts go into the status block named by
 MODBTCPS.XML's ``status`` attribute, so a rung can alarm on refusals as it
 does on a MODBMAST slave's status. The layout is a softplc choice, listed in
 docs/modbtcps.md ("Status words").
@@ -9,25 +10,15 @@ docs/modbtcps.md ("Status words").
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from ...netserver.counters import (  # noqa: F401 - the counters by name, for the benchmarks and the tests
+    BIT_CLIENT, BIT_FAILED, BIT_LISTENING, CONNECTED, CONNECTIONS, COUNTERS, IDLE, LISTENING, MALFORMED, OWN, PORT,
+    REFUSED_LIMIT, REFUSED_NETWORK, REFUSED_RATE, REQUESTS, WRITES, StatusWords)
 
-# The server's counters (u32, wrapping), by index in the shared image.
-CONNECTED = 0  # connections open now
-CONNECTIONS = 1  # connections accepted, ever
-REQUESTS = 2  # requests answered normally
-REFUSED_NETWORK = 3  # connections refused: client address not in the allow-list
-REFUSED_LIMIT = 4  # connections refused: maxConnections reached
-REFUSED_RATE = 5  # requests answered exception 06: the client passed maxRequestsPerSecond
-EXCEPTION_01 = 6  # illegal function: a function not served, or a write to a unit with no writable region of it
-EXCEPTION_02 = 7  # illegal data address: outside the map, or not writable
-EXCEPTION_03 = 8  # illegal data value: a count out of range, a string length over 82
-EXCEPTION_0B = 9  # unit id not configured (gateway target did not respond)
-MALFORMED = 10  # connections closed: a frame that is not Modbus TCP
-IDLE = 11  # connections closed: no whole request for idleTimeout
-WRITES = 12  # write requests passed to the scan
-LISTENING = 13  # 1 while the server listens
-PORT = 14  # the port it listens on
-COUNTERS = 16
+# Modbus's own counters, after the server's.
+EXCEPTION_01 = OWN  # illegal function: a function not served, or a write to a unit with no writable region of it
+EXCEPTION_02 = OWN + 1  # illegal data address: outside the map, or not writable
+EXCEPTION_03 = OWN + 2  # illegal data value: a count out of range, a string length over 82
+EXCEPTION_0B = OWN + 3  # unit id not configured (gateway target did not respond)
 
 # Status words (offsets in the status block).
 W_BITS = 0  # /0 listening, /1 server failed, /2 a client is connected
@@ -47,10 +38,6 @@ W_IDLE = 13
 W_REFUSALS = 14  # the sum of words 5..13
 STATUS_WORDS = 16
 
-BIT_LISTENING = 1
-BIT_FAILED = 2
-BIT_CLIENT = 4
-
 # status word <- counter
 COPIED = ((W_CONNECTED, CONNECTED), (W_REQUESTS, REQUESTS), (W_REFUSED_NETWORK, REFUSED_NETWORK),
           (W_REFUSED_LIMIT, REFUSED_LIMIT), (W_REFUSED_RATE, REFUSED_RATE), (W_EXCEPTION_02, EXCEPTION_02),
@@ -60,25 +47,6 @@ COPIED = ((W_CONNECTED, CONNECTED), (W_REQUESTS, REQUESTS), (W_REFUSED_NETWORK, 
 REFUSAL_NAMES = (("not allowed", REFUSED_NETWORK), ("connection limit", REFUSED_LIMIT), ("rate limit", REFUSED_RATE),
                  ("exception 01", EXCEPTION_01), ("exception 02", EXCEPTION_02), ("exception 03", EXCEPTION_03),
                  ("exception 0B", EXCEPTION_0B), ("malformed", MALFORMED), ("idle", IDLE))
-REFUSAL_COUNTERS = tuple(counter for _, counter in REFUSAL_NAMES)
 
-
-def word(value: int) -> int:
-    """A count as a data table word: its low 16 bits, signed (it wraps as a PLC counter word does)."""
-    value &= 0xFFFF
-    return value - 0x10000 if value & 0x8000 else value
-
-
-@dataclass
-class ServerStatus:
-    """The server as the watch view shows it."""
-
-    listening: str  # "127.0.0.1:502", or why not
-    up: bool
-    clients: int = 0
-    rate: int = 0  # requests per second
-    requests: int = 0
-    writes: int = 0
-    refusals: int = 0
-    refused: dict[str, int] | None = None  # by kind, only those not zero
-    pending: bool = False  # not started yet, or starting: neither up nor failed
+LAYOUT = StatusWords(bits=W_BITS, rate=W_RATE, writes_applied=W_WRITES_APPLIED, refusals=W_REFUSALS,
+                     copied=COPIED, refusal_names=REFUSAL_NAMES, words=STATUS_WORDS)

@@ -1,5 +1,5 @@
 """The memory the runtime and its server process share: the data table
-image clients read, and the server's counters.
+image clients read, and the server's counters (counters.py).
 
 The scan publishes the mapped words at its output point; the server copies
 what a request asks for. A sequence number around each publication (a
@@ -10,15 +10,15 @@ the server, the server retries its copy (a few microseconds) instead.
 Layout of the file (native byte order: both processes run on this machine)::
 
     0     u64   sequence: odd while the scan is writing
-    8     u32 x COUNTERS   the server's counters (status.py); only the server writes them
-    ...   the image: each region's words at the offset the Layout gave it
+    8     u32 x COUNTERS   the server's counters (counters.py); only the server writes them
+    ...   the image: each region's words at the offset the protocol's map gave it
 
 The memory is a file in /dev/shm where there is one (memory, not disk),
-named ``softplc-modbtcps-PID-RANDOM`` after the runtime that made it, and
-unlinked as soon as it is open: the server process gets the open file
+named ``softplc-NAME-PID-RANDOM`` after the protocol's server (``Segments``:
+``softplc-modbtcps-...``) and the runtime that made it, and unlinked as soon as it is open: the server process gets the open file
 itself (its descriptor), never the name. A runtime killed in the
 microseconds between creating and unlinking it leaves the file behind; the
-next runtime that creates one removes every such file whose runtime is gone
+next runtime that creates one of that name removes every such file whose runtime is gone
 (``remove_stale``): named after a process that no longer exists, and locked
 by no one (its maker holds a lock on it while it has a name).
 """
@@ -34,13 +34,11 @@ import struct
 import tempfile
 from array import array
 
-from .status import COUNTERS
+from .counters import COUNTERS
 
 SEQUENCE = struct.Struct("=Q")
 COUNTER_ARRAY = struct.Struct(f"={COUNTERS}I")
 IMAGE_START = SEQUENCE.size + COUNTER_ARRAY.size
-PREFIX = "softplc-modbtcps-"
-_NAME = re.compile(re.escape(PREFIX) + r"(\d+)-[0-9a-f]+$")
 
 
 def segment_directory() -> str:
@@ -57,58 +55,82 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def remove_stale(directory: str | None = None) -> list[str]:
-    """Remove the segments runtimes killed while they had a name left
-    behind; the names removed. A segment is removed only when the process
-    it is named after no longer exists and no one holds its lock: a live
-    runtime's (another test's, a user's running PLC's) is never touched."""
-    directory = directory or segment_directory()
-    removed = []
-    try:
-        names = os.listdir(directory)
-    except OSError:
-        return removed
-    for name in names:
-        m = _NAME.match(name)
-        if m is None or int(m.group(1)) == os.getpid() or _alive(int(m.group(1))):
-            continue
-        path = os.path.join(directory, name)
+class Segments:
+    """The files of one protocol's images, ``softplc-NAME-PID-RANDOM``."""
+
+    def __init__(self, name: str) -> None:
+        self.PREFIX = f"softplc-{name}-"
+        self._name = re.compile(re.escape(self.PREFIX) + r"(\d+)-[0-9a-f]+$")
+
+    segment_directory = staticmethod(segment_directory)
+
+    def remove_stale(self, directory: str | None = None) -> list[str]:
+        """Remove the segments runtimes killed while they had a name left
+        behind; the names removed. A segment is removed only when the process
+        it is named after no longer exists and no one holds its lock: a live
+        runtime's (another test's, a user's running PLC's) is never touched."""
+        directory = directory or segment_directory()
+        removed = []
         try:
-            fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+            names = os.listdir(directory)
         except OSError:
-            continue
-        try:
-            if os.fstat(fd).st_uid != os.geteuid():
+            return removed
+        for name in names:
+            m = self._name.match(name)
+            if m is None or int(m.group(1)) == os.getpid() or _alive(int(m.group(1))):
                 continue
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # held by its maker while it has a name
-            os.unlink(path)
-            removed.append(name)
-        except OSError:
-            continue
-        finally:
-            os.close(fd)
-    return removed
+            path = os.path.join(directory, name)
+            try:
+                fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+            except OSError:
+                continue
+            try:
+                if os.fstat(fd).st_uid != os.geteuid():
+                    continue
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # held by its maker while it has a name
+                os.unlink(path)
+                removed.append(name)
+            except OSError:
+                continue
+            finally:
+                os.close(fd)
+        return removed
 
-
-def create_named(size: int, directory: str | None = None) -> tuple[int, str]:
-    """A new segment of ``size`` bytes, named after this process and locked:
-    (its descriptor, its path)."""
-    directory = directory or segment_directory()
-    while True:
-        path = os.path.join(directory, f"{PREFIX}{os.getpid()}-{secrets.token_hex(6)}")
+    def create_named(self, size: int, directory: str | None = None) -> tuple[int, str]:
+        """A new segment of ``size`` bytes, named after this process and locked:
+        (its descriptor, its path)."""
+        directory = directory or segment_directory()
+        while True:
+            path = os.path.join(directory, f"{self.PREFIX}{os.getpid()}-{secrets.token_hex(6)}")
+            try:
+                fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
+                break
+            except FileExistsError:
+                continue
         try:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
-            break
-        except FileExistsError:
-            continue
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX)
-        os.ftruncate(fd, size)
-    except BaseException:
-        os.close(fd)
-        os.unlink(path)
-        raise
-    return fd, path
+            fcntl.flock(fd, fcntl.LOCK_EX)
+            os.ftruncate(fd, size)
+        except BaseException:
+            os.close(fd)
+            os.unlink(path)
+            raise
+        return fd, path
+
+    def create_image(self, image_bytes: int) -> "SharedImage":
+        """A new image; its file is gone from the directory when this returns."""
+        directory = segment_directory()
+        self.remove_stale(directory)
+        size = max(IMAGE_START + image_bytes, IMAGE_START)
+        fd, path = self.create_named(size, directory)
+        try:
+            os.unlink(path)
+        except FileNotFoundError:  # removed by another runtime's clean-up meanwhile: the open file serves
+            pass
+        try:
+            return SharedImage(fd, size)
+        except BaseException:
+            os.close(fd)
+            raise
 
 
 class SharedImage:
@@ -118,23 +140,6 @@ class SharedImage:
         self.size = max(size, IMAGE_START)
         self.mm = mmap.mmap(fd, self.size)
         self._sequence = 0
-
-    @classmethod
-    def create(cls, image_bytes: int) -> "SharedImage":
-        """A new image; its file is gone from the directory when this returns."""
-        directory = segment_directory()
-        remove_stale(directory)
-        size = max(IMAGE_START + image_bytes, IMAGE_START)
-        fd, path = create_named(size, directory)
-        try:
-            os.unlink(path)
-        except FileNotFoundError:  # removed by another runtime's clean-up meanwhile: the open file serves
-            pass
-        try:
-            return cls(fd, size)
-        except BaseException:
-            os.close(fd)
-            raise
 
     @classmethod
     def attach(cls, fd: int, size: int) -> "SharedImage":

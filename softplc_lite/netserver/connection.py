@@ -1,10 +1,10 @@
-"""One client connection of the Modbus TCP server, with the rules a PLC's
-server needs around pymodbus's request handler (docs/modbtcps.md, "Safe by
-default"): the allow-list and the connection limit at connect, the request
-rate per client address, a malformed frame closing its connection, an idle
-connection (half-open, slowloris) closed after idleTimeout, and a client
-that sends faster than it reads its replies no longer read. Every refusal is
-counted (status.py) and logged at debug 1.
+"""One client connection, with the rules a PLC's server needs around the
+protocol's handler (docs/modbtcps.md, "Safe by default"): the allow-list and
+the connection limit at connect, the request rate per client address, a
+malformed frame closing its connection, an idle connection (half-open,
+slowloris) closed after the idle timeout, and a client that sends faster
+than it reads its replies no longer read. Every refusal is counted
+(counters.py) and logged at debug 1.
 """
 
 from __future__ import annotations
@@ -15,37 +15,45 @@ import ipaddress
 from collections import deque
 from typing import TYPE_CHECKING
 
-from . import rules
-from . import status as C
-from .pymodbus_glue import ConnectionBase, decode, exception_response
-from .rules import Refusal
+from . import counters as C
+from .protocol import Link, Malformed, Refusal
 
 if TYPE_CHECKING:
-    from .serverproc import Server
+    from .server import Server
 
 PEER: contextvars.ContextVar[str] = contextvars.ContextVar("peer", default="?")  # whose request a task serves
 MAX_QUEUED = 64  # requests queued on one connection; past it the connection is not read until served
-MBAP = 7  # transaction, protocol, length, unit
-MAX_LENGTH = 254  # the MBAP length field: unit id + the largest PDU (253)
 
 
-class Connection(ConnectionBase):
-    """One client connection, with the server's rules around pymodbus's handler.
+class _ToServe:
+    """A decoded request in the queue, with what its reply needs."""
+
+    __slots__ = ("header", "request")
+
+    def __init__(self, header, request) -> None:
+        self.header, self.request = header, request
+
+
+class Connection:
+    """One client connection, with the server's rules around the protocol's handler.
 
     Requests are answered in arrival order (a client may pipeline them, and
     a read after a write sees the write), by one task per connection: a
-    write waiting for the scan holds up this client only. Every exception
-    answer goes through ``Server.refused``, which counts it."""
+    write waiting for the scan holds up this client only. Every refusal
+    answer goes through ``Server.refused``, which counts it. ``link`` is
+    the listener's connection (protocol.Link), which calls ``connected``,
+    ``received``, ``pause_writing``/``resume_writing`` and ``ended``."""
 
-    def __init__(self, owner: Server) -> None:
-        super().__init__(owner)
+    def __init__(self, owner: Server, link: Link) -> None:
         self.owner = owner
+        self.link = link
+        self.handler = owner.handler
         self.peer = "?"
         self.address = "?"  # the client's address, whose request rate is limited
         self.idle_timer: asyncio.TimerHandle | None = None
         self.counted = False
         self.inbox = bytearray()  # received, not yet a whole frame
-        self.queue: deque = deque()  # requests to serve in order: a Request, or a reply ready
+        self.queue: deque = deque()  # requests to serve in order: a _ToServe, or a reply ready
         self.worker: asyncio.Task | None = None
         self.serving = False  # the worker awaits a request's answer (a write: the scan)
         self.paused: set[str] = set()  # why reading is paused: "queue" full, "writing" (replies unread)
@@ -54,21 +62,21 @@ class Connection(ConnectionBase):
 
     def connected(self) -> None:
         owner = self.owner
-        peer = self.peername() or ("?", 0)
+        peer = self.link.peername() or ("?", 0)
         self.peer, self.address = f"{peer[0]}:{peer[1]}", str(peer[0])
         try:
             ip = ipaddress.ip_address(self.address.split("%")[0])
             ip = getattr(ip, "ipv4_mapped", None) or ip  # ::ffff:10.1.2.3 is 10.1.2.3 for the allow-list
         except ValueError:
             ip = None
-        if ip is None or not any(ip in net for net in owner.config.allow):
+        if ip is None or not any(ip in net for net in owner.settings.allow):
             owner.count(C.REFUSED_NETWORK, f"{self.peer}: refused, not in the allow-list")
-            self.abort()
+            self.link.abort()
             return
-        if owner.open_connections >= owner.config.max_connections:
+        if owner.open_connections >= owner.settings.max_connections:
             owner.count(C.REFUSED_LIMIT, f"{self.peer}: refused, maxConnections "
-                                         f"{owner.config.max_connections} reached")
-            self.abort()
+                                         f"{owner.settings.max_connections} reached")
+            self.link.abort()
             return
         self.counted = True
         owner.open_connections += 1
@@ -97,7 +105,7 @@ class Connection(ConnectionBase):
     def _rearm(self) -> None:
         if self.idle_timer is not None:
             self.idle_timer.cancel()
-        self.idle_timer = self.owner.loop.call_later(self.owner.config.idle_timeout_ms / 1000, self._idle)
+        self.idle_timer = self.owner.loop.call_later(self.owner.settings.idle_timeout_ms / 1000, self._idle)
 
     def _idle(self) -> None:
         self.idle_timer = None
@@ -105,8 +113,8 @@ class Connection(ConnectionBase):
             self._rearm()
             return
         self.owner.count(C.IDLE, f"{self.peer}: closed, no whole request for "
-                                 f"{self.owner.config.idle_timeout_ms} ms")
-        self.abort()
+                                 f"{self.owner.settings.idle_timeout_ms} ms")
+        self.link.abort()
 
     # -- flow control: a client that sends faster than it reads stops being served and read --------
     def pause_writing(self) -> None:
@@ -121,14 +129,14 @@ class Connection(ConnectionBase):
 
     def _pause(self, why: str) -> None:
         if not self.paused:
-            self.pause_reading()
+            self.link.pause_reading()
         self.paused.add(why)
 
     def _resume(self, why: str) -> None:
         if why in self.paused:
             self.paused.discard(why)
             if not self.paused:
-                self.resume_reading()
+                self.link.resume_reading()
 
     # -- requests ---------------------------------------------------------------------------------
     def received(self, data: bytes) -> None:
@@ -142,7 +150,7 @@ class Connection(ConnectionBase):
             used = self._frames(self.inbox)
         except Exception as exc:  # noqa: BLE001 - a bug here must cost this connection only, and be said
             self.owner.log(1, f"{self.peer}: closed, {type(exc).__name__}: {exc}")
-            self.abort()
+            self.link.abort()
             return
         del self.inbox[:used]
 
@@ -150,47 +158,36 @@ class Connection(ConnectionBase):
         """The whole frames at the start of ``data`` queued (MAX_QUEUED at
         most); the bytes used."""
         used = 0
-        while len(data) - used >= MBAP and len(self.queue) < MAX_QUEUED:
-            pid = int.from_bytes(data[used + 2:used + 4], "big")
-            length = int.from_bytes(data[used + 4:used + 6], "big")
-            if pid != 0 or not 2 <= length <= MAX_LENGTH:
-                self.owner.count(C.MALFORMED, f"{self.peer}: closed, not a Modbus TCP frame "
-                                              f"(protocol id {pid}, length {length})")
-                self.abort()
+        frame_length = self.handler.frame_length
+        while len(self.queue) < MAX_QUEUED:
+            try:
+                n = frame_length(data, used)
+            except Malformed as e:
+                self.owner.count(C.MALFORMED, f"{self.peer}: closed, {e}")
+                self.link.abort()
                 return len(data)
-            end = used + 6 + length
-            if len(data) < end:
+            if n is None:
                 break
-            self._request(bytes(data[used:end]))
-            used = end
+            self._request(bytes(data[used:used + n]))
+            used += n
         if len(self.queue) >= MAX_QUEUED:
             self._pause("queue")
         return used
 
     def _request(self, frame: bytes) -> None:
-        """Check one frame; queue the request it holds, or the exception that answers it."""
-        owner = self.owner
+        """Take one frame: queue the request it holds, or the reply that refuses it."""
+        owner, handler = self.owner, self.handler
         self._rearm()
-        tid, unit, function = int.from_bytes(frame[:2], "big"), frame[6], frame[7]
-
-        def refuse(code: int, why: str) -> None:
-            self._queue(owner.refused(Refusal(code, why), function, unit, tid))
-
+        header = handler.header(frame)
         if not owner.rate_ok(self.address):
-            return refuse(rules.DEVICE_BUSY, "over maxRequestsPerSecond")
-        if function not in rules.KIND_OF_FUNCTION:
-            return refuse(rules.ILLEGAL_FUNCTION, f"function {function} is not served")
-        problem = rules.body_problem(frame[7:])
-        if problem is not None:  # Modbus spec 7: exception 03
-            return refuse(rules.ILLEGAL_VALUE, problem)
-        request = decode(frame[7:], unit, tid)
-        if request is None:
-            return refuse(rules.ILLEGAL_VALUE, f"function {function} with a body that does not decode")
-        if unit not in owner.units:
-            return refuse(rules.GATEWAY_NO_RESPONSE, f"unit id {unit} is not configured")
+            self._queue(owner.refused(Refusal(handler.busy, "over maxRequestsPerSecond"), header))
+            return
+        request = handler.decode(frame, header)
+        if isinstance(request, Refusal):
+            self._queue(owner.refused(request, header))
+            return
         owner.log(2, f"{self.peer}: {request}")
-        self._queue(request)
-        return None
+        self._queue(_ToServe(header, request))
 
     def _queue(self, item) -> None:
         self.queue.append(item)
@@ -201,37 +198,37 @@ class Connection(ConnectionBase):
         """Answer the queued requests in order, until none is left."""
         PEER.set(self.peer)  # this task's log lines name its client
         try:
-            while self.queue and self.is_open:
+            while self.queue and self.link.is_open:
                 await self.can_write.wait()
                 item = self.queue.popleft()
                 if "queue" in self.paused and len(self.queue) <= MAX_QUEUED // 2:
                     self._take_frames()  # those received already first, then the socket again
                     if len(self.queue) < MAX_QUEUED:
                         self._resume("queue")
-                if isinstance(item, rules.Request):
+                if isinstance(item, _ToServe):
                     self.serving = True
                     response = await self._serve(item)
                     self.serving = False
                     self._rearm()  # a client that waited for its answer has a whole idleTimeout after it
                 else:
                     response = item
-                if self.is_open:
-                    self.reply(response)
+                if self.link.is_open:
+                    self.link.reply(response)
         except Exception as exc:  # noqa: BLE001 - a reply that cannot be built: this connection ends, said
             self.owner.log(1, f"{self.peer}: closed, {type(exc).__name__}: {exc}")
-            self.abort()
+            self.link.abort()
         finally:
             if self.worker is asyncio.current_task():
                 self.worker = None
 
-    async def _serve(self, request: rules.Request):
-        owner = self.owner
+    async def _serve(self, item: _ToServe):
+        owner, handler = self.owner, self.handler
         try:
-            answer = await owner.serve(request)
-        except Exception as exc:  # noqa: BLE001 - a bug in this module: exception 04, nothing else stops
-            owner.log(1, f"{self.peer}: exception 04: {type(exc).__name__}: {exc}")
-            return exception_response(request.function, rules.DEVICE_FAILURE, request.unit, request.tid)
+            answer = await handler.serve(item.request)
+        except Exception as exc:  # noqa: BLE001 - a bug in the protocol: its failure answer, nothing else stops
+            owner.log(1, f"{self.peer}: {handler.code_words(handler.failure)}: {type(exc).__name__}: {exc}")
+            return handler.refusal_reply(handler.failure, item.header)
         if isinstance(answer, Refusal):
-            return owner.refused(answer, request.function, request.unit, request.tid)
+            return owner.refused(answer, item.header)
         owner.image.add(C.REQUESTS)
         return answer
