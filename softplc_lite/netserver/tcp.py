@@ -15,8 +15,9 @@ if TYPE_CHECKING:
 class TcpLink(asyncio.Protocol):
     """One client connection: asyncio's calls go to the layer's Connection."""
 
-    def __init__(self, server: Server) -> None:
+    def __init__(self, server: Server, links: set) -> None:
         self.server = server
+        self.links = links  # the listener's open links
         self.transport: asyncio.Transport | None = None
         self.connection: Connection = server.connect(self)
         self._ended = False
@@ -24,6 +25,7 @@ class TcpLink(asyncio.Protocol):
     # asyncio -> the connection
     def connection_made(self, transport) -> None:
         self.transport = transport
+        self.links.add(self)
         self.connection.connected()
 
     def data_received(self, data: bytes) -> None:
@@ -69,6 +71,7 @@ class TcpLink(asyncio.Protocol):
         self._end()
 
     def _end(self) -> None:
+        self.links.discard(self)
         if not self._ended:
             self._ended = True
             self.connection.ended()
@@ -78,15 +81,19 @@ class TcpListener:
     def __init__(self, server: Server) -> None:
         self.server = server
         self._listening: asyncio.Server | None = None
+        self._links: set[TcpLink] = set()
 
     async def start(self) -> int:
         """Listen; the port bound."""
         settings = self.server.settings
         self._listening = await asyncio.get_running_loop().create_server(
-            lambda: TcpLink(self.server), settings.host, settings.port, reuse_address=True)
+            lambda: TcpLink(self.server, self._links), settings.host, settings.port, reuse_address=True)
         return self._listening.sockets[0].getsockname()[1]
 
     async def stop(self) -> None:
+        """Stop listening and close every connection."""
         if self._listening is not None:
             self._listening.close()
+            for link in list(self._links):
+                link.abort()
             await self._listening.wait_closed()
