@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from softplc_lite.app import app_instructions
-from softplc_lite.fmtcmd import fmt_command
+from softplc_lite.commands.fmt import fmt_command
 from softplc_lite.ladder.fmt import format_source, unprintable
 from softplc_lite.ladder.fmt_comments import scan_comments
 from softplc_lite.ladder.parser import parse_program

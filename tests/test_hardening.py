@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from softplc_lite import cli
+from softplc_lite.commands import check as check_command
 from softplc_lite.ladder.limits import MAX_BRANCH_DEPTH, MAX_EXPRESSION_DEPTH
 from softplc_lite.ladder.semantics import MAX_JSR_DEPTH
 
@@ -284,7 +285,7 @@ def test_an_internal_error_is_one_line_and_exit_code_4(capsys, monkeypatch):
     one line and exit code 4, never a traceback."""
     def broken(*args, **kwargs):
         raise ZeroDivisionError("planted")
-    monkeypatch.setattr(cli, "load_app", broken)
+    monkeypatch.setattr(check_command, "load_app", broken)
     code = cli.main(["check", "x"])
     err = capsys.readouterr().err
     assert code == cli.EXIT_INTERNAL == 4

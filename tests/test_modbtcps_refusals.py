@@ -29,7 +29,7 @@ from softplc_lite.ladder.engine import Engine
 from softplc_lite.runner import RunOptions
 from softplc_lite.tlm.modbtcps.protocol import SEGMENTS as shm
 from softplc_lite.tlm.modbtcps import status as S
-from softplc_lite.watch.cli import render
+from softplc_lite.watch.snapshot import render
 from softplc_lite.watch.serversview import ServersView
 from softplc_lite.watch.session import WatchOptions, WatchSession
 

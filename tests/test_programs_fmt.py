@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from softplc_lite.fmtcmd import fmt_command
+from softplc_lite.commands.fmt import fmt_command
 
 from helpers.cli import softplc_here
 

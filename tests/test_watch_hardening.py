@@ -277,7 +277,7 @@ def test_help_gives_the_size_ranges():
 def test_render_refuses_a_size_out_of_range(tmp_path):
     from softplc_lite.app import load_app
     from softplc_lite.runner import RunOptions
-    from softplc_lite.watch.cli import render
+    from softplc_lite.watch.snapshot import render
     from softplc_lite.watch.session import WatchOptions, WatchSession
 
     session = WatchSession(load_app(ROOT / "programs" / "blinker", tmp_path), WatchOptions(run=RunOptions(fresh=True)))
@@ -504,7 +504,7 @@ def test_a_huge_rung_comment_is_wrapped_only_as_far_as_it_is_drawn(monkeypatch):
 def test_thousands_of_forces_are_counted_not_listed(tmp_path):
     from softplc_lite.app import load_app
     from softplc_lite.runner import RunOptions
-    from softplc_lite.watch.cli import render
+    from softplc_lite.watch.snapshot import render
     from softplc_lite.watch.screen import FORCES_SHOWN
     from softplc_lite.watch.session import WatchOptions, WatchSession
 

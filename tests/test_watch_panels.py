@@ -14,7 +14,7 @@ from rich.console import Console
 
 from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions
-from softplc_lite.watch.cli import render
+from softplc_lite.watch.snapshot import render
 from softplc_lite.watch.portsview import ports_of
 from softplc_lite.watch.screen import WatchScreen, rung_view
 from softplc_lite.watch.session import WatchOptions, WatchSession

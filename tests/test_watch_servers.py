@@ -19,7 +19,7 @@ from rich.console import Console
 
 from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions
-from softplc_lite.watch.cli import render
+from softplc_lite.watch.snapshot import render
 from softplc_lite.watch.serversview import TABLE_WIDTH, ServersView
 from softplc_lite.watch.session import WatchOptions, WatchSession
 

@@ -31,7 +31,7 @@ from rich.cells import cell_len
 
 from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions
-from softplc_lite.watch.cli import render, write_snapshot
+from softplc_lite.watch.snapshot import render, write_snapshot
 from softplc_lite.watch.session import WatchOptions, WatchSession
 
 from helpers.cli import softplc, softplc_here

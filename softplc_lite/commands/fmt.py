@@ -1,6 +1,6 @@
 """``softplc fmt``: print, check or rewrite .lad files canonically.
 
-``fmt_command`` is the whole command (cli.py only parses its arguments):
+``fmt_command`` is the whole command (``run`` hands it the parsed options):
 every PATH (a .lad file, an app directory: each of its .lad files, or
 ``-``: standard input) is parsed with the instructions of its app (built-in
 plus the modules MODULES.LST enables) and printed by
@@ -18,6 +18,7 @@ plus the modules MODULES.LST enables) and printed by
 
 from __future__ import annotations
 
+import argparse
 import os
 import shutil
 import sys
@@ -26,17 +27,40 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Sequence
 
-from .app import AppError, app_instructions, lad_files
-from .errors import LocatedError, file_error, shown_path
-from .ladder.errors import LadderError
-from .ladder.fmt import STYLES, format_source, unprintable
-from .ladder.ast import Program
-from .ladder.parser import parse_program, syntax_problems
-from .ladder.validate import check
-from .textfile import PROGRAM, decode_text, read_bytes
+from ..app import AppError, app_instructions, lad_files
+from ..errors import LocatedError, file_error, shown_path
+from ..ladder.errors import LadderError
+from ..ladder.fmt import STYLES, format_source, unprintable
+from ..ladder.ast import Program
+from ..ladder.parser import parse_program, syntax_problems
+from ..ladder.validate import check
+from ..textfile import PROGRAM, decode_text, read_bytes
+from .common import EXIT_ERROR, EXIT_OK
 
+NAME = "fmt"
 STDIN = "-"
-EXIT_OK, EXIT_ERROR = 0, 1
+
+
+def add_parser(sub) -> argparse.ArgumentParser:
+    f = sub.add_parser(NAME, help="print, check or rewrite .lad programs canonically, keeping every comment",
+                       description="Print each .lad file (an app directory: each of its .lad files; -: standard "
+                                   "input) canonically, keeping every comment; what does not parse is refused "
+                                   "(exit 1, every problem listed). See docs/language.md.")
+    f.add_argument("paths", nargs="+", metavar="PATH", help=".lad file, app directory, or - for standard input")
+    f.add_argument("--style", choices=STYLES, default="mnemonic",
+                   help="mnemonic (XIC B3/0 OTE O:0/0; the default) or neutral text (XIC(B3/0)OTE(O:0/0);)")
+    mode = f.add_mutually_exclusive_group()
+    mode.add_argument("--check", action="store_true",
+                      help="print nothing; exit 1 naming each file that is not formatted (a CI gate)")
+    mode.add_argument("--write", action="store_true",
+                      help="rewrite each file that changes in place, atomically; nothing is written if a file "
+                           "is refused")
+    f.set_defaults(func=run)
+    return f
+
+
+def run(args: argparse.Namespace) -> int:
+    return fmt_command(args.paths, args.style, check=args.check, write=args.write)
 
 
 @dataclass
