@@ -111,8 +111,9 @@ def run(args: argparse.Namespace) -> int:
     save = not snapshot or getattr(args, "save", False)
     run_options = RunOptions(scan_ms=args.scan_ms, realtime=args.realtime, fresh=args.fresh, sets=tuple(args.set),
                              ports=tuple(args.port), replay=args.replay, save_state=save)
+    # online: a snapshot renders once, so there is nothing to watch for
     options = WatchOptions(run=run_options, watch=tuple(watch), forces=tuple(args.force),
-                           break_when=tuple(args.break_when), online=not snapshot)  # a snapshot renders once: nothing to watch
+                           break_when=tuple(args.break_when), online=not snapshot)
     session = WatchSession(app, options)
     problems = address_problems("--watch", session.engine.table, list(args.watch), app.program.symbols) + \
         address_problems(f"--watch-file {args.watch_file}:", session.engine.table, watch[len(args.watch):],
