@@ -51,6 +51,7 @@ class ServerHandle:
         self.log = log
         self.where = where
         self.words = status_words
+        self._refusal_counters = status_words.refusal_counters if status_words is not None else ()
         self.image: SharedImage | None = None
         self.process: subprocess.Popen | None = None
         self.port: int | None = None
@@ -257,7 +258,7 @@ class ServerHandle:
             data[i + word] = C.word(counters[counter])
         data[i + w.rate] = C.word(min(self.rate, 32767))
         data[i + w.writes_applied] = C.word(self.writes_applied)
-        data[i + w.refusals] = C.word(sum(counters[c] for c in w.refusal_counters))
+        data[i + w.refusals] = C.word(sum(counters[c] for c in self._refusal_counters))
 
     def _lost(self, why: str) -> None:
         self._ready_by = None
