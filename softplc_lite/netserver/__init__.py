@@ -27,7 +27,8 @@ What a protocol writes (protocol.py):
   the regions of the data table it maps (``regions``, ``image_bytes``), how
   the scan applies one of its writes (``apply``), why its process cannot
   serve (``unusable``: a library missing), the module its process runs as
-  (``process_module``: a module that calls ``process.main``), and
+  (``process_module``: a module that calls ``process.main``), the name of
+  its image's file (``segments``: ``softplc-NAME-PID-RANDOM``), and
 - the ``Handler`` it makes in the server process: how long a frame is
   (``frame_length``; ``Malformed`` when it is not one), what a reply needs
   of a frame (``header``), the request a frame holds (``decode``), its

@@ -1,7 +1,8 @@
 """Network servers in the watch view (MODBTCPS's Modbus TCP server, or any
-module's ``network_servers()``): per server, where it listens and whether it
-is up, the clients connected, requests a second, requests and writes
-served, and the refusals by kind (docs/watch.md, "Network servers")."""
+module's ``network_servers()``, each a netserver.ServerStatus): per server,
+where it listens and whether it is up, the clients connected, requests a
+second, requests and writes served, and the refusals by kind (docs/watch.md,
+"Network servers")."""
 
 from __future__ import annotations
 
