@@ -1,19 +1,7 @@
-"""Bound instructions: built-in instructions written once, as Python
-objects bound to their operands, and run the same way by both executors.
+"""Operand binding, the one protocol every instruction run by the engine
+uses to reach its operands, and the built-in instructions written on it.
 
-Most instructions have a compiler template (compiler.py) and a second,
-plain rule in the reference interpreter. Instructions with more state than
-a line of code (shift registers, FIFOs, sequencers, file arithmetic, PID)
-are written here instead, one module per group in ``ladder/instr/``: each
-declares a :class:`BoundInstruction`, whose ``bind(instr, access)`` returns
-a callable taking the rung-in condition and returning the rung-out one
-(as a plug-in module's instance does). The compiler emits ``c = _bN(c)``;
-the interpreter calls the same object. What differs is ``access``: the
-compiled path resolves a direct address once (:class:`BoundAccess`), the
-reference path every time it is used (:class:`ReferenceAccess`), so the
-differential test still compares two ways of finding operands.
-
-An operand is read through a getter made once at bind time:
+An :class:`Access` binds an operand once, at load, to a getter:
 
 - ``access.location(op)`` -> ``get() -> (array, index, bit or None)``
 - ``access.value(op)`` -> ``get() -> int | float`` (a constant, a word,
@@ -21,6 +9,24 @@ An operand is read through a getter made once at bind time:
 - ``access.expression(node)`` -> ``get() -> int | float`` (CPT-style
   expression; its ``#`` addresses follow S:24 at each call, which is how
   FAL and FSC step through files)
+- ``access.operand(op)`` -> :class:`Operand`, the same getters as one
+  object, with the operand's address or constant (what a plug-in module's
+  instruction is given, ``InstructionContext.operands``)
+
+Each executor binds through its own access: the compiled path resolves a
+direct address once (:class:`BoundAccess`), the reference interpreter every
+time it is used (:class:`ReferenceAccess`), so the executor differential
+test compares two ways of finding operands for every instruction that
+reads its operands through an access, built-in or a module's.
+
+Built-in instructions with more state than a line of code (shift registers,
+FIFOs, sequencers, file arithmetic, PID) are written on this protocol
+rather than as a compiler template and an interpreter rule: one module per
+group in ``ladder/instr/``, each declaring a :class:`BoundInstruction`
+whose ``bind(instr, access)`` returns a callable taking the rung-in
+condition and returning the rung-out one (as a module instruction's
+instance does). The compiler emits ``c = _bN(c)``; the interpreter calls
+the same object.
 
 Faults: a bad indirect address raises the same MajorFault as built-in
 instructions; a block past the end of its file raises FAULT_BLOCK_RANGE
@@ -69,7 +75,7 @@ class BoundInstruction:
 
 
 class Access:
-    """How a bound instruction reaches its operands (see the module doc)."""
+    """How an instruction reaches its operands (see the module doc)."""
 
     cache_direct = False
 
@@ -84,14 +90,21 @@ class Access:
             raise address_fault(address, e) from None
         return f.data, index, bit
 
+    def fixed(self, operand) -> Location | None:
+        """The location of ``operand`` resolved once, now, when this access
+        binds it so (a direct address on the compiled path); else None."""
+        if self.cache_direct and isinstance(operand, AddressRef) and operand.address.is_direct:
+            return self._resolve(operand.address)
+        return None
+
     def location(self, operand) -> Callable[[], Location]:
         if not isinstance(operand, AddressRef):
             raise TypeError(f"{operand!r} is not an address")
-        address = operand.address
-        if self.cache_direct and address.is_direct:
-            fixed = self._resolve(address)
+        fixed = self.fixed(operand)
+        if fixed is not None:
             return lambda: fixed
         resolve = self._resolve
+        address = operand.address
         return lambda: resolve(address)
 
     def value(self, operand) -> Callable[[], int | float]:
@@ -121,6 +134,44 @@ class Access:
                 return d[i] if bit is None else (d[i] >> bit) & 1
             return evaluate(node, read, machine)
         return compute
+
+    def operand(self, operand) -> "Operand":
+        return Operand(self, operand)
+
+
+def _no_location() -> Location:
+    raise TypeError("a constant operand has no location")
+
+
+class Operand:
+    """One operand bound through an :class:`Access`.
+
+    ``constant`` (a Const's value) or ``address`` (an AddressRef's) is set,
+    the other None; ``location()`` and ``value()`` are the access's getters;
+    ``fixed`` is the location when the access resolved it once at bind
+    (what an instance may keep instead of calling ``location()`` every
+    scan), else None. A bad indirect address raises the same major fault as
+    a built-in instruction's."""
+
+    __slots__ = ("operand", "constant", "address", "fixed", "location", "value")
+
+    def __init__(self, access: Access, operand) -> None:
+        self.operand = operand
+        self.constant = operand.value if isinstance(operand, Const) else None
+        self.address = operand.address if isinstance(operand, AddressRef) else None
+        if self.address is not None:
+            self.fixed = access.fixed(operand)
+            self.location = (lambda fixed=self.fixed: fixed) if self.fixed is not None else access.location(operand)
+            self.value = access.value(operand)
+        else:
+            self.fixed = None
+            self.location = _no_location
+            constant = self.constant
+            self.value = lambda: constant
+
+    @property
+    def text(self) -> str:
+        return str(self.address) if self.address is not None else repr(self.constant)
 
 
 class BoundAccess(Access):

@@ -182,6 +182,7 @@ def import_file(data: tuple, program: Program, number: int, table, machine, jsr,
     functions = _functions()
     env: dict[str, object] = {}
     named: dict[tuple, str] = {}
+    access = BoundAccess(table, machine)
     for name, (kind, *args) in recipe.items():
         if kind == "_jsr":
             env[name] = jsr
@@ -206,9 +207,9 @@ def import_file(data: tuple, program: Program, number: int, table, machine, jsr,
             target = node(args[0])
             named[(id(target), kind)] = name
             if kind == "bi":
-                env[name] = BOUND[target.mnemonic].bind(target, BoundAccess(table, machine))
+                env[name] = BOUND[target.mnemonic].bind(target, access)
             elif kind == "tli":
-                env[name] = module_instance(target)
+                env[name] = module_instance(target, access)
             elif kind == "loc":
                 env[name] = resolver(table, target.address)
             else:

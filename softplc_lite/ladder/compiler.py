@@ -61,7 +61,8 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.number = number
         self.rungs = rungs
         self.labels = labels_of(rungs)
-        self.module_instance = module_instance  # TLM instructions: Instruction -> callable(c) -> c
+        self.module_instance = module_instance  # module instructions: (Instruction, Access) -> callable(c) -> c
+        self.access = BoundAccess(table, machine)  # how bound and module instructions reach operands
         self.saw_mcr = False  # set by rung_words: compile() learns has_mcr in its first pass
         self.env: dict[str, object] = {"_jsr": jsr, "_zone": zone, "_m": machine, **expr_namespace(machine)}
         self.named: dict[tuple, str] = {}  # per-instruction objects, made once (a block compiled again reuses them)
@@ -343,12 +344,12 @@ class _FileCompiler(HeldWords, TableTemplates):
         bound = BOUND.get(m)
         if bound is not None:
             # A bound instruction (ladder/instr/): one object per instruction.
-            name = self.bind_once((id(ins), "bi"), "_bi", lambda: bound.bind(ins, BoundAccess(self.table, self.machine)))
+            name = self.bind_once((id(ins), "bi"), "_bi", lambda: bound.bind(ins, self.access))
             self.emit(ind, f"c = {name}({RUNG_BOOL})")
             return
         key = (id(ins), "tli")
         if key not in self.named:
-            instance = self.module_instance(ins) if self.module_instance is not None else None
+            instance = self.module_instance(ins, self.access) if self.module_instance is not None else None
             if instance is None:
                 raise NotImplementedError(f"no compiler template for {m}")  # validated programs never get here
             self.bind_once(key, "_tli", lambda: instance)

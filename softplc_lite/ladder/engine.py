@@ -154,15 +154,16 @@ class Engine:
             if overrides(m, "on_mode"):
                 self.mode_hooks.append(m.on_mode)
 
-    def _module_instance(self, ins):
+    def _module_instance(self, ins, access):
         """The run-time instance of a module instruction (called once per
-        instruction by either executor), or None for a built-in one."""
+        instruction by either executor, with the access it binds operands
+        through: ladder/bound.py), or None for a built-in one."""
         module = self._owner.get(ins.mnemonic)
         if module is None:
             return None
         instance = self._kept_instances.get(id(ins))  # an online edit: the same instruction in an unchanged rung
         if instance is None:
-            instance = module.instance(self, ins)
+            instance = module.bind(self, ins, access)
         self._instances[id(ins)] = instance
         return instance
 

@@ -13,9 +13,9 @@ A module's life with one engine:
 1. ``instructions()`` and ``references(instr)`` at load: the mnemonics it
    owns, and what its instructions reach beyond their operands;
 2. ``attach(engine, options)`` once, before the first scan;
-3. ``instance(engine, instr)`` once per instruction it owns: the callable
-   the executors run each scan with the rung-in condition, returning the
-   rung-out condition;
+3. ``bind(engine, instr, access)`` once per instruction it owns (by
+   default ``instance(engine, instr)``): the callable the executors run each
+   scan with the rung-in condition, returning the rung-out condition;
 4. ``on_input`` / ``on_output`` every scan at the input and output points,
    ``on_mode`` on each mode change (only those a module overrides are
    called: :func:`overrides`);
@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Callable, Mapping
 
 if TYPE_CHECKING:  # pragma: no cover - types only
     from .ast import Instruction
+    from .bound import Access
     from .engine import Engine
 
 
@@ -85,6 +86,15 @@ class Module:
     def instance(self, engine: "Engine", instr: "Instruction") -> Instance:
         """The run-time callable of one of the module's instructions."""
         raise NotImplementedError(f"module {self.name} cannot run {instr.mnemonic}")
+
+    def bind(self, engine: "Engine", instr: "Instruction", access: "Access") -> Instance:
+        """The callable of one of the module's instructions for the executor
+        that binds it: ``access`` (ladder.bound.Access) is how that executor
+        reaches operands, as a built-in bound instruction's ``bind(instr,
+        access)`` gets it. A module whose instances read their operands
+        through it runs under the executor differential test like a built-in
+        instruction. By default: ``instance(engine, instr)``."""
+        return self.instance(engine, instr)
 
     # driver hooks: the engine calls only those a module overrides
     def on_input(self, engine: "Engine") -> None:

@@ -319,7 +319,7 @@ def interpret_file(program: Program, number: int, table: DataTable, machine: Mac
             if bound is not None:
                 interp.bound[id(ins)] = bound.bind(ins, access)
             elif module_instance is not None:
-                instance = module_instance(ins)
+                instance = module_instance(ins, access)
                 if instance is not None:
                     interp.modules[id(ins)] = instance
     return ReferenceFile(interp, number, rungs)

@@ -281,7 +281,7 @@ def _no_call(*args) -> None:  # precompile's JSR and module instances: never run
     raise AssertionError("precompiled code is bound again before it runs")
 
 
-def _stand_in(ins):
+def _stand_in(ins, access):
     return _no_call
 
 

@@ -42,9 +42,8 @@ from array import array
 from pathlib import Path
 from typing import TYPE_CHECKING, Mapping
 
-from ..datatable.errors import AddressRangeError
-from ..ladder.ast import AddressRef, Const, Instruction
-from ..ladder.resolvers import address_fault
+from ..ladder.ast import Instruction
+from ..ladder.bound import Access, BoundAccess, Operand
 from ..ladder.errors import LadderError
 from ..ladder.host import Instance, Module
 from ..ladder.instructions import InstructionSpec
@@ -53,7 +52,6 @@ from ..ports import PortClaim, Recorder, assign_port_overrides, claim_conflicts,
 from .errors import ModuleError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from ..datatable import DataTable
     from ..ladder.engine import Engine
 
 
@@ -84,6 +82,11 @@ class TLM(Module):
 
     def instance(self, engine: "Engine", instr: Instruction) -> Instance:
         return self.create(instr, InstructionContext(engine, instr))
+
+    def bind(self, engine: "Engine", instr: Instruction, access: Access) -> Instance:
+        if type(self).instance is not TLM.instance:  # a module that makes its instances itself
+            return self.instance(engine, instr)
+        return self.create(instr, InstructionContext(engine, instr, access))
 
     def port_claims(self) -> list[PortClaim]:
         """The serial ports the module will open, from its config."""
@@ -171,56 +174,24 @@ def find_file(directory: Path, name: str) -> Path | None:
 
 # -- operands --------------------------------------------------------------------------
 
-class BoundOperand:
-    """One operand of a TLM instruction, bound to the data table.
-
-    A direct address is resolved once; an indirect or indexed one each time
-    it is used (a bad one raises the same major fault as built-in
-    instructions do)."""
-
-    def __init__(self, table: "DataTable", operand) -> None:
-        self.operand = operand
-        self.table = table
-        self.constant = operand.value if isinstance(operand, Const) else None
-        self.address = operand.address if isinstance(operand, AddressRef) else None
-        self._location = None
-        if self.address is not None and self.address.is_direct:
-            self._location = self._resolve()
-
-    def _resolve(self):
-        try:
-            f, index, bit = self.table.resolve(self.address)
-        except AddressRangeError as e:
-            raise address_fault(self.address, e) from None
-        return f.data, index, bit
-
-    @property
-    def text(self) -> str:
-        return str(self.address) if self.address is not None else repr(self.constant)
-
-    def location(self) -> tuple[array, int, int | None]:
-        """(array, index, bit) of an address operand."""
-        return self._location if self._location is not None else self._resolve()
-
-    def value(self) -> int | float:
-        """A constant's value, or what the address holds (a word, a float,
-        or 0/1 for a bit)."""
-        if self.address is None:
-            return self.constant
-        d, i, bit = self.location()
-        return d[i] if bit is None else (d[i] >> bit) & 1
+# One operand of a module's instruction, bound to the data table through the
+# executor's access: the protocol built-in instructions use (ladder/bound.py).
+BoundOperand = Operand
 
 
 class InstructionContext:
-    """What ``TLM.create`` gets: the instruction, its bound operands and the
-    run-time machine (data table, status file, clock)."""
+    """What ``TLM.create`` gets: the instruction, its operands bound through
+    the executor's access (ladder.bound.Access; the compiled one when none is
+    given) and the run-time machine (data table, status file, clock)."""
 
-    def __init__(self, engine: "Engine", instr: Instruction) -> None:
+    def __init__(self, engine: "Engine", instr: Instruction, access: Access | None = None) -> None:
         self.engine = engine
         self.instr = instr
         self.table = engine.table
         self.machine: Machine = engine.machine
-        self.operands = [BoundOperand(engine.table, op) for op in instr.operands]
+        if access is None:
+            access = BoundAccess(engine.table, engine.machine)
+        self.operands = [access.operand(op) for op in instr.operands]
 
     @property
     def now_ms(self) -> int:
@@ -311,10 +282,10 @@ class ControlledInstruction:
     def __init__(self, control: BoundOperand) -> None:
         self.control = control
         self.busy = False
-        # A direct CONTROL address is bound once (BoundOperand): its word and
-        # its ControlElement are kept, so a scan's call allocates and looks up
-        # nothing. An indirect one is resolved at every call.
-        location = getattr(control, "_location", None)  # None: resolved at every call (location())
+        # A CONTROL address the access resolved once (a direct one, compiled):
+        # its word and its ControlElement are kept, so a scan's call allocates
+        # and looks up nothing. Otherwise it is resolved at every call.
+        location = control.fixed
         self._d = location[0] if location is not None else None
         self._i = location[1] if location is not None else 0
         self._ctl = ControlElement(self._d, self._i) if location is not None else None
