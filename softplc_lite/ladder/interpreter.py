@@ -6,10 +6,14 @@ The differential tests run random programs through this and the compiler
 and require identical data tables. Kernels with real logic (timers,
 counters, math stores, strings) are shared from semantics.py; contacts,
 coils, branches, compares, operand access, expressions and control flow are
-written here a second time.
+written here a second time, one rule per instruction in ``RULES`` (mnemonic
+-> function), as the compiler has one template per instruction
+(ladder/templates.py).
 """
 
 from __future__ import annotations
+
+from typing import Callable
 
 from ..datatable import DataTable, bit_mask
 from ..datatable.errors import AddressRangeError
@@ -142,163 +146,16 @@ class Interpreter:
         return c
 
     def instruction(self, ins: Instruction, c: bool, rung: Rung, pfile: ReferenceFile) -> bool:
-        m, ops, mc = ins.mnemonic, ins.operands, self.m
+        m = ins.mnemonic
         if m in _WHEN_TRUE and not c:
             return c
-        if m == "XIC":
-            on = self.bit(ops[0])  # resolved even on a false rung, as compiled code does
-            return c and on
-        if m == "XIO":
-            on = self.bit(ops[0])
-            return c and not on
-        if m == "OTE":
-            self.set_bit(ops[0], c)
-        elif m in ("OTL", "OTU"):
-            d, i, bit = self.loc(ops[0])  # resolved even on a false rung, as compiled code does
-            if c:
-                mask = bit_mask(bit)
-                d[i] = (d[i] | mask) if m == "OTL" else (d[i] & ~mask)
-        elif m == "ONS":
-            stored = self.bit(ops[0])
-            self.set_bit(ops[0], c)
-            return c and not stored
-        elif m in ("OSR", "OSF"):
-            # Resolve both once, storage first, as compiled code does: writing
-            # the output bit may change a word the storage address goes through.
-            sd, si, sbit = self.loc(ops[0])
-            od, oi, obit = self.loc(ops[1])
-            stored = (sd[si] >> sbit) & 1
-            fire = (c and not stored) if m == "OSR" else (not c and stored)
-            omask, smask = bit_mask(obit), bit_mask(sbit)
-            od[oi] = (od[oi] | omask) if fire else (od[oi] & ~omask)
-            sd[si] = (sd[si] | smask) if c else (sd[si] & ~smask)
-        elif m in ("TON", "TOF", "RTO"):
-            d, i, _ = self.loc(ops[0])
-            getattr(mc, m.lower())(d, i, c, BASE_MS[ops[1].value])
-        elif m in ("CTU", "CTD"):
-            d, i, _ = self.loc(ops[0])
-            getattr(mc, m.lower())(d, i, c)
-        elif m == "RES":
-            d, i, _ = self.loc(ops[0])
-            mc.res(d, i)
-        elif m in ("EQU", "NEQ", "LES", "LEQ", "GRT", "GEQ"):
-            a, b = self.read(ops[0]), self.read(ops[1])
-            result = {"EQU": a == b, "NEQ": a != b, "LES": a < b, "LEQ": a <= b,
-                      "GRT": a > b, "GEQ": a >= b}[m]
-            return c and result
-        elif m == "LIM":
-            lo, t, hi = (self.read(o) for o in ops)
-            return c and lim(lo, t, hi)
-        elif m == "MEQ":
-            s, mask, cmp_ = (self.read(o) for o in ops)
-            return c and (s & mask) == (cmp_ & mask)
-        elif m == "CMP":
-            return bool(self.expr(ops[0]))
-        elif m in ("ADD", "SUB", "DIV", "MOD"):
-            a, b = self.read(ops[0]), self.read(ops[1])
-            d, i, _ = self.loc(ops[2])
-            getattr(mc, m.lower())(a, b, d, i)
-        elif m == "MUL":
-            a, b = self.read(ops[0]), self.read(ops[1])
-            d, i, _ = self.loc(ops[2])
-            mc.store(a * b, d, i)
-        elif m == "NEG":
-            v = self.read(ops[0])
-            d, i, _ = self.loc(ops[1])
-            mc.neg(v, d, i)
-        elif m in ("ABS", "MOV"):
-            v = self.read(ops[0])
-            d, i, _ = self.loc(ops[1])
-            mc.store(abs(v) if m == "ABS" else v, d, i)
-        elif m == "SQR":
-            v = self.read(ops[0])
-            d, i, _ = self.loc(ops[1])
-            mc.sqr(v, d, i)
-        elif m == "CPT":
-            compute = self.prepare(ops[1])
-            d, i, _ = self.loc(ops[0])
-            mc.store(compute(), d, i)
-        elif m == "CLR":
-            d, i, _ = self.loc(ops[0])
-            mc.clear(d, i)
-        elif m in ("AND", "OR", "XOR"):
-            a, b = self.read(ops[0]), self.read(ops[1])
-            d, i, _ = self.loc(ops[2])
-            mc.logic(a & b if m == "AND" else a | b if m == "OR" else a ^ b, d, i)
-        elif m == "NOT":
-            v = self.read(ops[0])
-            d, i, _ = self.loc(ops[1])
-            mc.logic(~v, d, i)
-        elif m == "MVM":
-            s, mask = self.read(ops[0]), self.read(ops[1])
-            d, i, _ = self.loc(ops[2])
-            mc.logic((d[i] & ~mask) | (s & mask), d, i)
-        elif m in ("COP", "FLL"):
-            n = ops[2].value * ops[1].address.ftype.words_per_element
-            if m == "COP":
-                sd, si = self._block(ops[0], source_units(n, ops[0].address.ftype, ops[1].address.ftype))
-                dd, di = self._block(ops[1], n)
-                mc.cop(sd, si, dd, di, n)
-            else:
-                v = self.read(ops[0])
-                dd, di = self._block(ops[1], n)
-                mc.fll(v, dd, di, n)
-        elif m == "BTD":
-            src = self.read(ops[0])
-            d, i, _ = self.loc(ops[2])
-            mc.btd(src, ops[1].value, d, i, ops[3].value, ops[4].value)
-        elif m == "JMP":
-            if c:
-                raise _Jump(pfile.labels[ops[0].value])
-        elif m == "JSR":
-            if c:
-                if len(ops) > 1:
-                    self.jsr(ops[0].value, ins)  # the engine moves the parameters
-                else:
-                    self.jsr(ops[0].value)
-        elif m == "RET":
-            if c:
-                raise _Jump(ins if ops else RET)  # with values: the engine reads them (Engine.run_file)
-        elif m == "TND":
-            if c:
-                raise _Jump(TND)
-        elif m == "MCR":
-            self.zone[0] = c if rung.elements[0] is not ins else True
-        elif m == "AFI":
-            return False
-        elif m in ("LBL", "SBR"):
-            pass
-        elif m == "ACI":
-            sd, si, _ = self.loc(ops[0])
-            d, i, _ = self.loc(ops[1])
-            mc.aci(sd, si, d, i)
-        elif m == "AIC":
-            v = self.read(ops[0])
-            d, i, _ = self.loc(ops[1])
-            mc.aic(v, d, i)
-        elif m == "ACN":
-            (ad, ai, _), (bd, bi, _), (d, i, _) = (self.loc(o) for o in ops)
-            mc.acn(ad, ai, bd, bi, d, i)
-        elif m == "AEX":
-            sd, si, _ = self.loc(ops[0])
-            index, count = self.read(ops[1]), self.read(ops[2])
-            d, i, _ = self.loc(ops[3])
-            mc.aex(sd, si, index, count, d, i)
-        elif m == "ASC":  # AB order: source (searched for), index, string search (examined), result
-            qd, qi, _ = self.loc(ops[0])
-            index = self.read(ops[1])
-            (sd, si, _), (d, i, _) = self.loc(ops[2]), self.loc(ops[3])
-            mc.asc(qd, qi, index, sd, si, d, i)
-        elif m == "ASR":
-            (ad, ai, _), (bd, bi, _) = self.loc(ops[0]), self.loc(ops[1])
-            return mc.asr(ad, ai, bd, bi)
-        elif id(ins) in self.bound:
-            return self.bound[id(ins)](c)
-        elif id(ins) in self.modules:
-            return self.modules[id(ins)](c)
-        else:
+        rule = RULES.get(m)
+        if rule is not None:
+            return rule(self, ins, c, rung, pfile)
+        instance = self.modules.get(id(ins))
+        if instance is None:
             raise NotImplementedError(f"the reference interpreter has no rule for {m}")
-        return c
+        return instance(c)
 
     def _block(self, ref, n):
         d, i, _ = self.loc(ref)
@@ -306,6 +163,325 @@ class Interpreter:
             raise MajorFault(S.FAULT_BLOCK_RANGE,
                              f"{n} words from {ref.address} run past the end of the file ({len(d)} words)")
         return d, i
+
+
+# -- the rules: mnemonic -> rule(interpreter, instruction, rung-in, rung, file) -> rung-out --------
+
+Rule = Callable[[Interpreter, Instruction, bool, Rung, ReferenceFile], bool]
+RULES: dict[str, Rule] = {}
+
+
+def rule(*mnemonics: str):
+    """Register the interpreter's rule for ``mnemonics``."""
+    def register(fn: Rule) -> Rule:
+        for m in mnemonics:
+            RULES[m] = fn
+        return fn
+    return register
+
+
+@rule("XIC")
+def _xic(it, ins, c, rung, pfile):
+    on = it.bit(ins.operands[0])  # resolved even on a false rung, as compiled code does
+    return c and on
+
+
+@rule("XIO")
+def _xio(it, ins, c, rung, pfile):
+    on = it.bit(ins.operands[0])
+    return c and not on
+
+
+@rule("OTE")
+def _ote(it, ins, c, rung, pfile):
+    it.set_bit(ins.operands[0], c)
+    return c
+
+
+@rule("OTL", "OTU")
+def _latch(it, ins, c, rung, pfile):
+    d, i, bit = it.loc(ins.operands[0])  # resolved even on a false rung, as compiled code does
+    if c:
+        mask = bit_mask(bit)
+        d[i] = (d[i] | mask) if ins.mnemonic == "OTL" else (d[i] & ~mask)
+    return c
+
+
+@rule("ONS")
+def _ons(it, ins, c, rung, pfile):
+    stored = it.bit(ins.operands[0])
+    it.set_bit(ins.operands[0], c)
+    return c and not stored
+
+
+@rule("OSR", "OSF")
+def _one_shot(it, ins, c, rung, pfile):
+    # Resolve both once, storage first, as compiled code does: writing
+    # the output bit may change a word the storage address goes through.
+    sd, si, sbit = it.loc(ins.operands[0])
+    od, oi, obit = it.loc(ins.operands[1])
+    stored = (sd[si] >> sbit) & 1
+    fire = (c and not stored) if ins.mnemonic == "OSR" else (not c and stored)
+    omask, smask = bit_mask(obit), bit_mask(sbit)
+    od[oi] = (od[oi] | omask) if fire else (od[oi] & ~omask)
+    sd[si] = (sd[si] | smask) if c else (sd[si] & ~smask)
+    return c
+
+
+@rule("TON", "TOF", "RTO")
+def _timer(it, ins, c, rung, pfile):
+    d, i, _ = it.loc(ins.operands[0])
+    getattr(it.m, ins.mnemonic.lower())(d, i, c, BASE_MS[ins.operands[1].value])
+    return c
+
+
+@rule("CTU", "CTD")
+def _counter(it, ins, c, rung, pfile):
+    d, i, _ = it.loc(ins.operands[0])
+    getattr(it.m, ins.mnemonic.lower())(d, i, c)
+    return c
+
+
+@rule("RES")
+def _res(it, ins, c, rung, pfile):
+    d, i, _ = it.loc(ins.operands[0])
+    it.m.res(d, i)
+    return c
+
+
+_COMPARE = {"EQU": lambda a, b: a == b, "NEQ": lambda a, b: a != b, "LES": lambda a, b: a < b,
+            "LEQ": lambda a, b: a <= b, "GRT": lambda a, b: a > b, "GEQ": lambda a, b: a >= b}
+
+
+@rule(*_COMPARE)
+def _compare(it, ins, c, rung, pfile):
+    a, b = it.read(ins.operands[0]), it.read(ins.operands[1])
+    return c and _COMPARE[ins.mnemonic](a, b)
+
+
+@rule("LIM")
+def _lim(it, ins, c, rung, pfile):
+    lo, t, hi = (it.read(o) for o in ins.operands)
+    return c and lim(lo, t, hi)
+
+
+@rule("MEQ")
+def _meq(it, ins, c, rung, pfile):
+    s, mask, cmp_ = (it.read(o) for o in ins.operands)
+    return c and (s & mask) == (cmp_ & mask)
+
+
+@rule("CMP")
+def _cmp(it, ins, c, rung, pfile):
+    return bool(it.expr(ins.operands[0]))
+
+
+@rule("ADD", "SUB", "DIV", "MOD")
+def _math(it, ins, c, rung, pfile):
+    ops = ins.operands
+    a, b = it.read(ops[0]), it.read(ops[1])
+    d, i, _ = it.loc(ops[2])
+    getattr(it.m, ins.mnemonic.lower())(a, b, d, i)
+    return c
+
+
+@rule("MUL")
+def _mul(it, ins, c, rung, pfile):
+    ops = ins.operands
+    a, b = it.read(ops[0]), it.read(ops[1])
+    d, i, _ = it.loc(ops[2])
+    it.m.store(a * b, d, i)
+    return c
+
+
+@rule("NEG")
+def _neg(it, ins, c, rung, pfile):
+    v = it.read(ins.operands[0])
+    d, i, _ = it.loc(ins.operands[1])
+    it.m.neg(v, d, i)
+    return c
+
+
+@rule("ABS", "MOV")
+def _move(it, ins, c, rung, pfile):
+    v = it.read(ins.operands[0])
+    d, i, _ = it.loc(ins.operands[1])
+    it.m.store(abs(v) if ins.mnemonic == "ABS" else v, d, i)
+    return c
+
+
+@rule("SQR")
+def _sqr(it, ins, c, rung, pfile):
+    v = it.read(ins.operands[0])
+    d, i, _ = it.loc(ins.operands[1])
+    it.m.sqr(v, d, i)
+    return c
+
+
+@rule("CPT")
+def _cpt(it, ins, c, rung, pfile):
+    compute = it.prepare(ins.operands[1])
+    d, i, _ = it.loc(ins.operands[0])
+    it.m.store(compute(), d, i)
+    return c
+
+
+@rule("CLR")
+def _clr(it, ins, c, rung, pfile):
+    d, i, _ = it.loc(ins.operands[0])
+    it.m.clear(d, i)
+    return c
+
+
+@rule("AND", "OR", "XOR")
+def _logic(it, ins, c, rung, pfile):
+    ops, m = ins.operands, ins.mnemonic
+    a, b = it.read(ops[0]), it.read(ops[1])
+    d, i, _ = it.loc(ops[2])
+    it.m.logic(a & b if m == "AND" else a | b if m == "OR" else a ^ b, d, i)
+    return c
+
+
+@rule("NOT")
+def _not(it, ins, c, rung, pfile):
+    v = it.read(ins.operands[0])
+    d, i, _ = it.loc(ins.operands[1])
+    it.m.logic(~v, d, i)
+    return c
+
+
+@rule("MVM")
+def _mvm(it, ins, c, rung, pfile):
+    ops = ins.operands
+    s, mask = it.read(ops[0]), it.read(ops[1])
+    d, i, _ = it.loc(ops[2])
+    it.m.logic((d[i] & ~mask) | (s & mask), d, i)
+    return c
+
+
+@rule("COP", "FLL")
+def _file(it, ins, c, rung, pfile):
+    ops = ins.operands
+    n = ops[2].value * ops[1].address.ftype.words_per_element
+    if ins.mnemonic == "COP":
+        sd, si = it._block(ops[0], source_units(n, ops[0].address.ftype, ops[1].address.ftype))
+        dd, di = it._block(ops[1], n)
+        it.m.cop(sd, si, dd, di, n)
+    else:
+        v = it.read(ops[0])
+        dd, di = it._block(ops[1], n)
+        it.m.fll(v, dd, di, n)
+    return c
+
+
+@rule("BTD")
+def _btd(it, ins, c, rung, pfile):
+    ops = ins.operands
+    src = it.read(ops[0])
+    d, i, _ = it.loc(ops[2])
+    it.m.btd(src, ops[1].value, d, i, ops[3].value, ops[4].value)
+    return c
+
+
+@rule("JMP")
+def _jmp(it, ins, c, rung, pfile):
+    if c:
+        raise _Jump(pfile.labels[ins.operands[0].value])
+    return c
+
+
+@rule("JSR")
+def _jsr(it, ins, c, rung, pfile):
+    if c:
+        if len(ins.operands) > 1:
+            it.jsr(ins.operands[0].value, ins)  # the engine moves the parameters
+        else:
+            it.jsr(ins.operands[0].value)
+    return c
+
+
+@rule("RET")
+def _ret(it, ins, c, rung, pfile):
+    if c:
+        raise _Jump(ins if ins.operands else RET)  # with values: the engine reads them (Engine.run_file)
+    return c
+
+
+@rule("TND")
+def _tnd(it, ins, c, rung, pfile):
+    if c:
+        raise _Jump(TND)
+    return c
+
+
+@rule("MCR")
+def _mcr(it, ins, c, rung, pfile):
+    it.zone[0] = c if rung.elements[0] is not ins else True
+    return c
+
+
+@rule("AFI")
+def _afi(it, ins, c, rung, pfile):
+    return False
+
+
+@rule("LBL", "SBR")
+def _nothing(it, ins, c, rung, pfile):
+    return c
+
+
+@rule("ACI")
+def _aci(it, ins, c, rung, pfile):
+    sd, si, _ = it.loc(ins.operands[0])
+    d, i, _ = it.loc(ins.operands[1])
+    it.m.aci(sd, si, d, i)
+    return c
+
+
+@rule("AIC")
+def _aic(it, ins, c, rung, pfile):
+    v = it.read(ins.operands[0])
+    d, i, _ = it.loc(ins.operands[1])
+    it.m.aic(v, d, i)
+    return c
+
+
+@rule("ACN")
+def _acn(it, ins, c, rung, pfile):
+    (ad, ai, _), (bd, bi, _), (d, i, _) = (it.loc(o) for o in ins.operands)
+    it.m.acn(ad, ai, bd, bi, d, i)
+    return c
+
+
+@rule("AEX")
+def _aex(it, ins, c, rung, pfile):
+    ops = ins.operands
+    sd, si, _ = it.loc(ops[0])
+    index, count = it.read(ops[1]), it.read(ops[2])
+    d, i, _ = it.loc(ops[3])
+    it.m.aex(sd, si, index, count, d, i)
+    return c
+
+
+@rule("ASC")
+def _asc(it, ins, c, rung, pfile):  # AB order: source (searched for), index, string search (examined), result
+    ops = ins.operands
+    qd, qi, _ = it.loc(ops[0])
+    index = it.read(ops[1])
+    (sd, si, _), (d, i, _) = it.loc(ops[2]), it.loc(ops[3])
+    it.m.asc(qd, qi, index, sd, si, d, i)
+    return c
+
+
+@rule("ASR")
+def _asr(it, ins, c, rung, pfile):
+    (ad, ai, _), (bd, bi, _) = it.loc(ins.operands[0]), it.loc(ins.operands[1])
+    return it.m.asr(ad, ai, bd, bi)
+
+
+@rule(*BOUND)
+def _bound(it, ins, c, rung, pfile):
+    return it.bound[id(ins)](c)  # the object ladder/instr/ bound to this instruction
 
 
 def interpret_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list,
