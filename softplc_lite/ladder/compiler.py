@@ -30,10 +30,10 @@ from ..gcpause import gc_paused
 from ..datatable import DataTable, ValueKind, bit_mask
 from ..datatable.filetypes import Storage
 from . import blocks
-from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, instructions_of, walk
+from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, address_refs, instructions_of, walk
 from .blocks import RET, RUNG_BOOL, TND, BlockCode, CompiledFile  # noqa: F401 (RET, TND: the block protocol, imported from here)
-from .held_words import _BIT_OPS, _FLAGS, _NO_BARRIER, HeldWords, _may_hold
-from .templates import _COMPARE, TableTemplates
+from .held_words import _FLAGS, _LOCAL_SAFE, _NO_BARRIER, HeldWords, _cannot_fault, _may_hold, _word_store
+from .templates import _COMPARE, TEMPLATES
 from .bound import BoundAccess
 from .expr import namespace as expr_namespace
 from .expr import to_python
@@ -53,7 +53,16 @@ def describe(instr: Instruction) -> str:
     return f"{format_instruction(instr, 'mnemonic')} at {instr.pos}"
 
 
-class _FileCompiler(HeldWords, TableTemplates):
+class _FileCompiler:
+    """Compiles one program file into block functions (CompiledFile).
+
+    It holds a locals allocator (``held``: ladder/held_words.HeldWords) and
+    emits each instruction through its template (``TEMPLATES``:
+    ladder/templates.py, ladder/held_templates.py). Templates are functions
+    of this compiler, and use of it: ``emit``, ``location``, ``value``,
+    ``expression``, ``bind``, ``bind_once``, ``resolve``, ``array_name``,
+    ``barrier``, ``mark_rung``, ``dispatch``, and the state below."""
+
     def __init__(self, table: DataTable, machine: Machine, number: int, rungs: list[Rung], zone: list, jsr,
                  module_instance=None) -> None:
         self.table = table
@@ -63,18 +72,27 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.labels = labels_of(rungs)
         self.module_instance = module_instance  # module instructions: (Instruction, Access) -> callable(c) -> c
         self.access = BoundAccess(table, machine)  # how bound and module instructions reach operands
-        self.saw_mcr = False  # set by rung_words: compile() learns has_mcr in its first pass
         self.env: dict[str, object] = {"_jsr": jsr, "_zone": zone, "_m": machine, **expr_namespace(machine)}
         self.named: dict[tuple, str] = {}  # per-instruction objects, made once (a block compiled again reuses them)
         self.rung_elements: list = []
         self.current: Instruction | None = None
         self.inline_dest: str | None = None  # the local a word store writes (in_place)
         self.inline_flags: str | None = None  # the local holding S:0, if held, for that store
-        self.uses: Counter = Counter()  # how often the block being compiled addresses each word
-        self._word_keys: dict[int, tuple | None] = {}  # id(Address) -> (file, word) a local could hold, or None
         self.first_contact = (None, None)  # a rung's first element and its contact expression
         self._locations: dict[int, object] = {}  # id(Address) -> Location, for direct addresses
         self._bits: dict[int, tuple] = {}  # id(Address) -> what bit() needs of a direct bit address
+        self.held = HeldWords(self)  # the words the block being compiled holds in locals
+        # The block being compiled (begin_block): its lines, and per line its
+        # instruction and rung; a counter for temporaries; the rung being
+        # compiled and the last one named to _m.rung; whether it reads the clock.
+        self.lines: list[str] = []
+        self.line_instr: list = []
+        self.line_rung: list[int] = []
+        self.temp = 0
+        self.rung_index = 0
+        self.rung_marked: int | None = None
+        self.uses_now = False
+        self.rung_in: str | None = None  # a rung's pending rung-in (start_rung)
 
     @cached_property
     def has_mcr(self) -> bool:
@@ -132,10 +150,10 @@ class _FileCompiler(HeldWords, TableTemplates):
         a = operand.address
         if a.is_direct:
             f, index, bit = self.resolve(a)
-            name = self.words.get((f.number, index))
+            name = self.held.held((f.number, index))
             if name is not None:  # held in a local (loaded at rung level before this instruction)
                 if (f.number, index) == _FLAGS:
-                    self.flags_exact(ind)
+                    self.held.flags_exact(ind)
                 return name if bit is None else f"(1 if {name} & {bit_mask(bit)!r} else 0)"
         d, i, m = self.location(ind, operand)
         if m is not None:
@@ -163,11 +181,12 @@ class _FileCompiler(HeldWords, TableTemplates):
                 bit_mask(bit) if bit is not None else None, f"{self.array_name(f)}[{index!r}]")
         key, f, index, mask, in_place = known
         if key is not None:
-            name = self.words.get(key)
-            if name is None and self.uses.get(key, 0) >= 2:
-                name = self.word_at(ind, f, index)  # loaded now, at rung level
+            held = self.held
+            name = held.held(key)
+            if name is None and held.uses.get(key, 0) >= 2:
+                name = held.word_at(ind, f, index)  # loaded now, at rung level
             elif name is not None and key == _FLAGS:
-                self.flags_exact(ind)
+                held.flags_exact(ind)
             if name is not None:
                 return name, mask, True
         return in_place, mask, False
@@ -277,7 +296,7 @@ class _FileCompiler(HeldWords, TableTemplates):
                 # A compare of direct words reads and writes nothing else: a contact too.
                 for op in el.operands:
                     if isinstance(op, AddressRef):
-                        self.word_local(2, op)
+                        self.held.local(2, op)
                 a, b = (self.value(2, op) for op in el.operands)
                 return f"{a} {_COMPARE[m]} {b}"
             return None
@@ -312,16 +331,17 @@ class _FileCompiler(HeldWords, TableTemplates):
         m = ins.mnemonic
         ops = ins.operands
         self.start_rung()
-        if m in _BIT_OPS:
-            words = [self.bit(ind, op) for op in ops]
-            if None not in words:
-                getattr(self, f"bit_{m}")(ind, *words)
+        template = TEMPLATES.get(m)
+        if template is not None:
+            if template.bits is not None:
+                words = [self.bit(ind, op) for op in ops]
+                if None not in words:
+                    template.bits(self, ind, *words)
+                    return
+            if template.held is not None and all(isinstance(op, Const) or op.address.is_direct for op in ops) and \
+                    self.resolve(ops[0].address).file.ftype.storage is Storage.WORD:
+                template.held(self, ind, ins)  # on the element's words held in locals
                 return
-        inline = getattr(self, f"local_{m}", None)
-        if inline is not None and all(isinstance(op, Const) or op.address.is_direct for op in ops) and \
-                self.resolve(ops[0].address).file.ftype.storage is Storage.WORD:
-            inline(ind, ins)  # on the element's words held in locals
-            return
         dest = self.local_safe(ins)
         if dest is not False:
             self.in_place(ind, ins, dest)
@@ -331,15 +351,12 @@ class _FileCompiler(HeldWords, TableTemplates):
         self.dispatch(ind, ins)
 
     def dispatch(self, ind: int, ins: Instruction) -> None:
+        """The instruction's code on the table in place: its template, or a
+        call of its bound (ladder/instr/) or module object."""
         m = ins.mnemonic
-        ops = ins.operands
-        handler = getattr(self, f"i_{m}", None)
-        if handler is not None:
-            handler(ind, ops)
-            return
-        if m in _COMPARE:
-            a, b = self.value(ind, ops[0]), self.value(ind, ops[1])
-            self.emit(ind, f"c = c and {a} {_COMPARE[m]} {b}")
+        template = TEMPLATES.get(m)
+        if template is not None:
+            template.table(self, ind, ins.operands)
             return
         bound = BOUND.get(m)
         if bound is not None:
@@ -353,26 +370,83 @@ class _FileCompiler(HeldWords, TableTemplates):
             if instance is None:
                 raise NotImplementedError(f"no compiler template for {m}")  # validated programs never get here
             self.bind_once(key, "_tli", lambda: instance)
-        # A module (TLM) instruction: its instance takes the rung-in and gives the rung-out.
+        # A module instruction: its instance takes the rung-in and gives the rung-out.
         self.emit(ind, f"c = {self.named[key]}({RUNG_BOOL})")
+
+    def barrier(self, ind: int) -> None:
+        """Before code that is not block code: the table made exact, the
+        locals forgotten (that code may write any word), and the rung
+        recorded for a minor fault it may set."""
+        self.held.flush(ind)
+        self.held.forget_all()
+        self.mark_rung(ind)
+
+    def mark_rung(self, ind: int) -> None:
+        """``_m.rung``: the rung being scanned, for what is not block code."""
+        if self.rung_marked != self.rung_index:
+            self.rung_marked = self.rung_index
+            self.emit(ind, f"_m.rung = {self.rung_index!r}")
+
+    def local_safe(self, ins: Instruction):
+        """For an instruction that reads and writes only its operands (and
+        S:0, minor fault words) and cannot fault, on direct addresses: its
+        destination operand (None: none). False for any other instruction:
+        it runs after a barrier."""
+        m = ins.mnemonic
+        where = _LOCAL_SAFE.get(m)
+        if where is None:
+            return False
+        for op in ins.operands:
+            for ref in address_refs(op):
+                if not ref.address.is_direct:
+                    return False
+            if m == "CPT" and not isinstance(op, (AddressRef, Const)) and not _cannot_fault(op):
+                return False
+        return ins.operands[where] if where >= 0 else None
+
+    def in_place(self, ind: int, ins: Instruction, dest) -> None:
+        """A safe instruction beside the locals: the words it reads are
+        loaded (at rung level), its destination word is written back first
+        if held and changed, and forgotten after (its kernel writes the
+        table)."""
+        held = self.held
+        for op in ins.operands:
+            if op is not dest:
+                for ref in address_refs(op):
+                    held.local(ind, ref)
+        forget = []
+        if dest is not None:
+            if _word_store(ins) and held.holdable(dest):
+                # A 16-bit result into a word: stored inline (i_MOV, i_CPT, _math2),
+                # into its local if held, else into the table; S:0 likewise.
+                f, index, _ = self.resolve(dest.address)
+                self.inline_dest = held.held((f.number, index)) or ""
+                self.inline_flags = held.flags_local(ind) or ""
+                self.dispatch(ind, ins)
+                held.changed(self.inline_dest, self.inline_flags)
+                self.inline_dest = self.inline_flags = None
+                return
+            self.mark_rung(ind)  # a store may set a minor fault (overflow)
+            # Its kernel writes the destination and S:0 in the table: held, they
+            # are written back first and forgotten after.
+            f, index, _ = self.resolve(dest.address)
+            forget = held.write_back(ind, ((f.number, index), _FLAGS))
+        self.dispatch(ind, ins)
+        held.forget(forget)
 
     # -- blocks -----------------------------------------------------------------------------------
     def block(self, first: int, end: int, words=None) -> BlockCode:
         """The code of one block function over rungs first..end-1
         (``words``: each rung's rung_words, when known)."""
         self.begin_block(first)
-        self.uses = Counter(key for k in range(first, end)
-                            for key in (words[k] if words is not None else self.rung_words(k)))
+        self.held.begin(Counter(key for k in range(first, end)
+                                for key in (words[k] if words is not None else self.held.rung_words(self.rungs[k]))))
         for k in range(first, end):
             self.rung(k, self.rungs[k])
         return self.end_block(end)
 
     def begin_block(self, first: int) -> None:
         self.lines, self.line_instr, self.line_rung = [], [], []
-        self.words: dict[tuple[int, int], str] = {}  # (file, word) -> the local holding it
-        self.local_names: set[str] = set()  # every word local of the block, held now or not
-        self.dirty: set[str] = set()  # locals a rung may have changed since the last write-back
-        self.flags_pending = False  # a word store may have left S:0's flags pending (flags_exact)
         self.temp = 0
         self.rung_index = first
         self.rung_marked = None
@@ -382,7 +456,7 @@ class _FileCompiler(HeldWords, TableTemplates):
 
     def end_block(self, end: int) -> BlockCode:
         self.current = None
-        self.flush_lines(2)
+        self.held.flush(2)
         if self.uses_now:  # the engine's clock of this scan, read once per block (TON)
             self.lines.insert(1, f"        _now = _m.now_ms; _ton_done = (_now & {STAMP!r}) | {EN | DN!r}; "
                                  f"_ton_timing = (_now & {STAMP!r}) | {EN | TT!r}")
@@ -401,8 +475,8 @@ class _FileCompiler(HeldWords, TableTemplates):
         # local by local.
         labels = set(self.labels.values())
         count = len(self.rungs)
-        words = [self.rung_words(k) for k in range(count)]
-        self.has_mcr = self.saw_mcr  # (the pass just made saw every instruction)
+        words = [self.held.rung_words(rung) for rung in self.rungs]
+        self.has_mcr = self.held.saw_mcr  # (the pass just made saw every instruction)
         cf = CompiledFile(self.number, len(self.rungs), self.has_mcr, self)
         k = 0
         while k < count:
@@ -418,7 +492,8 @@ class _FileCompiler(HeldWords, TableTemplates):
             cf.add(self.block(first, k, words))
         # The code is compiled: keep no text, and no caches a later isolate() can rebuild.
         self.lines = self.line_instr = self.line_rung = None
-        self._locations, self.uses, self._word_keys, self._bits = {}, Counter(), {}, {}
+        self._locations, self._bits = {}, {}
+        self.held.done()
         return cf
 
 
