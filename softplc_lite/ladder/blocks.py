@@ -5,8 +5,8 @@ CHUNK_RUNGS, and a block starts at every LBL rung, so a JMP lands at the
 start of one). Inside a block the data-table words its contacts and coils
 use are held in locals: read once, written back before anything that is
 not block code can look (docs/engine.md, "Compiled code"). One call per
-block rather than one per rung: a Python call costs about as much as the
-rest of a boolean rung.
+block rather than one per rung: a call per rung costs about half of a
+boolean scan.
 
 A block function ``fn(z)`` takes the rung-in of its rungs (the file's MCR
 zone) and returns None when its last rung is done, or what ended it early:
