@@ -70,7 +70,7 @@ import _common as C
 
 import serial  # noqa: E402
 
-from ptypair import PtyPair, SocatMissing  # noqa: E402
+from helpers.ptypair import PtyPair, SocatMissing  # noqa: E402
 from softplc_lite.datatable import DataTable  # noqa: E402
 from softplc_lite.ladder import Engine, Mode, load_text  # noqa: E402
 from softplc_lite.ladder.engine import SimulatedClock  # noqa: E402

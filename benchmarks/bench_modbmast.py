@@ -12,7 +12,7 @@ one-rung ladder ``XIC B3/0 OTE B3/1``) and run fresh with the compiled
 executor, through ``Runner`` and ``engine.scan()``.
 
 1. Real peer (pty). One pymodbus 3.16 ``ModbusSerialServer``
-   (tests/modbus_peer.py ``PeerProcess``: unit 2, 200 holding registers,
+   (tests/helpers/modbus_peer.py ``PeerProcess``: unit 2, 200 holding registers,
    RTU, 38400 8N1, in a process of its own) on end B of one socat pty pair
    for the whole part. On end A, in turn: ``modbmast``, one MODBMAST port
    (``requestGap="0"``) reading 125 holding registers from slave 2 into
@@ -115,9 +115,9 @@ from pathlib import Path
 import _common as C
 
 
-from modbmast_apps import serial_xml, write_app
-from modbus_peer import PeerProcess
-from ptypair import PtyPair, SocatMissing
+from helpers.modbmast_apps import serial_xml, write_app
+from helpers.modbus_peer import PeerProcess
+from helpers.ptypair import PtyPair, SocatMissing
 from pymodbus_clients import async_reads, sync_reads
 
 from softplc_lite.app import load_app

@@ -7,7 +7,7 @@ server over the same socat pty pair; and the ladder on the simulated
 
 The transaction everywhere is Read Holding Registers, slave 2, start 0,
 count 125 (query ``02 03 00 00 00 7D 85 D8``, 255-byte reply), answered by
-one pymodbus 3.16 ``ModbusSerialServer`` (tests/modbus_peer.py: unit 2,
+one pymodbus 3.16 ``ModbusSerialServer`` (tests/helpers/modbus_peer.py: unit 2,
 38400 8N1, 200 holding registers), in a process of its own, on end B of one
 socat pty pair, for the whole run. On end A, in turn:
 
@@ -63,8 +63,8 @@ import _common as C
 
 from pymodbus_clients import async_reads, sync_reads  # noqa: E402
 
-from modbus_peer import PeerProcess  # noqa: E402
-from ptypair import PtyPair, SocatMissing  # noqa: E402
+from helpers.modbus_peer import PeerProcess  # noqa: E402
+from helpers.ptypair import PtyPair, SocatMissing  # noqa: E402
 from softplc_lite.app import load_app  # noqa: E402
 from softplc_lite.runner import RunOptions, Runner  # noqa: E402
 
@@ -269,7 +269,7 @@ def main() -> int:
         "method": {"rounds": ROUNDS, "warmup": WARMUP, "transactions_per_sample": TRANSACTIONS,
                    "figures": "median over the rounds; ratios: median of per-round ratios",
                    "transaction": "read holding registers, slave 2, start 0, count 125 (8-byte query, 255-byte reply)",
-                   "server": "pymodbus 3.16 ModbusSerialServer (tests/modbus_peer.py) on a socat pty, "
+                   "server": "pymodbus 3.16 ModbusSerialServer (tests/helpers/modbus_peer.py) on a socat pty, "
                              "background thread of this process",
                    "ladder": "programs/modbus_master, T4:0.PRE=0, realtime, scan_ms=0 (free-running), compiled"},
         "pty": pty,

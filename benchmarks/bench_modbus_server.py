@@ -76,7 +76,7 @@ from pathlib import Path
 
 import _common as C
 
-from modbus_peer import free_tcp_port
+from helpers.modbus_peer import free_tcp_port
 
 SCAN_MS = 10
 RUNGS = 100

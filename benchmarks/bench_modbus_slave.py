@@ -7,7 +7,7 @@ pymodbus's own serial server over a pty, and the scan time it costs.
     python benchmarks/bench_modbus_slave.py --json PATH # also write the results to PATH
 
 Every app is a copy of programs/modbus_slave in a temporary directory
-(tests/modbus_slave_app.py ``copy_app``), run fresh with the compiled
+(tests/helpers/modbus_slave_app.py ``copy_app``), run fresh with the compiled
 executor unless said otherwise; its holding registers N10:0..199 hold
 REGISTERS (the same values pymodbus's server gets), so every reply is
 checked against what it must be. The three parts, in this order:
@@ -64,7 +64,7 @@ from modbus_slave_tps import (
     TARGET_LADDER_OVER_PYMODBUS,
     bench_pty,
 )
-from ptypair import SocatMissing, socat_processes
+from helpers.ptypair import SocatMissing, socat_processes
 
 # 1. simulated wire
 WIRE_BAUDS = {9600: 4, 19200: 2, 38400: 1}  # baud: N9:5, 3.5 characters rounded up to whole ms

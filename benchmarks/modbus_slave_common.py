@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 import _common  # noqa: F401  (tests/ on sys.path)
-from modbus_slave_app import WireSlave
+from helpers.modbus_slave_app import WireSlave
 
 from softplc_lite.ports.modbus_slave import with_crc
 

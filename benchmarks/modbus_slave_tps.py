@@ -1,7 +1,7 @@
 """Part 2 of bench_modbus_slave.py: the ladder Modbus slave's transactions
 per second over a pty, against pymodbus's own serial server.
 
-One socat pty pair (tests/ptypair.py ``PtyPair``); the slave on end A,
+One socat pty pair (tests/helpers/ptypair.py ``PtyPair``); the slave on end A,
 pymodbus's sync client ``ModbusSerialClient(B, framer=RTU, baudrate=19200,
 timeout=1, retries=0)`` calling ``read_holding_registers(0, count=125,
 device_id=1)`` on end B. Three slaves take turns on end A, one at a time,
@@ -15,7 +15,7 @@ each started and stopped in every round (the order rotating):
   frame or other frame);
 - ``ladder 1ms``: the same with ``--scan-ms 1`` (the period the app's
   softplc.toml sets);
-- ``pymodbus``: pymodbus 3.16's ``ModbusSerialServer`` (tests/modbus_peer.py
+- ``pymodbus``: pymodbus 3.16's ``ModbusSerialServer`` (tests/helpers/modbus_peer.py
   ``PeerProcess``: unit 1, 200 holding registers, RTU, in a process of its
   own).
 
@@ -53,8 +53,8 @@ import _common as C
 
 
 import serial
-from modbus_peer import PeerProcess
-from modbus_slave_app import SLAVE_APP, copy_app
+from helpers.modbus_peer import PeerProcess
+from helpers.modbus_slave_app import SLAVE_APP, copy_app
 from modbus_slave_common import (
     MS,
     REGISTERS,
@@ -65,7 +65,7 @@ from modbus_slave_common import (
     signed,
     verdict,
 )
-from ptypair import PtyPair
+from helpers.ptypair import PtyPair
 from pymodbus import FramerType
 from pymodbus.client import ModbusSerialClient
 from pymodbus.exceptions import ModbusException
@@ -84,7 +84,7 @@ START_S = 20.0  # how long a slave process may take to answer its first request
 STOP_S = 5.0
 
 
-def _die_with_parent() -> None:  # in the child between fork and exec (as tests/ptypair.py does for socat)
+def _die_with_parent() -> None:  # in the child between fork and exec (as tests/helpers/ptypair.py does for socat)
     try:
         ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM, 0, 0, 0)  # PR_SET_PDEATHSIG
     except (OSError, AttributeError):  # not Linux: SIGINT at the end (or SIGKILL) still ends it

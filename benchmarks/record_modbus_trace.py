@@ -21,7 +21,7 @@ COMGENIUS.LST), so a replay needs no --set at all. Port 0 is end A of the
 pty pair (``--port 0=A``). What answers on end B changes, in PHASES, from
 the slave side only:
 
-1. ``good``: pymodbus (tests/modbus_peer.py's ModbusPeer: unit 2, 38400,
+1. ``good``: pymodbus (tests/helpers/modbus_peer.py's ModbusPeer: unit 2, 38400,
    200 holding registers, register k = (k * 7 + 3) & 0xFFFF): good replies,
    copied to the safe block N11;
 2. ``silent``: nobody (pymodbus stopped): the master's COMSCANs time out
@@ -74,8 +74,8 @@ for _p in (REPO, REPO / "tests"):  # the package from a checkout; ptypair, modbu
 
 import serial  # noqa: E402
 
-from modbus_peer import ModbusPeer  # noqa: E402
-from ptypair import PtyPair  # noqa: E402
+from helpers.modbus_peer import ModbusPeer  # noqa: E402
+from helpers.ptypair import PtyPair  # noqa: E402
 from softplc_lite.app import load_app  # noqa: E402
 from softplc_lite.runner import RunOptions, Runner  # noqa: E402
 

@@ -14,13 +14,13 @@ from hypothesis import strategies as st
 from softplc_lite.datatable import DataTable
 from softplc_lite.datatable.filetypes import FILE_TYPES
 
-from clocks import Clock
-from isolation import bytecode_setup, hypothesis_setup, signals_setup, pytest_sessionfinish, pytest_sessionstart, pytest_terminal_summary  # noqa: F401
-from tmux_helpers import tmux  # noqa: F401  (the fixture of the terminal tests)
+from helpers.clocks import Clock
+from helpers.isolation import bytecode_setup, hypothesis_setup, signals_setup, pytest_sessionfinish, pytest_sessionstart, pytest_terminal_summary  # noqa: F401
+from helpers.tmux_helpers import tmux  # noqa: F401  (the fixture of the terminal tests)
 
-bytecode_setup()  # one bytecode cache for the run, outside the repository (tests/isolation.py)
-hypothesis_setup()  # nothing of hypothesis's in the repository, no deadline (tests/isolation.py)
-signals_setup()  # Ctrl-C heard by the processes tests start, however the run was started (tests/isolation.py)
+bytecode_setup()  # one bytecode cache for the run, outside the repository (tests/helpers/isolation.py)
+hypothesis_setup()  # nothing of hypothesis's in the repository, no deadline (tests/helpers/isolation.py)
+signals_setup()  # Ctrl-C heard by the processes tests start, however the run was started (tests/helpers/isolation.py)
 
 
 def pytest_collection_finish(session):
@@ -118,9 +118,9 @@ def run(request):
 
 @pytest.fixture
 def tcp_apps(tmp_path):
-    """MODBTCPS apps started by the test (tests/modbtcps_apps.py), each
+    """MODBTCPS apps started by the test (tests/helpers/modbtcps_apps.py), each
     stopped after it with its server process."""
-    from modbtcps_apps import Apps
+    from helpers.modbtcps_apps import Apps
 
     apps = Apps(tmp_path)
     yield apps
@@ -129,14 +129,14 @@ def tcp_apps(tmp_path):
 
 @pytest.fixture
 def tcp_plc(tcp_apps):
-    """A MODBTCPS runtime of tests/modbtcps_apps.UNIT_1 on a free port."""
+    """A MODBTCPS runtime of tests/helpers/modbtcps_apps.UNIT_1 on a free port."""
     return tcp_apps.start()
 
 
 @pytest.fixture
 def tcp_client(tcp_plc):
     """pymodbus's real client, connected to ``tcp_plc``."""
-    from modbtcps_apps import LIMIT_S
+    from helpers.modbtcps_apps import LIMIT_S
     from pymodbus.client import ModbusTcpClient
 
     c = ModbusTcpClient("127.0.0.1", port=tcp_plc.port, timeout=LIMIT_S, retries=0)

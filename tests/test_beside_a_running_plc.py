@@ -1,7 +1,7 @@
 """The suite runs on a machine where a PLC is already running: every test
 runs while another process holds the ports a user's PLC would
 (programs/hmi_server's 127.0.0.1:5020, and 44818, EtherNet/IP's). The
-run's first act is to start that process (tests/isolation.py), so the tests
+run's first act is to start that process (tests/helpers/isolation.py), so the tests
 that start a network server (every one that runs or loads
 programs/hmi_server, the MODBTCPS, Modbus and serial-over-TCP tests) pass
 beside it or the suite fails (docs/testing.md, "Isolation"). This test
@@ -17,8 +17,8 @@ import subprocess
 import sys
 
 import pytest
-from isolation import HELD_PORTS, HOLDER_ENV
-from shipped_apps import PROGRAMS
+from helpers.isolation import HELD_PORTS, HOLDER_ENV
+from helpers.shipped_apps import PROGRAMS
 
 
 @pytest.mark.parametrize("port", HELD_PORTS)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from instr_helpers import EXECUTORS
+from helpers.instr_helpers import EXECUTORS
 from softplc_lite.ladder import Engine, Mode, blocks, load_text
 from softplc_lite.ladder import status as S
 

@@ -15,8 +15,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from cli_tmux import SOFTPLC, open_terminal
-from shipped_apps import copy_programs
+from helpers.cli_tmux import SOFTPLC, open_terminal
+from helpers.shipped_apps import copy_programs
 
 ROOT = Path(__file__).resolve().parent.parent
 

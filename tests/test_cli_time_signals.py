@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 
 import pytest
-from cli_tmux import SOFTPLC, open_terminal
+from helpers.cli_tmux import SOFTPLC, open_terminal
 
 from helpers.cli import ROOT, softplc_here
 

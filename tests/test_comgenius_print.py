@@ -34,7 +34,7 @@ from softplc_lite.tlm.comgenius.formats import FormatError, params_needed, parse
 from softplc_lite.tlm.comgenius.params import Param, ParamError, ParamKind, TableParam, ValueParam
 from softplc_lite.tlm.comgenius.printf import c_integer, compile_print, format_text
 
-from reference_checks import crc16_modbus_ref
+from helpers.reference_checks import crc16_modbus_ref
 
 INF = float("inf")
 NAN = float("nan")

@@ -28,7 +28,7 @@ from pathlib import Path
 import pytest
 
 from helpers.cli import softplc_here
-from ptypair import PtyPair, require_socat, socat_processes
+from helpers.ptypair import PtyPair, require_socat, socat_processes
 from softplc_lite.datatable import DataTable
 from softplc_lite.ladder import Engine, Mode, load_text
 from softplc_lite.ladder import status as S

@@ -32,7 +32,7 @@ from softplc_lite.tlm.comgenius.printf import format_text
 from softplc_lite.tlm.comgenius.scanf import (MATCHED, MISMATCH, NEED_MORE, ScanResult, compile_scan,
                                               scan_text)
 
-from reference_checks import crc16_modbus_ref
+from helpers.reference_checks import crc16_modbus_ref
 
 WS = " \t\n\r\v\f"
 

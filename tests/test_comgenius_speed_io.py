@@ -29,8 +29,8 @@ from softplc_lite.tlm.comgenius import ComGenius, checksum
 from softplc_lite.tlm.comgenius.config import parse_config
 from softplc_lite.tlm.registry import instruction_set
 
-from clocks import Clock
-from reference_checks import crc16_modbus_ref
+from helpers.clocks import Clock
+from helpers.reference_checks import crc16_modbus_ref
 
 REPO_APP = Path(__file__).resolve().parent.parent / "programs" / "modbus_master"
 _names = itertools.count()

@@ -49,7 +49,7 @@ def test_program_text_never_reaches_generated_code():
 def test_every_example_program_compiles_to_allowed_names(tmp_path):
     from softplc_lite.app import load_app
 
-    from shipped_apps import copy_programs
+    from helpers.shipped_apps import copy_programs
 
     copy_programs(tmp_path)  # a server's port found free
     for app_dir in sorted((tmp_path / "programs").iterdir()):

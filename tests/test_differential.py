@@ -2,7 +2,7 @@
 interpreter on random programs, and fmt round trips (issue 3, sections 1
 and 4).
 
-(a) Random valid programs (tests/ladder_strategies.py) run for SCANS scans
+(a) Random valid programs (tests/helpers/ladder_strategies.py) run for SCANS scans
     through ``Engine(program, executor="compiled")`` and
     ``Engine(program, executor="reference")`` from the same initial table,
     with the same input words written into I:0 and B3:0 before every scan
@@ -30,14 +30,14 @@ import pytest
 from hypothesis import HealthCheck, given, note, settings
 from hypothesis import strategies as st
 
-from ladder_strategies import ADDRESS_SPACE, F8_FLOATS, N7_WORDS, input_seeds, input_words, programs
+from helpers.ladder_strategies import ADDRESS_SPACE, F8_FLOATS, N7_WORDS, input_seeds, input_words, programs
 from softplc_lite.datatable import DataTable, to_signed
 from softplc_lite.ladder import Engine, Mode, blocks, validate
 from softplc_lite.ladder.fmt import format_program
 from softplc_lite.app import app_instructions, load_app
 from softplc_lite.ladder.parser import parse_program
 from softplc_lite.tlm import load_modules
-from modbus_peer import free_tcp_port
+from helpers.modbus_peer import free_tcp_port
 
 SCANS = 50
 REPO = Path(__file__).resolve().parent.parent

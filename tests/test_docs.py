@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from helpers.cli import softplc_here
-from shipped_apps import SHIPPED_PORT, copy_programs
+from helpers.shipped_apps import SHIPPED_PORT, copy_programs
 
 ROOT = Path(__file__).resolve().parent.parent
 DOCS = sorted((ROOT / "docs").glob("*.md"))

@@ -21,8 +21,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from cli_tmux import open_terminal
-from shipped_apps import copy_programs
+from helpers.cli_tmux import open_terminal
+from helpers.shipped_apps import copy_programs
 from test_cli_readme import try_it_lines
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -71,7 +71,7 @@ def fresh_venv(tmp_path_factory) -> Path:
 def _clean_env() -> dict[str, str]:
     """The environment a user's shell would give: nothing of this test run's Python path."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME", "VIRTUAL_ENV")}
-    # Byte code goes to the run's PYTHONPYCACHEPREFIX (tests/isolation.py), never into the repository,
+    # Byte code goes to the run's PYTHONPYCACHEPREFIX (tests/helpers/isolation.py), never into the repository,
     # and is reused by every command after the first.
     return env
 

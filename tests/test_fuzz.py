@@ -1,6 +1,6 @@
 """Fuzzing softplc in the default suite: a few dozen inputs of every kind.
 
-The generators are tests/fuzz_inputs.py, the oracle tests/fuzz_oracle.py;
+The generators are tests/helpers/fuzz_inputs.py, the oracle tests/helpers/fuzz_oracle.py;
 tools/fuzz.py runs the same for minutes in several processes
 (docs/fuzzing.md). Here every input kind gets a bounded, derandomized run
 (the same inputs on every machine, no example database), with the profile
@@ -20,10 +20,10 @@ import tempfile
 import time
 from pathlib import Path
 
-import fuzz_inputs as fi
-import fuzz_oracle as fo
+from helpers import fuzz_inputs as fi
+from helpers import fuzz_oracle as fo
 import pytest
-from fuzz_inputs import KINDS, MUST_PASS, Case, cases
+from helpers.fuzz_inputs import KINDS, MUST_PASS, Case, cases
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -148,7 +148,7 @@ def test_run_main_catches_what_escapes_and_usage_exits(monkeypatch):
 def _files_case(name: str, spec: str) -> Case:
     import random
 
-    import fuzz_files
+    from helpers import fuzz_files
 
     return fuzz_files.special_case(name, spec, random.Random(0), fi.EVERYTHING)
 
@@ -183,7 +183,7 @@ def test_files_oracle_sees_a_code_cache_that_changes_the_logic(tmp_path):
 
 
 def test_special_files_cover_every_file_softplc_reads_and_every_special():
-    import fuzz_files
+    from helpers import fuzz_files
 
     assert set(fuzz_files.SPECIALS) == {"fifo", "devzero", "dangling", "loop", "dir", "sparse", "empty"}
     targets = {t[1].split("/")[-1] for t in fuzz_files.TARGETS.values()}

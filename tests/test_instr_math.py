@@ -15,7 +15,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from instr_helpers import flags
+from helpers.instr_helpers import flags
 from softplc_lite.datatable import DataTable
 from softplc_lite.ladder import Mode, Settings, run_text
 from softplc_lite.ladder import status as S

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from instr_helpers import EXECUTORS
+from helpers.instr_helpers import EXECUTORS
 from softplc_lite.datatable.jsonio import dumps
 from softplc_lite.ladder import Engine, Mode, ProgramErrors, load_text, run_text
 

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from instr_helpers import flags
+from helpers.instr_helpers import flags
 from softplc_lite.ladder import Mode, Settings
 from softplc_lite.ladder import status as S
 from softplc_lite.ladder.instructions import all_specs

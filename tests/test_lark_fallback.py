@@ -101,7 +101,7 @@ json.dump({"outcomes": out, "parser": type(parser._fast_parser()).__name__, "fas
 
 
 def run_child(mode: str, tmp_path: Path) -> dict:
-    # byte code goes to the run's PYTHONPYCACHEPREFIX (tests/isolation.py), never into the repository
+    # byte code goes to the run's PYTHONPYCACHEPREFIX (tests/helpers/isolation.py), never into the repository
     proc = subprocess.run([sys.executable, "-c", SCRIPT, mode, str(ROOT), json.dumps(BAD)], capture_output=True,
                           text=True, cwd=tmp_path, timeout=120)
     assert proc.returncode == 0, proc.stderr

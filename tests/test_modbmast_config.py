@@ -31,7 +31,7 @@ from softplc_lite.tlm.modbmast.config import (
 from softplc_lite.tlm.modbmast.requests import REQUEST_KINDS
 from softplc_lite.tlm.xmlreader import MAX_BYTES
 
-from located import locate, where
+from helpers.located import locate, where
 
 PATH = "MODBMAST.XML"
 

@@ -13,7 +13,7 @@ from softplc_lite.ports.modbus_slave import find_slave
 from softplc_lite.tlm.modbmast.status import NO_REPLY
 
 from helpers.cli import softplc_here
-from modbmast_apps import Apps, link, modbmast, scans, serial_xml, status, write_app
+from helpers.modbmast_apps import Apps, link, modbmast, scans, serial_xml, status, write_app
 
 
 @pytest.fixture
@@ -219,7 +219,7 @@ def test_a_port_that_opens_late_is_retried_and_recorded(tmp_path):
 
     from softplc_lite.runner import RunOptions, Runner
     from softplc_lite.tlm.modbmast.status import NO_XMIT_ROOM
-    from ptypair import PtyPair, require_socat
+    from helpers.ptypair import PtyPair, require_socat
 
     require_socat()
     late = tmp_path / "late-tty"

@@ -21,9 +21,9 @@ from softplc_lite.ports.modbus_slave import initial_value
 from softplc_lite.runner import RunOptions, Runner
 from softplc_lite.tlm.modbmast.status import NO_REPLY
 
-from modbmast_apps import serial_xml, status, write_app
-from modbus_peer import PeerProcess, free_tcp_port
-from ptypair import PtyPair, require_socat
+from helpers.modbmast_apps import serial_xml, status, write_app
+from helpers.modbus_peer import PeerProcess, free_tcp_port
+from helpers.ptypair import PtyPair, require_socat
 
 LIMIT_S = 15.0  # per waiting step; a step normally takes well under a second
 
@@ -182,7 +182,7 @@ def test_a_port_that_takes_no_more_bytes_fails_requests_with_no_xmit_room(tmp_pa
     conn = None
     try:
         conn, _ = server.accept()
-        from modbmast_apps import driver
+        from helpers.modbmast_apps import driver
 
         driver(runner, 1).port.serial._socket.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 4096)
         runner.engine.set_mode(Mode.RUN)

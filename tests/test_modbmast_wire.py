@@ -20,7 +20,7 @@ from softplc_lite.ports.modbus_slave import find_slave, initial_value, with_crc
 from softplc_lite.tlm.modbmast.status import BAD_CRC, BAD_REPLY, INCOMPLETE_REPLY, NO_CTS, NO_REPLY
 from softplc_lite.watch.forces import Forces, parse_force
 
-from modbmast_apps import Apps, char, driver, link, scans, serial_xml, slave_silence, status, traffic
+from helpers.modbmast_apps import Apps, char, driver, link, scans, serial_xml, slave_silence, status, traffic
 
 MS = 1_000_000
 

@@ -40,7 +40,7 @@ from softplc_lite.tlm.modbtcps.config import (
 from softplc_lite.tlm.xmlcheck import MAX_PROBLEMS
 
 from helpers.cli import softplc_here
-from located import locate, where
+from helpers.located import locate, where
 
 ROOT = Path(__file__).resolve().parent.parent
 DOC = ROOT / "docs" / "modbtcps.md"

@@ -23,7 +23,7 @@ import time
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from modbtcps_apps import LIMIT_S, Apps, server_xml
+from helpers.modbtcps_apps import LIMIT_S, Apps, server_xml
 from pymodbus.client import ModbusTcpClient
 
 from softplc_lite.tlm.modbtcps import status as S

@@ -33,14 +33,14 @@ from softplc_lite.watch.snapshot import render
 from softplc_lite.watch.serversview import ServersView
 from softplc_lite.watch.session import WatchOptions, WatchSession
 
-from modbtcps_apps import LIMIT_S, raw_request, server_xml, write_app
-from modbus_peer import free_tcp_port, wait_for_tcp
+from helpers.modbtcps_apps import LIMIT_S, raw_request, server_xml, write_app
+from helpers.modbus_peer import free_tcp_port, wait_for_tcp
 
 pytestmark = pytest.mark.timeout(180)
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "softplc_lite" / "tlm" / "modbtcps"
-# tests/modbtcps_apps.UNIT_1: coils 0..39 B3 (writable), holding 0..19 N7:0.. (writable), 50..54 N7:50..
+# tests/helpers/modbtcps_apps.UNIT_1: coils 0..39 B3 (writable), holding 0..19 N7:0.. (writable), 50..54 N7:50..
 # (read-only), 100..103 F8:0..1, 200..365 ST9:0..1 (ucs2, LEN at 200 and 283), 400..481 packed ST9:2..3
 
 

@@ -21,8 +21,8 @@ from pathlib import Path
 import pytest
 from pymodbus.client import ModbusTcpClient
 
-from modbtcps_apps import LIMIT_S, server_xml, write_app
-from modbus_peer import free_tcp_port, wait_for_tcp
+from helpers.modbtcps_apps import LIMIT_S, server_xml, write_app
+from helpers.modbus_peer import free_tcp_port, wait_for_tcp
 
 pytestmark = pytest.mark.timeout(120)
 PROGRAMS = Path(__file__).resolve().parent.parent / "programs"

@@ -21,7 +21,7 @@ from softplc_lite.ladder.engine import Mode
 from softplc_lite.tlm.modbtcps import status as S
 from softplc_lite.watch.forces import Forces, parse_force
 
-from modbtcps_apps import LIMIT_S, raw_request, server_xml
+from helpers.modbtcps_apps import LIMIT_S, raw_request, server_xml
 
 pytestmark = pytest.mark.timeout(120)
 

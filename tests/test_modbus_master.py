@@ -5,7 +5,7 @@ A. Against the simulated slave of its COMGENIUS.LST (``sim://modbus?
    executors): good replies fill the safe block N11; the simulated time of
    a transaction is close to the 38400-baud wire minimum; exception 02;
    garbage ahead of a reply; a silent slave (timeouts) and its return.
-B. Against pymodbus 3.16 as a real third-party slave (tests/modbus_peer.py,
+B. Against pymodbus 3.16 as a real third-party slave (tests/helpers/modbus_peer.py,
    unit 2, 38400), real time: over a socat pty pair (1 ms scans, the
    server in this process; free-running scans, the server in a process of
    its own: see PeerProcess) and over TCP with RTU framing (``socket://``);
@@ -42,10 +42,10 @@ from softplc_lite.ports.modbus_slave import initial_value, with_crc
 from softplc_lite.ports.trace import read_trace
 
 from helpers.cli import softplc_here
-from ptypair import PtyPair, require_socat, socat_processes
+from helpers.ptypair import PtyPair, require_socat, socat_processes
 
 pytest.importorskip("pymodbus", minversion="3.16.1")
-from modbus_peer import ModbusPeer, PeerProcess, free_tcp_port  # noqa: E402
+from helpers.modbus_peer import ModbusPeer, PeerProcess, free_tcp_port  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 TESTS = Path(__file__).resolve().parent

@@ -20,7 +20,7 @@ from softplc_lite.modbus.packing import pack_bits
 from softplc_lite.ports.modbus_master import find_master
 from softplc_lite.ports.modbus_slave import ModbusSlave, respond, with_crc
 
-from modbus_slave_app import WireSlave, slave_runner
+from helpers.modbus_slave_app import WireSlave, slave_runner
 
 SIZE = 200  # every table of the reference slave; the ladder's limits are set to match
 

@@ -21,9 +21,9 @@ from softplc_lite.app import load_app
 from softplc_lite.ladder.engine import Mode
 from softplc_lite.runner import RunOptions, Runner
 
-from modbmast_apps import serial_xml, status, write_app
-from modbus_slave_app import MASTER_APP, SLAVE_APP, copy_app
-from reference_checks import crc16_modbus_ref, rtu_frame as frame
+from helpers.modbmast_apps import serial_xml, status, write_app
+from helpers.modbus_slave_app import MASTER_APP, SLAVE_APP, copy_app
+from helpers.reference_checks import crc16_modbus_ref, rtu_frame as frame
 
 _names = itertools.count()
 

@@ -42,9 +42,9 @@ from softplc_lite.app import load_app
 from softplc_lite.ladder.engine import Mode
 from softplc_lite.runner import RunOptions, Runner
 
-from modbus_slave_app import SLAVE_APP, copy_app
-from ptypair import PtyPair, require_socat
-from reference_checks import rtu_frame as frame
+from helpers.modbus_slave_app import SLAVE_APP, copy_app
+from helpers.ptypair import PtyPair, require_socat
+from helpers.reference_checks import rtu_frame as frame
 
 logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
 

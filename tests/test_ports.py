@@ -13,7 +13,7 @@ from softplc_lite.ports import (OverrideError, PortClaim, Recorder, assign_port_
 from softplc_lite.ports.port import LineSettings, SerialPort
 from softplc_lite.ports.trace import parse_trace
 
-from clocks import Clock
+from helpers.clocks import Clock
 from helpers.cli import softplc_here
 
 CHAR = 260_417  # one character at 38400 8N1, ns

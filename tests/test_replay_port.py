@@ -10,7 +10,7 @@ import serial
 import softplc_lite.ports.urlhandler  # noqa: F401  (registers replay://)
 from softplc_lite.ports.urlhandler.protocol_replay import Mismatch
 
-from clocks import Clock
+from helpers.clocks import Clock
 
 QUERY = bytes.fromhex("02 03 00 00 00 7D 85 D8")
 

@@ -14,7 +14,7 @@ import softplc_lite.ports.urlhandler as urlhandler
 from softplc_lite.ports import simdevices, simlink, wire
 from softplc_lite.ports.simdevices import EchoDevice
 
-from clocks import Clock
+from helpers.clocks import Clock
 
 
 CHAR_38400 = 260417  # 10 bits at 38400 baud, ns

@@ -27,7 +27,7 @@ from softplc_lite.watch.power import rung_power
 from softplc_lite.watch.rungs import RungView
 
 from helpers.cli import softplc_here
-from ladder_strategies import programs
+from helpers.ladder_strategies import programs
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-from tmux_helpers import ROOT
+from helpers.tmux_helpers import ROOT
 
 ADDED_RUNG = "XIC B3/1 OTE O:0/1\n"  # what the edit adds: the lamp's twin, driven by a bit set before the edit
 

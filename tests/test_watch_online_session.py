@@ -16,7 +16,7 @@ from softplc_lite.watch.screen import WatchScreen, rung_view
 from softplc_lite.watch.session import WatchSession
 from softplc_lite.watch.terminal import BINDINGS, KEYS, PROMPTS, Controller
 
-from watch_sessions import sessions
+from helpers.watch_sessions import sessions
 
 PROGRAM = """
 SYMBOL Start I:0/0

@@ -18,7 +18,7 @@ from softplc_lite.runner import Runner, RunOptions
 from softplc_lite.watch.power import rung_power
 from softplc_lite.watch.rungs import ENERGIZED, FAULT, ProgramFileView, RungView
 
-from shipped_apps import copy_app
+from helpers.shipped_apps import copy_app
 
 ROOT = Path(__file__).resolve().parent.parent
 PROGRAMS = ROOT / "programs"

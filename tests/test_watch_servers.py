@@ -23,8 +23,8 @@ from softplc_lite.watch.snapshot import render
 from softplc_lite.watch.serversview import TABLE_WIDTH, ServersView
 from softplc_lite.watch.session import WatchOptions, WatchSession
 
-from modbtcps_apps import LIMIT_S, Running, server_xml, write_app
-from modbus_peer import free_tcp_port
+from helpers.modbtcps_apps import LIMIT_S, Running, server_xml, write_app
+from helpers.modbus_peer import free_tcp_port
 
 pytestmark = pytest.mark.timeout(120)
 

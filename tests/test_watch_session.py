@@ -15,7 +15,7 @@ from softplc_lite.watch.forces import ForceError, parse_force
 from softplc_lite.watch.history import DEPTH
 from softplc_lite.watch.session import WatchOptions, WatchSession
 
-from watch_sessions import sessions
+from helpers.watch_sessions import sessions
 
 PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
 

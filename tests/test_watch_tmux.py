@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 import time
 
-from tmux_helpers import Tmux  # noqa: F401  (for the modules that import it from here)
+from helpers.tmux_helpers import Tmux  # noqa: F401  (for the modules that import it from here)
 
 
 def test_step_run_and_quit_in_a_real_terminal(tmux, tmp_path):

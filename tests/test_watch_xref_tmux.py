@@ -9,7 +9,7 @@ import sys
 import time
 
 import pytest
-from tmux_helpers import Tmux
+from helpers.tmux_helpers import Tmux
 
 
 @pytest.fixture

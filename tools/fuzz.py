@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""A fuzz campaign against softplc: the generators of tests/fuzz_inputs.py and
-the oracle of tests/fuzz_oracle.py, for a time budget, in several processes.
+"""A fuzz campaign against softplc: the generators of tests/helpers/fuzz_inputs.py and
+the oracle of tests/helpers/fuzz_oracle.py, for a time budget, in several processes.
 
     python tools/fuzz.py --minutes 10 --seed 1 [--out fuzz-findings] [--jobs 2]
     python tools/fuzz.py --replay fuzz-findings/exception/ab12cd34ef   # re-run one finding
@@ -104,8 +104,8 @@ def save_finding(out: Path, finding, case, root: str) -> bool:
 
 
 def worker(args) -> int:
-    import fuzz_inputs as fi
-    import fuzz_oracle as fo
+    from helpers import fuzz_inputs as fi
+    from helpers import fuzz_oracle as fo
     from hypothesis import HealthCheck, Phase, Verbosity, given, seed, settings
 
     if args.memory_mb:
@@ -309,8 +309,8 @@ def campaign(args) -> int:
 
 
 def _save_worker_finding(out: Path, w: Worker, cls: str, sig: str, args) -> None:
-    import fuzz_inputs as fi
-    import fuzz_oracle as fo
+    from helpers import fuzz_inputs as fi
+    from helpers import fuzz_oracle as fo
 
     try:
         case = fi.Case.from_json(json.loads(w.current.read_text(encoding="utf-8")))
@@ -326,8 +326,8 @@ def _save_worker_finding(out: Path, w: Worker, cls: str, sig: str, args) -> None
 
 
 def replay(args) -> int:
-    import fuzz_inputs as fi
-    import fuzz_oracle as fo
+    from helpers import fuzz_inputs as fi
+    from helpers import fuzz_oracle as fo
 
     path = Path(args.replay)
     case = fi.Case.from_json(json.loads((path / "case.json").read_text(encoding="utf-8")))
@@ -370,7 +370,7 @@ def main(argv=None) -> int:
     p.add_argument("--seconds", type=float, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
     if args.kinds:
-        import fuzz_inputs as fi
+        from helpers import fuzz_inputs as fi
         unknown = set(args.kinds.split(",")) - set(fi.KINDS)
         if unknown:
             p.error(f"unknown kinds {', '.join(sorted(unknown))} (kinds: {', '.join(fi.KINDS)})")

@@ -3,7 +3,7 @@
 ``cases(kinds, profile)`` is a hypothesis strategy of :class:`Case`: a few
 files to write into a fresh directory (an app, a config file, a data file, a
 trace, a snapshot) and the ``softplc`` commands to run on them. The oracle
-(``tests/fuzz_oracle.py``) runs them; ``tests/test_fuzz.py`` draws a few dozen
+(``tests/helpers/fuzz_oracle.py``) runs them; ``tests/test_fuzz.py`` draws a few dozen
 of each kind, ``tools/fuzz.py`` draws them for minutes (docs/fuzzing.md).
 
 Each kind starts from valid inputs (programs drawn by ``ladder_strategies``,
@@ -41,15 +41,15 @@ import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import fuzz_files
-import fuzz_protocol
-import fuzz_signals
+from helpers import fuzz_files
+from helpers import fuzz_protocol
+from helpers import fuzz_signals
 from hypothesis import strategies as st
-from ladder_strategies import programs
+from helpers.ladder_strategies import programs
 
 from softplc_lite.ladder.fmt import format_program
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PROGRAMS = ROOT / "programs"
 
 # -- profiles ------------------------------------------------------------------------

@@ -1,7 +1,7 @@
 """Fuzz inputs: hostile Modbus TCP requests to a live MODBTCPS server.
 
 A ``modbus_tcp`` case starts a real runtime of an app with MODBTCPS
-(``tests/modbtcps_apps.py``: the scan in a thread of this process, the server
+(``tests/helpers/modbtcps_apps.py``: the scan in a thread of this process, the server
 its own process, on a port found free) and sends it a few hundred requests
 drawn from a seed: every function code (served or not), addresses at and
 outside the map's edges, quantities and byte counts at and past the
@@ -32,7 +32,7 @@ import time
 from pathlib import Path
 
 SERVED = [1, 2, 3, 4, 5, 6, 15, 16, 22, 23]
-# tests/modbtcps_apps.UNIT_1's edges: coils 0..39, 100..107; holding 0..19, 50..54, 100..103, 110..111,
+# tests/helpers/modbtcps_apps.UNIT_1's edges: coils 0..39, 100..107; holding 0..19, 50..54, 100..103, 110..111,
 # 200..365 (ST9:0..1, LEN at 200 and 283), 400..483 (packed ST9:2..3, LEN at 400 and 442); input 0..9, 20..21
 EDGES = [0, 1, 7, 8, 18, 19, 20, 39, 40, 49, 50, 54, 55, 99, 100, 103, 104, 107, 108, 110, 111, 112, 199, 200,
          201, 282, 283, 284, 365, 366, 399, 400, 401, 441, 442, 443, 483, 484, 1000, 9999, 65534, 65535]
@@ -53,7 +53,7 @@ SENTINEL = 19  # holding register 19 (N7:19): written with the value it holds, t
 
 
 def case_modbus_tcp(draw, rnd, profile):
-    from fuzz_inputs import Case
+    from helpers.fuzz_inputs import Case
 
     n = rnd.randint(*REQUESTS)
     return Case("modbus_tcp", {}, [], note=f"{n} requests", driver="modbus_tcp",
@@ -194,8 +194,8 @@ def _diff(before: dict, after: dict) -> list[str]:
 
 
 def run_modbus_case(case, root: Path, timeout: float, runner):
-    from fuzz_oracle import Finding, Result
-    from modbtcps_apps import Running, UNIT_1, server_xml, write_app
+    from helpers.fuzz_oracle import Finding, Result
+    from helpers.modbtcps_apps import Running, UNIT_1, server_xml, write_app
 
     from softplc_lite.tlm.modbtcps import status as S
 

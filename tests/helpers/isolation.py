@@ -45,7 +45,7 @@ import pytest
 from hypothesis import settings
 from hypothesis.configuration import set_hypothesis_home_dir
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 SKIPPED = {".git", "__pycache__"}
 SOURCES = (".py", ".md")
 STATE_DIR = ".softplc"

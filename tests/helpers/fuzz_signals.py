@@ -32,7 +32,7 @@ END_LIMIT_S = 20.0  # from the last signal to the process's end
 
 
 def case_signals(draw, rnd, profile):
-    from fuzz_inputs import Case, program_files
+    from helpers.fuzz_inputs import Case, program_files
 
     app = rnd.choice(APPS)
     sigs = [rnd.choice(list(SIGNALS))]
@@ -50,7 +50,7 @@ def _free_port_xml(app: Path) -> None:
     """A MODBTCPS app listens on a port found free, not the shipped 5020 (a user's PLC may hold it)."""
     xml = app / "MODBTCPS.XML"
     if xml.is_file():
-        from modbus_peer import free_tcp_port
+        from helpers.modbus_peer import free_tcp_port
 
         xml.write_text(re.sub(r'port="\d+"', f'port="{free_tcp_port()}"', xml.read_text()))
 
@@ -74,7 +74,7 @@ def _group_alive(pgid: int) -> bool:
 
 
 def run_signals_case(case, root: Path, timeout: float, runner):
-    from fuzz_oracle import CaseRun, Finding, Result, _first_error, softplc_command
+    from helpers.fuzz_oracle import CaseRun, Finding, Result, _first_error, softplc_command
 
     d = str(root)
     p = case.params

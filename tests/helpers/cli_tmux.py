@@ -15,7 +15,7 @@ import time
 from pathlib import Path
 
 import pytest
-from tmux_helpers import ROOT, Tmux
+from helpers.tmux_helpers import ROOT, Tmux
 
 SOFTPLC = f"{shlex.quote(sys.executable)} -m softplc_lite"
 

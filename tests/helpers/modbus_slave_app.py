@@ -22,8 +22,8 @@ from softplc_lite.ladder.engine import Mode
 from softplc_lite.ports.wire import char_time_ns
 from softplc_lite.runner import RunOptions, Runner
 
-SLAVE_APP = Path(__file__).resolve().parent.parent / "programs" / "modbus_slave"
-MASTER_APP = Path(__file__).resolve().parent.parent / "programs" / "modbus_master"
+SLAVE_APP = Path(__file__).resolve().parents[2] / "programs" / "modbus_slave"
+MASTER_APP = Path(__file__).resolve().parents[2] / "programs" / "modbus_master"
 _links = itertools.count()
 
 

@@ -10,9 +10,9 @@ import re
 import shutil
 from pathlib import Path
 
-from modbus_peer import free_tcp_port
+from helpers.modbus_peer import free_tcp_port
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 PROGRAMS = ROOT / "programs"
 SHIPPED_PORT = 5020  # programs/hmi_server/MODBTCPS.XML
 SERVER_CONFIG = "MODBTCPS.XML"

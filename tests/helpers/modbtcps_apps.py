@@ -14,7 +14,7 @@ from pathlib import Path
 from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions, Runner
 
-from modbus_peer import free_tcp_port
+from helpers.modbus_peer import free_tcp_port
 
 LIMIT_S = 15.0  # any one wait; a step normally takes well under a second
 

@@ -13,7 +13,7 @@ Two kinds of :mod:`fuzz_inputs` cases live here:
     the real snapshot and code cache a first run wrote, with bytes flipped,
     the file truncated or padded.
 
-Both are run by the ``files`` driver of ``tests/fuzz_oracle.py``: the case's
+Both are run by the ``files`` driver of ``tests/helpers/fuzz_oracle.py``: the case's
 ``prepare`` commands first (a run that writes the real state), then the
 change to the target, then the case's commands. What the oracle requires is
 the documented contract (docs/cli.md "Input file limits", docs/engine.md
@@ -152,7 +152,7 @@ def case_special_files(draw, rnd, profile):
 
 def special_case(name: str, spec: str, rnd, profile):
     """The target ``name`` (of TARGETS) replaced by ``spec`` (of SPECIALS)."""
-    from fuzz_inputs import Case, program_files, snapshot_bytes
+    from helpers.fuzz_inputs import Case, program_files, snapshot_bytes
 
     base, target, role, commands, prepare = TARGETS[name]
     files = program_files(base)
@@ -172,7 +172,7 @@ def special_case(name: str, spec: str, rnd, profile):
 
 
 def case_state_damage(draw, rnd, profile):
-    from fuzz_inputs import Case, program_files
+    from helpers.fuzz_inputs import Case, program_files
 
     which = rnd.choice(["datatable.snap", "datatable.snap", "codecache.bin", "codecache.bin", "datatable.snap.prev"])
     _base, target, role, commands, prepare = TARGETS[which]
@@ -268,7 +268,7 @@ def apply_change_unlinked(root: Path, target: str, change: dict) -> None:
 def run_files_case(case, root: Path, timeout: float, runner):
     """The ``files`` driver: prepare, a reference run where the role needs one,
     the change, the case's commands, and the role's oracle."""
-    from fuzz_oracle import CaseRun, Finding, _first_error
+    from helpers.fuzz_oracle import CaseRun, Finding, _first_error
 
     d = str(root)
     p = case.params

@@ -55,7 +55,7 @@ import traceback
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from fuzz_inputs import Case
+from helpers.fuzz_inputs import Case
 
 EXIT_CODES = {0, 1, 2, 3, 130}
 # Errors about a file as a whole, which have no line to give.
@@ -370,9 +370,9 @@ def check_case(case: Case, root: Path, timeout: float = 20.0, runner=run_main,
 
 
 def _drivers() -> dict:
-    import fuzz_files
-    import fuzz_protocol
-    import fuzz_signals
+    from helpers import fuzz_files
+    from helpers import fuzz_protocol
+    from helpers import fuzz_signals
 
     return {"files": fuzz_files.run_files_case, "signals": fuzz_signals.run_signals_case,
             "modbus_tcp": fuzz_protocol.run_modbus_case}

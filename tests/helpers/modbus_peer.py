@@ -177,7 +177,7 @@ class ModbusPeer:
 _PEER_PROCESS = """
 import json, sys
 sys.path.insert(0, sys.argv[1])
-from modbus_peer import ModbusPeer
+from helpers.modbus_peer import ModbusPeer
 peer = ModbusPeer(sys.argv[2], **json.loads(sys.argv[3])).start()
 print("ready", flush=True)
 sys.stdin.read()  # serve until the parent closes stdin (or dies)
@@ -194,7 +194,7 @@ class PeerProcess:
     process)."""
 
     def __init__(self, port: str, registers: list[int] | None = None, **options) -> None:
-        here = str(Path(__file__).resolve().parent)
+        here = str(Path(__file__).resolve().parents[1])  # the tests directory, where the helpers package is
         if registers is not None:
             options["registers"] = registers
         self.proc = subprocess.Popen([sys.executable, "-c", _PEER_PROCESS, here, port, json.dumps(options)],
