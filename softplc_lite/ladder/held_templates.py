@@ -253,8 +253,9 @@ def local_COP(fc, ind: int, ins: Instruction) -> None:
         fc.barrier(ind)
         fc.dispatch(ind, ins)
         return
-    held = fc.held.write_back(ind, [key for key in fc.held.words if (key[0] == sf.number and si <= key[1] < si + n)
-                                    or (key[0] == df.number and di <= key[1] < di + n)])
+    in_blocks = [key for key in fc.held.words
+                 if (key[0] == sf.number and si <= key[1] < si + n) or (key[0] == df.number and di <= key[1] < di + n)]
+    held = fc.held.write_back(ind, in_blocks)
     fc.emit(ind, f"if c: {fc.array_name(df)}[{di!r}:{di + n!r}] = {fc.array_name(sf)}[{si!r}:{si + n!r}]")
     fc.held.forget([(key, name) for key, name in held if key[0] == df.number])
 

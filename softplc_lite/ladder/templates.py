@@ -341,7 +341,7 @@ def i_BTD(fc, ind, ops):
     src = fc.value(ind + 1, ops[0])
     d, i, _ = fc.location(ind + 1, ops[2])
     fc.emit(ind + 1, f"{fc.bind('_btd', fc.machine.btd)}({src}, {ops[1].value!r}, {d}, {i}, "
-              f"{ops[3].value!r}, {ops[4].value!r})")
+            f"{ops[3].value!r}, {ops[4].value!r})")
 
 
 # program control: leaving the block writes its locals back first
