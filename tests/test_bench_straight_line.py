@@ -1,21 +1,17 @@
-"""The straight-line baseline of benchmarks/bench_ladder.py (issue 17) agrees
+"""The straight-line baseline of benchmarks/bench_ladder.py agrees
 with the engine, so the yardstick cannot rot silently. Not timed."""
 
 from __future__ import annotations
 
-import sys
 import types
-from pathlib import Path
 
 import pytest
-
-BENCHMARKS = Path(__file__).resolve().parent.parent / "benchmarks"
-sys.path.insert(0, str(BENCHMARKS))
-
-import ladder_programs as L
-import straight_line
+from helpers.benchmark_modules import load
 
 from softplc_lite.ladder import parse_program, validate
+
+L = load("ladder_programs")
+straight_line = load("straight_line")
 
 # Shapes the generator makes rarely or never: a coil first, coils inside
 # legs that have contacts, contacts after a coil, bit 15, an empty-ish leg.

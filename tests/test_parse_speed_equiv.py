@@ -1,4 +1,4 @@
-"""The fast parse loop (lalr_driver.py, issue 17) gives exactly what Lark's
+"""The fast parse loop (lalr_driver.py) gives exactly what Lark's
 own parser gives over the same grammar: the same AST with the same
 positions for every shipped program, the benchmark programs and thousands
 of damaged copies of them, and the same errors (message, file:line:col,
@@ -8,10 +8,10 @@ from __future__ import annotations
 
 import inspect
 import random
-import sys
 from pathlib import Path
 
 import pytest
+from helpers.benchmark_modules import load
 
 from softplc_lite.ladder import lalr_driver, parser
 from softplc_lite.ladder.ast import Pos
@@ -20,9 +20,7 @@ from softplc_lite.ladder.lalr_driver import FastLalr, NotFastPath
 from softplc_lite.ladder.parser import parse_expression, parse_program, syntax_problems
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT / "benchmarks"))
-
-import ladder_programs
+ladder_programs = load("ladder_programs")
 
 PROGRAMS = sorted([*ROOT.glob("programs/**/*.lad"), *ROOT.glob("tests/data/**/*.lad")])
 
