@@ -26,7 +26,6 @@ from __future__ import annotations
 import sys
 import threading
 from collections.abc import Iterator
-from functools import lru_cache
 from types import MappingProxyType
 
 from lark import Lark, Token
@@ -97,12 +96,6 @@ class LadderPostLex:
             elif kind in self.dropped_inside and True in spans:
                 continue
             yield tok
-
-
-@lru_cache(maxsize=1)
-def get_parser() -> Lark:
-    """The grammar, for tools (lark's own parse trees, error contexts)."""
-    return _lark(None)
 
 
 # This thread's parser and its fast loop ("lark", "fast"), see the module docstring.

@@ -183,15 +183,6 @@ class Enabled:
     line: int
 
 
-def read_modules_lst(app_dir: Path) -> tuple[Path | None, list[Enabled]]:
-    """The modules an app enables, from its MODULES.LST (none if absent);
-    ModuleError (or ModuleErrors) for its problems."""
-    path, enabled, problems = _read_modules_lst(app_dir)
-    if problems:
-        raise problems[0] if len(problems) == 1 else ModuleErrors(problems)
-    return path, enabled
-
-
 def _read_modules_lst(app_dir: Path) -> tuple[Path | None, list[Enabled], list[ModuleError]]:
     """MODULES.LST's modules (those of its good lines) and every problem of its lines."""
     path = find_file(app_dir, MODULES_FILE)

@@ -132,7 +132,3 @@ class Gather:
             stream |= value << offset
             offset += n
         return stream
-
-    def coil_bytes(self) -> bytes:
-        """The bits packed 8 to a byte, the first in the lowest bit."""
-        return self.coils().to_bytes((self.count + 7) // 8, "little")
