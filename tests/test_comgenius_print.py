@@ -35,6 +35,7 @@ from softplc_lite.tlm.comgenius.params import Param, ParamError, ParamKind, Tabl
 from softplc_lite.tlm.comgenius.printf import c_integer, compile_print, format_text
 
 from helpers.reference_checks import crc16_modbus_ref
+from helpers.words import signed
 
 INF = float("inf")
 NAN = float("nan")
@@ -763,7 +764,7 @@ def test_table_params_integer_long_float_string():
     text = "Hi\u8001"
     st9[83] = len(text)
     for k, ch in enumerate(text):
-        st9[84 + k] = ord(ch) - 0x10000 if ord(ch) >= 0x8000 else ord(ch)
+        st9[84 + k] = signed(ord(ch))
     params = [
         TableParam(ParamKind.INTEGER, n7, 0, "N7:0"),
         TableParam(ParamKind.INTEGER, n7, 1, "N7:1"),

@@ -16,6 +16,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from helpers.instr_helpers import flags
+from helpers.words import signed
 from softplc_lite.datatable import DataTable
 from softplc_lite.ladder import Mode, Settings, run_text
 from softplc_lite.ladder import status as S
@@ -146,7 +147,7 @@ def test_xpy_agrees_with_cpt_power(run):
 def _math_register(value: int) -> dict:
     v = value & 0xFFFFFFFF
     lo, hi = v & 0xFFFF, v >> 16
-    return {"S:106": lo - 0x10000 if lo & 0x8000 else lo, "S:107": hi - 0x10000 if hi & 0x8000 else hi}
+    return {"S:106": signed(lo), "S:107": signed(hi)}
 
 
 def test_ddv_divides_the_32_bit_math_register(run):

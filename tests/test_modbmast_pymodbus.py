@@ -24,6 +24,7 @@ from softplc_lite.tlm.modbmast.status import NO_REPLY
 from helpers.modbmast_apps import serial_xml, status, write_app
 from helpers.modbus_peer import PeerProcess, free_tcp_port
 from helpers.ptypair import PtyPair, require_socat
+from helpers.words import signed
 
 LIMIT_S = 15.0  # per waiting step; a step normally takes well under a second
 
@@ -68,10 +69,6 @@ MBR_GETFAULTMAP 1 #B13:0
 MBR_GETSTATUS #N20:0 1 1 3
 """
 LADDER = "\n".join(f"XIO B3/400 {line}" for line in LADDER.splitlines()) + "\n"
-
-
-def signed(v: int) -> int:
-    return v - 0x10000 if v & 0x8000 else v
 
 
 @pytest.fixture(params=["pty", "socket"])

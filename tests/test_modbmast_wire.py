@@ -21,6 +21,7 @@ from softplc_lite.tlm.modbmast.status import BAD_CRC, BAD_REPLY, INCOMPLETE_REPL
 from softplc_lite.watch.forces import Forces, parse_force
 
 from helpers.modbmast_apps import Apps, char, driver, link, scans, serial_xml, slave_silence, status, traffic
+from helpers.words import signed
 
 MS = 1_000_000
 
@@ -191,10 +192,6 @@ MOV 0x00AB N7:45
 MOV 11 N7:55
 MOV 22 N7:56
 """
-
-
-def signed(v: int) -> int:
-    return v - 0x10000 if v & 0x8000 else v
 
 
 def test_every_function_moves_its_data_where_the_xml_says(apps):

@@ -46,6 +46,7 @@ from helpers.ptypair import PtyPair, require_socat, socat_processes
 
 pytest.importorskip("pymodbus", minversion="3.16.1")
 from helpers.modbus_peer import ModbusPeer, PeerProcess, free_tcp_port  # noqa: E402
+from helpers.words import signed  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 TESTS = Path(__file__).resolve().parent
@@ -65,11 +66,6 @@ DEADLINE_S = 5.0  # wall-clock bound of each real-time wait
 COUNTERS = {"polls": "C5:0.ACC", "good": "C5:1.ACC", "exceptions": "C5:2.ACC", "timeouts": "C5:3.ACC",
             "garbage": "C5:4.ACC"}
 OUTCOMES = ("good", "exceptions", "timeouts", "garbage")
-
-
-def signed(word: int) -> int:
-    """A 16-bit register as the INTEGER an N word reads back."""
-    return word - 0x10000 if word & 0x8000 else word
 
 
 SIM_REGISTERS = [signed(initial_value(k)) for k in range(125)]  # the simulated slave's registers 0..124

@@ -24,19 +24,13 @@ from softplc_lite.runner import RunOptions, Runner
 from helpers.modbmast_apps import serial_xml, status, write_app
 from helpers.modbus_slave_app import MASTER_APP, SLAVE_APP, copy_app
 from helpers.reference_checks import crc16_modbus_ref, rtu_frame as frame
+from helpers.words import signed
 
 _names = itertools.count()
 
 
 def link_name() -> str:
     return f"mbs-masters-{next(_names)}"
-
-
-
-
-def signed(value: int) -> int:
-    value &= 0xFFFF
-    return value - 0x10000 if value & 0x8000 else value
 
 
 def slave_counters(runner: Runner) -> dict[str, int]:

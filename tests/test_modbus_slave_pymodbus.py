@@ -45,6 +45,7 @@ from softplc_lite.runner import RunOptions, Runner
 from helpers.modbus_slave_app import SLAVE_APP, copy_app
 from helpers.ptypair import PtyPair, require_socat
 from helpers.reference_checks import rtu_frame as frame
+from helpers.words import signed
 
 logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
 
@@ -65,11 +66,6 @@ def pack_bits(bits) -> bytes:
         if bit:
             out[k // 8] |= 1 << (k % 8)
     return bytes(out)
-
-
-def signed(value: int) -> int:
-    value &= 0xFFFF
-    return value - 0x10000 if value & 0x8000 else value
 
 
 # Known data for the limit tests: every word of O, I (128 words = 2,048 bits each), N10 (1000)

@@ -23,6 +23,7 @@ from softplc_lite.ladder import status as S
 from softplc_lite.ladder.rounding import FLOAT32_MAX, round_half_even
 
 from helpers.cli import softplc_here
+from helpers.words import signed
 
 EXECUTORS = ("compiled", "reference")
 
@@ -55,8 +56,7 @@ def stored(n: int, overflow: str = "clamp") -> tuple[int, bool]:
         return n, False
     if overflow == "clamp":
         return (32767 if n > 0 else -32768), True
-    n &= 0xFFFF
-    return (n - 0x10000 if n & 0x8000 else n), True
+    return signed(n), True
 
 
 def bcd(n: int) -> int:
@@ -64,7 +64,7 @@ def bcd(n: int) -> int:
     if not 0 <= n <= 9999:
         return 0
     v = int(str(n), 16)
-    return v - 0x10000 if v & 0x8000 else v
+    return signed(v)
 
 
 def overflowed(e: Engine) -> bool:
