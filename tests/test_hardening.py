@@ -5,8 +5,6 @@ point (``softplc_lite.cli.main``) in-process, and a few run the real
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from softplc_lite import cli
@@ -15,6 +13,7 @@ from softplc_lite.ladder.limits import MAX_BRANCH_DEPTH, MAX_EXPRESSION_DEPTH
 from softplc_lite.ladder.semantics import MAX_JSR_DEPTH
 
 from helpers.cli import softplc
+from helpers.apps import make_app
 
 
 def short(value) -> str:
@@ -34,15 +33,6 @@ def run_cli(capsys, *args: str) -> tuple[int, str, str]:
     assert "Traceback" not in out + err
     assert "internal error" not in out + err
     return code, out, err
-
-
-def make_app(root: Path, lad: str | bytes, **files: str | bytes) -> Path:
-    app = root / "app"
-    app.mkdir()
-    for name, text in {"main.lad": lad, **files}.items():
-        path = app / name.replace("_", ".") if name != "main.lad" else app / name
-        path.write_bytes(text if isinstance(text, bytes) else text.encode())
-    return app
 
 
 HUGE = "9" * 5000
@@ -66,7 +56,7 @@ HUGE = "9" * 5000
     ("MOV(-1e39,F8:0);\n", "main.lad:1:6", "out of range"),
 ], ids=short)
 def test_huge_and_overflowing_literals_are_located_check_errors(tmp_path, capsys, lad, where, says):
-    app = make_app(tmp_path, lad)
+    app = make_app(tmp_path / "app", lad)
     for command in ("check", "run", "fmt"):
         code, _, err = run_cli(capsys, command, str(app))
         assert code == cli.EXIT_ERROR, (command, err)
@@ -75,7 +65,7 @@ def test_huge_and_overflowing_literals_are_located_check_errors(tmp_path, capsys
 
 
 def test_literals_at_the_top_of_the_range_run_and_format_back(tmp_path, capsys):
-    app = make_app(tmp_path, "MOV 3.4e38 F8:0\nMOV 1e-999 F8:1\nMOV 123456789012345678901234567890 F8:2\n"
+    app = make_app(tmp_path / "app", "MOV 3.4e38 F8:0\nMOV 1e-999 F8:1\nMOV 123456789012345678901234567890 F8:2\n"
                              "MOV -10000000000.0 F8:3\nCPT F8:4 \"1.5e30 * 2.0\"\n")
     code, out, _ = run_cli(capsys, "run", str(app), "--fresh", "--scans", "1", "--print", "F8:0", "--print", "F8:1")
     assert code == 0 and out.splitlines() == ["F8:0 = 3.4e+38", "F8:1 = 0.0"]  # 7 significant digits (JSON keeps them exact)
@@ -94,7 +84,7 @@ def test_literals_at_the_top_of_the_range_run_and_format_back(tmp_path, capsys):
     ('{"N' + HUGE + '": [1]}', "expected a file name such as N7"),
 ], ids=short)
 def test_bad_datatable_json_is_a_located_error_in_check_run_and_load(tmp_path, capsys, doc, says):
-    app = make_app(tmp_path, "MOV 1 N7:0\n", datatable_json=doc)
+    app = make_app(tmp_path / "app", "MOV 1 N7:0\n", datatable_json=doc)
     for args in (("check", str(app)), ("run", str(app), "--scans", "1"),
                  ("run", str(app), "--fresh", "--scans", "1", "--load", str(app / "datatable.json"))):
         code, _, err = run_cli(capsys, *args)
@@ -106,7 +96,7 @@ def test_bad_datatable_json_is_a_located_error_in_check_run_and_load(tmp_path, c
     ("[" * 5000 + "]" * 5000, "nested more than 100 levels deep"),
 ], ids=short)
 def test_bad_set_values(tmp_path, capsys, value, says):
-    app = make_app(tmp_path, "MOV 1 N7:1\n")
+    app = make_app(tmp_path / "app", "MOV 1 N7:1\n")
     code, _, err = run_cli(capsys, "run", str(app), "--fresh", "--scans", "1", "--set", f"N7:0={value}")
     assert code == cli.EXIT_ERROR and says in err
 
@@ -122,7 +112,7 @@ def _branches(depth: int, neutral: bool = False) -> str:
 @pytest.mark.parametrize("neutral", [False, True])
 @pytest.mark.parametrize("depth", [MAX_BRANCH_DEPTH + 1, 600, 1500])  # deeper is past the rung size limit too
 def test_branches_nested_past_the_limit_are_a_check_error(tmp_path, capsys, depth, neutral):
-    app = make_app(tmp_path, _branches(depth, neutral) + "\n")
+    app = make_app(tmp_path / "app", _branches(depth, neutral) + "\n")
     for command in ("check", "run", "fmt"):
         code, _, err = run_cli(capsys, command, str(app))
         assert code == cli.EXIT_ERROR
@@ -136,7 +126,7 @@ def test_branches_nested_past_the_limit_are_a_check_error(tmp_path, capsys, dept
     "(" * 150 + "-" * 0 + "N7:1" + " * 2)" * 150,
 ], ids=short)
 def test_expressions_past_the_limit_are_a_check_error(tmp_path, capsys, expression):
-    app = make_app(tmp_path, f'CPT N7:0 "{expression}"\n')
+    app = make_app(tmp_path / "app", f'CPT N7:0 "{expression}"\n')
     code, _, err = run_cli(capsys, "check", str(app))
     assert code == cli.EXIT_ERROR and f"the limit is {MAX_EXPRESSION_DEPTH}" in err and "main.lad:1:" in err
     code, _, err = run_cli(capsys, "run", str(app), "--scans", "1")
@@ -156,7 +146,7 @@ def test_every_stage_works_at_exactly_the_limits(tmp_path, capsys):
         f'CMP "{chain} > 0" OTE B3/5',
         "JSR 3", "FILE 3", _branches(MAX_BRANCH_DEPTH), f'CPT N7:3 "{chain} + 2"', "JSR 3",
     ]
-    app = make_app(tmp_path, "\n".join(rungs) + "\n", softplc_toml=f"[scan]\njsr_depth = {MAX_JSR_DEPTH}\n")
+    app = make_app(tmp_path / "app", "\n".join(rungs) + "\n", softplc_toml=f"[scan]\njsr_depth = {MAX_JSR_DEPTH}\n")
     code, out, _ = run_cli(capsys, "check", str(app))
     assert code == 0, out
     for executor in ("compiled", "reference"):
@@ -187,7 +177,7 @@ def test_every_stage_works_at_exactly_the_limits(tmp_path, capsys):
     (b"[scan]\nscan_ms = 5 # \xff\xfe\n", "softplc.toml:2:15: byte 0xff is not UTF-8 text"),
 ], ids=short)
 def test_settings_out_of_range_or_not_utf8_are_located_errors(tmp_path, capsys, toml, says):
-    app = make_app(tmp_path, "MOV 1 N7:0\n", softplc_toml=toml)
+    app = make_app(tmp_path / "app", "MOV 1 N7:0\n", softplc_toml=toml)
     for command in ("check", "run"):
         code, _, err = run_cli(capsys, command, str(app))
         assert code == cli.EXIT_ERROR and says in err, err
@@ -195,7 +185,7 @@ def test_settings_out_of_range_or_not_utf8_are_located_errors(tmp_path, capsys, 
 
 def test_every_settings_problem_is_listed_at_once(tmp_path, capsys):
     toml = "[scan]\nscan_ms = 5\njsr_depth = 0\nfoo = 1\n[bar]\nx = 1\n[retentive]\nsave_ms = -5\n"
-    app = make_app(tmp_path, "MOV 1 N7:0\nBAD N7:0\n", softplc_toml=toml)
+    app = make_app(tmp_path / "app", "MOV 1 N7:0\nBAD N7:0\n", softplc_toml=toml)
     code, _, err = run_cli(capsys, "check", str(app))
     lines = [line for line in err.splitlines() if "softplc.toml:" in line or "main.lad:" in line]
     assert code == cli.EXIT_ERROR and "5 problems found" in err
@@ -210,7 +200,7 @@ def test_every_settings_problem_is_listed_at_once(tmp_path, capsys):
     (("--scans", "-1"), "argument --scans: expected an integer 0 or more"),
 ], ids=short)
 def test_cli_values_out_of_range_are_usage_errors(tmp_path, capsys, args, says):
-    app = make_app(tmp_path, "MOV 1 N7:0\n")
+    app = make_app(tmp_path / "app", "MOV 1 N7:0\n")
     code, _, err = run_cli(capsys, "run", str(app), "--scans", "1", *args)
     assert code == cli.EXIT_USAGE and says in err
 
@@ -218,14 +208,14 @@ def test_cli_values_out_of_range_are_usage_errors(tmp_path, capsys, args, says):
 # -- 3. internal errors and wrong faults -------------------------------------------------
 
 def test_a_program_with_no_rungs_scans_as_an_empty_plc(tmp_path, capsys):
-    app = make_app(tmp_path, "// nothing yet\n")
+    app = make_app(tmp_path / "app", "// nothing yet\n")
     assert run_cli(capsys, "check", str(app))[0] == 0
     code, out, _ = run_cli(capsys, "run", str(app), "--fresh", "--scans", "5", "--print", "S:100", "--print", "S:12")
     assert code == 0 and out.splitlines() == ["S:100 = 5", "S:12 = 0"]
 
 
 def test_jsr_depth_is_bounded_where_the_engine_can_honour_it(tmp_path, capsys):
-    app = make_app(tmp_path, "JSR 3\nFILE 3\nJSR 3\n", softplc_toml="[scan]\njsr_depth = 100000\n")
+    app = make_app(tmp_path / "app", "JSR 3\nFILE 3\nJSR 3\n", softplc_toml="[scan]\njsr_depth = 100000\n")
     code, _, err = run_cli(capsys, "run", str(app), "--scans", "1")
     assert code == cli.EXIT_ERROR and f"jsr_depth = 100000; expected an integer from 1 to {MAX_JSR_DEPTH}" in err
 
@@ -239,7 +229,7 @@ def test_jsr_depth_is_bounded_where_the_engine_can_honour_it(tmp_path, capsys):
 ], ids=short)
 def test_what_run_refuses_check_reports_first_located(tmp_path, capsys, lad, toml, says):
     files = {"softplc_toml": toml} if toml else {}
-    app = make_app(tmp_path, lad, **files)
+    app = make_app(tmp_path / "app", lad, **files)
     code, _, err = run_cli(capsys, "check", str(app))
     assert code == cli.EXIT_ERROR and says in err, err
     code, _, err = run_cli(capsys, "run", str(app), "--scans", "1")
@@ -248,7 +238,7 @@ def test_what_run_refuses_check_reports_first_located(tmp_path, capsys, lad, tom
 
 def test_a_format_width_cannot_allocate_more_than_its_destination(tmp_path, capsys):
     """%999999999d once built a 1 GB string for an 82-character STRING."""
-    app = make_app(tmp_path, "DATA N7 3 = 5 32767 1\nSTRPRINT ST10:0 1 N7:0\nSTRPRINT ST10:1 2 N7:0 N7:0 N7:0\n"
+    app = make_app(tmp_path / "app", "DATA N7 3 = 5 32767 1\nSTRPRINT ST10:0 1 N7:0\nSTRPRINT ST10:1 2 N7:0 N7:0 N7:0\n"
                              "STRPRINT ST10:2 3 N7:1 N7:2\n",
                    MODULES_LST="COMGENIUS\n",
                    COMGENIUS_LST='[STRINGS]\n1 "%999999999d"\n2 "%32767d|%32767d|%32767d"\n3 "%-*d|"\n')
@@ -273,7 +263,7 @@ def test_printf_render_stops_at_its_limit():
 # -- the real command, and the last-resort handler --------------------------------------------
 
 def test_the_real_command_reports_without_a_traceback(tmp_path):
-    app = make_app(tmp_path, f"MOV {HUGE} N7:0\n" + _branches(600) + "\n")
+    app = make_app(tmp_path / "app", f"MOV {HUGE} N7:0\n" + _branches(600) + "\n")
     # A process: a fresh interpreter, with Python's own limits on digits and recursion, and its real stderr.
     p = softplc("check", str(app))
     assert p.returncode == 1 and "Traceback" not in p.stderr
@@ -302,13 +292,13 @@ def test_an_internal_error_is_one_line_and_exit_code_4(capsys, monkeypatch):
 ], ids=short)
 def test_other_numbers_and_encodings_are_clear_errors(tmp_path, capsys, files, args, says):
     lad = files.pop("main.lad", "MOV 1 N7:0\n")
-    app = make_app(tmp_path, lad, **files)
+    app = make_app(tmp_path / "app", lad, **files)
     code, _, err = run_cli(capsys, "run", str(app), "--fresh", "--scans", "1", *args)
     assert code in (cli.EXIT_ERROR, cli.EXIT_USAGE) and says in err, err
 
 
 def test_a_utf8_bom_is_accepted(tmp_path, capsys):
-    app = make_app(tmp_path, b"\xef\xbb\xbfMOV 1 N7:0\n", softplc_toml=b"\xef\xbb\xbf[scan]\nscan_ms = 5\n",
+    app = make_app(tmp_path / "app", b"\xef\xbb\xbfMOV 1 N7:0\n", softplc_toml=b"\xef\xbb\xbf[scan]\nscan_ms = 5\n",
                    datatable_json=b'\xef\xbb\xbf{"N7": [0, 7]}')
     code, out, _ = run_cli(capsys, "run", str(app), "--fresh", "--scans", "1", "--print", "N7:1")
     assert code == 0 and out == "N7:1 = 7\n"
@@ -382,7 +372,7 @@ def test_validate_refuses_trees_past_the_limits_built_through_the_library():
     ('[display]\nstatus = { x = "N7:" }\n', "softplc.toml:2: [display] x = 'N7:': bad address"),
 ], ids=short)
 def test_every_softplc_toml_problem_is_located(tmp_path, capsys, toml, says):
-    app = make_app(tmp_path, "MOV 1 N7:0\n", softplc_toml=toml)
+    app = make_app(tmp_path / "app", "MOV 1 N7:0\n", softplc_toml=toml)
     code, _, err = run_cli(capsys, "check", str(app))
     assert code == cli.EXIT_ERROR and says in err, err
 
@@ -432,7 +422,7 @@ def test_fmt_refuses_what_it_could_not_print_back(tmp_path, capsys, lad, style, 
     ("sim://bad name", "bad link name"),
 ])
 def test_check_refuses_the_sim_urls_run_would_refuse(tmp_path, capsys, url, says):
-    app = make_app(tmp_path, "MOV 1 N7:0\n", MODULES_LST="COMGENIUS\n",
+    app = make_app(tmp_path / "app", "MOV 1 N7:0\n", MODULES_LST="COMGENIUS\n",
                    COMGENIUS_LST=f"[DRIVER]\n[PORTS]\n0, {url}, ISO-8859-1, 9600, 8, N, 1, 100\n")
     for command in ("check", "run"):
         code, _, err = run_cli(capsys, command, str(app))

@@ -27,18 +27,11 @@ from softplc_lite.retentive import Retentive, StorageFaults
 from softplc_lite.runner import RunOptions, Runner
 
 from helpers.cli import ROOT, softplc_here
+from helpers.apps import make_app
 
 STORAGE = 1 << S.MINOR_STORAGE_BIT
 
 COUNTER = "ADD N7:0 1 N7:0\nMOV -1 N7:2\nMOV N7:0 N7:1\nMOV 0 N7:2\n"
-
-
-def make_app(directory: Path, ladder: str = COUNTER, **files: str) -> Path:
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / "main.lad").write_text(ladder)
-    for name, text in files.items():
-        (directory / name.replace("_", ".")).write_text(text)
-    return directory
 
 
 def realtime_runner(app: Path, state: Path, save_ms: int = 100, **kw) -> tuple[Runner, list[str]]:
@@ -81,7 +74,7 @@ def test_remove_stale_deletes_what_a_killed_save_left(tmp_path):
 
 
 def test_a_run_removes_stale_temp_files_at_start(tmp_path):
-    app = make_app(tmp_path / "app")
+    app = make_app(tmp_path / "app", COUNTER)
     state = tmp_path / "state"
     state.mkdir()
     (state / "datatable.snap.tmp").write_bytes(b"x" * 100)
@@ -125,7 +118,7 @@ def test_storage_faults_set_s17_bit_4_and_s102_and_log_once_per_reason():
 
 
 def test_saves_every_save_ms_of_wall_clock_and_each_is_a_whole_scan(tmp_path):
-    app = make_app(tmp_path / "app")
+    app = make_app(tmp_path / "app", COUNTER)
     state = tmp_path / "state"
     runner, logged = realtime_runner(app, state, save_ms=50)
     seen: list[int] = []
@@ -160,7 +153,7 @@ def test_saves_every_save_ms_of_wall_clock_and_each_is_a_whole_scan(tmp_path):
 
 
 def test_save_ms_0_saves_only_at_the_end(tmp_path):
-    app = make_app(tmp_path / "app")
+    app = make_app(tmp_path / "app", COUNTER)
     state = tmp_path / "state"
     runner, _ = realtime_runner(app, state, save_ms=0)
     runner.run(40)  # 0.2 s
@@ -261,7 +254,7 @@ def test_disk_full_is_a_minor_fault_retried_until_saving_works_again(tmp_path):
     a failed save leaves no partial temp file behind."""
     import json
 
-    app = make_app(tmp_path / "app")
+    app = make_app(tmp_path / "app", COUNTER)
     state = tmp_path / "state"
     state.mkdir()
     # a process: the write limit (RLIMIT_FSIZE) is the whole process's
@@ -287,7 +280,7 @@ def test_disk_full_is_a_minor_fault_retried_until_saving_works_again(tmp_path):
 def test_an_unusable_state_directory_keeps_the_plc_running_and_exits_1(tmp_path):
     """--state under a regular file: every save fails with ENOTDIR (as a
     read-only directory would, but also for root)."""
-    app = make_app(tmp_path / "app")
+    app = make_app(tmp_path / "app", COUNTER)
     (tmp_path / "a-file").write_text("not a directory")
     state = tmp_path / "a-file" / "state"
     dump = tmp_path / "dump.json"
@@ -307,7 +300,7 @@ def test_an_unusable_state_directory_keeps_the_plc_running_and_exits_1(tmp_path)
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root writes into a read-only directory anyway (CI runs as root)")
 def test_a_read_only_state_directory_is_a_minor_fault(tmp_path):
-    app = make_app(tmp_path / "app")
+    app = make_app(tmp_path / "app", COUNTER)
     state = tmp_path / "state"
     state.mkdir()
     state.chmod(0o555)

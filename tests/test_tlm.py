@@ -21,6 +21,7 @@ from softplc_lite.ladder.fmt import format_program
 from softplc_lite.tlm import ModuleError, installed, load_modules
 
 from helpers.cli import softplc, softplc_here
+from helpers.apps import make_app
 
 DEMO_MODULE = '''
 """A third-party TLM for the tests: PULSE and TWICE, a config file, hooks."""
@@ -118,15 +119,11 @@ def demo_path(tmp_path, monkeypatch) -> Path:
     sys.modules.pop("demo_tlm", None)
 
 
-def make_app(tmp_path: Path, program: str, modules: str = "demo ; the test module\n", **files: str) -> Path:
-    app = tmp_path / "app"
-    app.mkdir(exist_ok=True)
-    (app / "main.lad").write_text(textwrap.dedent(program))
-    if modules is not None:
-        (app / "MODULES.LST").write_text(modules)
-    for name, text in files.items():
-        (app / name).write_text(text)
-    return app
+def demo_app(tmp_path: Path, program: str, modules: str | None = "demo ; the test module\n", **files: str) -> Path:
+    """TMP_PATH/app running PROGRAM with MODULES as its MODULES.LST (none
+    for None); FILES named as they are."""
+    listed = {} if modules is None else {"MODULES.LST": modules}
+    return make_app(tmp_path / "app", textwrap.dedent(program), **listed, **files)
 
 
 PROGRAM = """\
@@ -157,7 +154,7 @@ def test_a_module_installed_or_removed_while_the_process_lives_is_seen_at_the_ne
 
 @pytest.mark.parametrize("executor", ["compiled", "reference"])
 def test_a_third_party_module_runs_through_the_same_door(demo_path, tmp_path, executor):
-    app = load_app(make_app(tmp_path, PROGRAM, **{"DEMO.LST": "3\n"}))
+    app = load_app(demo_app(tmp_path, PROGRAM, **{"DEMO.LST": "3\n"}))
     assert [m.name for m in app.modules] == ["DEMO"]
     assert app.warnings[0] == "demo says hello"
     assert "main.lad:3:45: PULSE longer than 3 scans ends with ER" in app.warnings[1]
@@ -187,7 +184,7 @@ def test_a_third_party_module_runs_through_the_same_door(demo_path, tmp_path, ex
 
 
 def test_a_false_rung_before_completion_gives_no_completion(demo_path, tmp_path):
-    app = load_app(make_app(tmp_path, "XIC B3/0 PULSE R6:0 3\n"))
+    app = load_app(demo_app(tmp_path, "XIC B3/0 PULSE R6:0 3\n"))
     table = DataTable()
     engine = Engine(app.program, table, modules=app.modules)
     engine.set_mode(Mode.RUN)
@@ -204,7 +201,7 @@ def test_a_false_rung_before_completion_gives_no_completion(demo_path, tmp_path)
 
 
 def test_module_errors_set_er_with_dn(demo_path, tmp_path):
-    app = load_app(make_app(tmp_path, "PULSE R6:0 4\n"))
+    app = load_app(demo_app(tmp_path, "PULSE R6:0 4\n"))
     table = DataTable()
     Engine(app.program, table, modules=app.modules, executor="reference")
     engine = Engine(app.program, table, modules=app.modules)
@@ -215,7 +212,7 @@ def test_module_errors_set_er_with_dn(demo_path, tmp_path):
 
 
 def test_test_mode_tells_output_hooks_outputs_are_disabled(demo_path, tmp_path):
-    app = load_app(make_app(tmp_path, "TWICE 1 N7:1\n"))
+    app = load_app(demo_app(tmp_path, "TWICE 1 N7:1\n"))
     engine = Engine(app.program, modules=app.modules)
     engine.set_mode(Mode.TEST)
     engine.scan()
@@ -223,14 +220,14 @@ def test_test_mode_tells_output_hooks_outputs_are_disabled(demo_path, tmp_path):
 
 
 def test_fmt_prints_module_instructions_in_both_styles(demo_path, tmp_path):
-    app = load_app(make_app(tmp_path, PROGRAM))
+    app = load_app(demo_app(tmp_path, PROGRAM))
     mnemonic = format_program(app.source_program, "mnemonic")
     assert "XIC B3/1 BST TWICE N7:0 N7:2 NXB PULSE R6:1 5 BND" in mnemonic
     assert "XIC(B3/1)[TWICE(N7:0,N7:2),PULSE(R6:1,5)];" in format_program(app.source_program, "neutral")
 
 
 def test_check_validates_module_operands_with_location(demo_path, tmp_path, capsys):
-    make_app(tmp_path, "PULSE N7:0 2\nTWICE N7:0\n")
+    demo_app(tmp_path, "PULSE N7:0 2\nTWICE N7:0\n")
     assert main(["check", str(tmp_path / "app")]) == 1
     err = capsys.readouterr().err
     assert "main.lad:1:7: PULSE operand 1 (control) must be control element (R), not N7:0 (a word)" in err
@@ -238,7 +235,7 @@ def test_check_validates_module_operands_with_location(demo_path, tmp_path, caps
 
 
 def test_check_and_run_print_module_warnings(demo_path, tmp_path, capsys):
-    make_app(tmp_path, "PULSE R6:0 9\n")
+    demo_app(tmp_path, "PULSE R6:0 9\n")
     assert main(["check", str(tmp_path / "app")]) == 0
     captured = capsys.readouterr()
     assert "app: ok (1 program file, 1 rung, module DEMO, 2 warnings)" in captured.out
@@ -246,31 +243,31 @@ def test_check_and_run_print_module_warnings(demo_path, tmp_path, capsys):
 
 
 def test_modules_lst_is_case_insensitive_with_comments(demo_path, tmp_path):
-    app = load_app(make_app(tmp_path, "TWICE 1 N7:1\n", modules="; modules\n\n  Demo   ; the demo\n"))
+    app = load_app(demo_app(tmp_path, "TWICE 1 N7:1\n", modules="; modules\n\n  Demo   ; the demo\n"))
     assert [m.name for m in app.modules] == ["DEMO"]
 
 
 def test_a_module_not_installed_is_an_error_listing_the_installed_ones(demo_path, tmp_path):
     with pytest.raises(AppError) as e:
-        load_app(make_app(tmp_path, "TWICE 1 N7:1\n", modules="demo\nMODBSLAV\n"))
+        load_app(demo_app(tmp_path, "TWICE 1 N7:1\n", modules="demo\nMODBSLAV\n"))
     assert "MODULES.LST:2: module MODBSLAV is not installed (installed modules: COMGENIUS, DEMO, MODBMAST, MODBTCPS)" \
         in str(e.value)
 
 
 def test_a_module_named_twice_is_an_error(demo_path, tmp_path):
     with pytest.raises(AppError, match=r"MODULES.LST:2: module DEMO is named twice \(first on line 1\)"):
-        load_app(make_app(tmp_path, "TWICE 1 N7:1\n", modules="DEMO\ndemo\n"))
+        load_app(demo_app(tmp_path, "TWICE 1 N7:1\n", modules="DEMO\ndemo\n"))
 
 
 def test_instructions_of_a_module_not_enabled_are_unknown_with_a_hint(demo_path, tmp_path):
     with pytest.raises(AppError) as e:
-        load_app(make_app(tmp_path, "TWICE 1 N7:1\n", modules=None))
+        load_app(demo_app(tmp_path, "TWICE 1 N7:1\n", modules=None))
     assert ("main.lad:1:1: unknown instruction 'TWICE' (TWICE is an instruction of the DEMO module: "
             "add DEMO to the app's MODULES.LST)") in str(e.value)
 
 
 def test_without_modules_lst_an_app_has_no_modules(tmp_path):
-    app = load_app(make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules=None))
+    app = load_app(demo_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules=None))
     assert app.modules == [] and app.warnings == []
 
 
@@ -295,7 +292,7 @@ def test_a_module_claiming_a_builtin_mnemonic_is_refused(tmp_path, monkeypatch):
                 return [InstructionSpec("MOV", "my move", (), True, 0, "CLASH")]
     '''), "clash:Clash")
     monkeypatch.syspath_prepend(str(site))
-    app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="CLASH\n")
+    app = demo_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="CLASH\n")
     with pytest.raises(ModuleError, match="MOV of module CLASH is already an instruction of the built-in"):
         load_modules(app)
     sys.modules.pop("clash", None)
@@ -305,7 +302,7 @@ def test_a_module_that_fails_to_import_is_named_with_its_package(tmp_path, monke
     site = tmp_path / "site"
     _install(site, "BROKEN", "raise RuntimeError('no license key')\n", "broken:Broken")
     monkeypatch.syspath_prepend(str(site))
-    app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="; modules\nBROKEN\n")
+    app = demo_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="; modules\nBROKEN\n")
     with pytest.raises(ModuleError) as e:
         load_modules(app)
     assert str(e.value) == (f"{app / 'MODULES.LST'}:2: module BROKEN (package broken) failed to load: an error in "
@@ -337,7 +334,7 @@ def test_a_module_whose_library_is_missing_says_which_in_one_located_line(case, 
     source, requires, said = MISSING[case]
     site = tmp_path / "site"
     _install(site, "NEEDY", source, "needy:Lib", requires)
-    app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="; the test module\nneedy\n")
+    app = demo_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules="; the test module\nneedy\n")
     # a process: the module comes in at the start of a fresh interpreter, from PYTHONPATH, as a user's does
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(site), os.environ.get("PYTHONPATH", "")]))
     for command in (["run", str(app), "--fresh", "--scans", "3"], ["check", str(app)]):
@@ -371,7 +368,7 @@ def test_modbtcps_in_an_install_without_pymodbus_says_so_at_load(tmp_path):
 
 
 def test_the_softplc_command_runs_a_third_party_module(demo_path, tmp_path):
-    app = make_app(tmp_path, PROGRAM)
+    app = demo_app(tmp_path, PROGRAM)
     proc = softplc_here("run", str(app), "--fresh", "--scans", "3", "--set", "N7:0=5", "--set", "B3/0=1",
                         "--print", "N7:1", "--print", "R6:0.POS")  # demo_path: DEMO on this process's import path
     assert proc.returncode == 0, proc.stderr
@@ -380,7 +377,7 @@ def test_the_softplc_command_runs_a_third_party_module(demo_path, tmp_path):
 
 
 def test_a_config_file_of_a_module_not_enabled_is_pointed_out(tmp_path):
-    app = make_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules=None, **{"comgenius.lst": "not read\n", "notes.txt": ""})
+    app = demo_app(tmp_path, "XIC B3/0 OTE B3/1\n", modules=None, **{"comgenius.lst": "not read\n", "notes.txt": ""})
     assert load_app(app).warnings == [f"{app / 'comgenius.lst'}: COMGENIUS is not enabled (add COMGENIUS to "
                                       "MODULES.LST), so this file is not read"]
     (app / "comgenius.lst").unlink()

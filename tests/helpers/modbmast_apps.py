@@ -8,6 +8,7 @@ import itertools
 from collections import deque
 from pathlib import Path
 
+from helpers.apps import make_app
 from softplc_lite.app import load_app
 from softplc_lite.ladder.engine import Mode
 from softplc_lite.ports.wire import char_time_ns
@@ -23,13 +24,7 @@ def link() -> str:
 
 def write_app(directory: Path, xml: str, ladder: str = "XIC B3/0 OTE B3/1\n", modules: str = "MODBMAST\n",
               extra: dict[str, str] | None = None) -> Path:
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / "MODULES.LST").write_text(modules)
-    (directory / "MODBMAST.XML").write_text(xml)
-    (directory / "main.lad").write_text(ladder)
-    for name, text in (extra or {}).items():
-        (directory / name).write_text(text)
-    return directory
+    return make_app(directory, ladder, MODULES_LST=modules, MODBMAST_XML=xml, **(extra or {}))
 
 
 def serial_xml(ports: str, root: str = "") -> str:

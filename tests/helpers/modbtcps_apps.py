@@ -15,6 +15,7 @@ from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions, Runner
 
 from helpers.modbus_peer import free_tcp_port
+from helpers.apps import make_app
 
 LIMIT_S = 15.0  # any one wait; a step normally takes well under a second
 
@@ -43,13 +44,7 @@ def server_xml(units: str = UNIT_1, port: int | None = None, **root: object) -> 
 
 def write_app(directory: Path, xml: str, ladder: str = "ADD N11:0 1 N11:0\n", modules: str = "MODBTCPS\n",
               extra: dict[str, str] | None = None) -> Path:
-    directory.mkdir(parents=True, exist_ok=True)
-    (directory / "MODULES.LST").write_text(modules)
-    (directory / "MODBTCPS.XML").write_text(xml)
-    (directory / "main.lad").write_text(ladder)
-    for name, text in (extra or {}).items():
-        (directory / name).write_text(text)
-    return directory
+    return make_app(directory, ladder, MODULES_LST=modules, MODBTCPS_XML=xml, **(extra or {}))
 
 
 def raw_request(port: int, pdu: bytes, unit: int = 1) -> bytes:
