@@ -4,11 +4,11 @@ change of what the code depends on makes a new cache."""
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import pytest
 
+from helpers.shipped_apps import copy_app
 from softplc_lite.app import load_app
 from softplc_lite.ladder import Engine, Mode, load_text
 from softplc_lite.ladder import codecache
@@ -109,12 +109,6 @@ def test_breakpoints_and_source_work_on_cached_code(tmp_path):
     assert cached.table == fresh.table and breaks.after_scan() is not None
 
 
-def _app(tmp_path: Path, name: str = "blinker") -> Path:
-    app = tmp_path / name
-    shutil.copytree(PROGRAMS / name, app, ignore=shutil.ignore_patterns(".softplc"))
-    return app
-
-
 def _run(app_dir: Path, scans: int = 30):
     app = load_app(app_dir)
     runner = Runner(app, RunOptions(fresh=True))
@@ -127,7 +121,7 @@ def _run(app_dir: Path, scans: int = 30):
 
 
 def test_an_app_loads_from_its_cache_the_second_time(tmp_path):
-    app_dir = _app(tmp_path)
+    app_dir = copy_app("blinker", tmp_path)
     first, table1 = _run(app_dir)
     assert first.code is None and first.source_program is not None  # compiled, then cached
     assert (app_dir / ".softplc" / codecache.CACHE_FILE).exists()
@@ -139,7 +133,7 @@ def test_an_app_loads_from_its_cache_the_second_time(tmp_path):
 
 @pytest.mark.parametrize("change", ["program", "settings", "version"])
 def test_any_change_of_what_the_code_depends_on_makes_a_new_cache(tmp_path, change, monkeypatch):
-    app_dir = _app(tmp_path)
+    app_dir = copy_app("blinker", tmp_path)
     _run(app_dir)
     if change == "program":
         lad = sorted(app_dir.glob("*.lad"))[0]
@@ -165,7 +159,7 @@ def test_the_module_set_is_part_of_the_key():
 
 @pytest.mark.parametrize("damage", [b"", b"\x00garbage\xff" * 50, "truncate"])
 def test_a_damaged_cache_is_ignored_and_replaced(tmp_path, damage):
-    app_dir = _app(tmp_path)
+    app_dir = copy_app("blinker", tmp_path)
     _, table1 = _run(app_dir)
     path = app_dir / ".softplc" / codecache.CACHE_FILE
     blob = path.read_bytes()
@@ -178,7 +172,7 @@ def test_a_damaged_cache_is_ignored_and_replaced(tmp_path, damage):
 
 
 def test_an_unwritable_state_directory_only_loses_the_cache(tmp_path):
-    app_dir = _app(tmp_path)
+    app_dir = copy_app("blinker", tmp_path)
     cache = CodeCache(app_dir / "plain-file" / "sub")
     (app_dir / "plain-file").write_text("not a directory")
     program = load_text("XIC B3/0 OTE B3/1\n")
@@ -188,7 +182,7 @@ def test_an_unwritable_state_directory_only_loses_the_cache(tmp_path):
 
 @pytest.mark.parametrize("app_name", sorted(p.name for p in PROGRAMS.iterdir() if any(p.glob("*.lad"))))
 def test_every_shipped_app_caches_and_compiles_the_same_code(tmp_path, app_name):
-    app_dir = _app(tmp_path, app_name)
+    app_dir = copy_app(app_name, tmp_path)
     app = load_app(app_dir)
     engine = Engine(app.program, modules=app.modules)
     try:

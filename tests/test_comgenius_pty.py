@@ -29,6 +29,7 @@ import pytest
 
 from helpers.cli import softplc_here
 from helpers.ptypair import PtyPair, require_socat, socat_processes
+from helpers.apps import make_app
 from softplc_lite.datatable import DataTable
 from softplc_lite.ladder import Engine, Mode, load_text
 from softplc_lite.ladder import status as S
@@ -534,19 +535,16 @@ def test_pty_vanishes_while_running_then_comes_back(pty, runtimes):
     exchange(a, b, "again")
 
 
-def make_app(tmp_path: Path, device: str, driver: str = "") -> Path:
+def serial_app(tmp_path: Path, device: str, driver: str = "") -> Path:
     """An app directory as programs/strings/ is laid out: MODULES.LST, main.lad, COMGENIUS.LST."""
-    app = tmp_path / "serialapp"
-    app.mkdir()
-    (app / "MODULES.LST").write_text("; the modules this app uses\nCOMGENIUS\n")
-    (app / "main.lad").write_text('DATA ST9 1 = "ping"\nXIC B3/0 COMPRINT R6:0 0 7 ST9:0\n')
-    (app / "COMGENIUS.LST").write_text(lst(device, driver=driver), encoding="latin-1")
-    return app
+    return make_app(tmp_path / "serialapp", 'DATA ST9 1 = "ping"\nXIC B3/0 COMPRINT R6:0 0 7 ST9:0\n',
+                    MODULES_LST="; the modules this app uses\nCOMGENIUS\n",
+                    COMGENIUS_LST=lst(device, driver=driver).encode("latin-1"))
 
 
 def test_cli_reports_a_missing_device_without_a_traceback(tmp_path):
     missing = tmp_path / "no-such-tty"
-    app = make_app(tmp_path, str(missing))
+    app = serial_app(tmp_path, str(missing))
     p = softplc_here("run", str(app), "--scans", "5", "--fresh")
     assert p.returncode == 1, (p.stdout, p.stderr)
     line = ports_line((app / "COMGENIUS.LST").read_text())
@@ -557,7 +555,7 @@ def test_cli_reports_a_missing_device_without_a_traceback(tmp_path):
 
 def test_cli_with_retry_runs_on_without_the_device(tmp_path):
     missing = tmp_path / "no-such-tty"
-    app = make_app(tmp_path, str(missing), driver="PORT_ERRORS=RETRY\nRETRY_MS=50")
+    app = serial_app(tmp_path, str(missing), driver="PORT_ERRORS=RETRY\nRETRY_MS=50")
     p = softplc_here("run", str(app), "--scans", "5", "--fresh", "--set", "B3/0=1", "--print", "R6:0")
     assert p.returncode == 0, (p.stdout, p.stderr)
     line = ports_line((app / "COMGENIUS.LST").read_text())
@@ -570,7 +568,7 @@ def test_cli_with_retry_runs_on_without_the_device(tmp_path):
 def test_cli_port_override_sends_over_the_pty(tmp_path, pty):
     import serial
 
-    app = make_app(tmp_path, str(tmp_path / "no-such-tty"))
+    app = serial_app(tmp_path, str(tmp_path / "no-such-tty"))
     reader = serial.Serial(pty.b, 38400, timeout=0)
     try:
         p = softplc_here("run", str(app), "--scans", "3", "--fresh", "--set", "B3/0=1", "--port", f"0={pty.a}",

@@ -9,17 +9,15 @@ import pytest
 from rich.console import Console
 
 from helpers.cli import softplc_here
+from helpers.apps import make_app
 from softplc_lite.app import AppError, load_app
 from softplc_lite.datatable import DataTable
 from softplc_lite.run_output import StatusLine, parse_display
 
 
 def app_dir(tmp_path: Path, display: str) -> Path:
-    d = tmp_path / "counting"
-    d.mkdir()
-    (d / "main.lad").write_text("SYMBOL Count N7:0\nADD Count 1 Count\nXIC S:1/15 FLL 7 #N11:0 4\n")
-    (d / "softplc.toml").write_text("[scan]\nscan_ms = 5\n\n[display]\n" + display)
-    return d
+    return make_app(tmp_path / "counting", "SYMBOL Count N7:0\nADD Count 1 Count\nXIC S:1/15 FLL 7 #N11:0 4\n",
+                    softplc_toml="[scan]\nscan_ms = 5\n\n[display]\n" + display)
 
 
 def test_summary_after_a_bounded_run(tmp_path):

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import os
 import resource
-import shutil
 import socket
 import subprocess
 import sys
@@ -30,16 +29,10 @@ from softplc_lite.textfile import FileRefused, Limit, read_bytes, read_text, siz
 from softplc_lite.watch.watchlist import read_watch_file
 
 from helpers.cli import softplc
+from helpers.shipped_apps import copy_app
 
-PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
 GiB = 1 << 30
 PROMPT_S = 30  # a refusal comes at once; a command that waits on a FIFO never ends, and is stopped after this
-
-
-def copy_app(tmp_path: Path, name: str) -> Path:
-    app = tmp_path / name
-    shutil.copytree(PROGRAMS / name, app, ignore=shutil.ignore_patterns(".softplc"))
-    return app
 
 
 def sparse(path: Path, size: int) -> Path:
@@ -191,7 +184,7 @@ def test_every_kind_of_file_has_its_limit_and_says_it(tmp_path):
     # softplc.toml, MODULES.LST, a module's config file, datatable.json.
     for name, limit in (("softplc.toml", textfile.CONFIG), ("MODULES.LST", textfile.CONFIG),
                         ("COMGENIUS.LST", textfile.CONFIG), ("datatable.json", textfile.DATA_JSON)):
-        app = copy_app(tmp_path / name, "loopback")
+        app = copy_app("loopback", tmp_path / name)
         (app / name).unlink(missing_ok=True)
         over(limit, app / name)
         with pytest.raises(AppError) as info:
@@ -211,7 +204,7 @@ def test_every_kind_of_file_has_its_limit_and_says_it(tmp_path):
 def test_a_special_file_in_an_app_directory_is_reported_not_left_out(tmp_path):
     """A FIFO named like a program file, or a dangling link, is a program file
     that cannot be read: the app does not run without it."""
-    app = copy_app(tmp_path, "blinker")
+    app = copy_app("blinker", tmp_path)
     fifo(app / "extra.lad")
     (app / "gone.lad").symlink_to(tmp_path / "nowhere.lad")
     with unblocked(app / "extra.lad"), pytest.raises(AppError) as info:
@@ -223,7 +216,7 @@ def test_a_special_file_in_an_app_directory_is_reported_not_left_out(tmp_path):
 
 
 def test_a_special_modules_lst_is_refused_not_ignored(tmp_path):
-    app = copy_app(tmp_path, "loopback")
+    app = copy_app("loopback", tmp_path)
     (app / "MODULES.LST").unlink()
     zero_link(app / "MODULES.LST")
     with pytest.raises(AppError, match=r"MODULES.LST: not a regular file \(a character device\)"):
@@ -269,7 +262,7 @@ CLI_CASES = [
 @pytest.mark.parametrize("what, app_name, name, make, args, said", CLI_CASES, ids=[c[0] for c in CLI_CASES])
 def test_the_cli_refuses_a_special_or_huge_input_promptly_and_says_where(tmp_path, what, app_name, name, make,
                                                                          args, said):
-    app = copy_app(tmp_path, app_name)
+    app = copy_app(app_name, tmp_path)
     (app / name).unlink(missing_ok=True)
     make(app / name)
     p = softplc_capped(*args, cwd=tmp_path)
@@ -305,7 +298,7 @@ TWO_BLINKS = {"C5:0.ACC": 2, "T4:0.ACC": 50}  # after 100 more
 def damage_snapshot(tmp_path: Path, make) -> tuple[Path, Path]:
     """The blinker run once (its snapshot and, durable at the end, .prev),
     then its snapshot replaced by ``make(path)``."""
-    app = copy_app(tmp_path, "blinker")
+    app = copy_app("blinker", tmp_path)
     assert run_in_process(app, fresh=True)[0] == ONE_BLINK
     snap = app / ".softplc" / "datatable.snap"
     snap.unlink()
@@ -346,7 +339,7 @@ def test_a_snapshot_linked_to_dev_zero_is_said_and_the_previous_one_used_by_the_
 
 
 def test_a_snapshot_that_is_a_fifo_without_a_previous_one_stops_the_start_and_suggests_fresh(tmp_path):
-    app = copy_app(tmp_path, "blinker")
+    app = copy_app("blinker", tmp_path)
     (app / ".softplc").mkdir()
     fifo(app / ".softplc" / "datatable.snap")
     p = run_blinker(tmp_path)
@@ -357,7 +350,7 @@ def test_a_snapshot_that_is_a_fifo_without_a_previous_one_stops_the_start_and_su
 
 @pytest.mark.parametrize("damage", ["FIFO", "over its limit"])
 def test_a_code_cache_that_is_not_a_usable_file_is_said_and_rebuilt(tmp_path, damage):
-    app = copy_app(tmp_path, "blinker")
+    app = copy_app("blinker", tmp_path)
     assert run_in_process(app, fresh=True)[0] == ONE_BLINK
     cache = app / ".softplc" / "codecache.bin"
     kept = cache.read_bytes()
@@ -373,7 +366,7 @@ def test_a_code_cache_that_is_not_a_usable_file_is_said_and_rebuilt(tmp_path, da
 
 
 def test_a_code_cache_linked_to_dev_zero_is_said_and_rebuilt_by_the_cli(tmp_path, monkeypatch):
-    app = copy_app(tmp_path, "blinker")
+    app = copy_app("blinker", tmp_path)
     assert run_in_process(app, fresh=True)[0] == ONE_BLINK
     cache = app / ".softplc" / "codecache.bin"
     kept = cache.read_bytes()  # made in this process: positions name the files by their absolute paths

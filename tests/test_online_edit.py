@@ -9,6 +9,7 @@ import weakref
 
 import pytest
 
+from helpers.apps import make_app
 from softplc_lite.app import load_app
 from softplc_lite.ladder import Engine, Mode, load_text
 from softplc_lite.ladder import status as S
@@ -256,10 +257,7 @@ def scan_until_edit(watcher: ProgramWatcher, engine: Engine, timeout_s: float = 
 
 @pytest.fixture
 def app_dir(tmp_path):
-    app = tmp_path / "app"
-    app.mkdir()
-    (app / "main.lad").write_text("XIC B3/0 TON T4:0 0.01 1000 0\nADD N7:0 1 N7:0\n")
-    return app
+    return make_app(tmp_path / "app", "XIC B3/0 TON T4:0 0.01 1000 0\nADD N7:0 1 N7:0\n")
 
 
 @pytest.mark.parametrize("executor", EXECUTORS)

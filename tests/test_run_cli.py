@@ -14,14 +14,12 @@ from pathlib import Path
 import pytest
 
 from helpers.cli import ROOT, softplc_here
+from helpers.apps import make_app
 
 
 @pytest.fixture
 def app(tmp_path: Path) -> Path:
-    d = tmp_path / "counter"
-    d.mkdir()
-    (d / "main.lad").write_text("// count scans\nADD N7:0 1 N7:0\nXIC S:1/15 MOV 7 N7:1\n")
-    return d
+    return make_app(tmp_path / "counter", "// count scans\nADD N7:0 1 N7:0\nXIC S:1/15 MOV 7 N7:1\n")
 
 
 def test_run_counts_scans_and_keeps_retentive_memory(app):

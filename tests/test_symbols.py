@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from helpers.cli import softplc_here
+from helpers.apps import make_app
 from softplc_lite.app import load_app
 from softplc_lite.datatable import DataTableError, parse_address
 from softplc_lite.run_output import parse_item
@@ -160,13 +161,10 @@ def test_name_slash_name_in_an_expression_is_a_bit_and_the_error_says_how_to_div
 
 @pytest.fixture
 def app(tmp_path: Path) -> Path:
-    d = tmp_path / "sym"
-    d.mkdir()
-    (d / "main.lad").write_text(DECLS + "XIC Start TON PollTimer 0.01 100 0\nXIC Flags/3 OTE Reply/EN\n"
-                                "XIC PollTimer/TT MOV PollTimer.ACC Levels[3]\n")
-    (d / "softplc.toml").write_text('[display]\nstatus = { "timer" = "PollTimer.ACC", "reply" = "Reply/EN" }\n'
-                                    'summary = { "levels" = "#Levels 4" }\n')
-    return d
+    return make_app(tmp_path / "sym", DECLS + "XIC Start TON PollTimer 0.01 100 0\nXIC Flags/3 OTE Reply/EN\n"
+                    "XIC PollTimer/TT MOV PollTimer.ACC Levels[3]\n",
+                    softplc_toml='[display]\nstatus = { "timer" = "PollTimer.ACC", "reply" = "Reply/EN" }\n'
+                                 'summary = { "levels" = "#Levels 4" }\n')
 
 
 def test_set_and_force_and_watch_take_symbol_members(app):

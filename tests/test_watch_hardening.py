@@ -28,6 +28,7 @@ from softplc_lite.watch.rungs import RungView
 
 from helpers.cli import softplc_here
 from helpers.ladder_strategies import programs
+from helpers.apps import make_app
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -92,10 +93,7 @@ def best_time(fn, repeat: int = 5, number: int = 3) -> float:
 
 
 def app(tmp_path: Path, text: str, name: str = "app") -> Path:
-    directory = tmp_path / name
-    directory.mkdir()
-    (directory / "main.lad").write_text(text, encoding="utf-8")
-    return directory
+    return make_app(tmp_path / name, text)
 
 
 # -- layout: linear in the rung's size -----------------------------------------------------------
