@@ -1,5 +1,5 @@
 """AB-documented cases: programs whose results Allen-Bradley's manuals state,
-run on both executors (issue 16, "Measured").
+run on both executors.
 
 Each file in tests/data/ab_cases/ is TOML: a list of ``[[case]]`` tables with
 ``name``, ``source`` (the AB publication and section the expectation comes

@@ -1,4 +1,4 @@
-"""The compact syntax tree (issue 17, "Memory"): slotted nodes that keep
+"""The compact syntax tree: slotted nodes that keep
 their position as slots, tuples in the validated tree, pickling (a code
 cache pickles the validated Program), and the value semantics the
 dataclass nodes had."""

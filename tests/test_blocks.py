@@ -1,4 +1,4 @@
-"""The block code shapes (issue 17): words held in locals are written back
+"""The block code shapes: words held in locals are written back
 wherever anything else can look at the table, on both executors alike
 (docs/engine.md, "Compiled code")."""
 

@@ -1,4 +1,4 @@
-"""issue 18, section 2: ``--replay`` as a CI gate. Output differences exit
+"""``--replay`` as a CI gate. Output differences exit
 5; a trace says how many scans it covers (``# scans: N``) and a replay
 without --scans stops at the end of the trace. Real runs of the shipped
 Modbus master against its shipped recording, by cli.main in the test's

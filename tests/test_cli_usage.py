@@ -1,7 +1,7 @@
-"""issue 18, section 2: usage errors name only the rule broken (exit 2),
+"""Usage errors name only the rule broken (exit 2),
 addresses are checked before scan 0 (exit 1, nothing run or saved), the
 help texts, --version, softplc alone, softplc datatable alone, and the
-CLI-level watch fixes (--snapshot leaves the retentive state alone unless
+watch options' rules at the command line (--snapshot leaves the retentive state alone unless
 --save; --scans needs --snapshot). The command run by cli.main in the
 test's process, on real files: each test checks what it prints, returns and
 writes."""

@@ -1,4 +1,4 @@
-"""The code cache (issue 17): a program loaded before runs from its cached
+"""The code cache: a program loaded before runs from its cached
 tree and compiled code exactly as it runs when compiled afresh, and any
 change of what the code depends on makes a new cache."""
 

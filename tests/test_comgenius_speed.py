@@ -1,4 +1,4 @@
-"""The shortcuts of issue 17 in COMSCAN and the simulated wire, each with a
+"""The shortcuts COMSCAN and the simulated wire take, each with a
 test that fails if the work it skips was needed:
 
 - COMSCAN does not repeat a match on the same receive buffer when the last

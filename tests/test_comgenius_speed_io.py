@@ -1,4 +1,4 @@
-"""The second round of issue-17 shortcuts on the Modbus master's scan, each
+"""The shortcuts on the Modbus master's scan, each
 with a test that fails if the work it skips was needed:
 
 - a clocked COMGENIUS port does not read a quiet simulated link at all, and

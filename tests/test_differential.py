@@ -1,6 +1,5 @@
 """Differential tests: the compiled fast path against the reference
-interpreter on random programs, and fmt round trips (issue 3, sections 1
-and 4).
+interpreter on random programs, and fmt round trips.
 
 (a) Random valid programs (tests/helpers/ladder_strategies.py) run for SCANS scans
     through ``Engine(program, executor="compiled")`` and

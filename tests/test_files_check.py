@@ -1,5 +1,5 @@
-"""softplc check lists every problem of every config file, not the first
-(issue 18): MODULES.LST, COMGENIUS.LST (sim:// options included),
+"""softplc check lists every problem of every config file, not the first:
+MODULES.LST, COMGENIUS.LST (sim:// options included),
 MODBMAST.XML sim:// devices, softplc.toml; each with file and line, and
 "N problems found". Each runs the CLI in this process (helpers.cli): the
 test reads only what it prints and returns."""

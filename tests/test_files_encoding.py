@@ -1,4 +1,4 @@
-"""Input files from Windows editors (issue 18): a UTF-8 BOM, and UTF-16 LE
+"""Input files from Windows editors: a UTF-8 BOM, and UTF-16 LE
 or BE with a BOM, are read in every file kind: .lad, softplc.toml,
 MODULES.LST, COMGENIUS.LST, MODBMAST.XML, datatable.json, --load JSON,
 watch files, port traces. Line and column numbers count the characters

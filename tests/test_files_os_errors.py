@@ -1,4 +1,4 @@
-"""OS errors on a user's files are said in words (issue 18): "cannot read
+"""OS errors on a user's files are said in words: "cannot read
 APP/softplc.toml: it is a directory", never "[Errno 21] Is a directory:
 '...'"; and a retentive snapshot that does not fit the program says that
 it is the retentive snapshot in APP/.softplc/ and suggests --fresh.

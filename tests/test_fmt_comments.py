@@ -1,4 +1,4 @@
-"""softplc fmt keeps every comment (issue 18): the file header, comment
+"""softplc fmt keeps every comment: the file header, comment
 lines between rungs, SYMBOL/DATA/FILE line comments, comments inside
 SOR ... EOR and inside a multi-line neutral rung, trailing rung comments.
 What it prints parses back to the same program and is a fixed point."""

@@ -37,9 +37,9 @@ EXAMPLES = {
     "special_files": 20, "state_damage": 12, "signals": 3, "modbus_tcp": 2,
 }
 
-# Findings the product still has for inputs the MUST_PASS profile draws,
-# each reported (issue 15); tolerated here by signature until fixed.
-TOLERATED: dict[str, str] = {}  # none now: the three the harness first met are fixed
+# Findings the product has for inputs the MUST_PASS profile draws, each a
+# known bug, tolerated here by signature until it is fixed; none is known.
+TOLERATED: dict[str, str] = {}
 
 
 COMMAND_TIMEOUT = 20.0

@@ -1,4 +1,4 @@
-"""Fuzzing the bound instructions of issue 16 (ladder/instr/): random
+"""Fuzzing the bound instructions (ladder/instr/): random
 programs of NOP END BSL BSR FFL FFU LFL LFU SQO SQI SQL SQC FAL FSC AVE STD
 SRT TOD FRD DDV XPY SIN COS TAN ASN ACS ATN LN LOG SCL SCP SWP DCD ENC PID,
 with JSR/SBR/RET parameters, D/A/L files, SLC I/O addresses and symbol
@@ -314,9 +314,9 @@ def _plain(draw, m):
     return m
 
 
-# Instructions older than issue 16, on its new operands (L, D and A files, SLC
-# I/O addresses, symbol members and offsets): these have a compiler template
-# and a separate interpreter rule, so the two executors can disagree.
+# The instructions outside ladder/instr/, on the wider operands (L, D and A files, SLC I/O
+# addresses, symbol members and offsets): these have a compiler template and a separate
+# interpreter rule, so the two executors can disagree.
 
 
 def _integer_operand(draw, dest: bool = False) -> str:

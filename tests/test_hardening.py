@@ -1,5 +1,5 @@
-"""Issue 15: inputs that once reached the user as a Python traceback, a
-wrong fault or a check/run disagreement. Each case runs the real CLI entry
+"""Inputs that must not reach the user as a Python traceback, a wrong
+fault or a check/run disagreement. Each case runs the real CLI entry
 point (``softplc_lite.cli.main``) in-process, and a few run the real
 ``softplc`` command, and require a located error or a clean run."""
 
@@ -396,7 +396,7 @@ def test_fmt_is_a_fixed_point(tmp_path, capsys, lad, style):
     ("XIC B3/0 OTE\n", "mnemonic"),  # an operand missing
 ])
 def test_fmt_refuses_what_check_refuses_with_the_same_problems(tmp_path, capsys, lad, style):
-    """Issue 18: fmt refuses invalid programs (exit 1), every problem as
+    """fmt refuses invalid programs (exit 1), every problem as
     softplc check lists it; nothing is printed."""
     (tmp_path / "a.lad").write_text(lad)
     code, out, err = run_cli(capsys, "fmt", "--style", style, str(tmp_path / "a.lad"))

@@ -1,4 +1,4 @@
-"""File arithmetic and search (issue 16 section 2): FAL and FSC in ALL,
+"""File arithmetic and search: FAL and FSC in ALL,
 INC and numeric modes, and AVE, STD, SRT (ladder/instr/filemath.py).
 
 Every behaviour runs on both executors: ``drive`` runs the same steps on

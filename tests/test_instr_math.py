@@ -1,4 +1,4 @@
-"""Math functions and conversions as instructions (issue 16 section 2):
+"""Math functions and conversions as instructions:
 SIN COS TAN ASN ACS ATN LN LOG, XPY, DDV, SCL, SCP (ladder/instr/mathfn.py)
 and TOD, FRD, SWP, DCD, ENC (ladder/instr/convert.py).
 

@@ -1,4 +1,4 @@
-"""JSR / SBR / RET with input and return parameters (issue 16, section 2).
+"""JSR / SBR / RET with input and return parameters.
 
 ``JSR file inputs in... ret...``: the first ``inputs`` parameters go to the
 addresses of the subroutine's SBR, the rest receive the values of the RET

@@ -1,5 +1,5 @@
-"""MODBTCPS against hostile and misbehaving clients (issue 19, "safe by
-default"): the allow-list, the connection and request-rate limits, garbage
+"""MODBTCPS against hostile and misbehaving clients (safe by
+default): the allow-list, the connection and request-rate limits, garbage
 and oversize frames, half-open and slowloris connections, a client that
 never reads its replies, pipelined requests, writes answered once applied.
 

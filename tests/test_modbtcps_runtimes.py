@@ -1,4 +1,4 @@
-"""MODBTCPS end to end (issue 19, section 2): 20 clients writing counters
+"""MODBTCPS end to end: 20 clients writing counters
 while the ladder runs on the wall clock, and two runtimes, one polling the
 other with COMGENIUS over a ``socket://`` port.
 

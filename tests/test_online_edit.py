@@ -1,4 +1,4 @@
-"""Online program edit (issue 18): Engine.replace_program on both
+"""Online program edit: Engine.replace_program on both
 executors, program_changes, and ProgramWatcher on real files."""
 
 from __future__ import annotations

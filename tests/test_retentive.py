@@ -1,4 +1,4 @@
-"""Retentive memory while running (issue 15): saves every save_ms between
+"""Retentive memory while running: saves every save_ms between
 scans, storage trouble as a minor fault, and what a real SIGKILL loses,
 measured from outside the process."""
 

@@ -1,4 +1,4 @@
-"""Symbols as engineers write them (issue 16 section 3): members, bits and
+"""Symbols as engineers write them: members, bits and
 offsets of a symbol in both rung syntaxes, in expressions and at every place
 an address is taken (--set, --print, --watch, --watch-file, --force,
 --break-when, [display]); names compare without regard to case."""

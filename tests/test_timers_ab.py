@@ -1,5 +1,5 @@
 """Timers add the time since their own last update, and the SLC free-running
-clock S:4 (issue 16 section 1; docs/instructions.md, timer rules, and
+clock S:4 (docs/instructions.md, timer rules, and
 docs/engine.md, the status file). Every test runs on both executors."""
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ def _acc_by_scan(text: str, scans: int, executor: str, addr: str = "T4:0", **kw)
     return out
 
 
-# A subroutine called twice a scan: the second evaluation adds nothing (today's bug added the scan twice).
+# A subroutine called twice a scan: the second evaluation adds nothing (adding at each evaluation counts the scan twice).
 TWICE = "JSR 3\nJSR 3\nFILE 3\n{timer}\n"
 
 

@@ -1,4 +1,4 @@
-"""The watch view against sizes that once hung or crashed it (issue 15):
+"""The watch view against sizes that could hang or crash a naive layout:
 deep, wide and long rungs, huge snapshot sizes, an app with no rungs,
 watch files too big or not text, expressions nested too deep. Layout is
 checked through the library, the command line through ``softplc``'s
@@ -102,9 +102,10 @@ def app(tmp_path: Path, text: str, name: str = "app") -> Path:
 @pytest.mark.parametrize("width", [64, 100])
 @pytest.mark.parametrize("second_leg", [True, False])
 def test_deep_rung_layout_grows_linearly(width, second_leg, monkeypatch):
-    # Each level used to be laid out twice (at its budget, then narrower)
-    # once the rung stopped fitting: 14 levels took 5 s at 64 columns, 16
-    # levels 22 s, 23 levels at 100 columns never finished. The work is
+    # A layout that lays each level out twice (at its budget, then narrower)
+    # once the rung stops fitting grows exponentially with depth: 14 levels
+    # take 5 s at 64 columns, 16 levels 22 s, 23 levels at 100 columns never
+    # finish. This checks the work grows linearly. The work is
     # counted (the layout's measurements), not timed: a count holds
     # whatever else the machine runs.
     measured = {}
@@ -240,7 +241,7 @@ def test_every_rung_line_is_exactly_the_width(program, width):
     (("--scans", "-1"), "argument --scans: expected an integer 0 or more, not '-1'"),
 ])
 def test_snapshot_size_and_scans_out_of_range_are_usage_errors(tmp_path, args, message):
-    # --width 100000 --height 100000 used to render ten billion cells: it never finished
+    # --width 100000 --height 100000 would be ten billion cells to render, a run that never ends: refused first
     out = tmp_path / "view.txt"
     proc = softplc_here("watch", "programs/blinker", "--fresh", "--state", str(tmp_path / "state"),
                         "--snapshot", str(out), *args)
@@ -414,7 +415,7 @@ def test_too_many_watch_addresses_and_long_arguments_give_short_errors(tmp_path)
 
 
 def test_setting_thousands_of_forces_costs_the_same_for_each(tmp_path):
-    # each force used to resolve every force again: 10,000 of them took minutes
+    # a force that resolves every force again makes 10,000 of them take minutes: each must cost the same
     from softplc_lite.app import load_app
     from softplc_lite.runner import RunOptions
     from softplc_lite.watch.forces import parse_force

@@ -1,4 +1,4 @@
-"""Online program edit in the real ``softplc watch`` (issue 18 §1), in tmux:
+"""Online program edit in the real ``softplc watch``, in tmux:
 the view watches the app's .lad files; a saved valid version replaces the
 running program between two scans with the data table kept, and the view
 says what changed; a saved version with errors changes nothing, the message

@@ -1,5 +1,5 @@
-"""The watch view's servers panel (issue 19: "softplc watch shows the
-server: clients connected, requests per second, refusals"), rendered from a
+"""The watch view's servers panel (clients connected, requests per second,
+refusals), rendered from a
 real MODBTCPS app with pymodbus's client making real requests, and once in
 the real ``softplc watch`` in tmux."""
 

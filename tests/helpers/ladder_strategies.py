@@ -64,7 +64,7 @@ N7_BITS = [f"N7:{e}/{b}" for e in range(10) for b in (0, 1, 2, 7, 15)]
 TIMER_BITS = [f"T4:{k}/{b}" for k in range(4) for b in ("EN", "TT", "DN")]
 COUNTER_BITS = [f"C5:{k}/{b}" for k in range(4) for b in ("CU", "CD", "DN", "OV", "UN")]
 # The arithmetic flags (carry, overflow, zero, sign), which math sets and the
-# compiled code may hold in a local (issue 17).
+# compiled code may hold in a local.
 STATUS_BITS = [f"S:0/{b}" for b in range(4)]
 STRUCT_WORDS = [f"T4:{k}.{m}" for k in range(4) for m in ("PRE", "ACC")] + [
     f"C5:{k}.{m}" for k in range(4) for m in ("PRE", "ACC")]
