@@ -193,8 +193,8 @@ class _Scanner:
         return False
 
     # One regex match a run, not a Python step a character: a 10,000-rung
-    # program names thousands of distinct addresses (issue 17, load time).
-    # ASCII only, as str.isascii() and isdigit()/isalpha() were.
+    # program names thousands of distinct addresses, each parsed at load.
+    # ASCII only, as str.isascii() with isdigit()/isalpha() accept.
     def digits(self) -> str:
         run = _DIGITS(self.text, self.pos).group()
         self.pos += len(run)

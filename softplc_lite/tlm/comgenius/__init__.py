@@ -1,4 +1,4 @@
-"""The COMGENIUS TLM: format engine and serial instructions (issues 4 and 5)."""
+"""The COMGENIUS TLM: format engine and serial instructions."""
 
 from .module import ComGenius
 

@@ -185,7 +185,7 @@ class ComScan(_Controlled):
     def step(self, ctl: ControlElement) -> bool:
         # Run on every true scan while a reply arrives: the common outcome
         # (NEED_MORE on a buffer seen before, or one that only grew) is worked
-        # out without a match, a result object or a property call (issue 17).
+        # out without a match, a result object or a property call.
         port = self.port_obj
         if port.error is not None:
             return self._error(ctl, f"port {port.number} is down: {port.error}")

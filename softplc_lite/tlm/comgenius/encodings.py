@@ -93,7 +93,7 @@ class _Latin1Decoder(Decoder):
         pass
 
     # bytes.decode itself, called without a Python frame (a port's input
-    # decodes at every scan while a reply arrives, issue 17)
+    # decodes at every scan while a reply arrives)
     decode = staticmethod(functools.partial(bytes.decode, encoding="latin-1"))
 
     def reset(self) -> None:

@@ -1,5 +1,5 @@
 """The MODBMAST TLM: a Modbus RTU/ASCII serial master driver configured by
-MODBMAST.XML, with its diagnostic ladder instructions (issue 13)."""
+MODBMAST.XML, with its diagnostic ladder instructions."""
 
 from .module import Modbmast
 
