@@ -8,29 +8,19 @@ has a timeout."""
 
 from __future__ import annotations
 
-import re
 import shlex
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 from helpers.cli_tmux import SOFTPLC, open_terminal
+from helpers.readme import try_it_lines
 from helpers.shipped_apps import copy_programs
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture(name="terminal")
 def fixture_terminal(request):
     yield from open_terminal(request)
-
-
-def try_it_lines() -> list[str]:
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = text.split("\n## Try it\n", 1)[1].split("\n## ", 1)[0]
-    block = re.search(r"```bash\n(.*?)```", section, re.DOTALL).group(1)
-    return [line for line in block.splitlines() if line.strip()]
 
 
 def test_the_try_it_block_is_what_this_test_runs():

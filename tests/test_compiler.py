@@ -4,17 +4,11 @@ line table maps faults back to instructions."""
 from __future__ import annotations
 
 import ast
-import re
+
+from helpers.generated_code import ALLOWED, names_in
 
 from softplc_lite.ladder import Engine, load_text
 
-# Every name generated code may use: data arrays, temporaries, rung
-# functions, bound kernels, module (TLM) instruction instances and
-# expression helpers.
-ALLOWED = re.compile(
-    r"^(f\d+|w\d+_\d+|z|_m|_block|_d\d+|_i\d+|_m\d+|b\d+|o\d+|r\d+|c|_env|_factory|_loc\d+|_tli\d+|_bi\d+|_jsr|_zone|_x_div|_x_mod|_x_pow|_int|"
-    r"_fn_[A-Z]+|_[a-z]+(?:_[a-z]+)*|abs|bool)$"
-)
 
 HOSTILE = r'''
 SYMBOL __import__ N7:0
@@ -27,18 +21,10 @@ CMP "exec_ > 0" OTE B3/1
 '''
 
 
-def _names(source: str) -> set[str]:
-    tree = ast.parse(source)
-    names = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}
-    names |= {n.name for n in ast.walk(tree) if isinstance(n, ast.FunctionDef)}
-    names |= {a.arg for n in ast.walk(tree) if isinstance(n, ast.FunctionDef) for a in n.args.args}
-    return names
-
-
 def test_program_text_never_reaches_generated_code():
     engine = Engine(load_text(HOSTILE, "hostile.lad"))
     source = engine.files[2][0].source
-    names = _names(source)
+    names = names_in(source)
     assert all(ALLOWED.match(n) for n in names), sorted(n for n in names if not ALLOWED.match(n))
     assert "__import__" not in source and "os" not in names and "pwned" not in source
     # Strings in generated code are only subscript keys of the bindings table.
@@ -59,7 +45,7 @@ def test_every_example_program_compiles_to_allowed_names(tmp_path):
         engine = Engine(app.program, modules=app.modules)
         try:
             for compiled, _ in engine.files.values():
-                assert all(ALLOWED.match(n) for n in _names(compiled.source)), app_dir
+                assert all(ALLOWED.match(n) for n in names_in(compiled.source)), app_dir
         finally:
             engine.close()  # the modules' ports
 

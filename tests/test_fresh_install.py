@@ -22,8 +22,8 @@ from pathlib import Path
 
 import pytest
 from helpers.cli_tmux import open_terminal
+from helpers.readme import try_it_lines
 from helpers.shipped_apps import copy_programs
-from test_cli_readme import try_it_lines
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "README.md"

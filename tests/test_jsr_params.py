@@ -398,13 +398,13 @@ def test_jsr_a_ninth_nested_call_faults_with_slc_depth_eight(run):
 
 def test_jsr_and_ret_compiled_code_names_only_allowed_names():
     # the compiled path hands the JSR and the RET to the engine through one bound list, _calls
-    from test_compiler import ALLOWED, _names
+    from helpers.generated_code import ALLOWED, names_in
 
     from softplc_lite.ladder import Engine
 
     engine = Engine(load_text(ADD_TWO + "XIC B3/0 RET 5\n"))
     for number in (2, 3):
         source = engine.files[number][0].source
-        assert not [n for n in _names(source) if not ALLOWED.match(n)]
+        assert not [n for n in names_in(source) if not ALLOWED.match(n)]
     assert "_jsr(3, _calls[0])" in engine.files[2][0].source
     assert "return _calls[0]" in engine.files[3][0].source and "return _calls[1]" in engine.files[3][0].source

@@ -6,8 +6,6 @@ from __future__ import annotations
 import sys
 import time
 
-from helpers.tmux_helpers import Tmux  # noqa: F401  (for the modules that import it from here)
-
 
 def test_step_run_and_quit_in_a_real_terminal(tmux, tmp_path):
     state = tmp_path / "state"
