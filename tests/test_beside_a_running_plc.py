@@ -13,10 +13,9 @@ import errno
 import os
 import shutil
 import socket
-import subprocess
-import sys
 
 import pytest
+from helpers.cli import softplc
 from helpers.isolation import HELD_PORTS, HOLDER_ENV
 from helpers.shipped_apps import PROGRAMS
 
@@ -38,6 +37,5 @@ def test_a_shipped_server_on_its_own_port_fails_beside_the_held_port(tmp_path):
     cannot serve during the suite; its server reports the port taken."""
     app = tmp_path / "hmi_server"
     shutil.copytree(PROGRAMS / "hmi_server", app, ignore=shutil.ignore_patterns(".softplc"))
-    p = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(app), "--fresh", "--scans", "5",
-                        "--state", str(tmp_path / "state")], capture_output=True, text=True, timeout=60)
+    p = softplc("run", str(app), "--fresh", "--scans", "5", "--state", str(tmp_path / "state"))
     assert "5020" in p.stderr and "in use" in p.stderr, p.stderr

@@ -9,10 +9,9 @@ has a timeout."""
 from __future__ import annotations
 
 import shlex
-import subprocess
-import sys
 
 import pytest
+from helpers.cli import softplc
 from helpers.cli_tmux import SOFTPLC, open_terminal
 from helpers.readme import try_it_lines
 from helpers.shipped_apps import copy_programs
@@ -46,7 +45,6 @@ def test_every_try_it_line_works_in_order(tmp_path, terminal):
             terminal.keys("q")
             assert terminal.exit_status() == 0, (line, terminal.screen())
             continue
-        p = subprocess.run([sys.executable, "-m", "softplc_lite", *argv[1:]], cwd=tmp_path, capture_output=True,
-                           text=True, timeout=120, check=False)
+        p = softplc(*argv[1:], cwd=tmp_path, timeout=120)
         assert p.returncode == 0, (line, p.stderr)
         assert "Traceback" not in p.stderr, line

@@ -33,6 +33,7 @@ from softplc_lite.watch.snapshot import render
 from softplc_lite.watch.serversview import ServersView
 from softplc_lite.watch.session import WatchOptions, WatchSession
 
+from helpers.cli import softplc
 from helpers.modbtcps_apps import LIMIT_S, raw_request, server_xml, write_app
 from helpers.modbus_peer import free_tcp_port, wait_for_tcp
 
@@ -319,8 +320,7 @@ def test_compiling_or_drawing_hmi_server_starts_no_server_even_with_its_port_tak
             assert "MODBTCPS 127.0.0.1:" in panel and "not started" in panel and "down" not in panel
         finally:
             session.quit()
-        check = subprocess.run([sys.executable, "-m", "softplc_lite", "check", str(tmp_path / "hmi_server")],
-                               capture_output=True, text=True, timeout=60)
+        check = softplc("check", str(tmp_path / "hmi_server"))
         assert check.returncode == 0 and "ok" in check.stdout, check.stderr
 
 
@@ -411,8 +411,7 @@ def test_kill_9_of_a_runtime_while_its_server_starts_leaves_nothing_in_dev_shm(t
         p.send_signal(signal.SIGKILL)
         p.wait(LIMIT_S)
         killed.append(p.pid)
-    second = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(app), "--scans", "3", "--fresh",
-                             "--print", "N40:0"], capture_output=True, text=True, timeout=60)
+    second = softplc("run", str(app), "--scans", "3", "--fresh", "--print", "N40:0")
     assert second.returncode == 0 and second.stdout.strip() == "N40:0 = 1", second.stderr
     assert left_behind(before, killed) == []
 
@@ -442,8 +441,7 @@ def test_a_pymodbus_lacking_what_the_glue_needs_fails_the_server_in_one_line(tmp
     (tmp_path / "site" / "sitecustomize.py").write_text(LACKING)
     app = write_app(tmp_path / "app", server_xml())
     env = {**os.environ, "PYTHONPATH": f"{tmp_path / 'site'}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"}
-    p = subprocess.run([sys.executable, "-m", "softplc_lite", "run", str(app), "--scans", "3", "--fresh",
-                        "--print", "N40:0"], capture_output=True, text=True, timeout=60, env=env)
+    p = softplc("run", str(app), "--scans", "3", "--fresh", "--print", "N40:0", env=env)
     assert p.returncode == 0 and p.stdout.strip() == "N40:0 = 2", p.stderr  # the failed bit; the scan went on
     assert "Traceback" not in p.stderr
     (line,) = [line for line in p.stderr.splitlines() if "lacks" in line]
