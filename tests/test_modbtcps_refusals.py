@@ -26,6 +26,7 @@ from rich.console import Console
 
 from softplc_lite.app import load_app
 from softplc_lite.ladder.engine import Engine
+from softplc_lite.ladder.host import Mode
 from softplc_lite.runner import RunOptions
 from softplc_lite.tlm.modbtcps.protocol import SEGMENTS as shm
 from softplc_lite.tlm.modbtcps import status as S
@@ -341,7 +342,7 @@ def test_the_first_scan_starts_the_server_and_a_taken_port_fails_it_not_the_run(
         taken.listen()
         app = load_app(hmi_copy(tmp_path / "taken", taken.getsockname()[1]), state_dir=None)
         engine = Engine(app.program, modules=app.modules)
-        engine.run_mode()
+        engine.set_mode(Mode.RUN)
         try:
             for _ in range(3):
                 engine.scan()

@@ -261,9 +261,6 @@ class Engine:
         for hook in self.mode_hooks:
             hook(self, old, mode)
 
-    def run_mode(self) -> None:
-        self.set_mode(Mode.RUN)
-
     # -- one scan ------------------------------------------------------------------------------
     def scan(self) -> None:
         m = self.machine

@@ -98,7 +98,7 @@ class TLM(Module):
 
     def network_servers(self) -> list:
         """The module's network servers, for the watch view: one item per
-        server, with the fields of tlm.modbtcps.status.ServerStatus
+        server, with the fields of netserver.counters.ServerStatus
         (listening, up, clients, rate, requests, writes, refusals, refused)."""
         return []
 
