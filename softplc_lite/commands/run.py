@@ -13,7 +13,7 @@ from pathlib import Path
 from ..app import SCAN_MS_RANGE, load_app
 from ..datatable import jsonio
 from ..errors import file_error
-from ..ladder.engine import Mode
+from ..ladder.host import Mode
 from ..run_output import StatusLine
 from ..runner import RunOptions, Runner
 from .common import (DOCS, EXIT_ERROR, EXIT_FAULT, EXIT_OK, EXIT_REPLAY, SCANS_RANGE, address_problems,

@@ -15,7 +15,7 @@ from rich.padding import Padding
 from rich.text import Text
 
 from ..ladder import status as S
-from ..ladder.engine import Mode
+from ..ladder.host import Mode
 from .portsview import PortsView
 from .serversview import ServersView
 from .session import WatchSession

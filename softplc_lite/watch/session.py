@@ -14,7 +14,7 @@ from ..app import App
 from ..datatable import DataTableError, ValueKind
 from ..datatable.display import format_read
 from ..ladder.ast import AddressRef, walk
-from ..ladder.engine import Mode, ModeError
+from ..ladder.host import Mode, ModeError
 from ..ladder.symbols import SymbolError, resolve_name
 from ..program_watcher import ProgramWatcher
 from ..runner import Runner, RunOptions
