@@ -1,4 +1,4 @@
-"""COMGENIUS format engine benchmark (issue 4): STRPRINT, STRSCAN, the
+"""COMGENIUS format engine benchmark: STRPRINT, STRSCAN, the
 manual's binary decoding example and CRC-16, each against naive baselines
 measured in the same run.
 

@@ -1,4 +1,4 @@
-"""COMGENIUS ports benchmark (issue 5): COMPRINT-to-COMSCAN round trips over
+"""COMGENIUS ports benchmark: COMPRINT-to-COMSCAN round trips over
 ``loop://`` and a socat pty pair, against raw pyserial moving the same bytes
 over the same kinds of port; and bytes per second through the simulated
 link (``sim://`` at an unlimited rate) against ``loop://``.

@@ -1,4 +1,4 @@
-"""Ladder engine benchmark (issue 3, issue 17): every target of issue 17
+"""Ladder engine benchmark: every engine target (docs/performance.md)
 with its baseline measured in the same run, PASS or MISS.
 
     python benchmarks/bench_ladder.py                 # about 2-3 minutes
@@ -8,7 +8,7 @@ with its baseline measured in the same run, PASS or MISS.
 
 Of the --scaling part, loading 100,000 rungs takes about a minute in each of
 two processes, and most of the rest is the memory figure: tracemalloc makes
-that load 5-6 minutes (figures of this 2-core machine at issue 17's start).
+that load 5-6 minutes (figures of this 2-core machine before the block compiler).
 
 The programs (ladder_programs.py, seeded, so every run scans the same text):
 boolean (XIC/XIO on I:0..7 and B3 bits, nested branches, OTE/OTL/OTU,
@@ -16,7 +16,7 @@ parallel outputs) and mixed (TON, CTU, ADD, MOV, EQU+OTE, CPT, COP), 10,000
 rungs each. Scans run on simulated time (the default clock) from the same
 initial table, with an input hook changing I:0..7 every scan.
 
-Figures (issue 17's targets, in its words):
+Figures (the engine targets):
 
 1. straight line: the compiled boolean scan against the straight-line
    baseline generated from the same validated rungs (straight_line.py: one
@@ -26,7 +26,7 @@ Figures (issue 17's targets, in its words):
    also shown: ``engine.run_file(2)`` against the function alone. After the
    same scans the two tables must be equal (a difference is a bug in the
    baseline, or in the engine). Target <= 2.0x (stretch 1.5x).
-2. against the commit before issue 17's compiler work (--baseline, default
+2. against the commit before the block compiler (--baseline, default
    2224470, in a temporary git worktree): each tree in its own process,
    blocks of scans interleaved, median of per-block ratios; the mixed
    program >= 2.5x faster (the boolean speedup printed too). Printed beside
@@ -47,8 +47,8 @@ Figures (issue 17's targets, in its words):
    benchmarks/bench_load_cache.py does (on this shared 2-core machine wall
    time ran 1.5-2.5x the CPU time); wall time printed beside it.
 
-Kept from issue 3: reference / compiled (the reference interpreter, same
-scans) and a cProfile top 10 of the compiled scan.
+Also measured, with the first engine targets: reference / compiled (the
+reference interpreter, same scans) and a cProfile top 10 of the compiled scan.
 
 Writes benchmarks/results/bench_ladder.json (bench_ladder_scaling.json with
 --scaling-only; nothing with --quick); always exits 0.
@@ -87,7 +87,7 @@ from ladder_programs import (  # noqa: F401 (re-exported: scripts import these f
 from softplc_lite.ladder import Mode, parse_program, validate
 
 RUNGS = 10_000
-BASELINE_COMMIT = "2224470"  # main before issue 17's compiler work
+BASELINE_COMMIT = "2224470"  # main before the block compiler
 WARMUP_SCANS = 3
 PAIRS = 51  # engine / straight-line scan pairs (a 10,000-rung pair is a few ms)
 REFERENCE_PAIRS = 7
@@ -103,7 +103,7 @@ TARGET_SCALING = 1.2
 TARGET_LOAD_S = 1.5
 TARGET_WARM_LOAD_S = 0.3
 TARGET_BYTES_PER_INSTRUCTION = 300
-TARGET_REFERENCE_RATIO = 10.0  # issue 3
+TARGET_REFERENCE_RATIO = 10.0  # a first engine target, like the two below
 ISSUE3_TARGET_NS = {"boolean": 100.0, "mixed": 400.0}
 ISSUE3_TARGET_LOAD_S = 3.0
 
@@ -161,7 +161,7 @@ def straight_line_figures(program, pairs: int) -> dict:
         for _ in range(pairs):
             file_ns.append(timed(lambda: engine.run_file(2)))
             fn_ns.append(timed(baseline.scan))
-    except Exception as exc:  # noqa: BLE001 - the engine is being rewritten (issue 17): report it, go on
+    except Exception as exc:  # noqa: BLE001 - run_file is internal and only shown, not judged: report it, go on
         file_error = f"{type(exc).__name__}: {exc}"
     finally:
         gc.enable()
@@ -219,7 +219,7 @@ def print_straight_line(r: dict) -> None:
           + ("" if equal else "  <-- BUG: the baseline or the engine is wrong"))
 
 
-# -- kept from issue 3: the reference interpreter, the profile -------------------------------------
+# -- the first engine targets: the reference interpreter, the profile ------------------------------
 
 
 def reference_ratio(program, pairs: int) -> dict:
@@ -292,11 +292,11 @@ def in_process(kind: str, text: str, pairs: int, reference_pairs: int) -> dict:
         print_straight_line(out["straight_line"])
     ref = out["reference"] = reference_ratio(program, reference_pairs)
     print(f"reference / compiled ({reference_pairs} interleaved scan pairs): {ref['ratio_reference_over_compiled']:.1f}x "
-          f"[{ref['verdict']} >= {TARGET_REFERENCE_RATIO:.0f}x, issue 3]; compiled median "
+          f"[{ref['verdict']} >= {TARGET_REFERENCE_RATIO:.0f}x]; compiled median "
           f"{ref['compiled_scan_ns']['median_ns'] / 1e6:.2f} ms = "
           f"{ref['compiled_scan_ns']['median_ns'] / instructions:.1f} ns/instruction; tables equal: {ref['tables_equal']}")
-    # Issue 3's figures under the keys run_all.py reads (per-instruction
-    # time, load in this process, the reference ratio), with its targets.
+    # The first engine targets' figures under the keys run_all.py reads
+    # (per-instruction time, load in this process, the reference ratio), with those targets.
     compiled_ns = ref["compiled_scan_ns"]["median_ns"] / instructions
     out.update({
         "compiled_scan_ns": {**ref["compiled_scan_ns"], "per_instruction": round(compiled_ns, 1)},
@@ -355,7 +355,7 @@ def section_against_baseline(figures: dict, tmp: Path, files: dict[str, Path], b
     subprocess.run(["git", "-C", str(C.REPO), "worktree", "add", "--detach", "-q", str(base_tree), base],
                    check=True)
     try:
-        print(f"--- against {base} (before issue 17's compiler work), each tree in its own process, "
+        print(f"--- against {base} (before the block compiler), each tree in its own process, "
               f"blocks of scans interleaved", flush=True)
         try:
             figures["against_baseline"] = against_baseline(base_tree, files, blocks, scans)
@@ -462,7 +462,7 @@ def main() -> int:
 
 
 def print_summary(f: dict) -> None:
-    print(f"\nsummary ({f['wall_s']:.0f} s), issue 17 targets:")
+    print(f"\nsummary ({f['wall_s']:.0f} s), targets:")
     if "boolean" in f:
         sl = f["boolean"]["straight_line"]
         print(f"  boolean / straight-line baseline  {sl['ratio_scan']:6.2f}x      [{sl['verdict']} <= "

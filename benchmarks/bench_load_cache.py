@@ -1,6 +1,6 @@
 """Load of the 10,000-rung boolean benchmark program, cold and through the
-code cache (issue 17: at most 1.5 s cold, at most 0.3 s for a program
-loaded before).
+code cache (targets: at most 1.5 s cold, at most 0.3 s for a program
+loaded before; docs/performance.md).
 
     python benchmarks/bench_load_cache.py [--rungs N] [--runs K]
 

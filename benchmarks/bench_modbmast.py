@@ -1,4 +1,4 @@
-"""MODBMAST benchmark (issue 13, section 6): the Modbus RTU serial master
+"""MODBMAST benchmark: the Modbus RTU serial master
 driver module against pymodbus on a pty, against the wire limit on the
 simulated wire, and at scale (32 ports x 32 slaves x 4 requests).
 

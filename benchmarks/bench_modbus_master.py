@@ -1,4 +1,4 @@
-"""Modbus RTU master benchmark (issue 6): the ladder master of
+"""Modbus RTU master benchmark: the ladder master of
 programs/modbus_master against pymodbus's own clients, on the same pymodbus
 server over the same socat pty pair; and the ladder on the simulated
 38400-baud wire against the wire-time minimum.

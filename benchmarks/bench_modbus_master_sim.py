@@ -1,4 +1,4 @@
-"""Modbus master app on simulated time (issue 17): scans per second of
+"""Modbus master app on simulated time: scans per second of
 programs/modbus_master as shipped, against a baseline commit measured in
 the same invocation.
 
@@ -21,7 +21,8 @@ reported too (on a busy machine, the least disturbed figures). Every run
 also reports the app's data table after the scans (the counters C5, the safe block N11, the clock); the two
 trees must agree exactly, or the script fails.
 
-Target (issue 17): current / baseline >= 1.5 on the shipped app.
+Target: current / baseline >= 1.5 on the shipped app (the engine-speed
+target, docs/performance.md).
 
 Writes benchmarks/results/bench_modbus_master_sim.json (not with --quick);
 exits 0, or 1 when the trees disagree.

@@ -1,4 +1,4 @@
-"""MODBTCPS, the Modbus TCP server over the data table (issue 19, section 3):
+"""MODBTCPS, the Modbus TCP server over the data table:
 requests per second beside pymodbus's own server, the scan time a request
 adds, and 50 busy clients against the scan.
 

@@ -1,4 +1,4 @@
-"""Peer soft PLCs on the same boolean logic (issue 17, optional): awlsim
+"""Peer soft PLCs on the same boolean logic (optional, for context): awlsim
 (Siemens S7 STL) and pyrung (CLICK-PLC ladder in Python), both on PyPI,
 against softplc's compiled engine, in one run.
 

@@ -1,4 +1,4 @@
-"""Retentive memory while running (issue 15): what saving the data table
+"""Retentive memory while running: what saving the data table
 every 100 ms costs the Modbus master app.
 
     python benchmarks/bench_retentive.py

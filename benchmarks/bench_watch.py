@@ -1,4 +1,4 @@
-"""Watch view benchmark (issue 7): what ``softplc watch`` running at full
+"""Watch view benchmark: what ``softplc watch`` running at full
 speed costs the scan loop, against ``softplc run``.
 
     python benchmarks/bench_watch.py             # about 25 s

@@ -163,7 +163,7 @@ def cold_load(text: str, cache_dir: Path) -> None:
     program, engine, times = load(text)
     times["total_cpu_s"] = time.process_time() - cpu0
     rungs, instructions = L.count_instructions(program)
-    # WARM LOAD (issue 17, the code cache kept beside the retentive state):
+    # WARM LOAD (the code cache kept beside the retentive state):
     # this cold load leaves the cache in cache_dir, and the "warm" child, a
     # fresh process, loads the same text through it.
     saved = False

@@ -1,4 +1,4 @@
-"""The ladder benchmark programs (issue 3, issue 17): seeded generators of
+"""The ladder benchmark programs: seeded generators of
 program text, the initial data table, the per-scan input hook, and an engine
 set up to scan them.
 
@@ -98,7 +98,7 @@ PROGRAMS = {"boolean": boolean_program, "mixed": mixed_program}
 
 def program_text(kind: str, rungs: int) -> str:
     """The benchmark program ``kind`` (boolean or mixed) of ``rungs`` rungs,
-    with its own seed (the mixed one's is SEED + 1, as since issue 3)."""
+    with its own seed (the mixed one's is SEED + 1, so recorded figures stay comparable)."""
     return boolean_program(rungs, SEED) if kind == "boolean" else mixed_program(rungs, SEED + 1)
 
 
@@ -107,8 +107,8 @@ def program_text(kind: str, rungs: int) -> str:
 
 def _instructions(elements) -> int:
     # Duck-typed (a branch has legs, anything else is an instruction): the
-    # AST classes are being slimmed down under issue 17 and this must count
-    # the same on a baseline commit's tree.
+    # AST classes differ between commits and this must count the same on a
+    # baseline commit's tree.
     count = 0
     for el in elements:
         legs = getattr(el, "legs", None)

@@ -1,6 +1,6 @@
-"""The figures of bench_ladder.py that need fresh processes (issue 17):
+"""The figures of bench_ladder.py that need fresh processes:
 
-- against the commit before issue 17's compiler work (``baseline_speedup``):
+- against the commit before the block compiler (``baseline_speedup``):
   a child per tree loads the same program text and the parent drives them
   in turn, a block of scans each, so the two trees' scans interleave; the
   figure is the median of the per-block ratios baseline / current, and the

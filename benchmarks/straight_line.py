@@ -1,5 +1,5 @@
-"""The straight-line baseline of issue 17: a boolean ladder program written
-as the Python one would write by hand for that one program.
+"""The straight-line baseline for the engine targets: a boolean ladder
+program written as the Python one would write by hand for that one program.
 
 ONE function for the whole main file: every data-table word the program
 uses is read once into a local at the top; the rungs follow in order as
@@ -38,7 +38,7 @@ class StraightLine:
 
 
 def _is_branch(element) -> bool:
-    return getattr(element, "legs", None) is not None  # duck-typed: the AST is being slimmed (issue 17)
+    return getattr(element, "legs", None) is not None  # duck-typed: a baseline commit's AST classes differ
 
 
 def _contacts_only(elements) -> bool:
