@@ -6,7 +6,7 @@ neutral-text forms of one rung compare equal and ``fmt`` round trips can be
 checked with ``==``.
 
 The nodes a program has one of per instruction (operands, instructions,
-branches, rungs) are compact (issue 17: at most 300 bytes an instruction
+branches, rungs) are compact (the memory target: at most 300 bytes an instruction
 after load): ``__slots__`` classes that keep their position as two slots
 (source and line as one int shared by the nodes of a line, and the column)
 and build the ``Pos`` when asked, not one Pos object per node. Operand
@@ -281,8 +281,8 @@ class Instruction(_Mutable):
     """``operands`` is kept as given (the parser's list grows as it reads),
     except that a tuple of one operand node, the most common instruction
     (XIC B3/0) in a validated tree, is kept as that node alone: ``operands``
-    gives it back as a 1-tuple (issue 17: a tuple object less per
-    instruction)."""
+    gives it back as a 1-tuple (a tuple object less per instruction,
+    for the memory target)."""
 
     __slots__ = ("mnemonic", "_operands")
     _fields = ("mnemonic", "operands")

@@ -1,4 +1,4 @@
-"""The code cache (issue 17): a program loaded before loads without being
+"""The code cache: a program loaded before loads without being
 parsed, validated or compiled again.
 
 An app's cache is one file, ``APP/.softplc/codecache.bin``, beside the

@@ -4,7 +4,7 @@ The parser keeps only rung comments (the comment lines just above a rung
 and the one at the end of its line) because nothing after it needs the
 others; ``fmt`` must keep every one. So comments are found here, from the
 text, only when formatting: the 10,000-rung parse the engine does on every
-load pays nothing for them (issue 18).
+load pays nothing for them.
 
 Every comment is attached to one statement (SYMBOL, DATA, FILE header,
 rung) or to the file:
