@@ -1,0 +1,1 @@
+"""Tests for ladder programs: scenario files, their runner and a Python API."""

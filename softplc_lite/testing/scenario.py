@@ -1,0 +1,167 @@
+"""Scenario files (``APP/tests/*.plctest``) -> typed steps with line and column.
+
+Each line is parsed on its own with ``scenario.lark``; the block a step
+belongs to (``setup:`` or ``scenario "name":``) is found by indentation.
+Every mistake of a file is collected and raised together as
+``ScenarioErrors``, each a ``LocatedError`` (file:line:col).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from lark import Lark, Transformer, Token
+from lark.exceptions import UnexpectedInput, VisitError
+
+from ..errors import LocatedError
+
+_GRAMMAR = (Path(__file__).with_name("scenario.lark")).read_text(encoding="utf-8")
+_PARSER = Lark(_GRAMMAR, parser="lalr", maybe_placeholders=False)
+
+
+@dataclass(frozen=True)
+class Step:
+    kind: str  # set force unforce scan run wait_until expect_cmp expect_within ...
+    args: tuple
+    line: int
+    column: int
+
+
+@dataclass
+class Scenario:
+    name: str
+    line: int
+    steps: list[Step] = field(default_factory=list)
+
+
+@dataclass
+class ScenarioFile:
+    path: str
+    setup: list[Step]
+    scenarios: list[Scenario]
+
+
+_KEYWORDS = {"set", "force", "unforce", "scan", "run", "wait", "expect", "scenario", "setup"}
+
+
+class ScenarioErrors(Exception):
+    """Every problem of a scenario file, reported together."""
+
+    def __init__(self, errors: list[LocatedError]) -> None:
+        self.errors = errors
+        super().__init__("\n".join(e.report() for e in errors))
+
+
+class _ToSteps(Transformer):
+    def __init__(self, line: int, column: int) -> None:
+        super().__init__()
+        self.line, self.column = line, column
+
+    def target(self, c):
+        t: Token = c[0]
+        return str(t)
+
+    def number(self, c):
+        text = str(c[0])
+        return float(text) if any(ch in text for ch in ".eE") else int(text)
+
+    def value(self, c):
+        v = c[0]
+        if isinstance(v, Token) and v.type == "STRING":
+            return json.loads(str(v))
+        return v
+
+    def _step(kind):  # noqa: N805 - a factory of rule actions
+        def act(self, c):
+            args = tuple(str(a) if isinstance(a, Token) and a.type in ("OP", "UNIT") else
+                         (int(a) if isinstance(a, Token) and a.type == "INT" else a) for a in c)
+            return Step(kind, args, self.line, self.column)
+        return act
+
+    set = _step("set")
+    force = _step("force")
+    unforce = _step("unforce")
+    scan = _step("scan")
+    run = _step("run")
+    wait_until = _step("wait_until")
+    expect_cmp = _step("expect_cmp")
+    expect_within = _step("expect_within")
+    expect_between = _step("expect_between")
+    expect_rising = _step("expect_rising")
+    expect_falling = _step("expect_falling")
+
+    def setup(self, c):
+        return ("setup", None)
+
+    def scenario(self, c):
+        return ("scenario", json.loads(str(c[0])))
+
+
+def _strip_comment(text: str) -> str:
+    out, quoted, i = [], False, 0
+    while i < len(text):
+        ch = text[i]
+        if ch == '"':
+            quoted = not quoted
+        elif not quoted and (ch == "#" or text.startswith("//", i)):
+            break
+        out.append(ch)
+        i += 1
+    return "".join(out).rstrip()
+
+
+def parse_scenarios(text: str, path: str = "<scenario>") -> ScenarioFile:
+    errors: list[LocatedError] = []
+    setup: list[Step] = []
+    scenarios: list[Scenario] = []
+    block: list[Step] | None = None
+    for number, raw in enumerate(text.splitlines(), 1):
+        body = _strip_comment(raw)
+        if not body.strip():
+            continue
+        indent = len(body) - len(body.lstrip())
+        column = indent + 1
+        try:
+            item = _ToSteps(number, column).transform(_PARSER.parse(body.strip()))
+        except UnexpectedInput as e:
+            first = body.split()[0]
+            known = first in _KEYWORDS or first.rstrip(":") == "setup"
+            col = indent + getattr(e, "column", 1) if known else column
+            errors.append(LocatedError(
+                "expected a step (set, force, unforce, scan, run, wait until, expect) "
+                "or a block header (setup:, scenario \"name\":)", path, number, col))
+            continue
+        except VisitError as e:
+            errors.append(LocatedError(str(e.orig_exc), path, number, column))
+            continue
+        if isinstance(item, tuple):
+            if indent:
+                errors.append(LocatedError("expected a block header at the start of the line",
+                                           path, number, column))
+                continue
+            if item[0] == "setup":
+                if setup or scenarios:
+                    errors.append(LocatedError("expected setup: before the scenarios, once",
+                                               path, number, column))
+                block = setup
+            else:
+                scenarios.append(Scenario(item[1], number))
+                block = scenarios[-1].steps
+            continue
+        if block is None or not indent:
+            errors.append(LocatedError("expected an indented step inside setup: or scenario \"name\":",
+                                       path, number, column))
+            continue
+        block.append(item)
+    if not scenarios and not errors:
+        errors.append(LocatedError("expected at least one scenario \"name\": block", path, 1, 1))
+    if errors:
+        raise ScenarioErrors(errors)
+    return ScenarioFile(path, setup, scenarios)
+
+
+def load_scenarios(path: str | Path) -> ScenarioFile:
+    p = Path(path)
+    return parse_scenarios(p.read_text(encoding="utf-8"), str(p))
