@@ -1,0 +1,151 @@
+"""Runs scenario files against an app: each scenario on a fresh ``PLC``
+(fresh data table, simulated clock, the app's modules as configured), after
+the file's setup, scan by scan. A failed expectation ends its scenario and
+says what was expected, the actual value, the scan number and the time."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from ..errors import LocatedError
+from .plc import PLC
+from .scenario import Scenario, ScenarioErrors, ScenarioFile, Step, load_scenarios
+
+SCENARIO_GLOB = "tests/*.plctest"
+
+
+@dataclass
+class Failure:
+    expectation: str
+    actual: object
+    scan: int
+    time_ms: int
+    path: str
+    line: int
+    address: str
+
+    def report(self) -> str:
+        return (f"{self.path}:{self.line}: expected {self.expectation}, got {self.actual!r} "
+                f"(scan {self.scan}, {self.time_ms / 1000:g} s)")
+
+
+@dataclass
+class Result:
+    path: str
+    name: str
+    failure: Failure | None = None
+
+    @property
+    def passed(self) -> bool:
+        return self.failure is None
+
+
+def scenario_files(app: str | Path) -> list[Path]:
+    base = Path(app)
+    return sorted(base.glob(SCENARIO_GLOB)) if base.is_dir() else []
+
+
+def check_names(file: ScenarioFile, plc: PLC) -> None:
+    """Every address or symbol a step names exists: all problems at once."""
+    errors = []
+    for step in file.setup + [s for sc in file.scenarios for s in sc.steps]:
+        if step.kind in ("scan", "run"):
+            continue
+        name = step.args[0]
+        try:
+            plc.address(name)
+        except Exception as e:  # AddressError / SymbolError: the reason is the message
+            reason = getattr(e, "reason", None) or str(e)
+            errors.append(LocatedError(f"expected an address or a symbol of the program: {name}: {reason}",
+                                       file.path, step.line, step.column))
+    if errors:
+        raise ScenarioErrors(errors)
+
+
+def _seconds(number, unit) -> float:
+    return number / 1000 if unit == "ms" else number
+
+
+class _Run:
+    def __init__(self, plc: PLC, path: str) -> None:
+        self.plc, self.path = plc, path
+        self.edges: dict[str, list] = {}
+
+    def scan(self) -> None:
+        self.plc.scan()
+        for name, seen in self.edges.items():
+            seen.append(self.plc[name])
+
+    def step(self, step: Step) -> Failure | None:
+        plc, k, a = self.plc, step.kind, step.args
+        if k in ("scan", "run", "wait_until"):
+            for seen in self.edges.values():  # an edge is looked for in the last scanning step
+                del seen[:-1]
+        if k == "set":
+            plc.set(a[0], a[1])
+        elif k == "force":
+            plc.force(a[0], a[1])
+        elif k == "unforce":
+            plc.unforce(a[0])
+        elif k == "scan":
+            for _ in range(a[0]):
+                self.scan()
+        elif k == "run":
+            end = plc.time_ms + round(_seconds(*a) * 1000)
+            while plc.time_ms < end:
+                self.scan()
+        elif k == "wait_until":
+            name, op, value, limit, unit = a
+            end = plc.time_ms + round(_seconds(limit, unit) * 1000)
+            while not _compare(plc[name], op, value):
+                if plc.time_ms >= end:
+                    return self._fail(step, f"{name} {op} {value!r} within {limit} {unit}", plc[name])
+                self.scan()
+        elif k == "expect_cmp":
+            name, op, value = a
+            if not _compare(plc[name], op, value):
+                return self._fail(step, f"{name} {op} {value!r}", plc[name])
+        elif k == "expect_within":
+            name, tol, value = a
+            if abs(plc[name] - value) > tol:
+                return self._fail(step, f"{name} within {tol} of {value}", plc[name])
+        elif k == "expect_between":
+            name, lo, hi = a
+            if not lo <= plc[name] <= hi:
+                return self._fail(step, f"{name} between {lo} and {hi}", plc[name])
+        else:
+            name = a[0]
+            seen = self.edges.get(name, [])
+            want = (0, 1) if k == "expect_rising" else (1, 0)
+            if not any((bool(x), bool(y)) == want for x, y in zip(seen, seen[1:])):
+                return self._fail(step, f"{'rising' if want == (0, 1) else 'falling'} edge of {name} "
+                                  "since the previous step", plc[name])
+        return None
+
+    def _fail(self, step: Step, expectation: str, actual) -> Failure:
+        return Failure(expectation, actual, self.plc.scan_number, self.plc.time_ms, self.path,
+                       step.line, step.args[0])
+
+
+def _compare(actual, op, value) -> bool:
+    return (actual == value) if op == "==" else (actual != value)
+
+
+def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario) -> Result:
+    with PLC.load(app) as plc:
+        check_names(file, plc)
+        run = _Run(plc, file.path)
+        for step in file.setup + scenario.steps:  # edges are watched from the start
+            if step.kind in ("expect_rising", "expect_falling"):
+                run.edges.setdefault(step.args[0], [plc[step.args[0]]])
+        for step in file.setup + scenario.steps:
+            failure = run.step(step)
+            if failure is not None:
+                return Result(file.path, scenario.name, failure)
+    return Result(file.path, scenario.name)
+
+
+def run_file(app: str | Path, path: str | Path) -> list[Result]:
+    file = load_scenarios(path)
+    return [run_scenario(app, file, sc) for sc in file.scenarios]
