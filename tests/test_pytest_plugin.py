@@ -1,0 +1,29 @@
+"""The pytest plugin in a real pytest run of a copied app: one item a
+scenario, named by it, and --junitxml read back."""
+
+import shutil
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def test_pytest_collects_scenarios_and_writes_junit(tmp_path):
+    app = tmp_path / "motor"
+    shutil.copytree(ROOT / "programs" / "motor", app, ignore=shutil.ignore_patterns(".softplc"))
+    (app / "tests" / "bad.plctest").write_text('scenario "never":\n    run 1 s\n    expect Motor == 1\n',
+                                               encoding="utf-8")
+    junit = tmp_path / "out.xml"
+    r = subprocess.run([sys.executable, "-m", "pytest", "-p", "softplc_lite.testing.pytest_plugin",
+                        "-p", "no:cacheprovider", "-p", "no:xdist", "-q", f"--basetemp={tmp_path / 'bt'}",
+                        f"--junitxml={junit}", "--rootdir", str(tmp_path), str(app / "tests")],
+                       cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=120, check=False)
+    assert r.returncode == 1, r.stdout + r.stderr
+    assert "expected Motor == 1, got 0 (scan 100, 1 s)" in r.stdout
+    cases = {c.get("name"): c.find("failure") is not None for c in ET.parse(junit).iter("testcase")}
+    assert cases == {"start seals in": False, "stop drops the motor": False,
+                     "overload trips and stop resets": False, "never": True}
+
