@@ -17,8 +17,8 @@ def test_pytest_collects_scenarios_and_writes_junit(tmp_path):
     (app / "tests" / "bad.plctest").write_text('scenario "never":\n    run 1 s\n    expect Motor == 1\n',
                                                encoding="utf-8")
     junit = tmp_path / "out.xml"
-    r = subprocess.run([sys.executable, "-m", "pytest", "-p", "softplc_lite.testing.pytest_plugin",
-                        "-p", "no:cacheprovider", "-p", "no:xdist", "-q", f"--basetemp={tmp_path / 'bt'}",
+    # the plugin comes from its pytest11 entry point, as in any project that installed softplc_lite
+    r = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-p", "no:xdist", "-q", f"--basetemp={tmp_path / 'bt'}",
                         f"--junitxml={junit}", "--rootdir", str(tmp_path), str(app / "tests")],
                        cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=120, check=False)
     assert r.returncode == 1, r.stdout + r.stderr
