@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from softplc_lite.testing.plc import PLC
-from softplc_lite.testing.runner import run_file, scenario_files
+from softplc_lite.testing.runner import SCENARIO_GLOB, run_file
 from softplc_lite.testing.scenario import ScenarioErrors
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -37,12 +37,18 @@ def test_each_scenario_starts_fresh(tmp_path):
     assert [r.passed for r in run_file(MOTOR, f)] == [True, True]
 
 
-@pytest.mark.parametrize("app", ["motor", "blinker"])
-def test_the_shipped_scenarios_pass(app):
-    files = scenario_files(ROOT / "programs" / app)
-    assert files
-    results = [r for f in files for r in run_file(ROOT / "programs" / app, f)]
+SHIPPED = sorted((ROOT / "programs").glob("*/" + SCENARIO_GLOB))
+
+
+@pytest.mark.parametrize("path", SHIPPED, ids=lambda p: f"{p.parent.parent.name}/{p.name}")
+def test_the_shipped_scenarios_pass(path):
+    """Every scenario file an app in programs/ ships passes: the apps' documented behaviour holds."""
+    results = run_file(path.parent.parent, path)
     assert results and all(r.passed for r in results), [r.failure.report() for r in results if r.failure]
+
+
+def test_the_shipped_apps_have_scenario_files():
+    assert {"motor", "blinker"} <= {p.parent.parent.name for p in SHIPPED}
 
 
 def test_a_failure_says_expectation_actual_scan_and_time(tmp_path):
