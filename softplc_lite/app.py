@@ -318,11 +318,17 @@ def display_problems(display: Display, table, path: Path, doc: dict) -> list[Loc
     return found
 
 
-def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: bool = True) -> App:
+def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: bool = True,
+             program: Program | None = None) -> App:
     """Parse, validate and configure an app; AppError lists every problem.
     With ``use_cache``, a program loaded before comes from the code cache in
-    the state directory (ladder/codecache.py; check passes False)."""
+    the state directory (ladder/codecache.py; check passes False).
+    ``program``: a parsed program checked in place of the app's .lad files,
+    the rest of the app (modules, settings, data) kept (mutation testing);
+    the code cache, keyed by the files, is then not used."""
     path = Path(path)
+    if program is not None:
+        use_cache = False
     if not path.exists():
         raise AppError(f"{shown_path(path)}: no such app directory or .lad file")
     is_dir = path.is_dir()
@@ -370,7 +376,7 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
         except Exception:  # not what a cache holds after all: load from the text
             cached = None
     if cached is None:
-        parsed, errors = parse_files(files, path, instructions)
+        parsed, errors = (program, []) if program is not None else parse_files(files, path, instructions)
         resolved, problems = check(parsed, instructions)
         errors += problems
         code = None

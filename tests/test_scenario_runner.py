@@ -80,3 +80,21 @@ def test_unknown_names_are_located_all_at_once(tmp_path):
         run_file(MOTOR, f)
     assert [(x.line, x.column) for x in e.value.errors] == [(2, 5), (4, 5)]
     assert "expected an address or a symbol of the program: Nope" in str(e.value)
+
+
+def test_a_substituted_program_runs_with_the_rest_of_the_app(tmp_path):
+    from softplc_lite.app import load_app
+    from softplc_lite.ladder.ast import Program, ProgramFile
+    source = load_app(MOTOR, state_dir=tmp_path, use_cache=False).source_program
+    main = source.files[2]
+    without_seal_in = Program({2: ProgramFile(2, main.name, main.rungs[1:], main.pos)}, source.data, source.symbols)
+    with PLC.load(MOTOR, program=without_seal_in) as plc:
+        plc.set("StopOk", 1)
+        plc.set("Start", 1)
+        plc.scan(2)
+        assert plc["Motor"] == 0
+    with PLC.load(MOTOR) as plc:  # the app's own files are untouched
+        plc.set("StopOk", 1)
+        plc.set("Start", 1)
+        plc.scan(2)
+        assert plc["Motor"] == 1

@@ -9,6 +9,7 @@ import tempfile
 from pathlib import Path
 
 from ..app import load_app
+from ..ladder.ast import Program
 from ..ladder.engine import Mode
 from ..ladder.symbols import resolve_name
 from ..runner import Runner, RunOptions
@@ -27,11 +28,13 @@ class PLC:
             self.engine.set_mode(Mode.RUN)
 
     @classmethod
-    def load(cls, path: str | Path, ports: tuple[str, ...] = ()) -> "PLC":
-        """``ports``: ``--port`` overrides, e.g. ``("1=sim://...")``."""
+    def load(cls, path: str | Path, ports: tuple[str, ...] = (), program: Program | None = None) -> "PLC":
+        """``ports``: ``--port`` overrides, e.g. ``("1=sim://...")``;
+        ``program``: a parsed program run in place of the app's own (a
+        mutant), with the app's modules, settings and data."""
         state_dir = tempfile.mkdtemp(prefix="softplc-test-")
         try:
-            app = load_app(path, state_dir=state_dir)
+            app = load_app(path, state_dir=state_dir, program=program)
             runner = Runner(app, RunOptions(fresh=True, ports=tuple(ports), save_state=False),
                             log=lambda msg: None)
         except BaseException:

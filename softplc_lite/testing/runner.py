@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import LocatedError
+from ..ladder.ast import Program
 from .plc import PLC
 from .scenario import Scenario, ScenarioErrors, ScenarioFile, Step, load_scenarios
 
@@ -132,8 +133,9 @@ def _compare(actual, op, value) -> bool:
     return (actual == value) if op == "==" else (actual != value)
 
 
-def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario) -> Result:
-    with PLC.load(app) as plc:
+def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario, program: Program | None = None) -> Result:
+    """``program``: a parsed program run in place of the app's (PLC.load)."""
+    with PLC.load(app, program=program) as plc:
         check_names(file, plc)
         run = _Run(plc, file.path)
         for step in file.setup + scenario.steps:  # edges are watched from the start
@@ -146,6 +148,6 @@ def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario) -> Res
     return Result(file.path, scenario.name)
 
 
-def run_file(app: str | Path, path: str | Path) -> list[Result]:
+def run_file(app: str | Path, path: str | Path, program: Program | None = None) -> list[Result]:
     file = load_scenarios(path)
-    return [run_scenario(app, file, sc) for sc in file.scenarios]
+    return [run_scenario(app, file, sc, program) for sc in file.scenarios]
