@@ -14,8 +14,8 @@ ROOT = Path(__file__).resolve().parent.parent
 def test_pytest_collects_scenarios_and_writes_junit(tmp_path):
     app = tmp_path / "motor"
     shutil.copytree(ROOT / "programs" / "motor", app, ignore=shutil.ignore_patterns(".softplc"))
-    (app / "tests" / "bad.plctest").write_text('scenario "never":\n    run 1 s\n    expect Motor == 1\n',
-                                               encoding="utf-8")
+    (app / "tests" / "bad.plctest").write_text('scenario "never":\n    run 1 s\n    expect Motor == 1\n'
+                                               'scenario "input":\n    expect Start == 1\n', encoding="utf-8")
     junit = tmp_path / "out.xml"
     # the plugin comes from its pytest11 entry point, as in any project that installed softplc_lite
     r = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-p", "no:xdist", "-q", f"--basetemp={tmp_path / 'bt'}",
@@ -23,7 +23,14 @@ def test_pytest_collects_scenarios_and_writes_junit(tmp_path):
                        cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=120, check=False)
     assert r.returncode == 1, r.stdout + r.stderr
     assert "expected Motor == 1, got 0 (scan 100, 1 s)" in r.stdout
-    cases = {c.get("name"): c.find("failure") is not None for c in ET.parse(junit).iter("testcase")}
-    assert cases == {"start seals in": False, "stop drops the motor": False,
-                     "overload trips and stop resets": False, "never": True}
+    # the rung that writes Motor, drawn as plain text under the failure, and said of an input
+    drawn = ["program file 2, rungs that write Motor (O:0/0):", "Rung 0", "Seal-in: start", "--( )--|"]
+    assert all(part in r.stdout for part in drawn) and "\x1b[" not in r.stdout
+    assert "no rung writes Start (I:0/0): it is an input, or set by the test" in r.stdout
+    cases = {c.get("name"): c.find("failure") for c in ET.parse(junit).iter("testcase")}
+    assert {name: f is not None for name, f in cases.items()} == {
+        "start seals in": False, "stop drops the motor": False, "overload trips and stop resets": False,
+        "never": True, "input": True}
+    assert all(part in cases["never"].text for part in drawn)
+    assert "no rung writes Start (I:0/0)" in cases["input"].text
 

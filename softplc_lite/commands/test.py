@@ -1,5 +1,6 @@
 """``softplc test``: run an app's scenario files (APP/tests/*.plctest),
-one line a scenario, then the totals; docs/testing.md."""
+one line a scenario (a failure with the rungs that write its address), then
+the totals; docs/testing.md."""
 
 from __future__ import annotations
 
@@ -47,7 +48,7 @@ def run(args: argparse.Namespace) -> int:
             else:
                 failed += 1
                 out.print(f"[red]FAIL[/] {escape(shown_path(path))}: {escape(r.name)}")
-                out.print(f"  {escape(r.failure.report())}")
+                out.print(r.failure)
     summary = f"{passed} passed, {failed} failed"
     out.print(f"[red]{summary}[/]" if failed else f"[green]{summary}[/]")
     return EXIT_ERROR if failed else EXIT_OK

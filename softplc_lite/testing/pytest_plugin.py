@@ -36,10 +36,14 @@ class ScenarioItem(pytest.Item):
     def runtest(self) -> None:
         result = run_scenario(self.path.parent.parent, self.file, self.scenario)
         if result.failure is not None:
-            raise ScenarioFailed(result.failure.report())
+            raise ScenarioFailed(result.failure)
 
     def repr_failure(self, excinfo):
-        if isinstance(excinfo.value, (ScenarioFailed, ScenarioErrors)):
+        """The failure and the rungs that write its address, as plain text
+        (the terminal report and --junitxml show the same)."""
+        if isinstance(excinfo.value, ScenarioFailed):
+            return excinfo.value.failure.text(_width(self.config))
+        if isinstance(excinfo.value, ScenarioErrors):
             return str(excinfo.value)
         return super().repr_failure(excinfo)
 
@@ -48,7 +52,17 @@ class ScenarioItem(pytest.Item):
 
 
 class ScenarioFailed(Exception):
-    pass
+    def __init__(self, failure) -> None:
+        super().__init__(failure.report())
+        self.failure = failure
+
+
+def _width(config) -> int:
+    """The terminal's width as pytest sees it (80 when not on a terminal)."""
+    try:
+        return max(config.get_terminal_writer().fullwidth, 40)
+    except (AssertionError, AttributeError):  # no terminal reporter: pytest's own default width
+        return 80
 
 
 @pytest.fixture

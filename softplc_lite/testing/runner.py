@@ -1,15 +1,23 @@
 """Runs scenario files against an app: each scenario on a fresh ``PLC``
 (fresh data table, simulated clock, the app's modules as configured), after
 the file's setup, scan by scan. A failed expectation ends its scenario and
-says what was expected, the actual value, the scan number and the time."""
+says what was expected, the actual value, the scan number and the time,
+and draws the rungs that write the failing address as they were then
+(drawing.py)."""
 
 from __future__ import annotations
 
+import io
 from dataclasses import dataclass
 from pathlib import Path
 
+from rich.console import Console, ConsoleOptions, RenderResult
+from rich.segment import Segment
+from rich.text import Text
+
 from ..errors import LocatedError
 from ..ladder.ast import Program
+from .drawing import RungsAt, writers_at
 from .plc import PLC
 from .scenario import Scenario, ScenarioErrors, ScenarioFile, Step, load_scenarios
 
@@ -25,10 +33,26 @@ class Failure:
     path: str
     line: int
     address: str
+    rungs: RungsAt | None = None  # the rungs that write the address, as they were at the failure
 
     def report(self) -> str:
         return (f"{self.path}:{self.line}: expected {self.expectation}, got {self.actual!r} "
                 f"(scan {self.scan}, {self.time_ms / 1000:g} s)")
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        yield Text(self.report(), style="red")  # one line on a soft-wrapping console
+        if self.rungs is not None:  # indented under the report, not padded to the width
+            for line in console.render_lines(self.rungs, options.update(width=max(options.max_width - 2, 20)),
+                                             pad=False):
+                yield Segment("  ")
+                yield from line
+                yield Segment.line()
+
+    def text(self, width: int = 80) -> str:
+        """The report (one line) and its rungs (``width`` columns wide) as plain text."""
+        out = io.StringIO()
+        Console(file=out, width=width, color_system=None, highlight=False, soft_wrap=True).print(self)
+        return out.getvalue().rstrip("\n")
 
 
 @dataclass
@@ -125,8 +149,11 @@ class _Run:
         return None
 
     def _fail(self, step: Step, expectation: str, actual) -> Failure:
-        return Failure(expectation, actual, self.plc.scan_number, self.plc.time_ms, self.path,
-                       step.line, step.args[0])
+        plc = self.plc
+        rungs = writers_at(plc.runner.app.program, plc.table, step.args[0], plc.forces.forces,
+                           plc.runner.app.instructions)
+        return Failure(expectation, actual, plc.scan_number, plc.time_ms, self.path, step.line, step.args[0],
+                       rungs)
 
 
 def _compare(actual, op, value) -> bool:

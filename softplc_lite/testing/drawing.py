@@ -1,0 +1,101 @@
+"""Rungs of a program drawn as they were at one moment, for a report made
+later: what a failed expectation shows (the rungs that write the failing
+address), and what any other reporter of a test can show.
+
+:func:`draw_rungs` is the glue: given a program, a data table and the rungs
+to draw, it keeps a copy of the table's values (its bytes, as a retentive
+snapshot holds them) and the rungs, and gives a :class:`RungsAt`. That is
+data only (it pickles, and the live table may move on), and a rich
+renderable that draws each rung with the watch view's ``RungView``: power
+flow and live values as they were at that moment, the rung's comment, its
+forced bits marked ``F``, to the console's width. :func:`writer_rungs` finds
+the rungs that write an address or a symbol, from the program's
+cross-reference (watch/xref.py).
+
+At most ``MAX_RUNGS`` rungs are drawn (a softplc_lite choice: four rungs of
+a typical width fit one screen beside the failure's own line), and ``and K
+more`` says how many were left out, with where they are.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+
+from rich.console import Console, ConsoleOptions, RenderResult
+from rich.text import Text
+
+from ..datatable import DataTable
+from ..datatable.snapshot import decode, encode
+from ..ladder.ast import Program, Rung
+from ..ladder.instructions import InstructionSet
+from ..watch.rungs import COMMENT, HEADER, RungView
+from ..watch.xref import XrefIndex
+
+MAX_RUNGS = 4
+
+
+@dataclass(frozen=True)
+class RungsAt:
+    """Rungs as they were at one moment. ``title`` names what they are
+    drawn for (``Motor (O:0/0)``); ``rungs`` holds (program file, rung
+    number, rung); ``table`` the data table's values then
+    (``datatable.snapshot.encode``); ``more`` the places of the rungs not
+    drawn; ``why_none`` what to say when there are no rungs."""
+
+    title: str
+    rungs: tuple[tuple[int, int, Rung], ...]
+    table: bytes
+    symbols: Mapping[str, object] | None = None
+    forced: frozenset[str] = frozenset()
+    instructions: InstructionSet | None = field(default=None, compare=False)
+    more: tuple[tuple[int, int], ...] = ()
+    why_none: str = ""
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        if not self.rungs:
+            yield Text(self.why_none or f"no rung to draw for {self.title}", style=COMMENT)
+            return
+        table = decode(self.table)
+        file = None
+        for number, k, rung in self.rungs:
+            if number != file:
+                file = number
+                yield Text(f"program file {number}, rungs that write {self.title}:", style=HEADER)
+            yield RungView(rung, k, table, symbols=self.symbols, forced=self.forced,
+                           instructions=self.instructions)
+        if self.more:
+            where = ", ".join(f"file {f} rung {r}" for f, r in self.more)
+            yield Text(f"and {len(self.more)} more: {where}", style=COMMENT)
+
+
+def writer_rungs(program: Program, name: str, instructions: InstructionSet | None = None
+                 ) -> tuple[str, list[tuple[int, int]]]:
+    """What ``name`` (an address or a symbol) names, as the cross-reference
+    titles it (``Motor (O:0/0)``), and the (program file, rung) of every
+    rung that writes it (or may: an indirect write into its file), in scan
+    order, each once."""
+    finding = XrefIndex(program, instructions).find(name)
+    return finding.title, list(dict.fromkeys((u.file, u.rung) for u in finding.writers))
+
+
+def draw_rungs(program: Program, table: DataTable, places: Iterable[tuple[int, int]], title: str = "",
+               forced: Iterable[str] = (), instructions: InstructionSet | None = None,
+               limit: int = MAX_RUNGS, why_none: str = "") -> RungsAt:
+    """The rungs at ``places`` ((program file, rung number) pairs) of
+    ``program``, to be drawn with ``table``'s values as they are now: at
+    most ``limit`` of them, the rest listed as ``more``. ``forced``: the
+    forced addresses (canonical text, ``I:0/0``)."""
+    places = list(places)
+    rungs = tuple((f, r, program.files[f].rungs[r]) for f, r in places[:max(limit, 0)])
+    return RungsAt(title, rungs, encode(table), program.symbols, frozenset(forced), instructions,
+                   tuple(places[len(rungs):]), why_none)
+
+
+def writers_at(program: Program, table: DataTable, name: str, forced: Iterable[str] = (),
+               instructions: InstructionSet | None = None, limit: int = MAX_RUNGS) -> RungsAt:
+    """The rungs that write ``name``, with ``table``'s values now; when no
+    rung does, a drawing that says so."""
+    title, places = writer_rungs(program, name, instructions)
+    return draw_rungs(program, table, places, title, forced, instructions, limit,
+                      why_none=f"no rung writes {title}: it is an input, or set by the test")
