@@ -28,9 +28,7 @@ def test_pytest_collects_scenarios_and_writes_junit(tmp_path):
     assert all(part in r.stdout for part in drawn) and "\x1b[" not in r.stdout
     assert "no rung writes Start (I:0/0): it is an input, or set by the test" in r.stdout
     cases = {c.get("name"): c.find("failure") for c in ET.parse(junit).iter("testcase")}
-    assert {name: f is not None for name, f in cases.items()} == {
-        "start seals in": False, "stop drops the motor": False, "overload trips and stop resets": False,
-        "never": True, "input": True}
+    assert "start seals in" in cases and {name for name, f in cases.items() if f is not None} == {"never", "input"}
     assert all(part in cases["never"].text for part in drawn)
     assert "no rung writes Start (I:0/0)" in cases["input"].text
 
