@@ -12,6 +12,8 @@ from rich.markup import escape
 
 from ..app import AppError
 from ..errors import shown_path
+from ..testing.mutation import DEFAULT_BUDGET_S
+from ..testing.mutation_report import mutate_and_report
 from ..testing.runner import SCENARIO_GLOB, run_file, scenario_files
 from ..testing.scenario import ScenarioErrors
 from .common import EXIT_ERROR, EXIT_OK
@@ -24,6 +26,15 @@ def add_parser(sub) -> argparse.ArgumentParser:
                        description=f"Run the scenario files of an app ({SCENARIO_GLOB}): exit 0 when every "
                                    "scenario passes, 1 when one fails or a file has problems. See docs/testing.md.")
     c.add_argument("app", metavar="APP", help="app directory")
+    m = c.add_argument_group("mutation testing (docs/testing.md, \"Mutation testing\")")
+    m.add_argument("--mutate", action="store_true",
+                   help="then run the scenarios against small faults of the program and report those not caught")
+    m.add_argument("--jobs", type=_positive_int, default=None, metavar="N",
+                   help="worker processes for the mutants (default: the CPU count)")
+    m.add_argument("--mutate-timeout", type=_positive_float, default=DEFAULT_BUDGET_S, metavar="SECONDS",
+                   help=f"total time for the mutants; those left are reported as not run (default {DEFAULT_BUDGET_S:g})")
+    m.add_argument("--fail-under-mutation", type=float, default=None, metavar="PERCENT",
+                   help="exit 1 when the mutation score is under PERCENT")
     c.set_defaults(func=run)
     return c
 
@@ -51,4 +62,29 @@ def run(args: argparse.Namespace) -> int:
                 out.print(r.failure)
     summary = f"{passed} passed, {failed} failed"
     out.print(f"[red]{summary}[/]" if failed else f"[green]{summary}[/]")
-    return EXIT_ERROR if failed else EXIT_OK
+    if failed:
+        return EXIT_ERROR
+    if args.mutate and not mutate_and_report(args.app, out, sys.stderr, args.jobs, args.mutate_timeout,
+                                             args.fail_under_mutation):
+        return EXIT_ERROR
+    return EXIT_OK
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number of 1 or more, got {text!r}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds above 0, got {text!r}")
+    return value

@@ -1,0 +1,119 @@
+"""Mutation testing (testing/mutation.py, mutation_report.py, softplc test
+--mutate): each mutant classified, the time budget and the per-mutant limit
+honoured, the same results in one process or several, the report."""
+
+import io
+import re
+
+import pytest
+from rich.console import Console
+
+from softplc_lite.testing.mutation import (INVALID, KILLED, NOT_COVERED, OUT_OF_TIME, SURVIVED, TIMED_OUT,
+                                           MutationError, run_mutation)
+from softplc_lite.testing.mutation_report import print_report
+from tests.helpers.apps import make_app
+from tests.helpers.cli import softplc_here
+
+LADDER = (
+    "XIC B3/0 OTE B3/1\n"  # checked by the scenarios
+    "XIC B3/0 OTE B3/2\n"  # executed, its output checked by none
+    "XIC B3/0 TON T4:0 0.01 32767 0\n"  # a preset one more does not validate
+    "XIC B3/3 OTE B3/4\n"  # counted as not covered below
+)
+SCENARIOS = (
+    'scenario "on":\n    set B3/0 = 1\n    scan 1\n    expect B3/1 == 1\n'
+    'scenario "off":\n    scan 1\n    expect B3/1 == 0\n'
+)
+EXPECTED = [
+    KILLED, KILLED, KILLED,  # rung 0: contact, OTE removed, rung deleted
+    SURVIVED, SURVIVED, SURVIVED,  # rung 1
+    SURVIVED, INVALID, SURVIVED, SURVIVED,  # rung 2: contact, preset +1, preset -1, rung deleted
+    NOT_COVERED, NOT_COVERED, NOT_COVERED,  # rung 3
+]
+
+
+def _app(tmp_path, ladder=LADDER, scenarios=SCENARIOS):
+    app = make_app(tmp_path / "app", ladder)
+    (app / "tests").mkdir()
+    (app / "tests" / "t.plctest").write_text(scenarios, encoding="utf-8")
+    return app
+
+
+def _not_rung_3(key):
+    return key != (2, 3)
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_each_mutant_is_killed_survives_is_invalid_or_not_covered(tmp_path, jobs):
+    report = run_mutation(_app(tmp_path), jobs=jobs, covered=_not_rung_3)
+    assert [o.status for o in report.outcomes] == EXPECTED
+    assert report.jobs == jobs
+    assert report.score == pytest.approx(100 * 3 / 9)
+    invalid = report.outcomes[7].detail
+    assert "main.lad:3:" in invalid and "32768" in invalid
+    assert report.outcomes[0].detail.startswith("on: ")  # the scenario that killed it, and why
+
+
+def test_serial_and_parallel_runs_agree_outcome_for_outcome(tmp_path):
+    app = _app(tmp_path)
+    serial = run_mutation(app, jobs=1)
+    parallel = run_mutation(app, jobs=2)
+    assert serial.outcomes == parallel.outcomes
+    assert [m.description for m in serial.mutants] == [m.description for m in parallel.mutants]
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_no_mutant_starts_once_the_budget_is_spent(tmp_path, jobs):
+    report = run_mutation(_app(tmp_path), jobs=jobs, budget=0, covered=_not_rung_3)
+    assert [o.status for o in report.outcomes] == [OUT_OF_TIME] * 10 + [NOT_COVERED] * 3
+    assert report.score is None
+
+
+def test_a_mutant_over_the_per_mutant_limit_is_timed_out(tmp_path):
+    # a millionth of a second: less than loading the app takes
+    report = run_mutation(_app(tmp_path), jobs=1, limit=1e-6, covered=_not_rung_3)
+    assert [o.status for o in report.outcomes] == [TIMED_OUT] * 10 + [NOT_COVERED] * 3
+    assert report.outcomes[0].detail == "over the per-mutant limit of 1e-06 s"
+
+
+def test_scenarios_failing_on_the_original_program_stop_it(tmp_path):
+    app = _app(tmp_path, scenarios='scenario "wrong":\n    scan 1\n    expect B3/1 == 1\n')
+    with pytest.raises(MutationError, match=r"fail on the unmutated program(.|\n)*wrong: .*t.plctest:3: expected"):
+        run_mutation(app, jobs=1)
+
+
+def _plain(report) -> str:
+    out = io.StringIO()
+    print_report(report, Console(file=out, width=90, color_system=None, highlight=False, soft_wrap=True))
+    return out.getvalue()
+
+
+def test_the_report_draws_each_survivor_with_its_change_and_the_counts(tmp_path):
+    app = _app(tmp_path)
+    text = _plain(run_mutation(app, jobs=1, covered=_not_rung_3))
+    lines = text.splitlines()
+    head = lines.index(f"SURVIVED {app}/main.lad:2:1: rung 1: XIC B3/0 -> XIO B3/0 (contact)")
+    # the mutated rung as the watch view draws it: the contact now ]/[ and its value
+    assert lines[head + 1].strip() == "Rung 1"
+    assert re.fullmatch(r"\|\s+B3/0\s+B3/2\s+\|", lines[head + 2])
+    assert re.match(r"\|-+\]/\[-+.*\( \)-+\|", lines[head + 3]), lines[head + 3]
+    assert f"SURVIVED {app}/main.lad:2:10: rung 1: OTE B3/2 removed (output)" in lines
+    # a deleted rung is drawn as it was
+    deleted = lines.index(f"SURVIVED {app}/main.lad:2:1: rung 1: rung deleted: XIC B3/0 OTE B3/2 (rung)")
+    assert re.match(r"\|-+\] \[-+.*\( \)-+\|", lines[deleted + 3]), lines[deleted + 3]
+    assert lines[-1].startswith("mutation score 33.3% (3 killed of 9), 3 not covered, 1 invalid, 13 mutants, "
+                                "2 scenarios, 1 job, ")
+
+
+def test_softplc_test_mutate_reports_and_fails_under_a_score(tmp_path):
+    app = _app(tmp_path, ladder="XIC B3/0 OTE B3/1\nXIC B3/0 OTE B3/2\n")
+    r = softplc_here("test", str(app), "--mutate", "--jobs", "2")
+    assert r.returncode == 0, r.stderr
+    assert "2 passed, 0 failed" in r.stdout
+    assert f"SURVIVED {app}/main.lad:2:1: rung 1: XIC B3/0 -> XIO B3/0 (contact)" in r.stdout
+    assert re.search(r"^mutation score 50\.0% \(3 killed of 6\), 6 mutants, 2 scenarios, 2 jobs, ", r.stdout, re.M)
+    r = softplc_here("test", str(app), "--mutate", "--jobs", "1", "--fail-under-mutation", "60")
+    assert r.returncode == 1
+    assert "mutation score 50.0% is under --fail-under-mutation 60%" in r.stdout
+    r = softplc_here("test", str(app), "--mutate", "--jobs", "0")
+    assert r.returncode != 0 and "expected a whole number of 1 or more, got '0'" in r.stderr
