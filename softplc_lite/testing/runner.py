@@ -20,6 +20,7 @@ from ..ladder.ast import Program
 from .drawing import RungsAt, writers_at
 from .plc import PLC
 from .scenario import Scenario, ScenarioErrors, ScenarioFile, Step, load_scenarios
+from .values import value_errors
 
 SCENARIO_GLOB = "tests/*.plctest"
 
@@ -72,7 +73,8 @@ def scenario_files(app: str | Path) -> list[Path]:
 
 
 def check_names(file: ScenarioFile, plc: PLC) -> None:
-    """Every address or symbol a step names exists: all problems at once."""
+    """Every address or symbol a step names exists, and its value is of a
+    kind the address holds (values.py): all problems at once, in file order."""
     errors = []
     for step in file.setup + [s for sc in file.scenarios for s in sc.steps]:
         if step.kind in ("scan", "run"):
@@ -84,8 +86,9 @@ def check_names(file: ScenarioFile, plc: PLC) -> None:
             reason = getattr(e, "reason", None) or str(e)
             errors.append(LocatedError(f"expected an address or a symbol of the program: {name}: {reason}",
                                        file.path, step.line, step.column))
+    errors += value_errors(file, plc)
     if errors:
-        raise ScenarioErrors(errors)
+        raise ScenarioErrors(sorted(errors, key=lambda e: (e.line, e.column)))
 
 
 def _seconds(number, unit) -> float:
