@@ -59,8 +59,8 @@ def test_a_failure_says_expectation_actual_scan_and_time(tmp_path):
 
 
 @pytest.mark.parametrize("step, want", [
-    ("expect Motor within 0.5 of 1", "expected Motor within 0.5 of 1, got 0"),
-    ("expect Motor between 1 and 2", "expected Motor between 1 and 2, got 0"),
+    ("expect C5:0.ACC within 0.5 of 1", "expected C5:0.ACC within 0.5 of 1, got 0"),
+    ("expect C5:0.ACC between 1 and 2", "expected C5:0.ACC between 1 and 2, got 0"),
     ("expect rising Motor", "expected rising edge of Motor since the previous step, got 0"),
     ("expect falling Motor", "expected falling edge of Motor since the previous step, got 0"),
     ("wait until Motor == 1 within 50 ms", "expected Motor == 1 within 50 ms, got 0 (scan 6, 0.06 s)"),
