@@ -36,7 +36,7 @@ def test_every_problem_of_every_config_file(tmp_path):
         f"{lst_path}:7: [DRIVER]: unknown setting 'FOO' (settings: DEBUG, PORT_ERRORS, RETRY_MS, COM1..COM99)",
         f"{lst_path}:11: COMGENIUS port 0: modbus device: turnaround_ms must be a number >= 0, not 'abc' "
         '(expected "sim://NAME[?device=KIND[&KEY=VALUE...]][&rate=unlimited]")',
-        f"{lst_path}:12: COMGENIUS port 1: unknown device kind 'nosuch' (known: echo, modbus, modbus_master) "
+        f"{lst_path}:12: COMGENIUS port 1: unknown device kind 'nosuch' (known: echo, modbus, modbus_master, scripted) "
         '(expected "sim://NAME[?device=KIND[&KEY=VALUE...]][&rate=unlimited]")',
         f"{lst_path}:13: [PORTS]: data bits 9 is out of range (5..8)",
         f"{toml}:2: [scan] scan_ms = -1; expected an integer from 0 to 32767",

@@ -569,7 +569,7 @@ def test_bad_options(options, message):
 
 
 def test_unknown_kind_lists_modbus():
-    with pytest.raises(ValueError, match=r"unknown device kind 'nope' \(known: echo, modbus, modbus_master\)"):
+    with pytest.raises(ValueError, match=r"unknown device kind 'nope' \(known: echo, modbus, modbus_master, scripted\)"):
         simdevices.create_device("nope", {})
 
 

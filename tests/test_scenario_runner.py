@@ -48,7 +48,8 @@ def test_the_shipped_scenarios_pass(path):
 
 
 def test_the_shipped_apps_have_scenario_files():
-    assert {"motor", "blinker"} <= {p.parent.parent.name for p in SHIPPED}
+    assert {"motor", "blinker", "modbus_slave", "modbus_master", "loopback", "strings", "modbus_scada",
+            "hmi_server"} <= {p.parent.parent.name for p in SHIPPED}
 
 
 def test_a_failure_says_expectation_actual_scan_and_time(tmp_path):

@@ -7,7 +7,9 @@ option (``check_options`` helps). The ``sim://`` handler turns that into a
 ``SerialException``. Register a kind at import of the module that defines
 it, before a port opens a URL naming it. The built-in kinds that live in
 other modules (``BUILTIN_DEVICES``: kind -> "module:factory", e.g. ``modbus``
-in modbus_slave.py) are imported and registered on first use.
+in modbus_slave.py) are imported and registered on first use. A kind whose
+name starts with ``_`` is private to the code that registers it (the testing
+API's devices given as objects): it is not listed among the known kinds.
 
 The device API (all times are int ns on the clock of the port the device
 is attached to):
@@ -80,7 +82,8 @@ DEVICES: dict[str, DeviceFactory] = {}
 _kinds_lock = threading.Lock()
 # Built-in kinds defined in other modules: imported when first created.
 BUILTIN_DEVICES: dict[str, str] = {"modbus": "softplc_lite.ports.modbus_slave:create",
-                                   "modbus_master": "softplc_lite.ports.modbus_master:create"}
+                                   "modbus_master": "softplc_lite.ports.modbus_master:create",
+                   "scripted": "softplc_lite.ports.scripted:create"}
 
 
 def register_device(kind: str, factory: DeviceFactory) -> None:
@@ -104,7 +107,7 @@ def create_device(kind: str, options: dict[str, str]) -> SimDevice:
         factory = getattr(importlib.import_module(module), name)
         register_device(kind, factory)
     if factory is None:
-        known = ", ".join(sorted({*DEVICES, *BUILTIN_DEVICES}))
+        known = ", ".join(sorted(k for k in {*DEVICES, *BUILTIN_DEVICES} if not k.startswith("_")))
         raise ValueError(f"unknown device kind {kind!r} (known: {known})")
     return factory(dict(options))
 

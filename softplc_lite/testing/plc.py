@@ -4,21 +4,26 @@ driven scan by scan through a ``Runner`` it owns."""
 
 from __future__ import annotations
 
+import dataclasses
 import shutil
 import tempfile
 from pathlib import Path
+from typing import Mapping
 
 from ..app import load_app
 from ..ladder.ast import Program
 from ..ladder.engine import Mode
 from ..ladder.symbols import resolve_name
 from ..runner import Runner, RunOptions
+from ..tlm.api import TLM
 from ..watch.forces import Force, Forces, _bit_address
+from .devices import Attached, attach, device_on
 
 
 class PLC:
-    def __init__(self, runner: Runner, state_dir: str) -> None:
+    def __init__(self, runner: Runner, state_dir: str, attached: Attached | None = None) -> None:
         self.runner = runner
+        self._attached = attached
         self.engine = runner.engine
         self.table = runner.table
         self.symbols = runner.app.program.symbols
@@ -28,19 +33,44 @@ class PLC:
             self.engine.set_mode(Mode.RUN)
 
     @classmethod
-    def load(cls, path: str | Path, ports: tuple[str, ...] = (), program: Program | None = None) -> "PLC":
+    def load(cls, path: str | Path, ports: tuple[str, ...] = (), program: Program | None = None,
+             devices: Mapping | None = None, configured_tcp_ports: bool = False) -> "PLC":
         """``ports``: ``--port`` overrides, e.g. ``("1=sim://...")``;
         ``program``: a parsed program run in place of the app's own (a
-        mutant), with the app's modules, settings and data."""
+        mutant), with the app's modules, settings and data; ``devices``:
+        {PORT: DEVICE} simulated devices on the app's ports (devices.py);
+        a network server listens on a port the system picks
+        (``server_port()``) unless ``configured_tcp_ports``."""
         state_dir = tempfile.mkdtemp(prefix="softplc-test-")
+        attached = None
         try:
             app = load_app(path, state_dir=state_dir, program=program)
+            if not configured_tcp_ports:
+                _ephemeral_servers(app.modules)
+            if devices:
+                attached = attach(app.modules, devices)
+                ports = tuple(ports) + attached.overrides
             runner = Runner(app, RunOptions(fresh=True, ports=tuple(ports), save_state=False),
                             log=lambda msg: None)
         except BaseException:
             shutil.rmtree(state_dir, ignore_errors=True)
+            if attached is not None:
+                attached.release()
             raise
-        return cls(runner, state_dir)
+        return cls(runner, state_dir, attached)
+
+    def device(self, port):
+        """The simulated device on ``port`` (a number, or ``MODULE:N``): the
+        app's own (its config's ``sim://...?device=``) or one ``load`` attached."""
+        return device_on(self.engine.modules, port)
+
+    def server_port(self, module: str | None = None) -> int | None:
+        """The TCP port the app's network server (of ``module``) listens on,
+        once the first scan has started it; None before or when it failed."""
+        for m in self.engine.modules:
+            if (module is None or m.name.upper() == module.upper()) and m.network_servers():
+                return getattr(m, "port", None)
+        return None
 
     def address(self, name: str):
         return resolve_name(name, self.symbols)
@@ -83,9 +113,22 @@ class PLC:
             self.runner.close()
         finally:
             shutil.rmtree(self._state_dir, ignore_errors=True)
+            if self._attached is not None:
+                self._attached.release()
 
     def __enter__(self) -> "PLC":
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _ephemeral_servers(modules) -> None:
+    """Every network server of the app listens on a port the system picks
+    (0) at its configured address: a test never depends on a fixed port,
+    nor fails beside a PLC that serves the app's port already."""
+    for m in modules:
+        config = getattr(m, "config", None)
+        if type(m).network_servers is not TLM.network_servers and dataclasses.is_dataclass(config) and \
+                "port" in {f.name for f in dataclasses.fields(config)} and hasattr(config, "host"):
+            m.config = dataclasses.replace(config, port=0)
