@@ -41,6 +41,16 @@ _EndScan = EndScan  # TND: end this scan now (defined with RET/TND so both execu
 Hook = Callable[["Engine"], None]
 
 
+def _builder(executor):
+    """The function that builds a program file's code: "compiled",
+    "reference" (the interpreter), or a build function of interpret_file's
+    signature given as the executor itself (testing/coverage.py's recording
+    interpreter)."""
+    if callable(executor):
+        return executor
+    return compile_file if executor == "compiled" else interpret_file
+
+
 class Engine:
     def __init__(
         self,
@@ -106,7 +116,7 @@ class Engine:
         reference_module_blocks(program, self.table, self._owner)
         self._attach_modules(module_options or {})
         self._attach_hooks()
-        build = compile_file if executor == "compiled" else interpret_file
+        build = _builder(executor)
         if code is not None:
             try:
                 self._build_files(program, self._cached_build(code))
@@ -224,7 +234,7 @@ class Engine:
         saved = self.program, self.files, self._instances
         self.program, self._instances, self._kept_instances = program, {}, kept_instances
         if build is None:
-            build = compile_file if self.executor == "compiled" else interpret_file
+            build = _builder(self.executor)
         try:
             self._build_files(program, build)
         except BaseException:

@@ -485,8 +485,10 @@ def _bound(it, ins, c, rung, pfile):
 
 
 def interpret_file(program: Program, number: int, table: DataTable, machine: Machine, jsr, zone: list,
-                   module_instance=None) -> ReferenceFile:
-    interp = Interpreter(table, machine, jsr, zone)
+                   module_instance=None, interpreter=Interpreter) -> ReferenceFile:
+    """``interpreter``: the Interpreter class to run the file with (a subclass
+    may watch the scan: testing/coverage.py records what each rung does)."""
+    interp = interpreter(table, machine, jsr, zone)
     rungs = program.files[number].rungs
     access = ReferenceAccess(table, machine)
     for rung in rungs:

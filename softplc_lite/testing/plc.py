@@ -17,6 +17,7 @@ from ..ladder.symbols import resolve_name
 from ..runner import Runner, RunOptions
 from ..tlm.api import TLM
 from ..watch.forces import Force, Forces, _bit_address
+from .coverage import Coverage
 from .devices import Attached, attach, device_on
 
 
@@ -34,13 +35,16 @@ class PLC:
 
     @classmethod
     def load(cls, path: str | Path, ports: tuple[str, ...] = (), program: Program | None = None,
-             devices: Mapping | None = None, configured_tcp_ports: bool = False) -> "PLC":
+             devices: Mapping | None = None, configured_tcp_ports: bool = False,
+             coverage: Coverage | None = None) -> "PLC":
         """``ports``: ``--port`` overrides, e.g. ``("1=sim://...")``;
         ``program``: a parsed program run in place of the app's own (a
         mutant), with the app's modules, settings and data; ``devices``:
         {PORT: DEVICE} simulated devices on the app's ports (devices.py);
         a network server listens on a port the system picks
-        (``server_port()``) unless ``configured_tcp_ports``."""
+        (``server_port()``) unless ``configured_tcp_ports``; ``coverage``:
+        a Coverage the scans record into (testing/coverage.py: the
+        reference interpreter instead of the compiled code)."""
         state_dir = tempfile.mkdtemp(prefix="softplc-test-")
         attached = None
         try:
@@ -50,7 +54,11 @@ class PLC:
             if devices:
                 attached = attach(app.modules, devices)
                 ports = tuple(ports) + attached.overrides
-            runner = Runner(app, RunOptions(fresh=True, ports=tuple(ports), save_state=False),
+            executor = "compiled"
+            if coverage is not None:
+                coverage.learn_modules(app.modules)
+                executor = coverage.executor
+            runner = Runner(app, RunOptions(fresh=True, ports=tuple(ports), save_state=False, executor=executor),
                             log=lambda msg: None)
         except BaseException:
             shutil.rmtree(state_dir, ignore_errors=True)

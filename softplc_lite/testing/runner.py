@@ -17,6 +17,7 @@ from rich.text import Text
 
 from ..errors import LocatedError
 from ..ladder.ast import Program
+from .coverage import Coverage
 from .drawing import RungsAt, writers_at
 from .plc import PLC
 from .scenario import Scenario, ScenarioErrors, ScenarioFile, Step, load_scenarios
@@ -163,9 +164,11 @@ def _compare(actual, op, value) -> bool:
     return (actual == value) if op == "==" else (actual != value)
 
 
-def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario, program: Program | None = None) -> Result:
-    """``program``: a parsed program run in place of the app's (PLC.load)."""
-    with PLC.load(app, program=program) as plc:
+def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario, program: Program | None = None,
+                 coverage: Coverage | None = None) -> Result:
+    """``program``: a parsed program run in place of the app's (PLC.load);
+    ``coverage``: a Coverage the scenario's scans record into."""
+    with PLC.load(app, program=program, coverage=coverage) as plc:
         check_names(file, plc)
         run = _Run(plc, file.path)
         for step in file.setup + scenario.steps:  # edges are watched from the start
@@ -178,6 +181,7 @@ def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario, progra
     return Result(file.path, scenario.name)
 
 
-def run_file(app: str | Path, path: str | Path, program: Program | None = None) -> list[Result]:
+def run_file(app: str | Path, path: str | Path, program: Program | None = None,
+             coverage: Coverage | None = None) -> list[Result]:
     file = load_scenarios(path)
-    return [run_scenario(app, file, sc, program) for sc in file.scenarios]
+    return [run_scenario(app, file, sc, program, coverage=coverage) for sc in file.scenarios]
