@@ -16,6 +16,7 @@ from ..testing.mutation import DEFAULT_BUDGET_S
 from ..testing.mutation_report import mutate_and_report
 from ..testing.runner import SCENARIO_GLOB, run_file, scenario_files
 from ..testing.scenario import ScenarioErrors
+from . import test_coverage
 from .common import EXIT_ERROR, EXIT_OK
 
 NAME = "test"
@@ -26,6 +27,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
                        description=f"Run the scenario files of an app ({SCENARIO_GLOB}): exit 0 when every "
                                    "scenario passes, 1 when one fails or a file has problems. See docs/testing.md.")
     c.add_argument("app", metavar="APP", help="app directory")
+    test_coverage.add_arguments(c)
     m = c.add_argument_group("mutation testing (docs/testing.md, \"Mutation testing\")")
     m.add_argument("--mutate", action="store_true",
                    help="then run the scenarios against small faults of the program and report those not caught")
@@ -46,9 +48,10 @@ def run(args: argparse.Namespace) -> int:
         print(f"{shown_path(args.app)}: no scenario files ({SCENARIO_GLOB})", file=sys.stderr)
         return EXIT_ERROR
     passed = failed = 0
+    cov = test_coverage.wanted(args)
     for path in files:
         try:
-            results = run_file(args.app, path)
+            results = run_file(args.app, path, coverage=cov)
         except (ScenarioErrors, AppError) as e:
             print(str(e), file=sys.stderr)
             return EXIT_ERROR
@@ -62,8 +65,11 @@ def run(args: argparse.Namespace) -> int:
                 out.print(r.failure)
     summary = f"{passed} passed, {failed} failed"
     out.print(f"[red]{summary}[/]" if failed else f"[green]{summary}[/]")
-    if failed:
-        return EXIT_ERROR
+    code = EXIT_ERROR if failed else EXIT_OK
+    if cov is not None:
+        code = test_coverage.report(args, cov, out, code)
+    if code != EXIT_OK:
+        return code
     if args.mutate and not mutate_and_report(args.app, out, sys.stderr, args.jobs, args.mutate_timeout,
                                              args.fail_under_mutation):
         return EXIT_ERROR
