@@ -80,3 +80,12 @@ def test_a_leg_of_three_removed_leaves_a_branch_and_nested_legs_mutate(tmp_path)
         "BST BST XIC B3/1 NXB XIC B3/2 BND NXB XIC B3/3 BND OTE B3/4"
     assert applied["branch leg 1 of 2 removed: XIC B3/1"] == "BST XIC B3/0 NXB XIC B3/2 NXB XIC B3/3 BND OTE B3/4"
     assert applied["XIC B3/2 -> XIO B3/2"] == "BST XIC B3/0 NXB BST XIC B3/1 NXB XIO B3/2 BND NXB XIC B3/3 BND OTE B3/4"
+
+
+def test_deleting_a_bare_sbr_or_a_final_bare_ret_is_no_mutant(tmp_path):
+    """Either deletion leaves the program doing the same, so no scenario could catch it;
+    a RET before the end of its file still is one (it skips the rungs after it)."""
+    source, instructions = _source(tmp_path, "JSR 3\nFILE 3 Sub\nSBR\nRET\nADD N7:0 1 N7:0\nRET\n")
+    deleted = [(m.key, m.description) for m in mutants(source, instructions) if m.operator == "rung"]
+    assert deleted == [((2, 0), "rung deleted: JSR 3"), ((3, 1), "rung deleted: RET"),
+                       ((3, 2), "rung deleted: ADD N7:0 1 N7:0")]

@@ -71,14 +71,26 @@ def mutants(program: Program, instructions: InstructionSet = BUILTIN) -> list[Mu
     """Every mutant of a parsed program, in file, rung and element order."""
     found: list[Mutant] = []
     for number in sorted(program.files):
-        for index, rung in enumerate(program.files[number].rungs):
+        rungs = program.files[number].rungs
+        for index, rung in enumerate(rungs):
             for operator, description, pos, elements in _series(rung.elements, instructions):
                 found.append(Mutant(len(found), operator, (number, index), pos, description,
                                     Rung(elements, rung.comment, rung.pos)))
-            if rung.elements:
+            if rung.elements and not _deletion_changes_nothing(rungs, index):
                 found.append(Mutant(len(found), RUNG, (number, index), rung.pos,
                                     f"rung deleted: {format_series(rung.elements, 'mnemonic')}", None))
     return found
+
+
+def _deletion_changes_nothing(rungs, index: int) -> bool:
+    """A lone SBR without parameters (it receives nothing), or a lone RET
+    without parameters ending its file (the file's end returns the same):
+    deleting it makes a mutant no test could catch, which would only lower
+    the score."""
+    elements = rungs[index].elements
+    if len(elements) != 1 or not isinstance(elements[0], Instruction) or elements[0].operands:
+        return False
+    return elements[0].mnemonic == "SBR" or (elements[0].mnemonic == "RET" and index == len(rungs) - 1)
 
 
 def _series(elements, instructions) -> Iterator[tuple[str, str, Pos, list]]:
