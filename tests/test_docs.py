@@ -1,6 +1,7 @@
 """The examples in docs/ and the README are run: ``>>>`` lines as doctests,
 ``$ softplc ...`` lines in ```console blocks as real commands whose output
-must match what the page shows.
+must match what the page shows, and exit 0 unless the output ends with an
+``[exit N]`` line (the status it must exit with).
 
 They run in a copy of programs/ and docs/examples/ in the test's temporary
 directory (so the apps' state is written there, not in the repository),
@@ -75,8 +76,12 @@ def test_doctests_in_docs(page: Path, here):
 def test_console_examples(command: str, expected: list[str], here, tmp_path):
     argv = shlex.split(here(command))
     assert argv[0] == "softplc", "console examples run the softplc command"
-    proc = softplc_here(*argv[1:], cwd=tmp_path)  # the text it prints; test_cli_readme runs the command itself
-    assert proc.returncode == 0, proc.stderr
+    status = re.fullmatch(r"\[exit (\d+)\]", expected[-1]) if expected else None
+    if status:
+        expected = expected[:-1]
+    # the width a console without a terminal has, whatever the environment says
+    proc = softplc_here(*argv[1:], cwd=tmp_path, env={"COLUMNS": "80"})  # test_cli_readme runs the command itself
+    assert proc.returncode == (int(status.group(1)) if status else 0), proc.stderr
     assert proc.stdout.splitlines() == [here(line) for line in expected]
 
 
