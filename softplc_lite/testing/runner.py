@@ -170,15 +170,22 @@ def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario, progra
     ``coverage``: a Coverage the scenario's scans record into."""
     with PLC.load(app, program=program, coverage=coverage) as plc:
         check_names(file, plc)
-        run = _Run(plc, file.path)
-        for step in file.setup + scenario.steps:  # edges are watched from the start
-            if step.kind in ("expect_rising", "expect_falling"):
-                run.edges.setdefault(step.args[0], [plc[step.args[0]]])
-        for step in file.setup + scenario.steps:
-            failure = run.step(step)
-            if failure is not None:
-                return Result(file.path, scenario.name, failure)
-    return Result(file.path, scenario.name)
+        return Result(file.path, scenario.name, run_steps(plc, file, scenario))
+
+
+def run_steps(plc: PLC, file: ScenarioFile, scenario: Scenario) -> Failure | None:
+    """The file's setup, then the scenario's steps, on ``plc`` as it is (its
+    names checked): the first failure, or None."""
+    run = _Run(plc, file.path)
+    steps = file.setup + scenario.steps
+    for step in steps:  # edges are watched from the start
+        if step.kind in ("expect_rising", "expect_falling"):
+            run.edges.setdefault(step.args[0], [plc[step.args[0]]])
+    for step in steps:
+        failure = run.step(step)
+        if failure is not None:
+            return failure
+    return None
 
 
 def run_file(app: str | Path, path: str | Path, program: Program | None = None,
