@@ -19,6 +19,7 @@ from ..tlm.api import TLM
 from ..watch.forces import Force, Forces, _bit_address
 from .coverage import Coverage
 from .devices import Attached, attach, device_on
+from .scenario import DeviceCounter
 
 
 class PLC:
@@ -84,6 +85,8 @@ class PLC:
         return resolve_name(name, self.symbols)
 
     def __getitem__(self, name: str):
+        if isinstance(name, DeviceCounter):  # a scenario's ``device PORT NAME``
+            return getattr(self.device(int(name.port) if name.port.isdigit() else name.port), name.attribute)
         return self.table.read(self.address(name))
 
     def set(self, name: str, value) -> None:

@@ -20,7 +20,8 @@ from ..ladder.ast import Program
 from .coverage import Coverage
 from .drawing import RungsAt, writers_at
 from .plc import PLC
-from .scenario import Scenario, ScenarioErrors, ScenarioFile, Step, load_scenarios
+from .scenario import DeviceCounter, Scenario, ScenarioErrors, ScenarioFile, Step, load_scenarios
+from .scenario_devices import counter_errors, open_plc
 from .values import value_errors
 
 SCENARIO_GLOB = "tests/*.plctest"
@@ -78,7 +79,7 @@ def check_names(file: ScenarioFile, plc: PLC) -> None:
     kind the address holds (values.py): all problems at once, in file order."""
     errors = []
     for step in file.setup + [s for sc in file.scenarios for s in sc.steps]:
-        if step.kind in ("scan", "run"):
+        if step.kind in ("scan", "run") or isinstance(step.args[0], DeviceCounter):
             continue
         name = step.args[0]
         try:
@@ -87,7 +88,7 @@ def check_names(file: ScenarioFile, plc: PLC) -> None:
             reason = getattr(e, "reason", None) or str(e)
             errors.append(LocatedError(f"expected an address or a symbol of the program: {name}: {reason}",
                                        file.path, step.line, step.column))
-    errors += value_errors(file, plc)
+    errors += value_errors(file, plc) + counter_errors(file, plc)
     if errors:
         raise ScenarioErrors(sorted(errors, key=lambda e: (e.line, e.column)))
 
@@ -154,8 +155,9 @@ class _Run:
 
     def _fail(self, step: Step, expectation: str, actual) -> Failure:
         plc = self.plc
-        rungs = writers_at(plc.runner.app.program, plc.table, step.args[0], plc.forces.forces,
-                           plc.runner.app.instructions)
+        rungs = None if isinstance(step.args[0], DeviceCounter) else \
+            writers_at(plc.runner.app.program, plc.table, step.args[0], plc.forces.forces,
+                       plc.runner.app.instructions)
         return Failure(expectation, actual, plc.scan_number, plc.time_ms, self.path, step.line, step.args[0],
                        rungs)
 
@@ -168,7 +170,7 @@ def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario, progra
                  coverage: Coverage | None = None) -> Result:
     """``program``: a parsed program run in place of the app's (PLC.load);
     ``coverage``: a Coverage the scenario's scans record into."""
-    with PLC.load(app, program=program, coverage=coverage) as plc:
+    with open_plc(app, file, program=program, coverage=coverage) as plc:
         check_names(file, plc)
         return Result(file.path, scenario.name, run_steps(plc, file, scenario))
 

@@ -36,14 +36,40 @@ class Scenario:
     steps: list[Step] = field(default_factory=list)
 
 
+@dataclass(frozen=True)
+class DeviceLine:
+    """``device PORT = KIND KEY=VALUE...``: a simulated device on a port of
+    the app, for every scenario of the file (testing/devices.py)."""
+
+    port: str
+    kind: str
+    options: tuple[tuple[str, str], ...]
+    line: int
+    column: int
+
+
+class DeviceCounter(str):
+    """A step's ``device PORT NAME``: a number of a simulated device's score
+    (``device 0 bad``), read where an address is read; the text is the name."""
+
+    port: str
+    attribute: str
+
+    def __new__(cls, port: str, attribute: str) -> "DeviceCounter":
+        self = super().__new__(cls, f"device {port} {attribute}")
+        self.port, self.attribute = port, attribute
+        return self
+
+
 @dataclass
 class ScenarioFile:
     path: str
     setup: list[Step]
     scenarios: list[Scenario]
+    devices: list[DeviceLine] = field(default_factory=list)
 
 
-_KEYWORDS = {"set", "force", "unforce", "scan", "run", "wait", "expect", "scenario", "setup"}
+_KEYWORDS = {"set", "force", "unforce", "scan", "run", "wait", "expect", "scenario", "setup", "device"}
 
 
 class ScenarioErrors(Exception):
@@ -92,6 +118,16 @@ class _ToSteps(Transformer):
     expect_rising = _step("expect_rising")
     expect_falling = _step("expect_falling")
 
+    def counter(self, c):
+        return DeviceCounter(str(c[0]), str(c[1]))
+
+    def option(self, c):
+        v = c[1]
+        return (str(c[0]), json.loads(str(v)) if v.type == "STRING" else str(v))
+
+    def device(self, c):
+        return ("device", DeviceLine(str(c[0]), str(c[1]), tuple(c[2:]), self.line, self.column))
+
     def setup(self, c):
         return ("setup", None)
 
@@ -116,6 +152,7 @@ def parse_scenarios(text: str, path: str = "<scenario>") -> ScenarioFile:
     errors: list[LocatedError] = []
     setup: list[Step] = []
     scenarios: list[Scenario] = []
+    devices: list[DeviceLine] = []
     block: list[Step] | None = None
     for number, raw in enumerate(text.splitlines(), 1):
         body = _strip_comment(raw)
@@ -130,8 +167,9 @@ def parse_scenarios(text: str, path: str = "<scenario>") -> ScenarioFile:
             known = first in _KEYWORDS or first.rstrip(":") == "setup"
             col = indent + getattr(e, "column", 1) if known else column
             errors.append(LocatedError(
-                "expected a step (set, force, unforce, scan, run, wait until, expect) "
-                "or a block header (setup:, scenario \"name\":)", path, number, col))
+                "expected a step (set, force, unforce, scan, run, wait until, expect), "
+                "a block header (setup:, scenario \"name\":) or a device line (device PORT = KIND KEY=VALUE...)",
+                path, number, col))
             continue
         except VisitError as e:
             errors.append(LocatedError(str(e.orig_exc), path, number, column))
@@ -140,6 +178,22 @@ def parse_scenarios(text: str, path: str = "<scenario>") -> ScenarioFile:
             if indent:
                 errors.append(LocatedError("expected a block header at the start of the line",
                                            path, number, column))
+                continue
+            if item[0] == "device":
+                line: DeviceLine = item[1]
+                if setup or scenarios or block is not None:
+                    errors.append(LocatedError("expected device lines before setup: and the scenarios",
+                                               path, number, column))
+                elif any(d.port == line.port for d in devices):
+                    errors.append(LocatedError(f"expected one device a port: port {line.port} has one already",
+                                               path, number, column))
+                else:
+                    seen = [k for k, _ in line.options]
+                    twice = sorted({k for k in seen if seen.count(k) > 1})
+                    if twice:
+                        errors.append(LocatedError(f"expected each option once: {', '.join(twice)} given twice",
+                                                   path, number, column))
+                    devices.append(line)
                 continue
             if item[0] == "setup":
                 if setup or scenarios:
@@ -159,7 +213,7 @@ def parse_scenarios(text: str, path: str = "<scenario>") -> ScenarioFile:
         errors.append(LocatedError("expected at least one scenario \"name\": block", path, 1, 1))
     if errors:
         raise ScenarioErrors(errors)
-    return ScenarioFile(path, setup, scenarios)
+    return ScenarioFile(path, setup, scenarios, devices)
 
 
 def load_scenarios(path: str | Path) -> ScenarioFile:
