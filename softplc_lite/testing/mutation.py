@@ -200,10 +200,13 @@ def _run_covered(app, file, scenario, cov):
 
 def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DEFAULT_BUDGET_S,
                  limit: float | None = None, covered: Callable[[RungKey], bool] | None = None,
-                 coverage_factory: Callable[[], object] | None = None) -> MutationReport:
+                 coverage_factory: Callable[[], object] | None = None,
+                 select: Callable[[Mutant], bool] | None = None) -> MutationReport:
     """Mutation-test ``app`` with its scenario files. ``covered`` says which
     rungs the scenarios execute (measured by the baseline run when None);
-    ``limit``: the per-mutant limit in seconds (from the baseline when None)."""
+    ``limit``: the per-mutant limit in seconds (from the baseline when None);
+    ``select``: the mutants to make (all when None; the others are left
+    out of the report, e.g. a sample of a large program's)."""
     app = str(app)
     paths = [str(p) for p in scenario_files(app)]
     if not paths:
@@ -216,7 +219,7 @@ def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DE
     covered = covered or measured
     if limit is None:
         limit = max(MIN_LIMIT_S, LIMIT_FACTOR * seconds)
-    found = mutants(source, loaded.instructions)
+    found = [m for m in mutants(source, loaded.instructions) if select is None or select(m)]
     outcomes: dict[int, Outcome] = {m.index: Outcome(m.index, NOT_COVERED) for m in found if not covered(m.key)}
     todo = [m for m in found if m.index not in outcomes]
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(todo) or 1))
