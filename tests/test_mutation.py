@@ -117,3 +117,25 @@ def test_softplc_test_mutate_reports_and_fails_under_a_score(tmp_path):
     assert "mutation score 50.0% is under --fail-under-mutation 60%" in r.stdout
     r = softplc_here("test", str(app), "--mutate", "--jobs", "0")
     assert r.returncode != 0 and "expected a whole number of 1 or more, got '0'" in r.stderr
+
+
+def test_mutants_of_rungs_the_scenarios_never_execute_are_not_run(tmp_path):
+    # the baseline run measures coverage: the JMP skips rung 2 on every scan
+    app = _app(tmp_path, ladder="XIC B3/0 OTE B3/1\nJMP 1\nXIC B3/3 OTE B3/4\nLBL 1\n")
+    report = run_mutation(app, jobs=1)
+    assert [(m.key, o.status) for m, o in zip(report.mutants, report.outcomes)] == [
+        ((2, 0), KILLED), ((2, 0), KILLED), ((2, 0), KILLED),
+        ((2, 1), SURVIVED),  # the JMP deleted: rung 2 then runs, and no scenario looks at B3/4
+        ((2, 2), NOT_COVERED), ((2, 2), NOT_COVERED), ((2, 2), NOT_COVERED),
+        ((2, 3), INVALID),  # the label deleted: the JMP has nowhere to go
+    ]
+
+
+def test_a_mutant_that_loops_within_a_scan_is_killed_by_the_watchdog_fault(tmp_path):
+    # XIC B3/2 -> XIO B3/2 jumps back to LBL 1 on every pass: the engine's
+    # watchdog ends the scan with a major fault, which kills the mutant
+    app = _app(tmp_path, ladder="LBL 1 XIC B3/0 OTE B3/1\nXIC B3/2 JMP 1\n")
+    report = run_mutation(app, jobs=1, select=lambda m: m.description == "XIC B3/2 -> XIO B3/2")
+    [outcome] = report.outcomes
+    assert outcome.status == KILLED
+    assert "major fault: watchdog" in outcome.detail

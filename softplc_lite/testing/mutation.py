@@ -32,6 +32,7 @@ from typing import Callable
 
 from ..app import AppError, load_app
 from ..ladder.ast import Program
+from .coverage import Coverage
 from .mutants import Mutant, RungKey, mutants
 from .runner import run_scenario, scenario_files
 from .scenario import ScenarioFile, load_scenarios
@@ -146,6 +147,8 @@ def _verdict(mutant: Mutant, program: Program) -> Outcome:
                 return Outcome(mutant.index, KILLED, f"{file.path}: {scenario.name}: {type(e).__name__}: {e}")
             if not result.passed:
                 return Outcome(mutant.index, KILLED, f"{scenario.name}: {result.failure.report()}")
+            if result.fault is not None:
+                return Outcome(mutant.index, KILLED, f"{scenario.name}: major fault: {result.fault}")
     return Outcome(mutant.index, SURVIVED)
 
 
@@ -172,15 +175,16 @@ def _install_timer() -> object | None:
 
 
 def baseline(app: str | Path, files: list[ScenarioFile],
-             coverage_factory: Callable[[], object] | None = None) -> tuple[float, Callable[[RungKey], bool]]:
+             coverage_factory: Callable[[], Coverage] | None = Coverage) -> tuple[float, Callable[[RungKey], bool]]:
     """Run the scenarios on the unmutated program: the seconds it took and
-    which rungs they executed. MutationError when one fails."""
+    which rungs they executed (testing/coverage.py; every rung when
+    ``coverage_factory`` is None). MutationError when one fails."""
     cov = coverage_factory() if coverage_factory is not None else None
     failures = []
     start = time.perf_counter()
     for file in files:
         for scenario in file.scenarios:
-            result = _run_covered(app, file, scenario, cov)
+            result = run_scenario(app, file, scenario, coverage=cov)
             if not result.passed:
                 failures.append(f"{scenario.name}: {result.failure.report()}")
     seconds = time.perf_counter() - start
@@ -192,15 +196,11 @@ def baseline(app: str | Path, files: list[ScenarioFile],
     return seconds, cov.executed
 
 
-def _run_covered(app, file, scenario, cov):
-    if cov is None:
-        return run_scenario(app, file, scenario)
-    return run_scenario(app, file, scenario, coverage=cov)
 
 
 def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DEFAULT_BUDGET_S,
                  limit: float | None = None, covered: Callable[[RungKey], bool] | None = None,
-                 coverage_factory: Callable[[], object] | None = None,
+                 coverage_factory: Callable[[], Coverage] | None = Coverage,
                  select: Callable[[Mutant], bool] | None = None) -> MutationReport:
     """Mutation-test ``app`` with its scenario files. ``covered`` says which
     rungs the scenarios execute (measured by the baseline run when None);

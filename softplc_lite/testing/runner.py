@@ -63,6 +63,7 @@ class Result:
     path: str
     name: str
     failure: Failure | None = None
+    fault: str | None = None  # the major fault the PLC ended in, if any (mutation testing kills on it)
 
     @property
     def passed(self) -> bool:
@@ -172,7 +173,13 @@ def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario, progra
     ``coverage``: a Coverage the scenario's scans record into."""
     with open_plc(app, file, program=program, coverage=coverage) as plc:
         check_names(file, plc)
-        return Result(file.path, scenario.name, run_steps(plc, file, scenario))
+        failure = run_steps(plc, file, scenario)
+        return Result(file.path, scenario.name, failure, _fault(plc))
+
+
+def _fault(plc: PLC) -> str | None:
+    fault = plc.engine.fault
+    return None if fault is None else fault.message
 
 
 def run_steps(plc: PLC, file: ScenarioFile, scenario: Scenario) -> Failure | None:
