@@ -7,10 +7,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from rich.console import Console
 
 from ..testing.coverage import Coverage
+from ..testing.coverage_annotate import annotate
+from ..testing.coverage_formats import cobertura, lcov
 from ..testing.coverage_report import figures, print_summary
 from .common import EXIT_ERROR, EXIT_USAGE
 
@@ -32,13 +35,18 @@ def add_arguments(c: argparse.ArgumentParser) -> None:
                                          "each report option implies --coverage")
     g.add_argument("--coverage", action="store_true",
                    help="measure rung, leg, condition and output coverage and print a summary per program file")
+    g.add_argument("--coverage-annotate", metavar="DIR",
+                   help="write each .lad file annotated with what never happened, as DIR/NAME.lad.cover")
+    g.add_argument("--coverage-xml", metavar="FILE", help="write a Cobertura XML report to FILE")
+    g.add_argument("--coverage-lcov", metavar="FILE", help="write an LCOV tracefile to FILE")
     g.add_argument("--fail-under", type=_percent, metavar="PERCENT",
                    help="exit 2 when the total coverage is below PERCENT (the scenarios all passing)")
 
 
 def wanted(args: argparse.Namespace) -> Coverage | None:
     """A Coverage to record into when any coverage option is given."""
-    if args.coverage or args.fail_under is not None:
+    if args.coverage or args.fail_under is not None or args.coverage_annotate or args.coverage_xml \
+            or args.coverage_lcov:
         return Coverage()
     return None
 
@@ -48,6 +56,17 @@ def report(args: argparse.Namespace, cov: Coverage, out: Console, code: int) -> 
     scenarios' own (a failed scenario's 1 wins over --fail-under's 2)."""
     out.print()
     print_summary(cov, out)
+    writes = [(args.coverage_annotate, lambda d: annotate(cov, d)),
+              (args.coverage_xml, lambda f: Path(f).write_text(cobertura(cov), encoding="utf-8")),
+              (args.coverage_lcov, lambda f: Path(f).write_text(lcov(cov), encoding="utf-8"))]
+    for target, write in writes:
+        if target:
+            try:
+                write(target)
+            except OSError as e:
+                print(f"{e.filename or target}: cannot write the coverage report: {e.strerror or e}",
+                      file=sys.stderr)
+                return EXIT_ERROR
     _, total = figures(cov)
     if args.fail_under is not None and total.below(args.fail_under):
         print(f"coverage {total.percent:.2f}% is below --fail-under {args.fail_under:g}%", file=sys.stderr)

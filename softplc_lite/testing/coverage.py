@@ -51,6 +51,7 @@ class ElementInfo:
     line: int
     column: int
     legs: int = 0  # a branch: how many legs
+    leg_ranges: tuple = ()  # a branch: each leg's elements, as a range of element indices (pre-order)
 
 
 @dataclass
@@ -58,7 +59,8 @@ class RungInfo:
     key: RungKey
     line: int
     column: int
-    elements: list[ElementInfo] = field(default_factory=list)
+    elements: list[ElementInfo] = field(default_factory=list)  # the counted ones
+    starts: list[tuple[int, int]] = field(default_factory=list)  # (line, column) of every element
 
 
 @dataclass
@@ -147,10 +149,13 @@ class Coverage:
             self.rungs[(number, r)] = [0, 0]
             found: list = []
             _elements(rung.elements, found)
+            ranges = _leg_ranges(rung.elements)
             for e, el in enumerate(found):
                 p = el.pos
+                rinfo.starts.append((p.line, p.column))
                 if isinstance(el, Branch):
-                    rinfo.elements.append(ElementInfo(e, "branch", "BST", p.line, p.column, len(el.legs)))
+                    rinfo.elements.append(ElementInfo(e, "branch", "BST", p.line, p.column, len(el.legs),
+                                                      ranges[id(el)]))
                     for k, leg in enumerate(el.legs):
                         self.legs[(number, r, e, k)] = [0, 0]
                     continue
@@ -205,6 +210,27 @@ class Coverage:
                 into = mine.setdefault(key, [0] * len(counts))
                 for i, n in enumerate(counts):
                     into[i] += n
+
+
+def _leg_ranges(rung_elements) -> dict[int, tuple[range, ...]]:
+    """id(branch) -> the element indices of each of its legs (pre-order
+    numbering, as _elements gives: a leg's elements, nested ones included,
+    are consecutive)."""
+    ranges: dict[int, tuple[range, ...]] = {}
+    counter = [0]
+
+    def visit(elements) -> None:
+        for el in elements:
+            counter[0] += 1
+            if isinstance(el, Branch):
+                legs = []
+                for leg in el.legs:
+                    start = counter[0]
+                    visit(leg)
+                    legs.append(range(start, counter[0]))
+                ranges[id(el)] = tuple(legs)
+    visit(rung_elements)
+    return ranges
 
 
 def _flat(elements) -> list:
