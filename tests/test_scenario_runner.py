@@ -79,7 +79,7 @@ def test_unknown_names_are_located_all_at_once(tmp_path):
     f.write_text('scenario "s":\n    set Nope = 1\n    scan 1\n    expect Q9:0 == 1\n', encoding="utf-8")
     with pytest.raises(ScenarioErrors) as e:
         run_file(MOTOR, f)
-    assert [(x.line, x.column) for x in e.value.errors] == [(2, 5), (4, 5)]
+    assert [(x.line, x.column) for x in e.value.errors] == [(2, 9), (4, 12)]  # at the name
     assert "expected an address or a symbol of the program: Nope" in str(e.value)
 
 

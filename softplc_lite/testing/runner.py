@@ -88,7 +88,7 @@ def check_names(file: ScenarioFile, plc: PLC) -> None:
         except Exception as e:  # AddressError / SymbolError: the reason is the message
             reason = getattr(e, "reason", None) or str(e)
             errors.append(LocatedError(f"expected an address or a symbol of the program: {name}: {reason}",
-                                       file.path, step.line, step.column))
+                                       file.path, step.line, step.column_of(0)))
     errors += value_errors(file, plc) + counter_errors(file, plc)
     if errors:
         raise ScenarioErrors(sorted(errors, key=lambda e: (e.line, e.column)))

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 from lark import Lark, Transformer, Token
 from lark.exceptions import UnexpectedInput, VisitError
@@ -26,6 +27,18 @@ class Step:
     kind: str  # set force unforce scan run wait_until expect_cmp expect_within ...
     args: tuple
     line: int
+    column: int
+    at: tuple[int, ...] = field(default=(), compare=False)  # the column of each of args
+
+    def column_of(self, k: int) -> int:
+        """Where argument ``k`` starts (the step's column when not known)."""
+        return self.at[k] if k < len(self.at) else self.column
+
+
+class _At(NamedTuple):
+    """A value of a step and the column it starts at (in the parsed line)."""
+
+    value: object
     column: int
 
 
@@ -86,24 +99,31 @@ class _ToSteps(Transformer):
         self.line, self.column = line, column
 
     def target(self, c):
-        t: Token = c[0]
-        return str(t)
+        t = c[0]
+        return t if isinstance(t, _At) else _At(str(t), t.column)
 
     def number(self, c):
         text = str(c[0])
-        return float(text) if any(ch in text for ch in ".eE") else int(text)
+        return _At(float(text) if any(ch in text for ch in ".eE") else int(text), c[0].column)
 
     def value(self, c):
         v = c[0]
         if isinstance(v, Token) and v.type == "STRING":
-            return json.loads(str(v))
+            return _At(json.loads(str(v)), v.column)
         return v
 
     def _step(kind):  # noqa: N805 - a factory of rule actions
         def act(self, c):
-            args = tuple(str(a) if isinstance(a, Token) and a.type in ("OP", "UNIT") else
-                         (int(a) if isinstance(a, Token) and a.type == "INT" else a) for a in c)
-            return Step(kind, args, self.line, self.column)
+            args, at = [], []
+            for a in c:
+                if isinstance(a, _At):
+                    a, column = a
+                else:
+                    column = a.column
+                    a = int(a) if a.type == "INT" else str(a)  # INT, or OP and UNIT
+                args.append(a)
+                at.append(self.column - 1 + column)  # the line was parsed without its indent
+            return Step(kind, tuple(args), self.line, self.column, tuple(at))
         return act
 
     set = _step("set")
@@ -119,7 +139,7 @@ class _ToSteps(Transformer):
     expect_falling = _step("expect_falling")
 
     def counter(self, c):
-        return DeviceCounter(str(c[0]), str(c[1]))
+        return _At(DeviceCounter(str(c[0]), str(c[1])), c[0].column)  # located at its port
 
     def option(self, c):
         v = c[1]

@@ -25,7 +25,7 @@ from ..datatable.address import Address, ValueKind
 from ..datatable.snapshot import decode, encode
 from ..errors import LocatedError
 from ..ladder.symbols import SymbolError
-from .scenario import ScenarioFile, Step
+from .scenario import DeviceCounter, ScenarioFile, Step
 
 _STRUCTURES = (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL)
 _BIT_STEPS = {"force": "force", "unforce": "unforce", "expect_rising": "expect rising",
@@ -41,64 +41,68 @@ def value_errors(file: ScenarioFile, plc) -> list[LocatedError]:
     table = decode(encode(plc.table))
     errors = []
     for step in file.setup + [s for sc in file.scenarios for s in sc.steps]:
-        if step.kind in ("scan", "run"):
-            continue
+        if step.kind in ("scan", "run") or isinstance(step.args[0], DeviceCounter):
+            continue  # a device's score is checked with the devices (devices.py)
         try:
             address = plc.address(step.args[0])
         except (DataTableError, SymbolError):  # an unknown name, which check_names reports
             continue
         problem = _problem(step, address, table)
         if problem:
-            errors.append(LocatedError(problem, file.path, step.line, step.column))
+            message, k = problem
+            errors.append(LocatedError(message, file.path, step.line, step.column_of(k)))
     return errors
 
 
-def _problem(step: Step, a: Address, table: DataTable) -> str | None:
+def _problem(step: Step, a: Address, table: DataTable) -> tuple[str, int] | None:
+    """What is wrong with ``step`` (its name standing for ``a``), and the
+    argument it is about (0 the name, then the values); None when nothing is."""
     k, name = step.kind, step.args[0]
     shown = name if name == str(a) else f"{name} ({a})"
     if k in _BIT_STEPS:
         if a.bit is None or not a.is_direct:
             return (f"expected a bit address after {_BIT_STEPS[k]} (I:0/0, B3/5, N7:0/3, T4:0/DN): "
-                    f"{shown} is {_what(a)}")
+                    f"{shown} is {_what(a)}"), 0
         if k == "force" and (isinstance(step.args[1], str) or step.args[1] not in (0, 1)):
-            return f"expected 0 or 1 to force {shown} to, not {_value(step.args[1])}"
-        return None if k in ("force", "unforce") else _exists(a, shown, table)
+            return f"expected 0 or 1 to force {shown} to, not {_value(step.args[1])}", 1
+        return None if k in ("force", "unforce") else _exists(a, table)
     if a.kind in _STRUCTURES:
-        return (f"expected a member or a bit of {shown}, a whole {a.kind.value} element "
-                f"(e.g. {a}.ACC, {a}/DN)" if a.kind is not ValueKind.CONTROL else
-                f"expected a member or a bit of {shown}, a whole control element (e.g. {a}.POS, {a}/DN)")
+        example = f"{a}.POS, {a}/DN" if a.kind is ValueKind.CONTROL else f"{a}.ACC, {a}/DN"
+        return f"expected a member or a bit of {shown}, a whole {a.kind.value} element (e.g. {example})", 0
     if k in ("expect_within", "expect_between"):
         if a.kind in (ValueKind.STRING, ValueKind.BIT):
             word = f'expect {name} == "text"' if a.kind is ValueKind.STRING else f"expect {name} == 1"
             return (f"expected a number address for {'within' if k == 'expect_within' else 'between'}: "
-                    f"{shown} holds {_HOLDS[a.kind]}; use {word}")
+                    f"{shown} holds {_HOLDS[a.kind]}; use {word}"), 0
         if k == "expect_within" and step.args[1] < 0:
-            return f"expected a tolerance of 0 or more, not {_value(step.args[1])}"
+            return f"expected a tolerance of 0 or more, not {_value(step.args[1])}", 1
         if k == "expect_between" and step.args[1] > step.args[2]:
-            return f"expected the lower bound first: between {_value(step.args[1])} and {_value(step.args[2])} holds nothing"
-        return _exists(a, shown, table)
-    value = step.args[1] if k == "set" else step.args[2]  # set NAME = V; expect/wait NAME OP V
+            return (f"expected the lower bound first: between {_value(step.args[1])} and "
+                    f"{_value(step.args[2])} holds nothing"), 1
+        return _exists(a, table)
+    at = 1 if k == "set" else 2  # set NAME = V; expect/wait NAME OP V
+    value = step.args[at]
     if k != "set" and isinstance(value, str) and a.kind is not ValueKind.STRING:
-        return f"expected a number to compare {shown} with: it holds {_HOLDS[a.kind]}, not a string"
+        return f"expected a number to compare {shown} with: it holds {_HOLDS[a.kind]}, not a string", at
     if not a.is_direct:
         return None  # where it points is known only at run time
-    missing = _exists(a, shown, table)
+    missing = _exists(a, table)
     if missing:
         return missing
     try:
         table.write(a, value)
-    except DataTableError as e:  # the table says why (range, kind, past the end of its file)
-        return f"expected a value {shown} can hold: {e}"
+    except DataTableError as e:  # the table says why (range, kind)
+        return f"expected a value {shown} can hold: {e}", at
     return None
 
 
-def _exists(a: Address, shown: str, table: DataTable) -> str | None:
+def _exists(a: Address, table: DataTable) -> tuple[str, int] | None:
     if not a.is_direct:
         return None
     try:
         table.resolve(a)
     except DataTableError as e:  # past the end of its file, or no such file
-        return f"expected an address of the data table: {e}"
+        return f"expected an address of the data table: {e}", 0
     return None
 
 
