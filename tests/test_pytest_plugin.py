@@ -32,3 +32,49 @@ def test_pytest_collects_scenarios_and_writes_junit(tmp_path):
     assert all(part in cases["never"].text for part in drawn)
     assert "no rung writes Start (I:0/0)" in cases["input"].text
 
+
+
+def test_the_plc_fixture_in_a_projects_test_file(tmp_path):
+    """A project's own test file uses the ``plc`` fixture (from the entry
+    point, nothing imported for it): a PLC with a simulated device on its
+    port, closed after each test (its sim:// link gone)."""
+    app = tmp_path / "modbus_slave"
+    shutil.copytree(ROOT / "programs" / "modbus_slave", app, ignore=shutil.ignore_patterns(".softplc", "tests"))
+    tests = tmp_path / "tests"
+    tests.mkdir()
+    (tests / "test_slave.py").write_text(f'''
+from softplc_lite.ports import simlink
+from softplc_lite.ports.modbus_master import ModbusMaster
+
+APP = {str(app)!r}
+
+
+def test_the_slave_serves_a_fast_master(plc):
+    slave = plc(APP, devices={{0: ModbusMaster(1, period_ms=10)}})
+    slave.run(0.5)
+    master = slave.device(0)
+    assert master.bad == 0 and master.replies > 20
+    assert slave["N10:0"] == master.model.registers[0]
+    assert [n for n in simlink.link_names() if n.startswith("plc")]
+
+
+def test_the_link_was_closed_with_the_plc():
+    assert not [n for n in simlink.link_names() if n.startswith("plc")]
+
+
+def test_a_wrong_expectation_fails(plc):
+    slave = plc(APP)
+    slave.run(0.1)
+    assert slave.device(0).timeouts == 1
+''', encoding="utf-8")
+    junit = tmp_path / "out.xml"
+    r = subprocess.run([sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-p", "no:xdist", "-p", "no:randomly",
+                        "-q", f"--basetemp={tmp_path / 'bt'}", f"--junitxml={junit}", "--rootdir", str(tmp_path),
+                        str(tests)],
+                       cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True,
+                       timeout=120, check=False)
+    assert r.returncode == 1, r.stdout + r.stderr
+    cases = {c.get("name"): c.find("failure") is not None for c in ET.parse(junit).iter("testcase")}
+    assert cases == {"test_the_slave_serves_a_fast_master": False, "test_the_link_was_closed_with_the_plc": False,
+                     "test_a_wrong_expectation_fails": True}, r.stdout
+    assert "assert 0 == 1" in r.stdout
