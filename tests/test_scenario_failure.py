@@ -120,3 +120,11 @@ def test_softplc_test_prints_the_drawing(tmp_path):
     assert lines[1].endswith("expected Motor == 0, got 1 (scan 1, 0.01 s)")
     assert lines[2:4] == ["  program file 2, rungs that write Motor (O:0/0):", "     Rung 0"]
     assert max(len(line) for line in lines[2:-1]) == 70 and "\x1b[" not in r.stdout  # piped: plain
+
+
+def test_a_failure_pickles_and_draws_the_same_after(tmp_path):
+    # the strings app's Ticket is written by STRPRINT, an instruction of one of its modules
+    failure = _failure(tmp_path, ROOT / "programs" / "strings", 'set NewReading = 1;scan 2;expect Ticket == "x"')
+    text = failure.text(100)
+    assert "rungs that write Ticket (ST9:1):" in text and "STRPRINT" in text
+    assert pickle.loads(pickle.dumps(failure)).text(100) == text

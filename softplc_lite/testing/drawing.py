@@ -88,6 +88,8 @@ def draw_rungs(program: Program, table: DataTable, places: Iterable[tuple[int, i
     forced addresses (canonical text, ``I:0/0``)."""
     places = list(places)
     rungs = tuple((f, r, program.files[f].rungs[r]) for f, r in places[:max(limit, 0)])
+    if instructions is not None:  # its specs only: an app's set holds functions that do not pickle
+        instructions = InstructionSet([s for s in instructions.all_specs() if s.module])
     return RungsAt(title, rungs, encode(table), program.symbols, frozenset(forced), instructions,
                    tuple(places[len(rungs):]), why_none)
 

@@ -73,6 +73,9 @@ class DeviceCounter(str):
         self.port, self.attribute = port, attribute
         return self
 
+    def __reduce__(self):  # pickles as what it is made from (a Failure that names one goes to other processes)
+        return DeviceCounter, (self.port, self.attribute)
+
 
 @dataclass
 class ScenarioFile:
