@@ -27,12 +27,14 @@ from .coverage_report import Figures, file_figures
 COBERTURA_DTD = "http://cobertura.sourceforge.net/xml/coverage-04.dtd"
 
 
-def _sources(cov: Coverage) -> dict[str, list[FileInfo]]:
-    """Absolute .lad path -> its program files, in file number order."""
-    by_source: dict[str, list[FileInfo]] = {}
-    for number in sorted(cov.files):
-        info = cov.files[number]
-        by_source.setdefault(os.path.abspath(info.source), []).append(info)
+def _sources(covs: tuple[Coverage, ...]) -> dict[str, list[tuple[Coverage, FileInfo]]]:
+    """Absolute .lad path -> its program files (with the measurement each
+    is in: several apps' may go in one report), in file number order."""
+    by_source: dict[str, list[tuple[Coverage, FileInfo]]] = {}
+    for cov in covs:
+        for number in sorted(cov.files):
+            info = cov.files[number]
+            by_source.setdefault(os.path.abspath(info.source), []).append((cov, info))
     return by_source
 
 
@@ -47,16 +49,17 @@ def _line_rates(fig: Figures) -> dict[str, str]:
             "complexity": "0"}
 
 
-def cobertura(cov: Coverage) -> str:
-    by_source = _sources(cov)
+def cobertura(*covs: Coverage) -> str:
+    """One report of one or more measurements (of different apps)."""
+    by_source = _sources(covs)
     root_dir = os.path.commonpath([os.path.dirname(s) for s in by_source]) if by_source else os.getcwd()
     total = Figures()
     classes = []
     for source, infos in by_source.items():
-        for info in infos:
+        for cov, info in infos:
             fig = file_figures(cov, info)
             total.add(fig)
-            classes.append((source, info, fig))
+            classes.append((source, cov, info, fig))
     branches = total.outcomes + total.legs + total.conditions + total.outputs
     branches_seen = total.outcomes_seen + total.legs_powered + total.conditions_seen + total.outputs_seen
     root = ET.Element("coverage", {
@@ -68,7 +71,7 @@ def cobertura(cov: Coverage) -> str:
     package = ET.SubElement(ET.SubElement(root, "packages"), "package",
                             {"name": os.path.basename(root_dir) or root_dir, **_line_rates(total)})
     classes_el = ET.SubElement(package, "classes")
-    for source, info, fig in classes:
+    for source, cov, info, fig in classes:
         name = f"{Path(source).name} file {info.number}" + (f" {info.name}" if info.name else "")
         cls = ET.SubElement(classes_el, "class", {"name": name, "filename": os.path.relpath(source, root_dir),
                                                   **_line_rates(fig)})
@@ -85,26 +88,27 @@ def cobertura(cov: Coverage) -> str:
             f'<!DOCTYPE coverage SYSTEM "{COBERTURA_DTD}">\n' + ET.tostring(root, encoding="unicode") + "\n")
 
 
-def lcov(cov: Coverage) -> str:
+def lcov(*covs: Coverage) -> str:
+    """One tracefile of one or more measurements (of different apps)."""
     out = ["TN:"]
-    for source, infos in _sources(cov).items():
+    for source, infos in _sources(covs).items():
         out.append(f"SF:{source}")
-        functions = [(info, info.rungs[0]) for info in infos if info.rungs]
-        for info, first in functions:
+        functions = [(cov, info, info.rungs[0]) for cov, info in infos if info.rungs]
+        for cov, info, first in functions:
             out.append(f"FN:{first.line},{_function(info)}")
-        for info, first in functions:
+        for cov, info, first in functions:
             out.append(f"FNDA:{cov.scans(first.key)},{_function(info)}")
         out.append(f"FNF:{len(functions)}")
-        out.append(f"FNH:{sum(cov.executed(first.key) for _, first in functions)}")
+        out.append(f"FNH:{sum(cov.executed(first.key) for cov, _, first in functions)}")
         lines = hit = branches = taken = 0
-        for info in infos:
+        for cov, info in infos:
             for rung in info.rungs:
                 ran = cov.executed(rung.key)
                 for o in rung_outcomes(cov, rung):
                     out.append(f"BRDA:{rung.line},{o.block},{o.branch},{o.count if ran else '-'}")
                     branches += 1
                     taken += o.covered
-        for info in infos:
+        for cov, info in infos:
             for rung in info.rungs:
                 out.append(f"DA:{rung.line},{cov.scans(rung.key)}")
                 lines += 1

@@ -1,15 +1,70 @@
 """pytest plugin: collects ``*.plctest`` files under an app's ``tests/``
-directory, one item a scenario, and gives a ``plc`` fixture factory."""
+directory, one item a scenario, and gives a ``plc`` fixture factory.
+``--plc-coverage`` measures the scenarios' coverage, an app at a time, and
+prints each app's summary at the end (``--plc-coverage-xml FILE``,
+``--plc-coverage-lcov FILE``: one report of every app); docs/testing.md."""
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import pytest
+from rich.console import Console
 
+from .coverage import Coverage
+from .coverage_formats import cobertura, lcov
+from .coverage_report import print_summary
 from .plc import PLC
 from .runner import run_scenario
 from .scenario import ScenarioErrors, load_scenarios
+
+
+_COVERAGE = pytest.StashKey[dict]()  # app directory -> its Coverage, when --plc-coverage is on
+_XDIST = pytest.StashKey[bool]()
+
+
+def pytest_addoption(parser) -> None:
+    g = parser.getgroup("softplc", "ladder scenarios (softplc_lite)")
+    g.addoption("--plc-coverage", action="store_true",
+                help="measure the scenarios' ladder coverage and print a summary per app")
+    g.addoption("--plc-coverage-xml", metavar="FILE", help="write the ladder coverage as Cobertura XML to FILE")
+    g.addoption("--plc-coverage-lcov", metavar="FILE", help="write the ladder coverage as an LCOV tracefile to FILE")
+
+
+def pytest_configure(config) -> None:
+    o = config.option
+    if getattr(o, "plc_coverage", False) or getattr(o, "plc_coverage_xml", None) \
+            or getattr(o, "plc_coverage_lcov", None):
+        config.stash[_COVERAGE] = {}
+        if getattr(o, "numprocesses", None) and not hasattr(config, "workerinput"):
+            config.stash[_XDIST] = True  # each worker would measure its own share, and none reports it
+
+
+def _coverage(config, app: Path) -> Coverage | None:
+    apps = config.stash.get(_COVERAGE, None)
+    if apps is None:
+        return None
+    return apps.setdefault(str(app), Coverage())
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config) -> None:
+    if config.stash.get(_XDIST, False):
+        terminalreporter.write_line("ladder coverage is not measured across pytest-xdist workers: "
+                                    "run the scenarios without -n")
+        return
+    apps = config.stash.get(_COVERAGE, None)
+    if not apps:
+        return
+    for app, cov in sorted(apps.items()):
+        terminalreporter.write_sep("-", f"ladder coverage: {app}")
+        text = io.StringIO()
+        print_summary(cov, Console(file=text, width=_width(config), highlight=False, color_system=None))
+        terminalreporter.write(text.getvalue())
+    for path, write in ((config.option.plc_coverage_xml, cobertura), (config.option.plc_coverage_lcov, lcov)):
+        if path:
+            Path(path).write_text(write(*apps.values()), encoding="utf-8")
+            terminalreporter.write_line(f"ladder coverage written to {path}")
 
 
 def pytest_collect_file(parent, file_path: Path):
@@ -34,7 +89,8 @@ class ScenarioItem(pytest.Item):
         self.file, self.scenario = file, scenario
 
     def runtest(self) -> None:
-        result = run_scenario(self.path.parent.parent, self.file, self.scenario)
+        app = self.path.parent.parent
+        result = run_scenario(app, self.file, self.scenario, coverage=_coverage(self.config, app))
         if result.failure is not None:
             raise ScenarioFailed(result.failure)
 
