@@ -319,16 +319,17 @@ def display_problems(display: Display, table, path: Path, doc: dict) -> list[Loc
 
 
 def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: bool = True,
-             program: Program | None = None) -> App:
+             program: Program | None = None, program_key: str | None = None) -> App:
     """Parse, validate and configure an app; AppError lists every problem.
     With ``use_cache``, a program loaded before comes from the code cache in
     the state directory (ladder/codecache.py; check passes False).
     ``program``: a parsed program checked in place of the app's .lad files,
     the rest of the app (modules, settings, data) kept (mutation testing);
-    the code cache, keyed by the files, is then not used."""
+    the code cache is then used only with ``program_key``, a text that
+    names that program among those loaded with the same state directory."""
     path = Path(path)
-    if program is not None:
-        use_cache = False
+    if program is not None:  # the cache is keyed by the files: it needs the program's own key
+        use_cache = use_cache and program_key is not None
     if not path.exists():
         raise AppError(f"{shown_path(path)}: no such app directory or .lad file")
     is_dir = path.is_dir()
@@ -358,7 +359,10 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
     key = cached = None
     if cache is not None:
         try:
-            key = cache_key(_cache_parts(files, path, modules))
+            parts = _cache_parts(files, path, modules)
+            if program is not None:
+                parts.append(("substituted program", program_key.encode("utf-8")))
+            key = cache_key(parts)
         except OSError:  # a file the parse below reports, in words
             cache = None
         else:

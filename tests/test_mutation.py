@@ -139,3 +139,25 @@ def test_a_mutant_that_loops_within_a_scan_is_killed_by_the_watchdog_fault(tmp_p
     [outcome] = report.outcomes
     assert outcome.status == KILLED
     assert "major fault: watchdog" in outcome.detail
+
+
+def test_a_mutant_is_checked_and_compiled_once_for_all_its_scenarios(tmp_path):
+    from softplc_lite.app import load_app
+    from softplc_lite.testing.mutants import mutants
+    from softplc_lite.testing.plc import PLC
+
+    app = _app(tmp_path)
+    loaded = load_app(app, state_dir=tmp_path / "s", use_cache=False)
+    first, second = mutants(loaded.source_program, loaded.instructions)[:2]  # rung 0: XIC -> XIO, OTE removed
+    cache = tmp_path / "cache"
+    cache.mkdir()
+
+    def load(mutant):
+        with PLC.load(app, program=mutant.apply(loaded.source_program), code_cache=(cache, f"m{mutant.index}")) as plc:
+            plc.scan()
+            return plc.runner.app.code is not None, plc["B3/1"]  # (from the cache, the mutant's output)
+
+    assert load(first) == (False, 1)  # XIO B3/0 with B3/0 off
+    assert load(first) == (True, 1)
+    assert load(second) == (False, 0)  # another key: checked and compiled, not the first's code
+    assert not list(app.glob(".softplc*"))  # the app is only read

@@ -136,10 +136,17 @@ def _run(mutant: Mutant, deadline: float, limit: float) -> Outcome:
 
 
 def _verdict(mutant: Mutant, program: Program) -> Outcome:
+    # The mutant is checked and compiled at its first scenario's load, and
+    # comes from the code cache for the others.
+    with tempfile.TemporaryDirectory(prefix="softplc-mutant-") as cache:
+        return _scenarios(mutant, program, (cache, f"mutant {mutant.index}"))
+
+
+def _scenarios(mutant: Mutant, program: Program, code_cache: tuple[str, str]) -> Outcome:
     for file in _state.files:
         for scenario in file.scenarios:
             try:
-                result = run_scenario(_state.app, file, scenario, program)
+                result = run_scenario(_state.app, file, scenario, program, code_cache=code_cache)
             except AppError as e:
                 first = e.errors[0].report() if e.errors else str(e).splitlines()[0]
                 return Outcome(mutant.index, INVALID, first)

@@ -37,7 +37,7 @@ class PLC:
     @classmethod
     def load(cls, path: str | Path, ports: tuple[str, ...] = (), program: Program | None = None,
              devices: Mapping | None = None, configured_tcp_ports: bool = False,
-             coverage: Coverage | None = None) -> "PLC":
+             coverage: Coverage | None = None, code_cache: tuple[str | Path, str] | None = None) -> "PLC":
         """``ports``: ``--port`` overrides, e.g. ``("1=sim://...")``;
         ``program``: a parsed program run in place of the app's own (a
         mutant), with the app's modules, settings and data; ``devices``:
@@ -45,11 +45,14 @@ class PLC:
         a network server listens on a port the system picks
         (``server_port()``) unless ``configured_tcp_ports``; ``coverage``:
         a Coverage the scans record into (testing/coverage.py: the
-        reference interpreter instead of the compiled code)."""
+        reference interpreter instead of the compiled code); ``code_cache``:
+        (DIRECTORY, KEY) keeps ``program`` checked and compiled in DIRECTORY
+        under KEY for the next load of it (the directory is the caller's)."""
         state_dir = tempfile.mkdtemp(prefix="softplc-test-")
+        cache_dir, program_key = code_cache if code_cache is not None else (state_dir, None)
         attached = None
         try:
-            app = load_app(path, state_dir=state_dir, program=program)
+            app = load_app(path, state_dir=cache_dir, program=program, program_key=program_key)
             if not configured_tcp_ports:
                 _ephemeral_servers(app.modules)
             if devices:

@@ -168,10 +168,11 @@ def _compare(actual, op, value) -> bool:
 
 
 def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario, program: Program | None = None,
-                 coverage: Coverage | None = None) -> Result:
+                 coverage: Coverage | None = None, code_cache: tuple | None = None) -> Result:
     """``program``: a parsed program run in place of the app's (PLC.load);
-    ``coverage``: a Coverage the scenario's scans record into."""
-    with open_plc(app, file, program=program, coverage=coverage) as plc:
+    ``coverage``: a Coverage the scenario's scans record into;
+    ``code_cache``: PLC.load's (DIRECTORY, KEY) for ``program``."""
+    with open_plc(app, file, program=program, coverage=coverage, code_cache=code_cache) as plc:
         check_names(file, plc)
         failure = run_steps(plc, file, scenario)
         return Result(file.path, scenario.name, failure, _fault(plc))
