@@ -105,8 +105,10 @@ class _Expired(BaseException):
 
 
 def _init(app: str, paths: list[str], source: Program) -> None:
-    """A worker's state (in a worker process: its timer installed for good)."""
+    """A worker's state (in a worker process: its timer installed for good).
+    Ctrl-C is the parent's to handle: it stops giving out mutants."""
     global _state
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     _state = _State(app, [load_scenarios(p) for p in paths], source, _install_timer() is not None)
 
 
@@ -203,8 +205,6 @@ def baseline(app: str | Path, files: list[ScenarioFile],
     return seconds, cov.executed
 
 
-
-
 def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DEFAULT_BUDGET_S,
                  limit: float | None = None, covered: Callable[[RungKey], bool] | None = None,
                  coverage_factory: Callable[[], Coverage] | None = Coverage,
@@ -245,9 +245,12 @@ def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DE
             if previous is not None:
                 signal.signal(signal.SIGALRM, previous)
     else:
-        with ProcessPoolExecutor(max_workers=jobs, initializer=_init, initargs=(app, paths, source)) as pool:
+        pool = ProcessPoolExecutor(max_workers=jobs, initializer=_init, initargs=(app, paths, source))
+        try:
             futures = [(m, pool.submit(_run, m, deadline, limit)) for m in todo]
             for m, future in futures:
                 outcomes[m.index] = future.result()
+        finally:  # on Ctrl-C too: no mutant is started after it, those running end within their limit
+            pool.shutdown(wait=True, cancel_futures=True)
     return MutationReport(app, found, [outcomes[m.index] for m in found], jobs, time.time() - start,
                           sum(len(f.scenarios) for f in files), source)
