@@ -129,3 +129,23 @@ def test_coverage_off_runs_the_compiled_code_with_no_recorder(tmp_path):
     with PLC.load(app, coverage=Coverage()) as plc:
         assert all(isinstance(f, ReferenceFile) for f, _ in plc.engine.files.values())
         assert any(isinstance(o, Recorder) for o in gc.get_objects())
+
+
+def test_outcomes_that_cannot_happen_are_not_counted(tmp_path):
+    from softplc_lite.testing.coverage_report import figures
+
+    # rung 0: nothing can end it false; rung 1: a leg with no condition, so the OTE is never off;
+    # rung 2: a condition, so both outcomes count
+    ladder = "MOV 5 N7:0\nBST XIC B3/0 NXB OTE B3/2 BND OTE B3/1\nXIC B3/0 OTE B3/3\n"
+    cov = _measure(tmp_path / "a", ladder, sets=[("B3/0", 1)])
+    info = cov.files[2]
+    assert [r.false_possible for r in info.rungs] == [False, False, True]
+    assert [(e.text, e.off_possible) for e in info.rungs[1].elements if e.kind == "output"] == [("OTE", False),
+                                                                                                ("OTE", False)]
+    fig = figures(cov)[0][2]
+    assert (fig.outcomes_seen, fig.outcomes) == (3, 4)  # rung 2 never false
+    assert (fig.outputs_seen, fig.outputs) == (4, 5)  # MOV on, the OTEs on; OTE B3/3 never off
+    # an MCR zone in the file can turn any rung off: every outcome counts
+    mcr = _measure(tmp_path / "b", "XIC B3/0 MCR\nMOV 5 N7:0\nMCR\n", sets=[("B3/0", 1)])
+    assert all(r.false_possible for r in mcr.files[2].rungs)
+    assert mcr.rung_outcomes((2, 1)) == (True, False)

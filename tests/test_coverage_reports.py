@@ -132,9 +132,7 @@ def test_annotated_gutters_a_rung_never_scanned_and_a_covered_one(tmp_path):
     (path,) = annotate(cov, tmp_path / "ann")
     assert path.read_text(encoding="utf-8").splitlines() == [
         "> XIC B3/0 JMP 1",
-        "! OTE B3/4",  # scanned only with B3/0 off, and always powered: nothing on it can be false
-        "  ^ rung never false",
-        "  ^^^^^^^^ never off",
+        "> OTE B3/4",  # scanned only with B3/0 off: ended true, and nothing in it can end it false
         "> LBL 1 XIC B3/0 OTE B3/5",
         "  FILE 3 Never",
         "- SBR",

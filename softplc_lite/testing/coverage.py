@@ -40,7 +40,7 @@ RungKey = tuple[int, int]  # (program file number, rung index in that file)
 ElementKey = tuple[int, int, int]  # (file, rung, element index in the rung: pre-order, branches included)
 LegKey = tuple[int, int, int, int]  # (file, rung, the branch's element index, leg index)
 
-NOT_COUNTED = frozenset({"LBL", "SBR"})  # they test nothing and pass power through
+NOT_COUNTED = frozenset({"LBL", "SBR", "NOP"})  # they test nothing and pass power through
 
 
 @dataclass
@@ -50,6 +50,7 @@ class ElementInfo:
     text: str  # the mnemonic ("BST" for a branch)
     line: int
     column: int
+    off_possible: bool = True  # an output: power into it can be off (something before it can block it)
     legs: int = 0  # a branch: how many legs
     leg_ranges: tuple = ()  # a branch: each leg's elements, as a range of element indices (pre-order)
 
@@ -59,6 +60,7 @@ class RungInfo:
     key: RungKey
     line: int
     column: int
+    false_possible: bool = True  # something in the rung (or an MCR zone) can leave it false
     elements: list[ElementInfo] = field(default_factory=list)  # the counted ones
     starts: list[tuple[int, int]] = field(default_factory=list)  # (line, column) of every element
 
@@ -143,9 +145,13 @@ class Coverage:
             return
         self._shapes[number] = shape
         info = FileInfo(number, pfile.name, pfile.pos.source, [])
+        has_mcr = any(isinstance(el, Instruction) and el.mnemonic == "MCR" for r in pfile.rungs for el in r.elements)
         for r, rung in enumerate(pfile.rungs):
             pos = rung.pos
-            rinfo = RungInfo((number, r), pos.line, pos.column)
+            may_be_off: dict[int, bool] = {}
+            false_possible = _may_end_off(rung.elements, has_mcr, lambda el: _kind(el, self.module_outputs),
+                                          may_be_off)
+            rinfo = RungInfo((number, r), pos.line, pos.column, false_possible)
             self.rungs[(number, r)] = [0, 0]
             found: list = []
             _elements(rung.elements, found)
@@ -154,15 +160,15 @@ class Coverage:
                 p = el.pos
                 rinfo.starts.append((p.line, p.column))
                 if isinstance(el, Branch):
-                    rinfo.elements.append(ElementInfo(e, "branch", "BST", p.line, p.column, len(el.legs),
-                                                      ranges[id(el)]))
+                    rinfo.elements.append(ElementInfo(e, "branch", "BST", p.line, p.column, legs=len(el.legs),
+                                                      leg_ranges=ranges[id(el)]))
                     for k, leg in enumerate(el.legs):
                         self.legs[(number, r, e, k)] = [0, 0]
                     continue
                 kind = _kind(el, self.module_outputs)
                 if kind is None:
                     continue
-                rinfo.elements.append(ElementInfo(e, kind, el.mnemonic, p.line, p.column))
+                rinfo.elements.append(ElementInfo(e, kind, el.mnemonic, p.line, p.column, may_be_off[id(el)]))
                 self.kinds[(number, r, e)] = kind
                 self.instructions[(number, r, e)] = [0, 0, 0, 0]
             info.rungs.append(rinfo)
@@ -210,6 +216,24 @@ class Coverage:
                 into = mine.setdefault(key, [0] * len(counts))
                 for i, n in enumerate(counts):
                     into[i] += n
+
+
+def _may_end_off(elements, off_in: bool, kind_of, may_be_off: dict[int, bool]) -> bool:
+    """Whether the power out of a series can be off, given whether the power
+    into it can (``off_in``); ``may_be_off`` gets, for each element, whether
+    the power into it can be off. A condition can block power, an output
+    passes it on, a branch blocks when all its legs can. An outcome that
+    cannot happen is not counted: an unconditional rung never ends false,
+    a coil with nothing before it is never off (unless an MCR zone in the
+    file can turn the rung off)."""
+    off = off_in
+    for el in elements:
+        may_be_off[id(el)] = off
+        if isinstance(el, Branch):
+            off = all([_may_end_off(leg, off, kind_of, may_be_off) for leg in el.legs])
+        elif kind_of(el) == "condition":
+            off = True
+    return off
 
 
 def _leg_ranges(rung_elements) -> dict[int, tuple[range, ...]]:

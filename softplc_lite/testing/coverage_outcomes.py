@@ -27,8 +27,9 @@ class Outcome:
 def rung_outcomes(cov: Coverage, rung: RungInfo) -> list[Outcome]:
     f, r = rung.key
     t, fl = cov.rungs.get(rung.key, (0, 0))
-    found = [Outcome(0, 0, "rung true", "rung never true", t, None),
-             Outcome(0, 1, "rung false", "rung never false", fl, None)]
+    found = [Outcome(0, 0, "rung true", "rung never true", t, None)]
+    if rung.false_possible:  # an outcome that cannot happen is not counted (coverage.py, _may_end_off)
+        found.append(Outcome(0, 1, "rung false", "rung never false", fl, None))
     for el in rung.elements:
         block = el.index + 1
         if el.kind == "branch":
@@ -42,5 +43,6 @@ def rung_outcomes(cov: Coverage, rung: RungInfo) -> list[Outcome]:
             found.append(Outcome(block, 1, f"{el.text} seen false", "never false", counts[3], el))
         else:
             found.append(Outcome(block, 0, f"{el.text} on", "never on", counts[0], el))
-            found.append(Outcome(block, 1, f"{el.text} off", "never off", counts[1], el))
+            if el.off_possible:
+                found.append(Outcome(block, 1, f"{el.text} off", "never off", counts[1], el))
     return found

@@ -64,20 +64,22 @@ def file_figures(cov: Coverage, info: FileInfo) -> Figures:
     for rung in info.rungs:
         fig.rungs += 1
         fig.rungs_run += cov.executed(rung.key)
-        fig.outcomes += 2
-        fig.outcomes_seen += sum(cov.rung_outcomes(rung.key))
-        f, r = rung.key
+        t, f = cov.rung_outcomes(rung.key)
+        fig.outcomes += 1 + rung.false_possible
+        fig.outcomes_seen += t + (f and rung.false_possible)
+        fnum, r = rung.key
         for el in rung.elements:
             if el.kind == "branch":
                 for k in range(el.legs):
                     fig.legs += 1
-                    fig.legs_powered += cov.leg_powered((f, r, el.index, k))
+                    fig.legs_powered += cov.leg_powered((fnum, r, el.index, k))
             elif el.kind == "condition":
                 fig.conditions += 2
-                fig.conditions_seen += sum(cov.element_outcomes((f, r, el.index)))
+                fig.conditions_seen += sum(cov.element_outcomes((fnum, r, el.index)))
             else:
-                fig.outputs += 2
-                fig.outputs_seen += sum(cov.element_outcomes((f, r, el.index)))
+                on, off = cov.element_outcomes((fnum, r, el.index))
+                fig.outputs += 1 + el.off_possible
+                fig.outputs_seen += on + (off and el.off_possible)
     return fig
 
 
