@@ -73,7 +73,8 @@ def test_a_mutant_applies_its_one_change_and_leaves_the_original_alone(tmp_path)
 
 
 def test_a_leg_of_three_removed_leaves_a_branch_and_nested_legs_mutate(tmp_path):
-    source, instructions = _source(tmp_path, "BST XIC B3/0 NXB BST XIC B3/1 NXB XIC B3/2 BND NXB XIC B3/3 BND OTE B3/4\n")
+    ladder = "BST XIC B3/0 NXB BST XIC B3/1 NXB XIC B3/2 BND NXB XIC B3/3 BND OTE B3/4\n"
+    source, instructions = _source(tmp_path, ladder)
     found = mutants(source, instructions)
     applied = {m.description: format_rung(m.apply(source).main.rungs[0]) for m in found if m.rung is not None}
     assert applied["branch leg 1 of 3 removed: XIC B3/0"] == \

@@ -161,3 +161,11 @@ def test_a_mutant_is_checked_and_compiled_once_for_all_its_scenarios(tmp_path):
     assert load(first) == (True, 1)
     assert load(second) == (False, 0)  # another key: checked and compiled, not the first's code
     assert not list(app.glob(".softplc*"))  # the app is only read
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_progress_is_told_each_mutant_judged(tmp_path, jobs):
+    seen = []
+    run_mutation(_app(tmp_path), jobs=jobs, covered=_not_rung_3,
+                 progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(k, 10) for k in range(1, 11)]

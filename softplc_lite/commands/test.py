@@ -34,7 +34,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
     m.add_argument("--jobs", type=_positive_int, default=None, metavar="N",
                    help="worker processes for the mutants (default: the CPU count)")
     m.add_argument("--mutate-timeout", type=_positive_float, default=DEFAULT_BUDGET_S, metavar="SECONDS",
-                   help=f"total time for the mutants; those left are reported as not run (default {DEFAULT_BUDGET_S:g})")
+                   help="total time for the mutants; those left are reported as not run "
+                        f"(default {DEFAULT_BUDGET_S:g})")
     m.add_argument("--fail-under-mutation", type=float, default=None, metavar="PERCENT",
                    help="exit 1 when the mutation score is under PERCENT")
     c.set_defaults(func=run)

@@ -208,12 +208,14 @@ def baseline(app: str | Path, files: list[ScenarioFile],
 def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DEFAULT_BUDGET_S,
                  limit: float | None = None, covered: Callable[[RungKey], bool] | None = None,
                  coverage_factory: Callable[[], Coverage] | None = Coverage,
-                 select: Callable[[Mutant], bool] | None = None) -> MutationReport:
+                 select: Callable[[Mutant], bool] | None = None,
+                 progress: Callable[[int, int], None] | None = None) -> MutationReport:
     """Mutation-test ``app`` with its scenario files. ``covered`` says which
     rungs the scenarios execute (measured by the baseline run when None);
     ``limit``: the per-mutant limit in seconds (from the baseline when None);
     ``select``: the mutants to make (all when None; the others are left
-    out of the report, e.g. a sample of a large program's)."""
+    out of the report, e.g. a sample of a large program's); ``progress``:
+    called with (mutants judged, mutants to run) as they are judged."""
     app = str(app)
     paths = [str(p) for p in scenario_files(app)]
     if not paths:
@@ -238,8 +240,10 @@ def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DE
         previous = _install_timer()
         _state = _State(app, files, source, previous is not None)
         try:
-            for m in todo:
+            for done, m in enumerate(todo, 1):
                 outcomes[m.index] = _run(m, deadline, limit)
+                if progress is not None:
+                    progress(done, len(todo))
         finally:
             _state = saved
             if previous is not None:
@@ -248,8 +252,10 @@ def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DE
         pool = ProcessPoolExecutor(max_workers=jobs, initializer=_init, initargs=(app, paths, source))
         try:
             futures = [(m, pool.submit(_run, m, deadline, limit)) for m in todo]
-            for m, future in futures:
+            for done, (m, future) in enumerate(futures, 1):
                 outcomes[m.index] = future.result()
+                if progress is not None:
+                    progress(done, len(todo))
         finally:  # on Ctrl-C too: no mutant is started after it, those running end within their limit
             pool.shutdown(wait=True, cancel_futures=True)
     return MutationReport(app, found, [outcomes[m.index] for m in found], jobs, time.time() - start,

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from rich.console import Console
 from rich.markup import escape
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from ..app import AppError
@@ -71,7 +72,14 @@ def mutate_and_report(app: str, out: Console, err, jobs: int | None, budget: flo
     """``softplc test APP --mutate`` after the scenarios passed: run, report;
     False when it cannot run or the score is under ``fail_under``."""
     try:
-        report = run_mutation(app, jobs=jobs, budget=budget)
+        if out.is_terminal:  # a long run shows it is alive; a log or a pipe gets the report only
+            with Progress(TextColumn("mutants"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
+                          console=out, transient=True) as bar:
+                task = bar.add_task("mutants", total=None)
+                report = run_mutation(app, jobs=jobs, budget=budget,
+                                      progress=lambda done, total: bar.update(task, completed=done, total=total))
+        else:
+            report = run_mutation(app, jobs=jobs, budget=budget)
     except (MutationError, ScenarioErrors, AppError) as e:
         print(str(e), file=err)
         return False
