@@ -99,3 +99,56 @@ def test_a_substituted_program_runs_with_the_rest_of_the_app(tmp_path):
         plc.set("Start", 1)
         plc.scan(2)
         assert plc["Motor"] == 1
+
+
+@pytest.mark.parametrize("steps, passed", [
+    # seen between two scans of the step: a multi-scan step, or an edge one scan long
+    ("set StopOk = 1\n    set Start = 1\n    scan 3\n    expect rising Motor", True),
+    ("set StopOk = 1\n    set Start = 1\n    scan 1\n    expect Motor == 1\n    expect rising Motor", True),
+    # an edge of an earlier scanning step is not one of the last
+    ("set StopOk = 1\n    set Start = 1\n    scan 1\n    scan 1\n    expect rising Motor", False),
+    ("set StopOk = 1\n    set Start = 1\n    run 1 s\n    wait until Motor == 1 within 1 s\n    expect rising Motor",
+     False),
+    # a value set between scans is no edge: the step starts from the value after the last scan
+    ("scan 1\n    set Motor = 1\n    scan 1\n    expect falling Motor", False),
+    # before any scan there is no edge
+    ("set StopOk = 1\n    set Start = 1\n    expect rising Motor", False),
+])
+def test_an_edge_is_one_between_two_scans_of_the_last_scanning_step(tmp_path, steps, passed):
+    f = tmp_path / "e.plctest"
+    f.write_text(f'scenario "s":\n    {steps}\n', encoding="utf-8")
+    [r] = run_file(MOTOR, f)
+    assert r.passed is passed, r.failure and r.failure.report()
+
+
+def test_a_long_run_sees_each_edge_of_a_blink_and_reads_stay_exact(tmp_path):
+    f = tmp_path / "b.plctest"
+    f.write_text('scenario "s":\n    run 1.55 s\n    expect rising Lamp\n    expect falling Lamp\n'
+                 '    expect C5:0.ACC == 2\n    expect T4:0/DN == 1\n    expect Lamp == 1\n', encoding="utf-8")
+    [r] = run_file(ROOT / "programs" / "blinker", f)
+    assert r.passed, r.failure and r.failure.report()
+
+
+@pytest.mark.parametrize("name, value", [
+    ("Start", 1), ("Motor", 0), ("B3/15", 1), ("T4:0/DN", 1), ("N7:0", -32768), ("C5:1.PRE", 32767),
+    ("C5:0.ACC", 999), ("F8:0", 2.5), ("C5:1.ACC", True),
+])
+def test_the_api_reads_and_writes_as_the_table_does(name, value):
+    """A direct bit or word is read and set straight in its file's array: the same values as the table's."""
+    with PLC.load(MOTOR) as plc:
+        for _ in range(2):  # the second time through the bound array
+            plc.set(name, value)
+            assert plc[name] == plc.table.read(plc.address(name)) == value
+            plc.scan()
+
+
+@pytest.mark.parametrize("name, value", [("Start", 2), ("B3/15", -1), ("N7:0", 70000), ("N7:0", 1.5),
+                                         ("N7:0", "x"), ("F8:0", "x")])
+def test_the_api_refuses_what_the_table_refuses_with_its_words(name, value):
+    with PLC.load(MOTOR) as plc:
+        with pytest.raises(Exception) as direct:
+            plc.table.write(plc.address(name), value)
+        plc.set(name, 0)  # bound
+        with pytest.raises(type(direct.value)) as through_api:
+            plc.set(name, value)
+        assert str(through_api.value) == str(direct.value)

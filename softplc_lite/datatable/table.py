@@ -88,7 +88,7 @@ def _example_member(ftype) -> str:
     return words[0].name if words else "PRE"
 
 
-def _check_int(value: Any, lo: int, hi: int, where: str, what: str) -> int:
+def _check_int(value: Any, lo: int, hi: int, where: object, what: str) -> int:
     if isinstance(value, bool):
         value = int(value)
     if not isinstance(value, int):
@@ -99,7 +99,7 @@ def _check_int(value: Any, lo: int, hi: int, where: str, what: str) -> int:
     return value
 
 
-def check_float32(value: Any, where: str) -> float:
+def check_float32(value: Any, where: object) -> float:
     """A number that fits a float32 element (inf and nan are allowed, as on
     the PLC; a finite value too large for float32 is refused)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
@@ -332,13 +332,14 @@ class DataTable:
         return data[start + m.offset]
 
     def write(self, addr: AddressLike, value: Any) -> None:
-        """Write a typed value; refuses values the element cannot hold."""
+        """Write a typed value; refuses values the element cannot hold (the
+        address is turned into text only for that message)."""
         a = _as_address(addr)
         f, i, bit = self.resolve(a)
         kind = a.kind
         data = f.data
         if kind is ValueKind.BIT:
-            on = _check_int(value, 0, 1, str(a), "a bit")
+            on = _check_int(value, 0, 1, a, "a bit")
             mask = bit_mask(bit)
             data[i] = (data[i] | mask) if on else (data[i] & ~mask)
         elif kind is ValueKind.WORD:
@@ -347,11 +348,11 @@ class DataTable:
             elif isinstance(value, str) and f.ftype.radix != "decimal" and a.member is None:
                 data[i] = word_from_text(value, f.ftype, str(a))
             else:
-                data[i] = _check_int(value, WORD_MIN, WORD_MAX, str(a), "a 16-bit signed integer")
+                data[i] = _check_int(value, WORD_MIN, WORD_MAX, a, "a 16-bit signed integer")
         elif kind is ValueKind.FLOAT:
-            data[i] = check_float32(value, str(a))
+            data[i] = check_float32(value, a)
         elif kind is ValueKind.LONG:
-            data[i] = _check_int(value, LONG_MIN, LONG_MAX, str(a), "a 32-bit signed integer")
+            data[i] = _check_int(value, LONG_MIN, LONG_MAX, a, "a 32-bit signed integer")
         elif kind is ValueKind.STRING:
             write_string(data, i, value, str(a))
         else:

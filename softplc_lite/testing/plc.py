@@ -5,12 +5,15 @@ driven scan by scan through a ``Runner`` it owns."""
 from __future__ import annotations
 
 import dataclasses
+import functools
 import shutil
 import tempfile
 from pathlib import Path
 from typing import Mapping
 
 from ..app import load_app
+from ..datatable import DataTableError, ValueKind
+from ..datatable.table import WORD_MAX, WORD_MIN
 from ..ladder.ast import Program
 from ..ladder.engine import Mode
 from ..ladder.symbols import resolve_name
@@ -31,6 +34,9 @@ class PLC:
         self.symbols = runner.app.program.symbols
         self.forces = Forces(self.engine)
         self._state_dir = state_dir
+        self._addresses: dict[str, object] = {}  # name -> address, resolved once
+        self._readers: dict[str, object] = {}  # name -> a function giving its value
+        self._writers: dict[str, object] = {}  # name -> a function setting it
         if self.engine.mode is not Mode.RUN:
             self.engine.set_mode(Mode.RUN)
 
@@ -85,15 +91,70 @@ class PLC:
         return None
 
     def address(self, name: str):
-        return resolve_name(name, self.symbols)
+        address = self._addresses.get(name)
+        if address is None:
+            address = self._addresses[name] = resolve_name(name, self.symbols)
+        return address
 
     def __getitem__(self, name: str):
         if isinstance(name, DeviceCounter):  # a scenario's ``device PORT NAME``
             return getattr(self.device(int(name.port) if name.port.isdigit() else name.port), name.attribute)
-        return self.table.read(self.address(name))
+        read = self._readers.get(name)
+        if read is None:
+            read = self._readers[name] = self._reader(name)
+        return read()
+
+    def _reader(self, name: str):
+        """A direct bit, word or float is read straight from its file's array,
+        as compiled rungs read it (the arrays stay in place for the table's
+        life): a scenario reads the same names scan after scan. Anything else
+        goes through ``table.read``."""
+        address, table = self.address(name), self.table
+        try:
+            if address.is_direct and address.kind is ValueKind.BIT:
+                data, index, mask = table.bit_ref(address)
+                return lambda: 1 if data[index] & mask else 0
+            if address.is_direct and address.kind in (ValueKind.WORD, ValueKind.FLOAT, ValueKind.LONG):
+                data, index = table.word_ref(address)
+                return lambda: data[index]
+        except DataTableError:
+            pass  # past the end of its file: table.read says why
+        return lambda: table.read(address)
 
     def set(self, name: str, value) -> None:
-        self.table.write(self.address(name), value)
+        write = self._writers.get(name)
+        if write is None:
+            write = self._writers[name] = self._writer(name)
+        write(value)
+
+    def _writer(self, name: str):
+        """As ``_reader``: a direct bit, or a word of a number file, takes an
+        int it can hold straight into its array; any other value or address
+        goes through ``table.write``, which checks it and says why not."""
+        address, table = self.address(name), self.table
+        slow = functools.partial(table.write, address)
+        try:
+            if address.is_direct and address.kind is ValueKind.BIT:
+                data, index, mask = table.bit_ref(address)
+
+                def write_bit(value) -> None:
+                    if value.__class__ is int and (value == 0 or value == 1):
+                        data[index] = (data[index] | mask) if value else (data[index] & ~mask)
+                    else:
+                        slow(value)
+                return write_bit
+            if address.is_direct and address.kind is ValueKind.WORD and not table.resolve(address)[0].ftype.is_string:
+                data, index = table.word_ref(address)
+
+                def write_word(value) -> None:
+                    if value.__class__ is int and WORD_MIN <= value <= WORD_MAX:
+                        data[index] = value
+                    else:
+                        slow(value)
+                return write_word
+        except DataTableError:
+            pass
+        return slow
 
     def __setitem__(self, name: str, value) -> None:
         self.set(name, value)

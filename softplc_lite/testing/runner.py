@@ -98,45 +98,67 @@ def _seconds(number, unit) -> float:
     return number / 1000 if unit == "ms" else number
 
 
+_SCANNING = ("scan", "run", "wait_until")
+_EDGES = ("expect_rising", "expect_falling")
+
+
 class _Run:
     def __init__(self, plc: PLC, path: str) -> None:
         self.plc, self.path = plc, path
-        self.edges: dict[str, list] = {}
+        self.edges: dict[str, list] = {}  # name -> its values after each scan of the last scanning step
+        self.watched: tuple[str, ...] = ()  # the names the next scanning step records scan by scan
 
-    def scan(self) -> None:
-        self.plc.scan()
-        for name, seen in self.edges.items():
-            seen.append(self.plc[name])
+    def _record(self) -> None:
+        plc, edges = self.plc, self.edges
+        plc.engine.scan()
+        for name in self.watched:
+            edges[name].append(plc[name])
 
     def step(self, step: Step) -> Failure | None:
+        if step.kind not in _SCANNING:
+            return self._check(step)
+        edges, plc = self.edges, self.plc
+        if not edges:
+            return self._scan(step, plc.engine.scan)
+        for seen in edges.values():  # an edge is looked for in the last scanning step
+            del seen[:-1]
+        try:
+            return self._scan(step, self._record if self.watched else plc.engine.scan)
+        finally:
+            # only the names an edge expectation after this step looks at were
+            # recorded scan by scan (the cost of a long run); the others keep
+            # their value after the last scan, as the next scanning step starts from
+            for name in edges.keys() - set(self.watched):
+                edges[name] = [plc[name]]
+
+    def _scan(self, step: Step, scan) -> Failure | None:
         plc, k, a = self.plc, step.kind, step.args
-        if k in ("scan", "run", "wait_until"):
-            for seen in self.edges.values():  # an edge is looked for in the last scanning step
-                del seen[:-1]
-        if k == "set":
-            plc.set(a[0], a[1])
-        elif k == "force":
-            plc.force(a[0], a[1])
-        elif k == "unforce":
-            plc.unforce(a[0])
-        elif k == "scan":
+        clock = plc.engine.clock
+        if k == "scan":
             for _ in range(a[0]):
-                self.scan()
+                scan()
         elif k == "run":
-            end = plc.time_ms + round(_seconds(*a) * 1000)
-            while plc.time_ms < end:
-                self.scan()
-        elif k == "wait_until":
+            end = clock.now_ms + round(_seconds(*a) * 1000)
+            while clock.now_ms < end:
+                scan()
+        else:
             name, op, value, limit, unit = a
-            end = plc.time_ms + round(_seconds(limit, unit) * 1000)
+            end = clock.now_ms + round(_seconds(limit, unit) * 1000)
             while not _compare(plc[name], op, value):
-                if plc.time_ms >= end:
+                if clock.now_ms >= end:
                     return self._fail(step, f"{name} {op} {value!r} within {limit} {unit}", plc[name])
-                self.scan()
-        elif k == "expect_cmp":
+                scan()
+        return None
+
+    def _check(self, step: Step) -> Failure | None:
+        plc, k, a = self.plc, step.kind, step.args
+        if k == "expect_cmp":
             name, op, value = a
-            if not _compare(plc[name], op, value):
-                return self._fail(step, f"{name} {op} {value!r}", plc[name])
+            actual = plc[name]
+            if (actual != value) if op == "==" else (actual == value):
+                return self._fail(step, f"{name} {op} {value!r}", actual)
+        elif k == "set":
+            plc.set(a[0], a[1])
         elif k == "expect_within":
             name, tol, value = a
             if abs(plc[name] - value) > tol:
@@ -145,6 +167,10 @@ class _Run:
             name, lo, hi = a
             if not lo <= plc[name] <= hi:
                 return self._fail(step, f"{name} between {lo} and {hi}", plc[name])
+        elif k == "force":
+            plc.force(a[0], a[1])
+        elif k == "unforce":
+            plc.unforce(a[0])
         else:
             name = a[0]
             seen = self.edges.get(name, [])
@@ -189,13 +215,27 @@ def run_steps(plc: PLC, file: ScenarioFile, scenario: Scenario) -> Failure | Non
     run = _Run(plc, file.path)
     steps = file.setup + scenario.steps
     for step in steps:  # edges are watched from the start
-        if step.kind in ("expect_rising", "expect_falling"):
+        if step.kind in _EDGES:
             run.edges.setdefault(step.args[0], [plc[step.args[0]]])
-    for step in steps:
+    for step, watched in zip(steps, _edges_expected_after(steps)):
+        run.watched = watched
         failure = run.step(step)
         if failure is not None:
             return failure
     return None
+
+
+def _edges_expected_after(steps: list[Step]) -> list[tuple[str, ...]]:
+    """For each step, the names whose edges are expected after it and
+    before the next scanning step: what a scanning step records each scan."""
+    out: list[tuple[str, ...]] = [()] * len(steps)
+    names: list[str] = []
+    for i in range(len(steps) - 1, -1, -1):
+        if steps[i].kind in _EDGES:
+            names.append(steps[i].args[0])
+        elif steps[i].kind in _SCANNING:
+            out[i], names = tuple(dict.fromkeys(names)), []
+    return out
 
 
 def run_file(app: str | Path, path: str | Path, program: Program | None = None,
