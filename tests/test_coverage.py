@@ -149,3 +149,24 @@ def test_outcomes_that_cannot_happen_are_not_counted(tmp_path):
     mcr = _measure(tmp_path / "b", "XIC B3/0 MCR\nMOV 5 N7:0\nMCR\n", sets=[("B3/0", 1)])
     assert all(r.false_possible for r in mcr.files[2].rungs)
     assert mcr.rung_outcomes((2, 1)) == (True, False)
+
+
+def test_a_scan_that_faults_leaves_its_rung_uncounted(tmp_path):
+    # the scan B3/0 turns on, file 3 calls itself until JSRs nest too deep (a major fault)
+    ladder = "XIC B3/1 OTE B3/2\nXIC B3/0 JSR 3\nOTE B3/3\n\nFILE 3 Loop\nSBR\nJSR 3\nRET\n"
+    app = make_app(tmp_path / "app", ladder)
+    cov = Coverage()
+    with PLC.load(app, coverage=cov) as plc:
+        plc.scan(2)
+        plc.set("B3/0", 1)
+        plc.scan(1)
+        assert plc.engine.fault is not None
+    assert [cov.rungs[(2, r)] for r in range(3)] == [[0, 3], [0, 2], [2, 0]]
+    assert cov.element_outcomes((2, 1, 0)) == (True, True)  # the XIC passed power into the JSR that faulted
+    assert cov.executed((3, 0)) and not cov.executed((3, 1)) and not cov.executed((3, 2))
+
+
+def test_merging_another_programs_measurement_is_refused(tmp_path):
+    cov = _measure(tmp_path / "1", "XIC B3/0 OTE B3/1\n")
+    with pytest.raises(ValueError, match="another program"):
+        cov.merge(_measure(tmp_path / "2", "XIC B3/0 XIC B3/2 OTE B3/1\n"))

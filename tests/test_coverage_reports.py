@@ -153,3 +153,23 @@ def test_the_command_writes_each_report(tmp_path):
     bad = softplc_here("test", str(app), "--coverage-xml", str(tmp_path / "missing" / "c.xml"))
     assert bad.returncode == 1
     assert bad.stderr == f"{tmp_path / 'missing' / 'c.xml'}: cannot write the coverage report: No such file or directory\n"
+
+
+def test_annotated_neutral_text_marks_each_instruction_and_leg(tmp_path):
+    app = make_app(tmp_path / "app", "XIC(B3/0)[XIC(B3/2),XIO(B3/3)]OTE(B3/1);\n")
+    cov = Coverage()
+    with PLC.load(app, coverage=cov) as plc:
+        plc.set("B3/0", 1)
+        plc.set("B3/2", 1)
+        plc.set("B3/3", 1)
+        plc.scan(1)
+    (path,) = annotate(cov, tmp_path / "ann")
+    assert path.read_text(encoding="utf-8").splitlines() == [
+        "! XIC(B3/0)[XIC(B3/2),XIO(B3/3)]OTE(B3/1);",
+        "  ^ rung never false",
+        "  ^^^^^^^^^ never false",
+        "            ^^^^^^^^^ never false",
+        "                      ^^^^^^^^^ leg never powered",
+        "                      ^^^^^^^^^ never true",
+        "                                ^^^^^^^^^ never off",
+    ]

@@ -2,7 +2,8 @@
 types, and how warnings, values and signals are handled.
 
 Exit codes: 0 ok; 1 a program, config or data error (reported with
-file:line:col, no traceback); 2 usage error; 3 the PLC faulted; 4 an
+file:line:col, no traceback); 2 usage error (and ``test --fail-under``:
+coverage below the figure, as coverage.py exits); 3 the PLC faulted; 4 an
 internal error in softplc itself (a bug, reported in one line, never as a
 traceback); 5 ``--replay``: the program's output differed from the
 recording; 130 interrupted (outside a run's scan loop: Ctrl-C or SIGTERM
