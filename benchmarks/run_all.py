@@ -1,5 +1,5 @@
 """Run every benchmark (data table, ladder engine, COMGENIUS format engine and ports, the Modbus RTU master, MODBMAST, the
-Modbus RTU slave in ladder, the watch view), each in its own process, and summarize.
+Modbus RTU slave in ladder, the watch view, the scenario runner), each in its own process, and summarize.
 
     python benchmarks/run_all.py
 
@@ -22,7 +22,7 @@ BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_load_cache",
     "bench_comgenius_format",
     "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_modbus_server",
-    "bench_watch",
+    "bench_watch", "bench_scenarios",
 )
 
 
@@ -183,6 +183,13 @@ def main() -> int:
             f"per-scan work alone {watch['ratio_session_over_run']:.2f}x; {watch['redraws_per_s']:.1f} redraws/s "
             f"of {watch['ms_per_redraw']:.1f} ms ({100 * watch['drawing_share_of_wall']:.0f}% of the time)"
         )
+
+    scen = load("bench_scenarios")
+    if scen:
+        parts = [f"{app} long {r['long']['ratio']:.2f}x, expects {r['expects']['ratio']:.2f}x, "
+                 f"dense {r['dense']['ratio']:.2f}x ({r['dense']['us_per_step']:.1f} us a step)"
+                 for app, r in scen["apps"].items()]
+        lines.append(f"scenarios runner / engine: {'; '.join(parts)} [{scen['verdict']} >= {scen['target_ratio']:.2f}]")
 
     print("=== summary " + "=" * 53)
     for line in lines:
