@@ -5,7 +5,7 @@ real sim:// ports; the network server of a test on a port the system picks."""
 import pytest
 from pymodbus.client import ModbusTcpClient
 
-from softplc_lite.ports.modbus_master import ModbusMaster
+from softplc_lite.ports.modbus_master import ModbusMaster, parse_requests
 from softplc_lite.ports.modbus_slave import ModbusSlave
 from softplc_lite.ports.scripted import ScriptedLine
 from softplc_lite.ports import simlink
@@ -96,3 +96,16 @@ def test_the_network_server_listens_on_a_port_the_system_picks():
             assert level.registers == [plc["Level"], plc["Starts"]] == [3, 1]
         finally:
             client.close()
+
+
+def test_a_master_with_its_own_requests_and_their_exception_codes():
+    master = ModbusMaster(1, period_ms=20, requests=parse_requests("03 0000 0001, 06 03E8 0001,08 0000 0000"))
+    with PLC.load(PROGRAMS / "modbus_slave", devices={0: master}) as plc:
+        plc.run(0.2)
+    assert (master.replies, master.exceptions, master.bad, master.timeouts) == (3, 6, 0, 0)
+    assert master.last_exception == 1
+    assert [request.hex(" ")[:8] for request, _ in list(master.log)[:3]] == ["01 03 00", "01 06 03", "01 08 00"]
+    with pytest.raises(ValueError, match="requests must be hex PDUs separated by commas .* not '03 0x'"):
+        parse_requests("03 0000,03 0x")
+    with pytest.raises(DeviceError, match="requests must be hex PDUs separated by commas .* not ''"):
+        PLC.load(PROGRAMS / "modbus_slave", devices={0: "sim://m?device=modbus_master&requests=03,"})

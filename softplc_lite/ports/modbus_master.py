@@ -17,6 +17,12 @@ option is a ValueError):
   for a reply's first byte (default 100).
 - ``start_ms``: when the first request goes (default 10), so the slave has
   scanned once and built its tables.
+- ``requests``: PDUs in hex (function code and data, no address, no CRC),
+  separated by commas, spaces ignored (``requests=05 0064 FF00,06 0000 0001``):
+  sent in turn, over and over, in place of the round below, to put a slave
+  through requests the round never makes (an address past its tables, a bad
+  value). Any well-formed reply of the slave polled counts: a normal one in
+  ``replies``, an exception in ``exceptions``, its code in ``last_exception``.
 
 The round (``ROUND``), one request a period, ``n`` counting rounds from 0:
 
@@ -54,7 +60,7 @@ from ..modbus.pdu import (ILLEGAL_DATA_ADDRESS, ExceptionResponse, ModbusDecodeE
                           WriteSingleRegisterRequest, decode_response)
 
 KIND = "modbus_master"
-OPTIONS = ("id", "period_ms", "timeout_ms", "start_ms")
+OPTIONS = ("id", "period_ms", "timeout_ms", "start_ms", "requests")
 PATTERN = (1, 0, 1, 0, 1, 1, 0, 0, 1, 1)
 
 
@@ -119,19 +125,50 @@ def _round(n: int, model: _Model) -> list[tuple[object, Callable[[object], bool]
 ROUND = len(_round(0, _Model()))
 
 
+class RawRequest:
+    """A request given as its PDU (the ``requests`` option)."""
+
+    def __init__(self, pdu: bytes) -> None:
+        if not pdu:
+            raise ValueError(f"{KIND} device: a request needs at least a function code")
+        self.pdu = bytes(pdu)
+        self.function_code = pdu[0]
+
+    def encode(self) -> bytes:
+        return self.pdu
+
+
+def _any_reply(reply) -> bool:
+    return True
+
+
+def parse_requests(text: str) -> list[RawRequest]:
+    """The ``requests`` option: hex PDUs separated by commas."""
+    out = []
+    for item in text.split(","):
+        try:
+            out.append(RawRequest(bytes.fromhex(item.replace(" ", ""))))
+        except ValueError:
+            raise ValueError(f"{KIND} device: requests must be hex PDUs separated by commas "
+                             f"(05 0064 FF00,06 0000 0001), not {item.strip()!r}") from None
+    return out
+
+
 class ModbusMaster(SimDevice):
     """A Modbus RTU master polling one slave (see the module docstring)."""
 
     name = KIND
 
     def __init__(self, slave_id: int = 1, period_ms: float = 20.0, timeout_ms: float = 100.0,
-                 start_ms: float = 10.0) -> None:
+                 start_ms: float = 10.0, requests: list[RawRequest] | None = None) -> None:
         if not 1 <= slave_id <= 247:
             raise ValueError(f"{KIND} device: id must be 1..247, not {slave_id}")
         self.slave_id = slave_id
         self.period_ns = round(period_ms * 1_000_000)
         self.timeout_ns = round(timeout_ms * 1_000_000)
         self.model = _Model()
+        self.requests = list(requests or [])
+        self.last_exception = 0  # the code of the last exception reply
         self.sent = self.replies = self.exceptions = self.timeouts = self.bad = 0
         self.log: deque[tuple[bytes, bytes | None]] = deque(maxlen=50)
         self._queue: list[tuple[object, Callable[[object], bool]]] = []
@@ -169,7 +206,7 @@ class ModbusMaster(SimDevice):
 
     def _send(self, at: int) -> None:
         if not self._queue:
-            self._queue = _round(self._rounds, self.model)
+            self._queue = [(r, _any_reply) for r in self.requests] or _round(self._rounds, self.model)
             self._rounds += 1
         request, check = self._queue.pop(0)
         frame = RtuFramer.encode(self.slave_id, request.encode())
@@ -197,6 +234,7 @@ class ModbusMaster(SimDevice):
             self.bad += 1
         elif isinstance(decoded, ExceptionResponse):
             self.exceptions += 1
+            self.last_exception = decoded.exception_code
         else:
             self.replies += 1
 
@@ -214,7 +252,8 @@ def create(options: dict[str, str]) -> ModbusMaster:
         raise ValueError(f"{KIND} device: id must be an integer 1..247, not {text!r}")
     return ModbusMaster(slave_id, float_option(KIND, options, "period_ms", 20.0),
                         float_option(KIND, options, "timeout_ms", 100.0),
-                        float_option(KIND, options, "start_ms", 10.0))
+                        float_option(KIND, options, "start_ms", 10.0),
+                        parse_requests(options["requests"]) if "requests" in options else None)
 
 
 def find_master(name: str) -> ModbusMaster:
