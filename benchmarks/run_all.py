@@ -22,7 +22,7 @@ BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_load_cache",
     "bench_comgenius_format",
     "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_modbus_server",
-    "bench_watch", "bench_scenarios",
+    "bench_watch", "bench_scenarios", "bench_mutation",
 )
 
 
