@@ -113,10 +113,29 @@ def test_softplc_test_mutate_reports_and_fails_under_a_score(tmp_path):
     assert f"SURVIVED {app}/main.lad:2:1: rung 1: XIC B3/0 -> XIO B3/0 (contact)" in r.stdout
     assert re.search(r"^mutation score 50\.0% \(3 killed of 6\), 6 mutants, 2 scenarios, 2 jobs, ", r.stdout, re.M)
     r = softplc_here("test", str(app), "--mutate", "--jobs", "1", "--fail-under-mutation", "60")
-    assert r.returncode == 1
+    assert r.returncode == 2
     assert "mutation score 50.0% is under --fail-under-mutation 60%" in r.stdout
+    r = softplc_here("test", str(app), "--mutate", "--jobs", "1", "--fail-under-mutation", "50")
+    assert r.returncode == 0
+
+
+def test_softplc_test_refuses_mutation_options_without_mutate_and_bad_values(tmp_path):
+    app = _app(tmp_path)
+    r = softplc_here("test", str(app), "--jobs", "2", "--fail-under-mutation", "90")
+    assert r.returncode == 2
+    assert r.stderr == "softplc test: --jobs, --fail-under-mutation apply to mutation testing: add --mutate\n"
+    assert r.stdout == ""
     r = softplc_here("test", str(app), "--mutate", "--jobs", "0")
-    assert r.returncode != 0 and "expected a whole number of 1 or more, got '0'" in r.stderr
+    assert r.returncode == 2 and "expected a whole number of 1 or more, got '0'" in r.stderr
+    r = softplc_here("test", str(app), "--mutate", "--mutate-timeout", "-1")
+    assert r.returncode == 2 and "expected a number of seconds above 0, got '-1'" in r.stderr
+
+
+def test_softplc_test_mutate_says_why_it_cannot_run(tmp_path):
+    app = _app(tmp_path, scenarios='scenario "wrong":\n    scan 1\n    expect B3/1 == 1\n')
+    r = softplc_here("test", str(app), "--mutate")
+    assert r.returncode == 1  # the scenario fails first: no mutant is made
+    assert "0 passed, 1 failed" in r.stdout and "mutation" not in r.stdout
 
 
 def test_mutants_of_rungs_the_scenarios_never_execute_are_not_run(tmp_path):

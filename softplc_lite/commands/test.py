@@ -13,13 +13,14 @@ from rich.markup import escape
 from ..app import AppError
 from ..errors import shown_path
 from ..testing.mutation import DEFAULT_BUDGET_S
-from ..testing.mutation_report import mutate_and_report
+from ..testing.mutation_report import OK, UNDER, mutate_and_report
 from ..testing.runner import SCENARIO_GLOB, run_file, scenario_files
 from ..testing.scenario import ScenarioErrors
 from . import test_coverage
-from .common import EXIT_ERROR, EXIT_OK
+from .common import EXIT_ERROR, EXIT_OK, EXIT_USAGE
 
 NAME = "test"
+EXIT_UNDER_MUTATION = EXIT_USAGE  # --fail-under-mutation not met: 2, as --fail-under for coverage
 
 
 def add_parser(sub) -> argparse.ArgumentParser:
@@ -33,17 +34,23 @@ def add_parser(sub) -> argparse.ArgumentParser:
                    help="then run the scenarios against small faults of the program and report those not caught")
     m.add_argument("--jobs", type=_positive_int, default=None, metavar="N",
                    help="worker processes for the mutants (default: the CPU count)")
-    m.add_argument("--mutate-timeout", type=_positive_float, default=DEFAULT_BUDGET_S, metavar="SECONDS",
+    m.add_argument("--mutate-timeout", type=_positive_float, default=None, metavar="SECONDS",
                    help="total time for the mutants; those left are reported as not run "
                         f"(default {DEFAULT_BUDGET_S:g})")
     m.add_argument("--fail-under-mutation", type=float, default=None, metavar="PERCENT",
-                   help="exit 1 when the mutation score is under PERCENT")
+                   help="exit 2 when the mutation score is under PERCENT")
     c.set_defaults(func=run)
     return c
 
 
 def run(args: argparse.Namespace) -> int:
     out = Console(highlight=False, soft_wrap=True)
+    alone = [flag for flag, value in (("--jobs", args.jobs), ("--mutate-timeout", args.mutate_timeout),
+                                      ("--fail-under-mutation", args.fail_under_mutation)) if value is not None]
+    if alone and not args.mutate:
+        print(f"softplc test: {', '.join(alone)} {'applies' if len(alone) == 1 else 'apply'} to mutation "
+              "testing: add --mutate", file=sys.stderr)
+        return EXIT_USAGE
     files = scenario_files(args.app)
     if not files:
         print(f"{shown_path(args.app)}: no scenario files ({SCENARIO_GLOB})", file=sys.stderr)
@@ -71,9 +78,10 @@ def run(args: argparse.Namespace) -> int:
         code = test_coverage.report(args, cov, out, code)
     if code != EXIT_OK:
         return code
-    if args.mutate and not mutate_and_report(args.app, out, sys.stderr, args.jobs, args.mutate_timeout,
-                                             args.fail_under_mutation):
-        return EXIT_ERROR
+    if args.mutate:
+        budget = DEFAULT_BUDGET_S if args.mutate_timeout is None else args.mutate_timeout
+        verdict = mutate_and_report(args.app, out, sys.stderr, args.jobs, budget, args.fail_under_mutation)
+        return {OK: EXIT_OK, UNDER: EXIT_UNDER_MUTATION}.get(verdict, EXIT_ERROR)
     return EXIT_OK
 
 

@@ -67,10 +67,14 @@ def score_line(report: MutationReport) -> str:
     return ", ".join(parts)
 
 
+OK, CANNOT_RUN, UNDER = "ok", "cannot run", "under"
+
+
 def mutate_and_report(app: str, out: Console, err, jobs: int | None, budget: float,
-                      fail_under: float | None) -> bool:
-    """``softplc test APP --mutate`` after the scenarios passed: run, report;
-    False when it cannot run or the score is under ``fail_under``."""
+                      fail_under: float | None) -> str:
+    """``softplc test APP --mutate`` after the scenarios passed: run and
+    report. OK; CANNOT_RUN (said on ``err``); UNDER, the score under
+    ``fail_under`` (or no score to compare)."""
     try:
         if out.is_terminal:  # a long run shows it is alive; a log or a pipe gets the report only
             with Progress(TextColumn("mutants"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
@@ -82,10 +86,10 @@ def mutate_and_report(app: str, out: Console, err, jobs: int | None, budget: flo
             report = run_mutation(app, jobs=jobs, budget=budget)
     except (MutationError, ScenarioErrors, AppError) as e:
         print(str(e), file=err)
-        return False
+        return CANNOT_RUN
     print_report(report, out)
     if fail_under is not None and (report.score is None or report.score < fail_under):
         shown = "no score" if report.score is None else f"{report.score:.1f}%"
         out.print(f"[red]mutation score {shown} is under --fail-under-mutation {fail_under:g}%[/]")
-        return False
-    return True
+        return UNDER
+    return OK
