@@ -7,8 +7,8 @@ baseline the speed-up is measured against).
 
 Each app is mutation-tested with its own scenario files (APP/tests), the
 same mutants in both runs: all of motor's, every K-th of modbus_slave's
-(``--sample``, 4 by default: its ~780 mutants each run six scenarios of
-simulated Modbus traffic). The budget is large enough that no mutant is cut
+(``--sample``, 4 by default: each of its ~760 mutants runs the app's
+scenarios of simulated Modbus traffic). The budget is large enough that no mutant is cut
 short, so both runs judge the same mutants, and the outcomes are checked to
 agree. Figures: wall seconds, mutants judged a second (killed, survived,
 invalid or timed out; not-covered ones are not run), and the cores used:
