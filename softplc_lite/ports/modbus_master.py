@@ -21,8 +21,11 @@ option is a ValueError):
   separated by commas, spaces ignored (``requests=05 0064 FF00,06 0000 0001``):
   sent in turn, over and over, in place of the round below, to put a slave
   through requests the round never makes (an address past its tables, a bad
-  value). Any well-formed reply of the slave polled counts: a normal one in
+  value; up to 300 bytes, past the 253 a PDU may have, so that a frame too
+  long is sent as it is). Any well-formed reply of the slave polled counts: a normal one in
   ``replies``, an exception in ``exceptions``, its code in ``last_exception``.
+  With ``requests``, ``id=0`` broadcasts them: the master waits for no
+  reply, and any byte a slave sends back counts in ``bad``.
 
 The round (``ROUND``), one request a period, ``n`` counting rounds from 0:
 
@@ -53,6 +56,7 @@ from collections.abc import Callable
 
 from . import simdevices, simlink
 from .simdevices import SimDevice, check_options, float_option, silence_ns
+from ..modbus.crc import crc16
 from ..modbus.framing import FrameError, RtuFramer
 from ..modbus.pdu import (ILLEGAL_DATA_ADDRESS, ExceptionResponse, ModbusDecodeError, ReadCoilsRequest,
                           ReadDiscreteInputsRequest, ReadHoldingRegistersRequest, ReadInputRegistersRequest,
@@ -125,12 +129,16 @@ def _round(n: int, model: _Model) -> list[tuple[object, Callable[[object], bool]
 ROUND = len(_round(0, _Model()))
 
 
+MAX_RAW_PDU = 300  # more than a PDU's 253 bytes: a slave's refusal of a frame too long is tested too
+
+
 class RawRequest:
     """A request given as its PDU (the ``requests`` option)."""
 
     def __init__(self, pdu: bytes) -> None:
-        if not pdu:
-            raise ValueError(f"{KIND} device: a request needs at least a function code")
+        if not 1 <= len(pdu) <= MAX_RAW_PDU:
+            raise ValueError(f"{KIND} device: a request has 1..{MAX_RAW_PDU} bytes (a function code, data), "
+                             f"not {len(pdu)}")
         self.pdu = bytes(pdu)
         self.function_code = pdu[0]
 
@@ -161,8 +169,8 @@ class ModbusMaster(SimDevice):
 
     def __init__(self, slave_id: int = 1, period_ms: float = 20.0, timeout_ms: float = 100.0,
                  start_ms: float = 10.0, requests: list[RawRequest] | None = None) -> None:
-        if not 1 <= slave_id <= 247:
-            raise ValueError(f"{KIND} device: id must be 1..247, not {slave_id}")
+        if not (1 if not requests else 0) <= slave_id <= 247:
+            raise ValueError(f"{KIND} device: id must be 1..247 (0, a broadcast, with requests), not {slave_id}")
         self.slave_id = slave_id
         self.period_ns = round(period_ms * 1_000_000)
         self.timeout_ns = round(timeout_ms * 1_000_000)
@@ -180,6 +188,9 @@ class ModbusMaster(SimDevice):
         self._last = 0
 
     def receive(self, data: bytes, times_ns: list[int]) -> None:
+        if self.slave_id == 0 and data:
+            self.bad += 1  # no slave answers a broadcast
+            return
         if self._pending is None:
             return  # nothing asked: noise on the line, ignored
         gap = silence_ns(self.end.char_ns)
@@ -209,10 +220,14 @@ class ModbusMaster(SimDevice):
             self._queue = [(r, _any_reply) for r in self.requests] or _round(self._rounds, self.model)
             self._rounds += 1
         request, check = self._queue.pop(0)
-        frame = RtuFramer.encode(self.slave_id, request.encode())
+        pdu = request.encode()
+        frame = bytes((self.slave_id,)) + pdu  # RtuFramer.encode refuses the over-long PDUs requests= may give
+        frame += crc16(frame).to_bytes(2, "little")
         self.end.send(frame, at)
         self.sent += 1
-        self._pending = (frame, check, request)
+        self._pending = (frame, check, request) if self.slave_id else None  # a broadcast waits for nothing
+        if self._pending is None:
+            self.log.append((frame, None))
         self._sent_end = at + len(frame) * self.end.char_ns
         self._next_at = at + self.period_ns
         self._reply.clear()
@@ -247,9 +262,10 @@ def create(options: dict[str, str]) -> ModbusMaster:
     """The ``modbus_master`` device factory: ``options`` as given in the URL."""
     check_options(KIND, options, OPTIONS)
     text = options.get("id", "1")
-    slave_id = int(text) if text.isascii() and text.isdigit() and len(text) < 4 else 0
-    if not 1 <= slave_id <= 247:
-        raise ValueError(f"{KIND} device: id must be an integer 1..247, not {text!r}")
+    slave_id = int(text) if text.isascii() and text.isdigit() and len(text) < 4 else -1
+    if not (0 if "requests" in options else 1) <= slave_id <= 247:
+        raise ValueError(f"{KIND} device: id must be an integer 1..247 (0, a broadcast, with requests), "
+                         f"not {text!r}")
     return ModbusMaster(slave_id, float_option(KIND, options, "period_ms", 20.0),
                         float_option(KIND, options, "timeout_ms", 100.0),
                         float_option(KIND, options, "start_ms", 10.0),
