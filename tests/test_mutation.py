@@ -97,10 +97,17 @@ def test_the_report_draws_each_survivor_with_its_change_and_the_counts(tmp_path)
     assert lines[head + 1].strip() == "Rung 1"
     assert re.fullmatch(r"\|\s+B3/0\s+B3/2\s+\|", lines[head + 2])
     assert re.match(r"\|-+\]/\[-+.*\( \)-+\|", lines[head + 3]), lines[head + 3]
+    assert lines[head + 4] == " " * lines[head + 3].index("/") + "^"  # the change marked under it
     assert f"SURVIVED {app}/main.lad:2:10: rung 1: OTE B3/2 removed (output)" in lines
-    # a deleted rung is drawn as it was
+    # a deleted rung is drawn as it was, nothing marked
     deleted = lines.index(f"SURVIVED {app}/main.lad:2:1: rung 1: rung deleted: XIC B3/0 OTE B3/2 (rung)")
     assert re.match(r"\|-+\] \[-+.*\( \)-+\|", lines[deleted + 3]), lines[deleted + 3]
+    assert "^" not in "".join(lines[deleted:deleted + 5])
+    # a preset one less: the digit marked under the box's line
+    preset = lines.index(f"SURVIVED {app}/main.lad:3:10: rung 2: TON T4:0 0.01 32767 0 -> TON T4:0 0.01 32766 0 "
+                         "(constant)")
+    row = next(k for k in range(preset, preset + 6) if "PRE 32766" in lines[k])
+    assert lines[row + 1] == " " * lines[row].index("32766") + "    ^"
     assert lines[-1].startswith("mutation score 33.3% (3 killed of 9), 3 not covered, 1 invalid, 13 mutants, "
                                 "2 scenarios, 1 job, ")
 
@@ -188,3 +195,13 @@ def test_progress_is_told_each_mutant_judged(tmp_path, jobs):
     run_mutation(_app(tmp_path), jobs=jobs, covered=_not_rung_3,
                  progress=lambda done, total: seen.append((done, total)))
     assert seen == [(k, 10) for k in range(1, 11)]
+
+
+def test_on_a_colour_console_the_change_is_in_reverse_video_without_marker_lines(tmp_path):
+    report = run_mutation(_app(tmp_path), jobs=1, covered=_not_rung_3,
+                          select=lambda m: m.description == "XIC B3/0 -> XIO B3/0" and m.key == (2, 1))
+    out = io.StringIO()
+    print_report(report, Console(file=out, width=90, color_system="standard", force_terminal=True, soft_wrap=True))
+    text = out.getvalue()
+    assert re.search(r"\x1b\[(\d+;)*7(;\d+)*m/\x1b\[0m", text)  # reverse video (7) on the contact's slash alone
+    assert "^" not in text

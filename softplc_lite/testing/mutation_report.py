@@ -1,14 +1,18 @@
 """The report of a mutation run: each surviving mutant with the change
 (``XIC Start -> XIO Start``), where it is, and its rung drawn as the watch
-view draws it (the mutated rung, or the deleted one), then the score and
-the counts of every outcome."""
+view draws it (the mutated rung with the change marked, or the deleted
+one), then the score and the counts of every outcome."""
 
 from __future__ import annotations
 
-from rich.console import Console
+import itertools
+
+from rich.console import Console, ConsoleOptions, RenderResult
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.style import Style
 from rich.table import Table
+from rich.text import Text
 
 from ..app import AppError
 from ..watch.rungs import RungView
@@ -18,26 +22,85 @@ from .mutation import (INVALID, KILLED, NOT_COVERED, OUT_OF_TIME, STATUSES, SURV
 from .plc import PLC
 from .scenario import ScenarioErrors
 
+MARKED = Style(reverse=True, bold=True)
 
-def survivor_view(report: MutationReport, mutant: Mutant) -> RungView:
+
+# The most differing characters marked: an in-place change (a contact, a
+# latch, a comparison, a constant) differs in a few; more means the layout
+# moved (a leg removed) and marks would only scatter over the drawing. Where
+# both drawings have wire or border there (a box grown by a character), the
+# difference is the layout's, not the change's: not marked.
+MARK_MAX = 12
+_WIRES = frozenset(" -+|")
+
+
+class ChangedRung:
+    """A surviving mutant's rung drawn as the watch view draws it, the
+    characters that differ from the original rung's drawing marked: in
+    reverse video, and on a console without colour by a ``^`` line under
+    each line that has them."""
+
+    def __init__(self, view: RungView, original: RungView | None) -> None:
+        self.view, self.original = view, original
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        lines = console.render_lines(self.view, options, pad=False)
+        marks = self._marks(console, options, lines)
+        for line, cols in zip(lines, marks):
+            text = Text.assemble(*((seg.text, seg.style) for seg in line if not seg.control))
+            for col in cols:
+                text.stylize(MARKED, col, col + 1)
+            yield text
+            if cols and console.color_system is None:
+                yield Text("".join("^" if k in cols else " " for k in range(max(cols) + 1)))
+
+    def _marks(self, console: Console, options: ConsoleOptions, lines) -> list[set[int]]:
+        none = [set() for _ in lines]
+        if self.original is None:
+            return none
+        before = console.render_lines(self.original, options, pad=False)
+        if len(before) != len(lines):
+            return none
+        marks = [{k for k, (a, b) in enumerate(itertools.zip_longest(_plain(x), _plain(y), fillvalue=" "))
+                  if a != b and not (a in _WIRES and b in _WIRES)} for x, y in zip(lines, before)]
+        return marks if 0 < sum(len(m) for m in marks) <= MARK_MAX else none
+
+
+def _plain(line) -> str:
+    return "".join(seg.text for seg in line if not seg.control)
+
+
+def survivor_view(report: MutationReport, mutant: Mutant, original: dict | None = None) -> ChangedRung:
     """The rung a surviving mutant changed, drawn at a fresh load's values:
-    the mutated rung, or for a deleted rung the original one."""
+    the mutated rung with its change marked, or for a deleted rung the
+    original one. ``original``: a dict this fills with the unmutated app's
+    drawing state, to share between the survivors of one report."""
     number, index = mutant.key
-    program = None if mutant.rung is None else mutant.apply(report.source)
-    with PLC.load(report.app, program=program) as plc:
-        app = plc.runner.app
-        rung = app.program.files[number].rungs[index]
-        return RungView(rung, index, plc.table, symbols=app.program.symbols, instructions=app.instructions,
-                        comments="hidden")
+    original = {} if original is None else original
+    if "program" not in original:
+        with PLC.load(report.app) as plc:
+            original.update(program=plc.runner.app.program, table=plc.table,
+                            instructions=plc.runner.app.instructions)
+    program, table, instructions = original["program"], original["table"], original["instructions"]
+
+    def view(rung, table):
+        return RungView(rung, index, table, symbols=program.symbols, instructions=instructions, comments="hidden")
+
+    before = view(program.files[number].rungs[index], table)
+    if mutant.rung is None:
+        return ChangedRung(before, None)
+    with PLC.load(report.app, program=mutant.apply(report.source)) as plc:
+        return ChangedRung(view(plc.runner.app.program.files[number].rungs[index], plc.table), before)
 
 
 def print_report(report: MutationReport, out: Console, survivors: bool = True) -> None:
+    original: dict = {}
     if survivors:
         for mutant, outcome in report.with_status(SURVIVED):
             file = f"file {mutant.key[0]} " if mutant.key[0] != 2 else ""
             out.print(f"[yellow]SURVIVED[/] {escape(str(mutant.pos))}: {file}rung {mutant.key[1]}: "
                       f"[bold]{escape(mutant.description)}[/] ({mutant.operator})")
-            out.print(survivor_view(report, mutant))
+            out.print(survivor_view(report, mutant, original))
     for mutant, outcome in report.with_status(TIMED_OUT):
         out.print(f"[red]TIMED OUT[/] {escape(str(mutant.pos))}: {escape(mutant.description)}: "
                   f"{escape(outcome.detail)}")
