@@ -108,6 +108,8 @@ def test_the_report_draws_each_survivor_with_its_change_and_the_counts(tmp_path)
                          "(constant)")
     row = next(k for k in range(preset, preset + 6) if "PRE 32766" in lines[k])
     assert lines[row + 1] == " " * lines[row].index("32766") + "    ^"
+    assert f"NOT COVERED rungs the scenarios never executed, their 3 mutants not run: {app}/main.lad:4 (rung 3)" \
+        in lines
     assert lines[-1].startswith("mutation score 33.3% (3 killed of 9), 3 not covered, 1 invalid, 13 mutants, "
                                 "2 scenarios, 1 job, ")
 

@@ -89,6 +89,7 @@ def survivor_view(report: MutationReport, mutant: Mutant, original: dict | None 
     before = view(program.files[number].rungs[index], table)
     if mutant.rung is None:
         return ChangedRung(before, None)
+    # loaded, not only checked: loading puts a timer's or counter's preset in the table
     with PLC.load(report.app, program=mutant.apply(report.source)) as plc:
         return ChangedRung(view(plc.runner.app.program.files[number].rungs[index], plc.table), before)
 
@@ -101,6 +102,11 @@ def print_report(report: MutationReport, out: Console, survivors: bool = True) -
             out.print(f"[yellow]SURVIVED[/] {escape(str(mutant.pos))}: {file}rung {mutant.key[1]}: "
                       f"[bold]{escape(mutant.description)}[/] ({mutant.operator})")
             out.print(survivor_view(report, mutant, original))
+    uncovered = list(dict.fromkeys(m.key for m, _ in report.with_status(NOT_COVERED)))
+    if uncovered:
+        out.print(f"[yellow]NOT COVERED[/] rungs the scenarios never executed, their "
+                  f"{report.count(NOT_COVERED)} mutants not run: "
+                  + ", ".join(escape(_rung_place(report, key)) for key in uncovered))
     for mutant, outcome in report.with_status(TIMED_OUT):
         out.print(f"[red]TIMED OUT[/] {escape(str(mutant.pos))}: {escape(mutant.description)}: "
                   f"{escape(outcome.detail)}")
@@ -115,6 +121,13 @@ def print_report(report: MutationReport, out: Console, survivors: bool = True) -
             table.add_row(f"[{style}]{status}[/]" if style else status, str(n))
     out.print(table)
     out.print(score_line(report))
+
+
+def _rung_place(report: MutationReport, key) -> str:
+    number, index = key
+    pos = report.source.files[number].rungs[index].pos
+    return f"{pos.source}:{pos.line} (rung {index})" if number == 2 else \
+        f"{pos.source}:{pos.line} (file {number} rung {index})"
 
 
 def score_line(report: MutationReport) -> str:
