@@ -12,6 +12,7 @@ from softplc_lite.ports import simlink
 from softplc_lite.testing.devices import DeviceError
 from softplc_lite.testing.plc import PLC
 
+from helpers.apps import make_app
 from helpers.shipped_apps import PROGRAMS, SHIPPED_PORT
 
 
@@ -109,3 +110,32 @@ def test_a_master_with_its_own_requests_and_their_exception_codes():
         parse_requests("03 0000,03 0x")
     with pytest.raises(DeviceError, match="requests must be hex PDUs separated by commas .* not ''"):
         PLC.load(PROGRAMS / "modbus_slave", devices={0: "sim://m?device=modbus_master&requests=03,"})
+
+
+LINKED = """XIO T4:0/DN TON T4:0 0.01 5 0
+XIC T4:0/DN COMPRINT R6:0 0 1 N7:0 N7:1
+XIC T4:0/DN CTU C5:0 32767 0
+"""
+
+
+def test_an_apps_own_link_between_its_ports_is_the_plcs_own(tmp_path):
+    """Port 0 and port 1 are the two ends of sim://line: two PLCs of the app
+    at once each get a link of their own (a third end would be refused)."""
+    app = make_app(tmp_path / "linked", LINKED, MODULES_LST="COMGENIUS\n", COMGENIUS_LST=(
+        "[PORTS]\n0, sim://line, ISO-8859-1, 38400, 8, N, 1, 100\n1, sim://line, ISO-8859-1, 38400, 8, N, 1, 100\n"
+        '[STRINGS]\n1 "%d %d\\r\\n"\n'))
+    with PLC.load(app) as one, PLC.load(app) as two:
+        one.run(0.5)
+        two.run(0.5)
+        names = [n for n in simlink.link_names() if n.endswith("-line")]
+        assert len(names) == 2 and "line" not in simlink.link_names()
+        for plc in (one, two):
+            port0, port1 = plc.engine.modules[0].serial_ports()
+            assert port0.up and port1.up and port0.serial.sim_link is port1.serial.sim_link
+            assert port1.rx_bytes == port0.tx_bytes == plc["C5:0.ACC"] * len(b"0 0\r\n") > 0
+    with pytest.raises(DeviceError, match="COMGENIUS:0 is given a device and a ports= override"):
+        PLC.load(app, ports=("0=loop://",), devices={0: ModbusMaster()})
+    with PLC.load(app, ports=("1=loop://",)) as plc:  # port 0 alone on its renamed link, port 1 as given
+        plc.scan()
+        port0, port1 = plc.engine.modules[0].serial_ports()
+        assert port1.url == "loop://" and port0.url.startswith("sim://plc") and port0.url.endswith("-line")

@@ -20,7 +20,7 @@ import threading
 from dataclasses import dataclass
 from typing import Iterable, Mapping
 
-from ..ports import simdevices
+from ..ports import parse_port_overrides, simdevices
 from ..ports.simdevices import SimDevice, check_options
 from ..ports.urlhandler.protocol_sim import parse_url
 
@@ -106,11 +106,20 @@ class Attached:
                 _GIVEN.pop(ref, None)
 
 
-def attach(modules: list, devices: Mapping) -> Attached:
+def attach(modules: list, devices: Mapping, ports: Iterable[str] = ()) -> Attached:
     """The overrides that put ``devices`` ({PORT: DEVICE}) on the ports of
-    ``modules`` (the app's, configured); DeviceError with every problem."""
+    ``modules`` (the app's, configured), and that give the app's own
+    port-to-port ``sim://NAME`` links a name of this PLC's (both ends
+    alike); ``ports``: the ``--port`` overrides given besides, whose ports
+    are left alone. DeviceError with every problem."""
     problems: list[tuple[object, str]] = []
     chosen: dict[tuple[str, int], tuple[SimDevice, bool]] = {}
+    given = set()
+    for module, number in parse_port_overrides(ports):
+        try:
+            given.add(resolve_port(modules, f"{module}:{number}" if module else number))
+        except ValueError:
+            pass  # the override's own check says why
     for key, spec in devices.items():
         try:
             port = resolve_port(modules, key)
@@ -120,11 +129,13 @@ def attach(modules: list, devices: Mapping) -> Attached:
             continue
         if port in chosen:
             problems.append((key, f"{port[0]}:{port[1]} is given a device twice"))
+        elif port in given:
+            problems.append((key, f"{port[0]}:{port[1]} is given a device and a ports= override"))
         chosen[port] = device
     if problems:
         raise DeviceError(problems)
     plc = next(_numbers)
-    overrides, refs = [], []
+    overrides, refs = _own_links(modules, set(chosen) | given, plc), []
     with _lock:
         for (module, number), (device, unlimited) in chosen.items():
             ref = f"{plc}-{module}-{number}"
@@ -133,6 +144,24 @@ def attach(modules: list, devices: Mapping) -> Attached:
             rate = "&rate=unlimited" if unlimited else ""
             overrides.append(f"{module}:{number}=sim://plc{ref.lower()}?device={KIND}&ref={ref}{rate}")
     return Attached(tuple(overrides), tuple(refs))
+
+
+def _own_links(modules: list, taken: set, plc: int) -> list[str]:
+    """Overrides renaming the app's port-to-port sim:// links (not a device's,
+    which is new at each opening) to ``plcN-NAME``."""
+    out = []
+    for m in modules:
+        for c in m.port_claims():
+            if (m.name.upper(), c.number) in taken or not c.url.lower().startswith("sim://"):
+                continue
+            try:
+                name, kind, _, _ = parse_url(c.url)
+            except ValueError:
+                continue  # the port's own open says why
+            if kind is None:
+                rest = c.url.split("://", 1)[1][len(name):]
+                out.append(f"{m.name.upper()}:{c.number}=sim://plc{plc}-{name}{rest}")
+    return out
 
 
 def device_on(modules: list, key) -> SimDevice:

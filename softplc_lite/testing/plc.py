@@ -61,9 +61,8 @@ class PLC:
             app = load_app(path, state_dir=cache_dir, program=program, program_key=program_key)
             if not configured_tcp_ports:
                 _ephemeral_servers(app.modules)
-            if devices:
-                attached = attach(app.modules, devices)
-                ports = tuple(ports) + attached.overrides
+            attached = attach(app.modules, devices or {}, ports)
+            ports = tuple(ports) + attached.overrides
             executor = "compiled"
             if coverage is not None:
                 coverage.learn_modules(app.modules)
