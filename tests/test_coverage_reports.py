@@ -68,6 +68,21 @@ def test_cobertura_has_the_dtd_shape_and_the_counts(conveyor):
                 assert 0 <= float(el.get(name)) <= 1
 
 
+def test_pycobertura_reads_the_report(conveyor, tmp_path):
+    """An independent reader (pycobertura, what CI coverage tools build on) sees the same file,
+    the same rates, and both rungs as partly covered lines."""
+    from pycobertura import Cobertura
+    from pycobertura.filesystem import filesystem_factory
+
+    app, cov = conveyor
+    (tmp_path / "c.xml").write_text(cobertura(cov), encoding="utf-8")
+    report = Cobertura(str(tmp_path / "c.xml"), filesystem=filesystem_factory(str(app)))
+    assert report.files() == ["main.lad"]
+    assert (report.line_rate("main.lad"), report.branch_rate("main.lad")) == (1.0, 0.65)
+    assert report.line_statuses("main.lad") == [(10, "partial"), (11, "partial")]
+    assert report.total_statements("main.lad") == 2
+
+
 LCOV_RECORD = re.compile(r"TN:.*|SF:.+|FN:\d+,\S+|FNDA:\d+,\S+|FNF:\d+|FNH:\d+|DA:\d+,\d+|"
                          r"BRDA:\d+,\d+,\d+,(\d+|-)|BRF:\d+|BRH:\d+|LF:\d+|LH:\d+|end_of_record")
 
