@@ -27,7 +27,7 @@ def test_the_try_it_block_is_what_this_test_runs():
     assert len(lines) >= 10 and all(line.startswith("softplc ") for line in lines)
     for line in lines:
         argv = shlex.split(line, comments=True)
-        bounded = argv[1] in ("check", "fmt", "watch") or "--scans" in argv or "--replay" in argv
+        bounded = argv[1] in ("check", "fmt", "watch", "test") or "--scans" in argv or "--replay" in argv
         assert bounded, f"a README line that would run until stopped: {line}"
 
 
