@@ -206,3 +206,18 @@ def ratio(samples: dict[str, list[float]], slow: str, fast: str) -> float:
     import statistics
 
     return statistics.median(s / f for s, f in zip(samples[slow], samples[fast]))
+
+
+def print_profile(body, title: str, lines: int = 12) -> None:
+    """Runs ``body()`` under cProfile and prints the functions that took the most time
+    of their own: what to look at before optimising."""
+    import cProfile
+    import pstats
+
+    prof = cProfile.Profile()
+    prof.enable()
+    body()
+    prof.disable()
+    stats = pstats.Stats(prof)
+    print(f"--- cProfile of {title} (times under the profiler, total {stats.total_tt:.2f} s)")
+    stats.sort_stats("tottime").print_stats(lines)

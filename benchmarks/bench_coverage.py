@@ -33,8 +33,6 @@ plain compiled engine.
 
 from __future__ import annotations
 
-import cProfile
-import pstats
 import sys
 import tempfile
 import time
@@ -102,15 +100,10 @@ def measure(rounds: int) -> dict:
 
 def profile(app: str = "motor", scans: int = 20000) -> None:
     loop = Loop(app, "on")
-    prof = cProfile.Profile()
-    prof.enable()
-    loop.body(scans)
-    prof.disable()
-    loop.close()
-    stats = pstats.Stats(prof)
-    print(f"--- cProfile of programs/{app} with coverage, {scans} scans (times under the profiler, "
-          f"total {stats.total_tt:.2f} s)")
-    stats.sort_stats("tottime").print_stats(12)
+    try:
+        C.print_profile(lambda: loop.body(scans), f"programs/{app} with coverage, {scans} scans")
+    finally:
+        loop.close()
 
 
 def main() -> int:

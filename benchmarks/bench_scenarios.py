@@ -35,8 +35,6 @@ checked, ``close``), which a scenario pays once whatever its length.
 
 from __future__ import annotations
 
-import cProfile
-import pstats
 import sys
 import time
 
@@ -56,71 +54,50 @@ LONG = {"motor": "setup:\n    set StopOk = 1\n    set Start = 1\n",
         "tank": ""}
 LONG_STEPS = 'scenario "long":\n    scan 500\n    run 5 s\n'
 
+# A block of steps of each app, its waits filled in per kind below.
+_BLOCKS = {
+    "motor": ("setup:\n    set StopOk = 1\n", """\
+    set Start = 1
+    scan 1
+    expect rising Motor
+    expect Motor == 1
+    set Start = 0
+    {wait}
+    expect Motor == 1
+    expect Tripped == 0
+    {wait}
+    expect Motor == 1
+    expect FaultLamp == 0
+    set StopOk = 0
+    scan 1
+    expect falling Motor
+    expect Motor == 0
+    set StopOk = 1
+"""),
+    "tank": ("", """\
+    {half}
+    expect Level between 0 and 4095
+    expect Valve between 0 and 4095
+    expect Percent within 60 of 50
+    set Loop[2] = 2000
+    {half}
+    expect N7:1 == 2041
+    expect Loop/9 == 0
+"""),
+}
+
+
+def _blocks(wait: str, half: str, scans: int) -> dict:
+    return {app: (setup, steps.format(wait=wait, half=half), scans) for app, (setup, steps) in _BLOCKS.items()}
+
+
 # Blocks of 100 scans (10 blocks: 1,000 scans) with the steps of a scenario
 # an engineer writes: about twice the steps a scan of programs/motor's own
 # scenario files (86 steps per 1,000 scans; the shipped apps' files have 2 to 130).
-EXPECTS = {
-    "motor": ("setup:\n    set StopOk = 1\n", """\
-    set Start = 1
-    scan 1
-    expect rising Motor
-    expect Motor == 1
-    set Start = 0
-    run 490 ms
-    expect Motor == 1
-    expect Tripped == 0
-    run 490 ms
-    expect Motor == 1
-    expect FaultLamp == 0
-    set StopOk = 0
-    scan 1
-    expect falling Motor
-    expect Motor == 0
-    set StopOk = 1
-""", 100),
-    "tank": ("", """\
-    scan 50
-    expect Level between 0 and 4095
-    expect Valve between 0 and 4095
-    expect Percent within 60 of 50
-    set Loop[2] = 2000
-    scan 50
-    expect N7:1 == 2041
-    expect Loop/9 == 0
-""", 100),
-}
+EXPECTS = _blocks("run 490 ms", "scan 50", 100)
 # The same kinds of step, 10 scans a block (100 blocks): far denser than any
 # shipped file, to give the cost of a step itself.
-DENSE = {
-    "motor": ("setup:\n    set StopOk = 1\n", """\
-    set Start = 1
-    scan 1
-    expect rising Motor
-    expect Motor == 1
-    set Start = 0
-    scan 4
-    expect Motor == 1
-    expect Tripped == 0
-    scan 4
-    expect Motor == 1
-    expect FaultLamp == 0
-    set StopOk = 0
-    scan 1
-    expect falling Motor
-    expect Motor == 0
-    set StopOk = 1
-""", 10),
-    "tank": ("", """\
-    scan 5
-    expect Level between 0 and 4095
-    expect Valve between 0 and 4095
-    expect Percent within 60 of 50
-    set Loop[2] = 2000
-    scan 5
-    expect N7:1 == 2041
-    expect Loop/9 == 0
-""", 10),
-}
+DENSE = _blocks("scan 4", "scan 5", 10)
 KINDS = ("long", "expects", "dense")
 TARGETED = ("long", "expects")  # the target is for scenarios as written; dense gives the step's cost
 APPS = tuple(EXPECTS)
@@ -203,15 +180,10 @@ def measure(rounds: int) -> dict:
 
 def profile(app: str = "motor", kind: str = "expects", repeats: int = 20) -> None:
     loop = Loop(app, kind)
-    prof = cProfile.Profile()
-    prof.enable()
-    loop.body(SCANS * repeats)
-    prof.disable()
-    loop.plc.close()
-    stats = pstats.Stats(prof)
-    print(f"--- cProfile of {app} {kind}, {SCANS * repeats} scans (times under the profiler, "
-          f"total {stats.total_tt:.2f} s)")
-    stats.sort_stats("tottime").print_stats(14)
+    try:
+        C.print_profile(lambda: loop.body(SCANS * repeats), f"{app} {kind}, {SCANS * repeats} scans", 14)
+    finally:
+        loop.plc.close()
 
 
 def main() -> int:
