@@ -466,7 +466,8 @@ def test_a_client_sending_faster_than_it_reads_is_no_longer_read_and_then_closed
                  limit=5.0)
     stuck.sock.setblocking(True)
     assert stuck.closed_within(5.0) is not None, "what was sent before the close, then the end"
-    assert plc.status(S.W_CONNECTED) == 1, "the poller only"
+    # The status words are copied at a scan's output point: the close shows there a scan after it.
+    plc.wait_for(lambda: plc.status(S.W_CONNECTED) == 1, "the poller only connected", limit=2.0)
     poller.stop()
     assert poller.slowest < 1.0, poller.slowest
     assert_server_alive(plc)
