@@ -75,3 +75,18 @@ def test_refused(catalogue, tag, extra, status):
     with pytest.raises(PathError) as e:
         target(catalogue, tag, extra)
     assert e.value.status == status
+
+
+def test_symbols_of_a_program():
+    from softplc_lite.ladder.ast import Program, SymbolDecl
+    from softplc_lite.datatable import parse_address
+    from softplc_lite.tlm.enips.tagnames import symbol_addresses
+
+    program = Program(symbols={"POLLTIMER": SymbolDecl("PollTimer", parse_address("T4:1")),
+                               "BIT": SymbolDecl("Bit", parse_address("B3/20"))})
+    symbols = symbol_addresses(program.symbols)
+    assert symbols == {"PollTimer": "T4:1", "Bit": "B3/20"}
+    t = DataTable()
+    t.reference("T4:1")
+    c = Catalogue(TableAccessOnTable(t), symbols)
+    assert c.target([("name", "pollTIMER"), ("name", "ACC")]).item == 5

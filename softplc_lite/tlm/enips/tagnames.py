@@ -106,6 +106,12 @@ def file_tags(files: list[FileInfo]) -> list[Tag]:
     return out
 
 
+def symbol_addresses(symbols) -> dict[str, str]:
+    """A program's symbols (``Program.symbols``: name -> declaration) as the
+    picklable name -> address text the tag services are built with."""
+    return {decl.name: str(decl.address) for decl in symbols.values()}
+
+
 def symbol_tags(symbols: dict[str, str], access: TableAccess) -> tuple[list[Tag], list[str]]:
     """The program symbols as tags, and what was left out and why (an
     indirect or indexed address, a file not served, an element past its
