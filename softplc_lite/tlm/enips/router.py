@@ -15,6 +15,7 @@ from ...cip import status
 from ...cip.epath import SYMBOLIC, PathError, logical
 from ...cip.mr import MessageError, MessageRouterRequest, MessageRouterResponse
 from .access import TableAccess
+from .identity import IdentityObject
 from .objects import REPLY, CipObject, CipReply, CipRequest
 
 MESSAGE_ROUTER_CLASS = 0x02
@@ -22,7 +23,7 @@ MULTIPLE_SERVICE_PACKET = 0x0A
 
 # The served object classes, one factory each; the Identity, Connection
 # Manager, PCCC and tag objects register here as they are built.
-OBJECTS: list[Callable[[], CipObject]] = []
+OBJECTS: list[Callable[[], CipObject]] = [IdentityObject]
 
 
 class MessageRouter:
