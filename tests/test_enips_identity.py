@@ -37,3 +37,13 @@ def test_list_identity_item_round_trips():
     assert back.type_id == cpf.LIST_IDENTITY
     assert back.data[4:6] == struct.pack(">H", 44818)
     assert back.data[-1] == 3 and b"softplc_lite PUMPS" in back.data
+
+
+def test_pycomm3_reads_the_list_identity_item():
+    from pycomm3.custom_types import ListIdentityObject
+
+    raw = cpf.encode([Identity("PUMPS").list_identity_item("127.0.0.1", 44818)])
+    seen = ListIdentityObject.decode(raw[2:])  # pycomm3 skips the item count
+    assert seen["product_name"] == "softplc_lite PUMPS"
+    assert seen["ip_address"] == "127.0.0.1"
+    assert seen["product_type"] == "Programmable Logic Controller"

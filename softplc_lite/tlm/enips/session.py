@@ -1,0 +1,82 @@
+"""One TCP connection's encapsulation state (CIP Volume 2, 2-4): the
+session it registered, and the reply to each encapsulation message. The
+network side frames messages by the header's length field and hands each
+whole message here.
+
+Our choices: one session per connection (a second RegisterSession is
+refused with incorrect data, 0x03); a message naming another session is
+answered with invalid session handle (0x64) and the data ignored; an unknown
+command gets invalid command (0x01)."""
+
+from __future__ import annotations
+
+import itertools
+import struct
+
+from ...cip import cpf, encap
+from ...cip.encap import EncapMessage
+from .access import TableAccess
+from .identity import Identity
+from .router import MessageRouter
+
+_handles = itertools.count(0x1001)
+PROTOCOL_VERSION = 1
+
+
+class EncapSession:
+    def __init__(self, router: MessageRouter, access: TableAccess, identity: Identity,
+                 host: str = "127.0.0.1", port: int = 44818):
+        self.router, self.access, self.identity = router, access, identity
+        self.host, self.port = host, port
+        self.session = 0
+
+    async def reply(self, message: EncapMessage) -> EncapMessage | None:
+        """The reply to one message, or None (NOP and UnRegisterSession get none)."""
+        command = message.command
+        if command == encap.NOP:
+            return None
+        if command == encap.LIST_IDENTITY:
+            return message.reply(cpf.encode([self.identity.list_identity_item(self.host, self.port)]))
+        if command == encap.LIST_SERVICES:
+            name = b"Communications\x00\x00"
+            item = cpf.Item(cpf.LIST_SERVICES, struct.pack("<HH", 1, 1 << 5)  # version 1; bit 5: CIP over TCP + name)
+            return message.reply(cpf.encode([item]))
+        if command == encap.LIST_INTERFACES:
+            return message.reply(struct.pack("<H", 0))
+        if command == encap.REGISTER_SESSION:
+            if self.session:
+                return message.reply(message.data, encap.INCORRECT_DATA)
+            if len(message.data) != 4:
+                return message.reply(message.data, encap.INCORRECT_DATA)
+            version, _ = struct.unpack("<HH", message.data)
+            if version != PROTOCOL_VERSION:
+                return message.reply(struct.pack("<HH", PROTOCOL_VERSION, 0), encap.UNSUPPORTED_PROTOCOL)
+            self.session = next(_handles)
+            return message.reply(message.data, session=self.session)
+        if command not in encap.COMMANDS:
+            return message.reply(status=encap.INVALID_COMMAND)
+        if not self.session or message.session != self.session:
+            return message.reply(status=encap.INVALID_SESSION)
+        if command == encap.UNREGISTER_SESSION:
+            self.session = 0
+            return None
+        if command == encap.SEND_RR_DATA:
+            return await self.send_rr_data(message)
+        return message.reply(status=encap.INVALID_COMMAND)  # SendUnitData: connections not yet served
+
+    async def send_rr_data(self, message: EncapMessage) -> EncapMessage:
+        """Interface handle (4), timeout (2), then the items: a null address
+        and an unconnected data item holding a Message Router request."""
+        try:
+            if len(message.data) < 6:
+                raise cpf.CpfError("no interface handle and timeout")
+            items = cpf.decode(message.data[6:])
+        except cpf.CpfError:
+            return message.reply(status=encap.INCORRECT_DATA)
+        data = [item for item in items if item.type_id == cpf.UNCONNECTED_DATA]
+        if len(items) != 2 or items[0].type_id != cpf.NULL_ADDRESS or len(data) != 1:
+            return message.reply(status=encap.INCORRECT_DATA)
+        response = await self.router.handle(data[0].data, self.access)
+        body = message.data[:6] + cpf.encode([cpf.Item(cpf.NULL_ADDRESS),
+                                              cpf.Item(cpf.UNCONNECTED_DATA, response)])
+        return message.reply(body)
