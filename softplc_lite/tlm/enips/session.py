@@ -39,7 +39,8 @@ class EncapSession:
             return message.reply(cpf.encode([self.identity.list_identity_item(self.host, self.port)]))
         if command == encap.LIST_SERVICES:
             name = b"Communications\x00\x00"
-            item = cpf.Item(cpf.LIST_SERVICES, struct.pack("<HH", 1, 1 << 5)  # version 1; bit 5: CIP over TCP + name)
+            # version 1; capability bit 5: CIP encapsulation over TCP
+            item = cpf.Item(cpf.LIST_SERVICES, struct.pack("<HH", 1, 1 << 5) + name)
             return message.reply(cpf.encode([item]))
         if command == encap.LIST_INTERFACES:
             return message.reply(struct.pack("<H", 0))
