@@ -15,6 +15,7 @@ from ...cip import status
 from ...cip.epath import SYMBOLIC, PathError, logical
 from ...cip.mr import MessageError, MessageRouterRequest, MessageRouterResponse
 from .access import TableAccess
+from .connmgr import ConnectionManager
 from .identity import IdentityObject
 from .objects import REPLY, CipObject, CipReply, CipRequest
 
@@ -23,7 +24,7 @@ MULTIPLE_SERVICE_PACKET = 0x0A
 
 # The served object classes, one factory each; the Identity, Connection
 # Manager, PCCC and tag objects register here as they are built.
-OBJECTS: list[Callable[[], CipObject]] = [IdentityObject]
+OBJECTS: list[Callable[[], CipObject]] = [IdentityObject, ConnectionManager]
 
 
 class MessageRouter:
@@ -31,6 +32,8 @@ class MessageRouter:
         self.objects: dict[int | None, CipObject] = {}
         for obj in objects if objects is not None else [make() for make in OBJECTS]:
             self.objects[obj.class_id] = obj
+            if hasattr(obj, "router"):
+                obj.router = self
 
     async def handle(self, raw: bytes, access: TableAccess) -> bytes:
         """The encoded response to one encoded Message Router request."""
