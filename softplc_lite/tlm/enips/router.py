@@ -28,9 +28,15 @@ OBJECTS: list[Callable[[], CipObject]] = [IdentityObject, ConnectionManager]
 
 
 class MessageRouter:
-    def __init__(self, objects: list[CipObject] | None = None):
+    def __init__(self, objects: list[CipObject] | None = None, identity=None):
+        """``identity`` (an ``identity.Identity``) names this server in place
+        of the Identity object's default."""
+        built = objects if objects is not None else [make() for make in OBJECTS]
+        if identity is not None:
+            built = [obj for obj in built if obj.class_id != IdentityObject.class_id]
+            built.append(IdentityObject(identity))
         self.objects: dict[int | None, CipObject] = {}
-        for obj in objects if objects is not None else [make() for make in OBJECTS]:
+        for obj in built:
             self.objects[obj.class_id] = obj
             if hasattr(obj, "router"):
                 obj.router = self
