@@ -60,3 +60,31 @@ def test_raw_socket_refusals():
             # A header announcing more data than the server takes closes the connection.
             sock.sendall(struct.pack("<HHII8sI", encap.SEND_RR_DATA, 0xFFFF, 0, 0, bytes(8), 0))
             assert sock.recv(4096) == b""
+
+
+def test_udp_list_identity():
+    import socket
+
+    from pycomm3.custom_types import ListIdentityObject
+
+    from softplc_lite.cip import encap
+    from softplc_lite.cip.encap import EncapMessage
+    from softplc_lite.tlm.enips.tcp import serve_udp
+
+    loop = asyncio.new_event_loop()
+    transport = loop.run_until_complete(serve_udp(Identity("PUMPS"), tcp_port=4242))
+    port = transport.get_extra_info("sockname")[1]
+    try:
+        with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as sock:
+            sock.setblocking(False)  # received on the server's loop, which must run to answer
+            sock.sendto(b"garbage", ("127.0.0.1", port))  # dropped, no reply
+            sock.sendto(EncapMessage(encap.LIST_IDENTITY, context=b"discover").encode(), ("127.0.0.1", port))
+            raw = loop.run_until_complete(asyncio.wait_for(loop.sock_recv(sock, 4096), 5))
+            reply = EncapMessage.decode(raw)
+        assert reply.context == b"discover"
+        seen = ListIdentityObject.decode(reply.data[2:])
+        assert seen["product_name"] == "softplc_lite PUMPS"
+        assert reply.data[10:12] == (4242).to_bytes(2, "big")
+    finally:
+        transport.close()
+        loop.close()

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import asyncio
 
-from ...cip import encap
+from ...cip import cpf, encap
 from ...cip.encap import EncapHeader, EncapMessage
 from .access import TableAccess
 from .identity import Identity
@@ -41,3 +41,32 @@ async def serve(access: TableAccess, identity: Identity, host: str = "127.0.0.1"
             writer.close()
 
     return await asyncio.start_server(connection, host, port)
+
+
+class _ListIdentityProtocol(asyncio.DatagramProtocol):
+    """Answers ListIdentity (and nothing else: other commands over UDP are
+    dropped, a choice) with the identity item; the sockaddr names the TCP
+    listener's address and port."""
+
+    def __init__(self, identity: Identity, host: str, tcp_port: int):
+        self.identity, self.host, self.tcp_port = identity, host, tcp_port
+
+    def connection_made(self, transport):
+        self.transport = transport
+
+    def datagram_received(self, data, addr):
+        try:
+            message = EncapMessage.decode(data)
+        except encap.EncapError:
+            return
+        if message.command == encap.LIST_IDENTITY:
+            item = self.identity.list_identity_item(self.host, self.tcp_port)
+            self.transport.sendto(message.reply(cpf.encode([item])).encode(), addr)
+
+
+async def serve_udp(identity: Identity, host: str = "127.0.0.1", port: int = 0,
+                    tcp_port: int = 44818) -> asyncio.DatagramTransport:
+    loop = asyncio.get_running_loop()
+    transport, _ = await loop.create_datagram_endpoint(
+        lambda: _ListIdentityProtocol(identity, host, tcp_port), local_addr=(host, port))
+    return transport
