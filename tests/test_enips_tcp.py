@@ -88,3 +88,14 @@ def test_udp_list_identity():
     finally:
         transport.close()
         loop.close()
+
+
+def test_pycomm3_connected_messaging():
+    with Served() as served:
+        with CIPDriver(f"127.0.0.1:{served.port}") as driver:
+            assert driver._forward_open()
+            name = driver.generic_message(service=0x0E, class_code=1, instance=1, attribute=7,
+                                          connected=True)
+            assert name.error is None, name.error
+            assert name.value[1:] == b"softplc_lite PUMPS"
+            assert driver._forward_close()

@@ -17,6 +17,12 @@ from .objects import CipObject, CipReply
 
 CLASS_ID = 0x06
 UNCONNECTED_SEND = 0x52
+FORWARD_OPEN = 0x54
+LARGE_FORWARD_OPEN = 0x5B
+FORWARD_CLOSE = 0x4E
+MAX_CONNECTIONS = 32  # a choice; more are refused with 0x01 / 0x0113 (out of connections)
+OUT_OF_CONNECTIONS = 0x0113
+CONNECTION_NOT_FOUND = 0x0107
 LINK_ADDRESS_NOT_VALID = 0x0312
 SERVED_ROUTES = ([], [(1, b"\x00")])
 
@@ -26,10 +32,17 @@ class ConnectionManager(CipObject):
 
     def __init__(self):
         self.router = None  # set by the Message Router that serves this object
+        # our O->T connection id -> (T->O id, connection serial, vendor, originator serial, timeout seconds)
+        self.connections: dict[int, tuple[int, int, int, int, float]] = {}
+        self._next_id = 0x10000001
 
     async def serve(self, request, access):
         if request.service == UNCONNECTED_SEND:
             return await self.unconnected_send(request, access)
+        if request.service in (FORWARD_OPEN, LARGE_FORWARD_OPEN):
+            return self.forward_open(request)
+        if request.service == FORWARD_CLOSE:
+            return self.forward_close(request)
         return CipReply.error(request, status.SERVICE_NOT_SUPPORTED)
 
     async def unconnected_send(self, request, access):
@@ -53,3 +66,31 @@ class ConnectionManager(CipObject):
         if hops not in SERVED_ROUTES:
             return CipReply.error(request, status.CONNECTION_FAILURE, LINK_ADDRESS_NOT_VALID)
         return await self.router.route(embedded, access)
+
+    def forward_open(self, request):
+        """Open a class-3 connection. Its timeout is the O->T RPI times the
+        multiplier 4 << n (CIP Volume 1, 3-5.4.1.4)."""
+        large = request.service == LARGE_FORWARD_OPEN
+        fmt = "<BBIIHHIB3xIIIIB" if large else "<BBIIHHIB3xIHIHB"
+        size = struct.calcsize(fmt)
+        if len(request.data) < size + 1:
+            return CipReply.error(request, status.NOT_ENOUGH_DATA)
+        (_, _, _, t_o_id, serial, vendor, orig_serial, multiplier,
+         o_t_rpi, _, t_o_rpi, _, _) = struct.unpack_from(fmt, request.data)
+        if len(self.connections) >= MAX_CONNECTIONS:
+            return CipReply.error(request, status.CONNECTION_FAILURE, OUT_OF_CONNECTIONS)
+        o_t_id, self._next_id = self._next_id, self._next_id + 1
+        timeout = o_t_rpi / 1e6 * (4 << min(multiplier, 7))
+        self.connections[o_t_id] = (t_o_id, serial, vendor, orig_serial, timeout)
+        return CipReply.ok(request, struct.pack("<IIHHIIIBx", o_t_id, t_o_id, serial, vendor,
+                                                orig_serial, o_t_rpi, t_o_rpi, 0))
+
+    def forward_close(self, request):
+        if len(request.data) < 10:
+            return CipReply.error(request, status.NOT_ENOUGH_DATA)
+        serial, vendor, orig_serial = struct.unpack_from("<HHI", request.data, 2)
+        for o_t_id, (_, s, v, o, _) in list(self.connections.items()):
+            if (s, v, o) == (serial, vendor, orig_serial):
+                del self.connections[o_t_id]
+                return CipReply.ok(request, struct.pack("<HHIBx", serial, vendor, orig_serial, 0))
+        return CipReply.error(request, status.CONNECTION_FAILURE, CONNECTION_NOT_FOUND)

@@ -63,7 +63,31 @@ class EncapSession:
             return None
         if command == encap.SEND_RR_DATA:
             return await self.send_rr_data(message)
-        return message.reply(status=encap.INVALID_COMMAND)  # SendUnitData: connections not yet served
+        return await self.send_unit_data(message)
+
+    async def send_unit_data(self, message: EncapMessage) -> EncapMessage:
+        """Interface handle, timeout, then a connected address item (our
+        O->T connection id) and a connected data item: a sequence count and
+        a Message Router request. The reply names the client's T->O id."""
+        try:
+            if len(message.data) < 6:
+                raise cpf.CpfError("no interface handle and timeout")
+            items = cpf.decode(message.data[6:])
+        except cpf.CpfError:
+            return message.reply(status=encap.INCORRECT_DATA)
+        if (len(items) != 2 or items[0].type_id != cpf.CONNECTED_ADDRESS or len(items[0].data) != 4
+                or items[1].type_id != cpf.CONNECTED_DATA or len(items[1].data) < 2):
+            return message.reply(status=encap.INCORRECT_DATA)
+        manager = self.router.objects.get(0x06)
+        o_t_id = struct.unpack("<I", items[0].data)[0]
+        connection = getattr(manager, "connections", {}).get(o_t_id)
+        if connection is None:
+            return message.reply(status=encap.INCORRECT_DATA)
+        response = await self.router.handle(items[1].data[2:], self.access)
+        body = message.data[:6] + cpf.encode([
+            cpf.Item(cpf.CONNECTED_ADDRESS, struct.pack("<I", connection[0])),
+            cpf.Item(cpf.CONNECTED_DATA, items[1].data[:2] + response)])
+        return message.reply(body)
 
     async def send_rr_data(self, message: EncapMessage) -> EncapMessage:
         """Interface handle (4), timeout (2), then the items: a null address
