@@ -9,6 +9,7 @@ extended status 0x0312 (link address not valid, Volume 1 Table 3-5.29)."""
 from __future__ import annotations
 
 import struct
+import time
 
 from ...cip import status
 from ...cip.epath import PathError, ports
@@ -35,6 +36,20 @@ class ConnectionManager(CipObject):
         # our O->T connection id -> (T->O id, connection serial, vendor, originator serial, timeout seconds)
         self.connections: dict[int, tuple[int, int, int, int, float]] = {}
         self._next_id = 0x10000001
+        self.last_seen: dict[int, float] = {}
+
+    def alive(self, o_t_id: int):
+        """The connection ``o_t_id`` names, its timeout restarted; None if
+        there is none or it timed out (then it is closed)."""
+        connection = self.connections.get(o_t_id)
+        if connection is None:
+            return None
+        now = time.monotonic()
+        if now - self.last_seen[o_t_id] > connection[4]:
+            del self.connections[o_t_id], self.last_seen[o_t_id]
+            return None
+        self.last_seen[o_t_id] = now
+        return connection
 
     async def serve(self, request, access):
         if request.service == UNCONNECTED_SEND:
@@ -82,6 +97,7 @@ class ConnectionManager(CipObject):
         o_t_id, self._next_id = self._next_id, self._next_id + 1
         timeout = o_t_rpi / 1e6 * (4 << min(multiplier, 7))
         self.connections[o_t_id] = (t_o_id, serial, vendor, orig_serial, timeout)
+        self.last_seen[o_t_id] = time.monotonic()
         return CipReply.ok(request, struct.pack("<IIHHIIIBx", o_t_id, t_o_id, serial, vendor,
                                                 orig_serial, o_t_rpi, t_o_rpi, 0))
 
@@ -91,6 +107,6 @@ class ConnectionManager(CipObject):
         serial, vendor, orig_serial = struct.unpack_from("<HHI", request.data, 2)
         for o_t_id, (_, s, v, o, _) in list(self.connections.items()):
             if (s, v, o) == (serial, vendor, orig_serial):
-                del self.connections[o_t_id]
+                del self.connections[o_t_id], self.last_seen[o_t_id]
                 return CipReply.ok(request, struct.pack("<HHIBx", serial, vendor, orig_serial, 0))
         return CipReply.error(request, status.CONNECTION_FAILURE, CONNECTION_NOT_FOUND)

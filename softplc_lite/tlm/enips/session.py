@@ -80,7 +80,7 @@ class EncapSession:
             return message.reply(status=encap.INCORRECT_DATA)
         manager = self.router.objects.get(0x06)
         o_t_id = struct.unpack("<I", items[0].data)[0]
-        connection = getattr(manager, "connections", {}).get(o_t_id)
+        connection = manager.alive(o_t_id) if manager is not None else None
         if connection is None:
             return message.reply(status=encap.INCORRECT_DATA)
         response = await self.router.handle(items[1].data[2:], self.access)
