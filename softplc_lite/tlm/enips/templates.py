@@ -1,0 +1,87 @@
+"""What pycomm3's LogixDriver asks of a controller at connect besides its
+identity and tag list (docs/enips.md, "CIP tags"): the controller's program
+name (class 0x64, Rockwell KB 23341 as pycomm3 cites it) and the template
+of each structure type a tag has (Template object, class 0x6C). The only
+structure served is Logix's STRING (ST files), so the only template is its:
+DINT LEN at offset 0 and SINT[82] DATA at offset 4, 88 bytes, which pycomm3
+recognises as a string by those two member names and types.
+"""
+
+from __future__ import annotations
+
+import struct
+
+from ...cip import status as st
+from .access import TableAccess
+from .objects import CipObject, CipReply, CipRequest
+from .tagnames import DINT, SINT, STRING_BYTES, STRING_CHARS, STRING_HANDLE
+
+GET_ATTRIBUTES_ALL, GET_ATTRIBUTE_LIST, READ_TEMPLATE = 0x01, 0x03, 0x4C
+
+# Member info (UINT array size or bit, UINT type, UDINT offset) per member,
+# then "name;n" and the member names, NUL-terminated: the layout pycomm3's
+# _parse_template_data and pylogix's _get_template read. ASCIISTRING82 is
+# the name Logix gives its STRING template (pycomm3 maps it to STRING).
+STRING_TEMPLATE = (struct.pack("<HHI", 0, DINT, 0) + struct.pack("<HHI", STRING_CHARS, SINT, 4)
+                   + b"ASCIISTRING82;n\x00LEN\x00DATA\x00")
+# Attribute 4 counts 32-bit words of the definition plus the 23 bytes a
+# Logix template read adds (pycomm3 asks size * 4 - 21 bytes, so no less).
+DEFINITION_WORDS = (len(STRING_TEMPLATE) + 23) // 4
+REPLY_BYTES = 480
+
+
+class TemplateObject(CipObject):
+    """Class 0x6C: Get_Attribute_List (attributes 1 handle, 2 member count,
+    4 definition size, 5 structure size) and Read (0x4C: UDINT offset, UINT
+    byte count) of the STRING template, instance 0x0FCE."""
+
+    class_id = 0x6C
+
+    async def serve(self, request: CipRequest, access: TableAccess) -> CipReply:
+        instance = request.logical[1] if request.logical else None
+        if instance != STRING_HANDLE:
+            return CipReply.error(request, st.PATH_DESTINATION_UNKNOWN)
+        try:
+            if request.service == GET_ATTRIBUTE_LIST:
+                return _attributes(request)
+            if request.service == READ_TEMPLATE:
+                offset, count = struct.unpack_from("<IH", request.data)
+                if offset >= len(STRING_TEMPLATE):
+                    return CipReply.error(request, st.GENERAL_ERROR, 0x2104)
+                end = min(len(STRING_TEMPLATE), offset + count)
+                status = st.SUCCESS
+                if end - offset > REPLY_BYTES:
+                    end, status = offset + REPLY_BYTES, st.PARTIAL_TRANSFER
+                return CipReply(request.service | 0x80, status, (), STRING_TEMPLATE[offset:end])
+        except struct.error:
+            return CipReply.error(request, st.NOT_ENOUGH_DATA)
+        return CipReply.error(request, st.SERVICE_NOT_SUPPORTED)
+
+
+def _attributes(request: CipRequest) -> CipReply:
+    count = struct.unpack_from("<H", request.data)[0]
+    numbers = struct.unpack_from(f"<{count}H", request.data, 2)
+    values = {1: struct.pack("<H", STRING_HANDLE), 2: struct.pack("<H", 2),
+              4: struct.pack("<I", DEFINITION_WORDS), 5: struct.pack("<I", STRING_BYTES)}
+    out = bytearray(struct.pack("<H", count))
+    for number in numbers:
+        if number in values:
+            out += struct.pack("<HH", number, 0) + values[number]
+        else:
+            out += struct.pack("<HH", number, st.ATTRIBUTE_NOT_SUPPORTED)
+    return CipReply(request.service | 0x80, st.SUCCESS, (), bytes(out))
+
+
+class ProgramName(CipObject):
+    """Class 0x64 instance 1, Get_Attributes_All: the controller's program
+    name as a UINT-length string, the app's name here."""
+
+    class_id = 0x64
+
+    def __init__(self, name: str) -> None:
+        self.name = name.encode("ascii", "replace")[:255]
+
+    async def serve(self, request: CipRequest, access: TableAccess) -> CipReply:
+        if request.service != GET_ATTRIBUTES_ALL:
+            return CipReply.error(request, st.SERVICE_NOT_SUPPORTED)
+        return CipReply(request.service | 0x80, st.SUCCESS, (), struct.pack("<H", len(self.name)) + self.name)
