@@ -43,6 +43,20 @@ def test_string_template_as_pycomm3_parses_it():
     assert serve(obj, 0x4C, 0x0FCE, struct.pack("<IH", 999, 1)).extended == (0x2104,)
 
 
+def test_template_attributes_where_pylogix_reads_them():
+    # pylogix's _get_udt: attributes 4, 3, 2, 1; definition size at data[6],
+    # member count at data[20]; then it reads (size * 4 - 23) rounded up to 4
+    reply = serve(TemplateObject(), 0x03, 0x0FCE, struct.pack("<5H", 4, 4, 3, 2, 1))
+    size = struct.unpack_from("<I", reply.data, 6)[0]
+    assert struct.unpack_from("<H", reply.data, 20)[0] == 2
+    want = -(-(size * 4 - 23) // 4) * 4
+    first = serve(TemplateObject(), 0x4C, 0x0FCE, struct.pack("<IH", 0, want))
+    names = first.data[16:].split(b"\x00")
+    assert names[:3] == [b"ASCIISTRING82", b"LEN", b"DATA"] and b";" not in first.data
+    # what is left of its request past the end is refused, which ends its loop
+    assert serve(TemplateObject(), 0x4C, 0x0FCE, struct.pack("<IH", len(first.data), want - len(first.data))).status
+
+
 def test_program_name():
     reply = serve(ProgramName("pumps"), 0x01, 1, b"")
     assert reply.data == b"\x05\x00pumps"

@@ -19,11 +19,13 @@ from .tagnames import DINT, SINT, STRING_BYTES, STRING_CHARS, STRING_HANDLE
 GET_ATTRIBUTES_ALL, GET_ATTRIBUTE_LIST, READ_TEMPLATE = 0x01, 0x03, 0x4C
 
 # Member info (UINT array size or bit, UINT type, UDINT offset) per member,
-# then "name;n" and the member names, NUL-terminated: the layout pycomm3's
-# _parse_template_data and pylogix's _get_template read. ASCIISTRING82 is
-# the name Logix gives its STRING template (pycomm3 maps it to STRING).
+# then the template's name and the member names, NUL-terminated: the layout
+# pycomm3's _parse_template_data and pylogix's _get_udt read. ASCIISTRING82
+# is the name Logix gives its STRING template (pycomm3 maps it to STRING).
+# No ";n..." after the name: pylogix reads member scope bytes from what
+# follows a ';', and a predefined type's name may stand alone (pycomm3).
 STRING_TEMPLATE = (struct.pack("<HHI", 0, DINT, 0) + struct.pack("<HHI", STRING_CHARS, SINT, 4)
-                   + b"ASCIISTRING82;n\x00LEN\x00DATA\x00")
+                   + b"ASCIISTRING82\x00LEN\x00DATA\x00")
 # Attribute 4 counts 32-bit words of the definition plus the 23 bytes a
 # Logix template read adds (pycomm3 asks size * 4 - 21 bytes, so no less).
 DEFINITION_WORDS = (len(STRING_TEMPLATE) + 23) // 4
@@ -33,7 +35,9 @@ REPLY_BYTES = 480
 class TemplateObject(CipObject):
     """Class 0x6C: Get_Attribute_List (attributes 1 handle, 2 member count,
     4 definition size, 5 structure size) and Read (0x4C: UDINT offset, UINT
-    byte count) of the STRING template, instance 0x0FCE."""
+    byte count) of the STRING template, instance 0x0FCE. Attribute 3 is
+    served as a UINT (the handle again): pylogix asks 4, 3, 2, 1 and finds
+    the member count where a 2-byte attribute 3 puts it."""
 
     class_id = 0x6C
 
@@ -61,7 +65,7 @@ class TemplateObject(CipObject):
 def _attributes(request: CipRequest) -> CipReply:
     count = struct.unpack_from("<H", request.data)[0]
     numbers = struct.unpack_from(f"<{count}H", request.data, 2)
-    values = {1: struct.pack("<H", STRING_HANDLE), 2: struct.pack("<H", 2),
+    values = {1: struct.pack("<H", STRING_HANDLE), 2: struct.pack("<H", 2), 3: struct.pack("<H", STRING_HANDLE),
               4: struct.pack("<I", DEFINITION_WORDS), 5: struct.pack("<I", STRING_BYTES)}
     out = bytearray(struct.pack("<H", count))
     for number in numbers:
