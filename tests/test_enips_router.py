@@ -46,7 +46,7 @@ def test_multiple_service_packet():
              MessageRouterRequest(0x0E, epath.encode_logical(0x71, 1)).encode()]
     data = struct.pack("<HHH", 2, 6, 6 + len(inner[0])) + b"".join(inner)
     reply = route(router, 0x0A, epath.encode_logical(0x02, 1), data)
-    assert reply.status == status.GENERAL_ERROR  # the second names no object
+    assert reply.status == status.EMBEDDED_SERVICE_ERROR  # the second names no object
     count, first, second = struct.unpack_from("<HHH", reply.data)
     assert count == 2
     assert MessageRouterResponse.decode(reply.data[first:second]).data == b"\x70\x02\x01"

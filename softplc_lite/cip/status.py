@@ -27,9 +27,9 @@ ATTRIBUTE_NOT_SUPPORTED = 0x14
 TOO_MUCH_DATA = 0x15
 OBJECT_DOES_NOT_EXIST = 0x16
 INVALID_PARAMETER = 0x20
-GENERAL_ERROR = 0x1E
+EMBEDDED_SERVICE_ERROR = 0x1E  # a service of a Multiple Service Packet failed
 PATH_SIZE_INVALID = 0x26
-GENERAL_LOGIX_ERROR = 0xFF  # Logix: the extended status word says what (1756-PM020)
+GENERAL_ERROR = 0xFF  # Logix's general error: the extended status word says what (1756-PM020)
 
 NAMES = {value: name.replace("_", " ").lower() for name, value in globals().items()
          if name.isupper() and isinstance(value, int)}

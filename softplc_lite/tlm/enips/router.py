@@ -95,5 +95,5 @@ class MessageRouter:
             out += struct.pack("<H", offset)
             offset += len(reply)
         failed = any(reply[2] != status.SUCCESS for reply in replies)
-        return CipReply(request.service | REPLY, status.GENERAL_ERROR if failed else 0, (),
+        return CipReply(request.service | REPLY, status.EMBEDDED_SERVICE_ERROR if failed else 0, (),
                         out + b"".join(replies))
