@@ -69,11 +69,8 @@ class EncapSession:
         """Interface handle, timeout, then a connected address item (our
         O->T connection id) and a connected data item: a sequence count and
         a Message Router request. The reply names the client's T->O id."""
-        try:
-            if len(message.data) < 6:
-                raise cpf.CpfError("no interface handle and timeout")
-            items = cpf.decode(message.data[6:])
-        except cpf.CpfError:
+        items = _items(message)
+        if items is None:
             return message.reply(status=encap.INCORRECT_DATA)
         if (len(items) != 2 or items[0].type_id != cpf.CONNECTED_ADDRESS or len(items[0].data) != 4
                 or items[1].type_id != cpf.CONNECTED_DATA or len(items[1].data) < 2):
@@ -92,11 +89,8 @@ class EncapSession:
     async def send_rr_data(self, message: EncapMessage) -> EncapMessage:
         """Interface handle (4), timeout (2), then the items: a null address
         and an unconnected data item holding a Message Router request."""
-        try:
-            if len(message.data) < 6:
-                raise cpf.CpfError("no interface handle and timeout")
-            items = cpf.decode(message.data[6:])
-        except cpf.CpfError:
+        items = _items(message)
+        if items is None:
             return message.reply(status=encap.INCORRECT_DATA)
         data = [item for item in items if item.type_id == cpf.UNCONNECTED_DATA]
         if len(items) != 2 or items[0].type_id != cpf.NULL_ADDRESS or len(data) != 1:
@@ -105,3 +99,14 @@ class EncapSession:
         body = message.data[:6] + cpf.encode([cpf.Item(cpf.NULL_ADDRESS),
                                               cpf.Item(cpf.UNCONNECTED_DATA, response)])
         return message.reply(body)
+
+
+def _items(message: EncapMessage) -> list | None:
+    """The item list after SendRRData's and SendUnitData's interface handle
+    (4 bytes) and timeout (2), or None when there is none to decode."""
+    if len(message.data) < 6:
+        return None
+    try:
+        return cpf.decode(message.data[6:])
+    except cpf.CpfError:
+        return None
