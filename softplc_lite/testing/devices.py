@@ -49,6 +49,11 @@ def _from_python(options: dict[str, str]) -> SimDevice:
 simdevices.register_device(KIND, _from_python)
 
 
+def port_key(port: str) -> int | str:
+    """A PORT as a scenario file writes it (``0``, ``MODBMAST:1``) as the API takes it."""
+    return int(port) if port.isdigit() else port
+
+
 def make_device(kind: str, options: Mapping[str, str]) -> SimDevice:
     """A new device of ``kind`` (ValueError naming the bad kind or option)."""
     if kind == KIND:

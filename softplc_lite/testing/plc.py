@@ -21,7 +21,7 @@ from ..runner import Runner, RunOptions
 from ..tlm.api import TLM
 from ..watch.forces import Force, Forces, _bit_address
 from .coverage import Coverage
-from .devices import Attached, attach, device_on
+from .devices import Attached, attach, device_on, port_key
 from .scenario import DeviceCounter
 
 
@@ -97,7 +97,7 @@ class PLC:
 
     def __getitem__(self, name: str):
         if isinstance(name, DeviceCounter):  # a scenario's ``device PORT NAME``
-            return getattr(self.device(int(name.port) if name.port.isdigit() else name.port), name.attribute)
+            return getattr(self.device(port_key(name.port)), name.attribute)
         read = self._readers.get(name)
         if read is None:
             read = self._readers[name] = self._reader(name)

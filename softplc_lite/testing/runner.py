@@ -79,7 +79,7 @@ def check_names(file: ScenarioFile, plc: PLC) -> None:
     """Every address or symbol a step names exists, and its value is of a
     kind the address holds (values.py): all problems at once, in file order."""
     errors = []
-    for step in file.setup + [s for sc in file.scenarios for s in sc.steps]:
+    for step in file.all_steps():
         if step.kind in ("scan", "run") or isinstance(step.args[0], DeviceCounter):
             continue
         name = step.args[0]
@@ -155,7 +155,7 @@ class _Run:
         if k == "expect_cmp":
             name, op, value = a
             actual = plc[name]
-            if (actual != value) if op == "==" else (actual == value):
+            if not _compare(actual, op, value):
                 return self._fail(step, f"{name} {op} {value!r}", actual)
         elif k == "set":
             plc.set(a[0], a[1])

@@ -84,6 +84,10 @@ class ScenarioFile:
     scenarios: list[Scenario]
     devices: list[DeviceLine] = field(default_factory=list)
 
+    def all_steps(self) -> list[Step]:
+        """The setup's steps, then every scenario's, in file order."""
+        return self.setup + [s for sc in self.scenarios for s in sc.steps]
+
 
 _KEYWORDS = {"set", "force", "unforce", "scan", "run", "wait", "expect", "scenario", "setup", "device"}
 

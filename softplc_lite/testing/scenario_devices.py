@@ -7,14 +7,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import LocatedError
-from .devices import DeviceError, make_device
+from .devices import DeviceError, make_device, port_key
 from .plc import PLC
 from .scenario import DeviceCounter, ScenarioErrors, ScenarioFile
-
-
-def port_key(port: str) -> int | str:
-    """A PORT as written (``0``, ``MODBMAST:1``) as the API takes it."""
-    return int(port) if port.isdigit() else port
 
 
 def open_plc(app: str | Path, file: ScenarioFile, **load) -> PLC:
@@ -44,7 +39,7 @@ def counter_errors(file: ScenarioFile, plc: PLC) -> list[LocatedError]:
     """Each step's ``device PORT NAME`` names a port with a simulated device
     and a number of its score."""
     errors = []
-    for step in file.setup + [s for sc in file.scenarios for s in sc.steps]:
+    for step in file.all_steps():
         name = step.args[0] if step.args else None
         if not isinstance(name, DeviceCounter):
             continue

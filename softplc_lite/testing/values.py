@@ -40,7 +40,7 @@ def value_errors(file: ScenarioFile, plc) -> list[LocatedError]:
     is). A step whose name is unknown is left to the name check."""
     table = decode(encode(plc.table))
     errors = []
-    for step in file.setup + [s for sc in file.scenarios for s in sc.steps]:
+    for step in file.all_steps():
         if step.kind in ("scan", "run") or isinstance(step.args[0], DeviceCounter):
             continue  # a device's score is checked with the devices (devices.py)
         try:
