@@ -83,7 +83,7 @@ _kinds_lock = threading.Lock()
 # Built-in kinds defined in other modules: imported when first created.
 BUILTIN_DEVICES: dict[str, str] = {"modbus": "softplc_lite.ports.modbus_slave:create",
                                    "modbus_master": "softplc_lite.ports.modbus_master:create",
-                   "scripted": "softplc_lite.ports.scripted:create"}
+                                   "scripted": "softplc_lite.ports.scripted:create"}
 
 
 def register_device(kind: str, factory: DeviceFactory) -> None:
