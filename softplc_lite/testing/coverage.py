@@ -103,7 +103,6 @@ class Coverage:
         self.instructions: dict[ElementKey, list[int]] = {}
         self.kinds: dict[ElementKey, str] = {}
         self.module_outputs: dict[str, bool] = {}  # module mnemonic -> its spec's output flag
-        self._shapes: dict[int, list[int]] = {}  # file -> elements a rung: another program is refused
 
     # -- recording --------------------------------------------------------------------------
     def learn_modules(self, modules) -> None:
@@ -138,12 +137,10 @@ class Coverage:
         return interpret_file(program, number, *args, interpreter=_Bound, **kw)
 
     def _describe(self, number: int, pfile) -> None:
-        shape = [len(_flat(r.elements)) for r in pfile.rungs]
         if number in self.files:
-            if self._shapes[number] != shape:
+            if _shape(self.files[number]) != [len(_flat(r.elements)) for r in pfile.rungs]:
                 raise ValueError(f"coverage of program file {number}: another program was recorded into it")
             return
-        self._shapes[number] = shape
         info = FileInfo(number, pfile.name, pfile.pos.source, [])
         has_mcr = any(isinstance(el, Instruction) and el.mnemonic == "MCR" for r in pfile.rungs for el in r.elements)
         for r, rung in enumerate(pfile.rungs):
@@ -206,9 +203,8 @@ class Coverage:
         for number, info in other.files.items():
             if number not in self.files:
                 self.files[number] = info
-                self._shapes[number] = other._shapes[number]
                 self.kinds.update({k: v for k, v in other.kinds.items() if k[0] == number})
-            elif self._shapes[number] != other._shapes[number]:
+            elif _shape(self.files[number]) != _shape(info):
                 raise ValueError(f"coverage of program file {number}: another program was recorded into it")
         for mine, theirs in ((self.rungs, other.rungs), (self.legs, other.legs),
                              (self.instructions, other.instructions)):
@@ -255,6 +251,11 @@ def _leg_ranges(rung_elements) -> dict[int, tuple[range, ...]]:
                 ranges[id(el)] = tuple(legs)
     visit(rung_elements)
     return ranges
+
+
+def _shape(info: FileInfo) -> list[int]:
+    """Elements a rung: what tells a measurement of another program apart."""
+    return [len(rung.starts) for rung in info.rungs]
 
 
 def _flat(elements) -> list:

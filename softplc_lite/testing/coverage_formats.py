@@ -43,9 +43,7 @@ def _rate(covered: int, total: int) -> str:
 
 
 def _line_rates(fig: Figures) -> dict[str, str]:
-    branches = fig.outcomes + fig.legs + fig.conditions + fig.outputs
-    branches_seen = fig.outcomes_seen + fig.legs_powered + fig.conditions_seen + fig.outputs_seen
-    return {"line-rate": _rate(fig.rungs_run, fig.rungs), "branch-rate": _rate(branches_seen, branches),
+    return {"line-rate": _rate(fig.rungs_run, fig.rungs), "branch-rate": _rate(fig.branches_seen, fig.branches),
             "complexity": "0"}
 
 
@@ -60,12 +58,11 @@ def cobertura(*covs: Coverage) -> str:
             fig = file_figures(cov, info)
             total.add(fig)
             classes.append((source, cov, info, fig))
-    branches = total.outcomes + total.legs + total.conditions + total.outputs
-    branches_seen = total.outcomes_seen + total.legs_powered + total.conditions_seen + total.outputs_seen
+    rates = _line_rates(total)
     root = ET.Element("coverage", {
-        "line-rate": _rate(total.rungs_run, total.rungs), "branch-rate": _rate(branches_seen, branches),
+        "line-rate": rates["line-rate"], "branch-rate": rates["branch-rate"],
         "lines-covered": str(total.rungs_run), "lines-valid": str(total.rungs),
-        "branches-covered": str(branches_seen), "branches-valid": str(branches),
+        "branches-covered": str(total.branches_seen), "branches-valid": str(total.branches),
         "complexity": "0", "version": f"softplc_lite {__version__}", "timestamp": str(int(time.time() * 1000))})
     ET.SubElement(ET.SubElement(root, "sources"), "source").text = root_dir
     package = ET.SubElement(ET.SubElement(root, "packages"), "package",

@@ -21,6 +21,7 @@ from rich.measure import Measurement
 from rich.table import Table
 
 from .coverage import Coverage, FileInfo
+from .coverage_outcomes import rung_outcomes
 
 
 @dataclass
@@ -43,12 +44,21 @@ class Figures:
             setattr(self, f.name, getattr(self, f.name) + getattr(other, f.name))
 
     @property
+    def branches(self) -> int:
+        """Every outcome (rung true/false, legs, conditions, outputs): a report's branches."""
+        return self.outcomes + self.legs + self.conditions + self.outputs
+
+    @property
+    def branches_seen(self) -> int:
+        return self.outcomes_seen + self.legs_powered + self.conditions_seen + self.outputs_seen
+
+    @property
     def covered(self) -> int:
-        return self.rungs_run + self.outcomes_seen + self.legs_powered + self.conditions_seen + self.outputs_seen
+        return self.rungs_run + self.branches_seen
 
     @property
     def total(self) -> int:
-        return self.rungs + self.outcomes + self.legs + self.conditions + self.outputs
+        return self.rungs + self.branches
 
     @property
     def percent(self) -> float:
@@ -59,27 +69,23 @@ class Figures:
         return self.covered * 100 < percent * self.total
 
 
+# Figures' (total, covered) fields for each kind of outcome: the rung's own
+# (true, false), then by the kind of element it is about.
+_FIELDS = {None: ("outcomes", "outcomes_seen"), "branch": ("legs", "legs_powered"),
+           "condition": ("conditions", "conditions_seen"), "output": ("outputs", "outputs_seen")}
+
+
 def file_figures(cov: Coverage, info: FileInfo) -> Figures:
+    """The figures of one program file, from the outcomes coverage_outcomes
+    lists (the ones that can happen), so every report counts the same."""
     fig = Figures()
     for rung in info.rungs:
         fig.rungs += 1
         fig.rungs_run += cov.executed(rung.key)
-        t, f = cov.rung_outcomes(rung.key)
-        fig.outcomes += 1 + rung.false_possible
-        fig.outcomes_seen += t + (f and rung.false_possible)
-        fnum, r = rung.key
-        for el in rung.elements:
-            if el.kind == "branch":
-                for k in range(el.legs):
-                    fig.legs += 1
-                    fig.legs_powered += cov.leg_powered((fnum, r, el.index, k))
-            elif el.kind == "condition":
-                fig.conditions += 2
-                fig.conditions_seen += sum(cov.element_outcomes((fnum, r, el.index)))
-            else:
-                on, off = cov.element_outcomes((fnum, r, el.index))
-                fig.outputs += 1 + el.off_possible
-                fig.outputs_seen += on + (off and el.off_possible)
+        for outcome in rung_outcomes(cov, rung):
+            total, seen = _FIELDS[None if outcome.element is None else outcome.element.kind]
+            setattr(fig, total, getattr(fig, total) + 1)
+            setattr(fig, seen, getattr(fig, seen) + outcome.covered)
     return fig
 
 
