@@ -241,3 +241,14 @@ def test_browse_as_pycomm3_parses_it(plc):
     assert tags["Level"]["data_type"] == "REAL" and tags["Running"]["data_type"] == "BOOL"
     assert tags["ST9"]["data_type_name"] == "STRING" and not tags["N7"]["alias"]
     assert tags["C5"]["external_access"] == "Read Only" and tags["N7"]["external_access"] == "Read/Write"
+
+
+def test_the_tag_catalogue_is_built_again_only_when_the_files_change():
+    t = table()
+    access = TableAccessOnTable(t)
+    services = TagServices(SYMBOLS)
+    first = services.catalogue(access)
+    assert services.catalogue(access) is first  # not at every request
+    t.reference("N7:400")
+    grown = services.catalogue(access)
+    assert grown is not first and grown.by_name["N7"].dims == (401,)

@@ -16,6 +16,7 @@ import struct
 from ...cip import cpf, encap
 from ...cip.encap import EncapMessage
 from .access import TableAccess
+from .connmgr import CLASS_ID as CONNECTION_MANAGER
 from .identity import Identity
 from .router import MessageRouter
 
@@ -75,7 +76,7 @@ class EncapSession:
         if (len(items) != 2 or items[0].type_id != cpf.CONNECTED_ADDRESS or len(items[0].data) != 4
                 or items[1].type_id != cpf.CONNECTED_DATA or len(items[1].data) < 2):
             return message.reply(status=encap.INCORRECT_DATA)
-        manager = self.router.objects.get(0x06)
+        manager = self.router.objects.get(CONNECTION_MANAGER)
         o_t_id = struct.unpack("<I", items[0].data)[0]
         connection = manager.alive(o_t_id) if manager is not None else None
         if connection is None:

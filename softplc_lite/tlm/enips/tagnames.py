@@ -12,10 +12,13 @@ so every value keeps the range the ladder gives it.
 
 from __future__ import annotations
 
+import math
 import struct
 from dataclasses import dataclass
 
+from ...cip.status import PATH_DESTINATION_UNKNOWN, PATH_SEGMENT_ERROR
 from ...datatable import AddressError, parse_address
+from ...datatable.filetypes import FILE_TYPES as FILE_SPECS
 from .access import FileInfo, TableAccess
 
 # CIP elementary data type codes (CIP Vol. 1 appendix C; the codes pylogix
@@ -30,7 +33,8 @@ STRING_BYTES = 88
 STRING_CHARS = 82
 
 UNIT_BYTES = {BOOL: 1, SINT: 1, INT: 2, DINT: 4, REAL: 4, STRUCT: STRING_BYTES}
-_FORMATS = {INT: "<h", DINT: "<i", REAL: "<f"}
+UNIT_FORMATS = {BOOL: "B", INT: "h", DINT: "i", REAL: "f"}  # struct codes of the elementary units
+ST_ITEMS = 83  # storage items of an ST element: .LEN, then 82 characters
 
 # The CIP type of one item of each file type.
 FILE_TYPES = {letter: INT for letter in "OISBTCRNDA"}
@@ -66,7 +70,7 @@ class Target:
 
     @property
     def items_per_unit(self) -> int:
-        return 83 if self.ctype == STRUCT else 1
+        return _items_per_unit(self.ctype)
 
     @property
     def type_bytes(self) -> bytes:
@@ -155,9 +159,11 @@ def symbol_tags(symbols: dict[str, str], access: TableAccess) -> tuple[list[Tag]
 
 
 def info_member_offset(kind: str, member: str) -> int:
-    from ...datatable.filetypes import FILE_TYPES as SPECS
+    return FILE_SPECS[kind].members_by_name[member].offset
 
-    return SPECS[kind].members_by_name[member].offset
+
+def _items_per_unit(ctype: int) -> int:
+    return ST_ITEMS if ctype == STRUCT else 1
 
 
 # -- request paths ---------------------------------------------------------
@@ -176,7 +182,7 @@ def parse_path(path: bytes) -> list[tuple[str, object]]:
                 size = path[i + 1]
                 raw = path[i + 2:i + 2 + size]
                 if len(raw) != size:
-                    raise PathError(0x04, "symbolic segment runs past the path's end")
+                    raise PathError(PATH_SEGMENT_ERROR, "symbolic segment runs past the path's end")
                 out.append(("name", raw.decode("ascii")))
                 i += 2 + size + (size & 1)
             elif seg in (0x28, 0x20, 0x24):
@@ -190,11 +196,11 @@ def parse_path(path: bytes) -> list[tuple[str, object]]:
                 out.append(("index" if seg == 0x2A else "instance", struct.unpack_from("<I", path, i + 2)[0]))
                 i += 6
             else:
-                raise PathError(0x04, f"segment 0x{seg:02X} has no place in a tag path")
+                raise PathError(PATH_SEGMENT_ERROR, f"segment 0x{seg:02X} has no place in a tag path")
     except (IndexError, struct.error):
-        raise PathError(0x04, "a segment runs past the path's end") from None
+        raise PathError(PATH_SEGMENT_ERROR, "a segment runs past the path's end") from None
     except UnicodeDecodeError:
-        raise PathError(0x04, "a symbolic segment that is not ASCII") from None
+        raise PathError(PATH_SEGMENT_ERROR, "a symbolic segment that is not ASCII") from None
     return out
 
 
@@ -209,26 +215,20 @@ def resolve(tag: Tag, rest: list[tuple[str, object]]) -> Target:
     if rest:
         kind, member = rest.pop(0)
         if kind != "name" or rest:
-            raise PathError(0x04, "a tag path ends after one member name")
+            raise PathError(PATH_SEGMENT_ERROR, "a tag path ends after one member name")
     if len(indexes) > len(tag.dims) or (indexes and len(indexes) != len(tag.dims) and len(tag.dims) > 1
                                         and len(indexes) != 1):
-        raise PathError(0x04, f"{tag.name} has {len(tag.dims)} dimension(s), not {len(indexes)}")
+        raise PathError(PATH_SEGMENT_ERROR, f"{tag.name} has {len(tag.dims)} dimension(s), not {len(indexes)}")
     for k, value in enumerate(indexes):
         if value >= tag.dims[k]:
-            raise PathError(0x05, f"{tag.name}: index {value} is past its end ({tag.dims[k]})")
-    ctype = tag.ctype
+            raise PathError(PATH_DESTINATION_UNKNOWN, f"{tag.name}: index {value} is past its end ({tag.dims[k]})")
+    ctype, per = tag.ctype, _items_per_unit(tag.ctype)
     if ctype == STRUCT:
-        item = tag.item + (indexes[0] if indexes else 0) * 83
+        item = tag.item + (indexes[0] if indexes else 0) * per
     else:
-        flat = 0
-        for k, value in enumerate(indexes):
-            stride = 1
-            for d in tag.dims[k + 1:]:
-                stride *= d
-            flat += value * stride
-        item = tag.item + flat
-    end = tag.item + _count(tag.dims) * (83 if ctype == STRUCT else 1)
-    units = (end - item) // (83 if ctype == STRUCT else 1)
+        item = tag.item + sum(value * math.prod(tag.dims[k + 1:]) for k, value in enumerate(indexes))
+    end = tag.item + math.prod(tag.dims) * per
+    units = (end - item) // per
     target = Target(info.name, info.kind, item, ctype, units, tag.bit)
     if member is None:
         return target
@@ -236,14 +236,12 @@ def resolve(tag: Tag, rest: list[tuple[str, object]]) -> Target:
 
 
 def _member(tag: Tag, target: Target, indexes: list, member: str) -> Target:
-    from ...datatable.filetypes import FILE_TYPES as SPECS
-
-    spec = SPECS[target.kind]
+    spec = FILE_SPECS[target.kind]
     upper = member.upper()
     if member.isdigit():
         bit = int(member)
         if target.ctype != INT or target.bit is not None or bit > 15:
-            raise PathError(0x04, f"{tag.name}: .{member} is not a bit of an INT")
+            raise PathError(PATH_SEGMENT_ERROR, f"{tag.name}: .{member} is not a bit of an INT")
         return Target(target.file, target.kind, target.item, BOOL, 1, bit)
     if target.kind == "ST" and upper == "LEN" and target.ctype == STRUCT:
         return Target(target.file, target.kind, target.item, DINT, 1, member_len=True)
@@ -254,19 +252,12 @@ def _member(tag: Tag, target: Target, indexes: list, member: str) -> Target:
         elif len(tag.dims) == 2 and len(indexes) <= 1:
             element_start = tag.item + (indexes[0] if indexes else 0) * 3
         else:
-            raise PathError(0x04, f"{tag.name}{list(indexes)} is a word; it has no .{member}")
+            raise PathError(PATH_SEGMENT_ERROR, f"{tag.name}{list(indexes)} is a word; it has no .{member}")
         m = spec.members_by_name[upper]
         if hasattr(m, "offset"):
             return Target(target.file, target.kind, element_start + m.offset, INT, 1)
         return Target(target.file, target.kind, element_start + m.word, BOOL, 1, m.bit)
-    raise PathError(0x04, f"{tag.name} has no member {member!r}")
-
-
-def _count(dims: tuple[int, ...]) -> int:
-    n = 1
-    for d in dims:
-        n *= d
-    return n
+    raise PathError(PATH_SEGMENT_ERROR, f"{tag.name} has no member {member!r}")
 
 
 class Catalogue:
@@ -283,16 +274,16 @@ class Catalogue:
 
     def target(self, segments: list[tuple[str, object]]) -> Target:
         if not segments:
-            raise PathError(0x04, "an empty tag path")
+            raise PathError(PATH_SEGMENT_ERROR, "an empty tag path")
         kind, first = segments[0]
         if kind == "instance":
             if not 1 <= first <= len(self.tags):
-                raise PathError(0x05, f"no symbol instance {first}")
+                raise PathError(PATH_DESTINATION_UNKNOWN, f"no symbol instance {first}")
             tag = self.tags[first - 1]
         elif kind == "name":
             tag = self.by_name.get(str(first).upper())
             if tag is None:
-                raise PathError(0x05, f"no tag named {first!r}")
+                raise PathError(PATH_DESTINATION_UNKNOWN, f"no tag named {first!r}")
         else:
-            raise PathError(0x04, "a tag path starts with a name or a symbol instance")
+            raise PathError(PATH_SEGMENT_ERROR, "a tag path starts with a name or a symbol instance")
         return resolve(tag, list(segments[1:]))

@@ -19,8 +19,8 @@ import struct
 
 from ...cip import status as st
 from .access import TableAccess
-from .objects import CipObject, CipReply, CipRequest
-from .tagnames import (BOOL, DINT, INT, REAL, STRING_BYTES, STRING_CHARS, STRUCT, UNIT_BYTES, Catalogue,
+from .objects import REPLY, CipObject, CipReply, CipRequest
+from .tagnames import (INT, ST_ITEMS, STRING_BYTES, STRING_CHARS, STRUCT, UNIT_BYTES, UNIT_FORMATS, Catalogue,
                        PathError, Target, parse_path)
 
 READ_TAG, WRITE_TAG, RMW_TAG = 0x4C, 0x4D, 0x4E
@@ -50,9 +50,18 @@ class TagServices(CipObject):
     def __init__(self, symbols: dict[str, str] | None = None, reply_bytes: int = REPLY_BYTES) -> None:
         self.symbols = dict(symbols or {})
         self.reply_bytes = reply_bytes
+        self._catalogue: tuple[tuple, Catalogue] | None = None  # (the files it was built on, it)
+
+    def catalogue(self, access: TableAccess) -> Catalogue:
+        """The tags of ``access``'s table, built again only when its files
+        change (a file grown, one added): not at every request."""
+        files = tuple(access.files())
+        if self._catalogue is None or self._catalogue[0] != files or self._catalogue[1].access is not access:
+            self._catalogue = (files, Catalogue(access, self.symbols))
+        return self._catalogue[1]
 
     async def serve(self, request: CipRequest, access: TableAccess) -> CipReply:
-        catalogue = Catalogue(access, self.symbols)
+        catalogue = self.catalogue(access)
         try:
             target = catalogue.target(parse_path(request.path))
         except PathError as e:
@@ -87,7 +96,7 @@ class TagServices(CipObject):
         units = min(count - first_unit, room // unit)
         values = await _read_units(access, target, first_unit, units)
         status = st.SUCCESS if first_unit + units == count else st.PARTIAL_TRANSFER
-        return CipReply(request.service | 0x80, status, (), target.type_bytes + values)
+        return CipReply(request.service | REPLY, status, (), target.type_bytes + values)
 
     # -- writes ------------------------------------------------------------
     async def _write(self, request: CipRequest, access: TableAccess, target: Target) -> CipReply:
@@ -145,9 +154,7 @@ class TagServices(CipObject):
 
 
 def _done(request: CipRequest, ok: bool) -> CipReply:
-    if ok:
-        return CipReply(request.service | 0x80, st.SUCCESS, (), b"")
-    return CipReply.error(request, st.PRIVILEGE_VIOLATION)
+    return CipReply.ok(request) if ok else CipReply.error(request, st.PRIVILEGE_VIOLATION)
 
 
 async def _read_units(access: TableAccess, target: Target, first: int, units: int) -> bytes:
@@ -161,12 +168,11 @@ async def _read_units(access: TableAccess, target: Target, first: int, units: in
     if target.ctype == STRUCT:
         out = bytearray()
         for k in range(units):
-            element = items[k * 83:(k + 1) * 83]
+            element = items[k * ST_ITEMS:(k + 1) * ST_ITEMS]
             chars = bytes(c if 0 <= c < 256 else 0x3F for c in element[1:])
             out += struct.pack("<i", element[0]) + chars + b"\x00\x00"
         return bytes(out)
-    fmt = {INT: "h", DINT: "i", REAL: "f"}[target.ctype]
-    return struct.pack(f"<{units}{fmt}", *items)
+    return struct.pack(f"<{units}{UNIT_FORMATS[target.ctype]}", *items)
 
 
 def _decode_units(target: Target, payload: bytes, units: int) -> list:
@@ -187,8 +193,7 @@ def _decode_units(target: Target, payload: bytes, units: int) -> list:
             items.append(length)
             items.extend(chunk[4:4 + STRING_CHARS])
         return items
-    fmt = {INT: "h", DINT: "i", REAL: "f", BOOL: "B"}[target.ctype]
-    return list(struct.unpack(f"<{units}{fmt}", payload))
+    return list(struct.unpack(f"<{units}{UNIT_FORMATS[target.ctype]}", payload))
 
 
 class SymbolObject(CipObject):
@@ -203,7 +208,7 @@ class SymbolObject(CipObject):
         self.reply_bytes = reply_bytes
 
     async def serve(self, request: CipRequest, access: TableAccess) -> CipReply:
-        catalogue = Catalogue(access, self.tags.symbols)
+        catalogue = self.tags.catalogue(access)
         try:
             segments = parse_path(request.path)
         except PathError as e:
@@ -268,4 +273,4 @@ def _browse(request: CipRequest, catalogue: Catalogue, first: int, budget: int) 
             status = st.PARTIAL_TRANSFER
             break
         out += entry
-    return CipReply(request.service | 0x80, status, (), bytes(out))
+    return CipReply(request.service | REPLY, status, (), bytes(out))

@@ -13,8 +13,9 @@ import struct
 
 from ...cip import status as st
 from .access import TableAccess
-from .objects import CipObject, CipReply, CipRequest
+from .objects import REPLY, CipObject, CipReply, CipRequest
 from .tagnames import DINT, SINT, STRING_BYTES, STRING_CHARS, STRING_HANDLE
+from .tags import EXT_OFFSET_OUT_OF_RANGE, REPLY_BYTES
 
 GET_ATTRIBUTES_ALL, GET_ATTRIBUTE_LIST, READ_TEMPLATE = 0x01, 0x03, 0x4C
 
@@ -29,7 +30,6 @@ STRING_TEMPLATE = (struct.pack("<HHI", 0, DINT, 0) + struct.pack("<HHI", STRING_
 # Attribute 4 counts 32-bit words of the definition plus the 23 bytes a
 # Logix template read adds (pycomm3 asks size * 4 - 21 bytes, so no less).
 DEFINITION_WORDS = (len(STRING_TEMPLATE) + 23) // 4
-REPLY_BYTES = 480
 
 
 class TemplateObject(CipObject):
@@ -51,12 +51,12 @@ class TemplateObject(CipObject):
             if request.service == READ_TEMPLATE:
                 offset, count = struct.unpack_from("<IH", request.data)
                 if offset >= len(STRING_TEMPLATE):
-                    return CipReply.error(request, st.GENERAL_ERROR, 0x2104)
+                    return CipReply.error(request, st.GENERAL_ERROR, EXT_OFFSET_OUT_OF_RANGE)
                 end = min(len(STRING_TEMPLATE), offset + count)
                 status = st.SUCCESS
                 if end - offset > REPLY_BYTES:
                     end, status = offset + REPLY_BYTES, st.PARTIAL_TRANSFER
-                return CipReply(request.service | 0x80, status, (), STRING_TEMPLATE[offset:end])
+                return CipReply(request.service | REPLY, status, (), STRING_TEMPLATE[offset:end])
         except struct.error:
             return CipReply.error(request, st.NOT_ENOUGH_DATA)
         return CipReply.error(request, st.SERVICE_NOT_SUPPORTED)
@@ -73,7 +73,7 @@ def _attributes(request: CipRequest) -> CipReply:
             out += struct.pack("<HH", number, 0) + values[number]
         else:
             out += struct.pack("<HH", number, st.ATTRIBUTE_NOT_SUPPORTED)
-    return CipReply(request.service | 0x80, st.SUCCESS, (), bytes(out))
+    return CipReply.ok(request, bytes(out))
 
 
 class ProgramName(CipObject):
@@ -88,4 +88,4 @@ class ProgramName(CipObject):
     async def serve(self, request: CipRequest, access: TableAccess) -> CipReply:
         if request.service != GET_ATTRIBUTES_ALL:
             return CipReply.error(request, st.SERVICE_NOT_SUPPORTED)
-        return CipReply(request.service | 0x80, st.SUCCESS, (), struct.pack("<H", len(self.name)) + self.name)
+        return CipReply.ok(request, struct.pack("<H", len(self.name)) + self.name)
