@@ -9,6 +9,7 @@ import struct
 import pytest
 from pylogix import PLC
 
+from softplc_lite.cip.mr import MessageRouterRequest
 from softplc_lite.datatable import DataTable
 from softplc_lite.tlm.enips.access import TableAccessOnTable
 from softplc_lite.tlm.enips.objects import CipRequest
@@ -45,8 +46,8 @@ def plc():
 
 def request(raw: bytes) -> CipRequest:
     """A pylogix-built service request as the router hands it on."""
-    words = raw[1]
-    return CipRequest(raw[0], raw[2:2 + 2 * words], None, raw[2 + 2 * words:])
+    decoded = MessageRouterRequest.decode(raw)
+    return CipRequest(decoded.service, decoded.path, None, decoded.data)
 
 
 def serve(raw: bytes, t: DataTable | None = None, writable=frozenset({"N7", "F8", "L10", "B3", "T4", "ST9"}),

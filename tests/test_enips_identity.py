@@ -1,15 +1,13 @@
-import asyncio
 import struct
 
+from helpers.cip import route
 from softplc_lite.cip import cpf, epath, status
-from softplc_lite.cip.mr import MessageRouterRequest, MessageRouterResponse
 from softplc_lite.tlm.enips.identity import Identity, IdentityObject, serial_for
 from softplc_lite.tlm.enips.router import MessageRouter
 
 
 def ask(router, service, *path):
-    raw = MessageRouterRequest(service, epath.encode_logical(*path)).encode()
-    return MessageRouterResponse.decode(asyncio.run(router.handle(raw, None)))
+    return route(router, service, epath.encode_logical(*path))
 
 
 def test_identity_attributes():

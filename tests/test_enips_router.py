@@ -1,6 +1,7 @@
 import asyncio
 import struct
 
+from helpers.cip import route
 from softplc_lite.cip import epath, status
 from softplc_lite.cip.mr import MessageRouterRequest, MessageRouterResponse
 from softplc_lite.tlm.enips.objects import CipObject, CipReply
@@ -21,11 +22,6 @@ class Symbols(CipObject):
 
     async def serve(self, request, access):
         return CipReply.ok(request, request.path)
-
-
-def route(router, service, path, data=b""):
-    raw = MessageRouterRequest(service, path, data).encode()
-    return MessageRouterResponse.decode(asyncio.run(router.handle(raw, None)))
 
 
 def test_dispatch_by_class_and_symbolic_path():
