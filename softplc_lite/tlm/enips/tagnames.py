@@ -16,6 +16,7 @@ import math
 import struct
 from dataclasses import dataclass
 
+from ...cip import epath
 from ...cip.status import PATH_DESTINATION_UNKNOWN, PATH_SEGMENT_ERROR
 from ...datatable import AddressError, parse_address
 from ...datatable.filetypes import FILE_TYPES as FILE_SPECS
@@ -168,39 +169,30 @@ def _items_per_unit(ctype: int) -> int:
 
 # -- request paths ---------------------------------------------------------
 
+# The segments a tag path may have (CIP Vol. 1 C-1.4.2), by logical kind:
+# what parse_path calls them, and the value widths served.
+_TAG_SEGMENTS = {epath.ELEMENT: ("index", (1, 2, 4)), epath.CLASS: ("class", (1, 2)),
+                 epath.INSTANCE: ("instance", (1, 2, 4))}
+
+
 def parse_path(path: bytes) -> list[tuple[str, object]]:
     """The segments of a symbolic path: ("name", text) for an ANSI extended
-    symbolic segment (0x91), ("index", n) for a member/element segment
-    (0x28 8-bit, 0x29 16-bit, 0x2A 32-bit; CIP Vol. 1 C-1.4.2), ("class",
-    n) and ("instance", n) for logical segments (0x20/0x21, 0x24/0x25/0x26)."""
-    out: list[tuple[str, object]] = []
-    i, n = 0, len(path)
+    symbolic segment (0x91), ("index", n) for an element segment (0x28 8-bit,
+    0x29 16-bit, 0x2A 32-bit), ("class", n) and ("instance", n) for logical
+    segments (0x20/0x21, 0x24/0x25/0x26)."""
     try:
-        while i < n:
-            seg = path[i]
-            if seg == 0x91:
-                size = path[i + 1]
-                raw = path[i + 2:i + 2 + size]
-                if len(raw) != size:
-                    raise PathError(PATH_SEGMENT_ERROR, "symbolic segment runs past the path's end")
-                out.append(("name", raw.decode("ascii")))
-                i += 2 + size + (size & 1)
-            elif seg in (0x28, 0x20, 0x24):
-                out.append(({0x28: "index", 0x20: "class", 0x24: "instance"}[seg], path[i + 1]))
-                i += 2
-            elif seg in (0x29, 0x21, 0x25):
-                out.append(({0x29: "index", 0x21: "class", 0x25: "instance"}[seg],
-                            struct.unpack_from("<H", path, i + 2)[0]))
-                i += 4
-            elif seg in (0x2A, 0x26):
-                out.append(("index" if seg == 0x2A else "instance", struct.unpack_from("<I", path, i + 2)[0]))
-                i += 6
-            else:
-                raise PathError(PATH_SEGMENT_ERROR, f"segment 0x{seg:02X} has no place in a tag path")
-    except (IndexError, struct.error):
-        raise PathError(PATH_SEGMENT_ERROR, "a segment runs past the path's end") from None
-    except UnicodeDecodeError:
-        raise PathError(PATH_SEGMENT_ERROR, "a symbolic segment that is not ASCII") from None
+        found = epath.segments(path)
+    except epath.PathError as e:
+        raise PathError(PATH_SEGMENT_ERROR, str(e)) from None
+    out: list[tuple[str, object]] = []
+    for s in found:
+        if s.kind == epath.SYMBOLIC:
+            out.append(("name", s.value))
+            continue
+        name, widths = _TAG_SEGMENTS.get(s.kind, (None, ()))
+        if s.width not in widths:
+            raise PathError(PATH_SEGMENT_ERROR, f"segment 0x{s.code:02X} has no place in a tag path")
+        out.append((name, s.value))
     return out
 
 
