@@ -61,6 +61,13 @@ def _check_unit_and_pdu(unit: int, pdu: bytes) -> None:
         raise ValueError(f"a PDU has 1..{MAX_PDU_LENGTH} bytes, not {len(pdu)}")
 
 
+def rtu_adu(unit: int, pdu: bytes) -> bytes:
+    """Unit, PDU and CRC, unchecked: ``RtuFramer.encode`` after its checks,
+    and a test peer's frames that a slave must refuse (a PDU too long)."""
+    frame = bytes((unit,)) + bytes(pdu)
+    return frame + crc16(frame).to_bytes(2, "little")
+
+
 class RtuFramer:
     """RTU frames (section 2.5.1.1): unit address, PDU, CRC low byte first.
 
@@ -85,8 +92,7 @@ class RtuFramer:
     def encode(unit: int, pdu: bytes) -> bytes:
         """The RTU ADU of ``pdu`` for ``unit`` (0 broadcast, 1..247, or up to 255)."""
         _check_unit_and_pdu(unit, pdu)
-        frame = bytes((unit,)) + bytes(pdu)
-        return frame + crc16(frame).to_bytes(2, "little")
+        return rtu_adu(unit, pdu)
 
     @staticmethod
     def decode(adu: bytes) -> tuple[int, bytes]:

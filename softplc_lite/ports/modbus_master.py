@@ -56,8 +56,7 @@ from collections.abc import Callable
 
 from . import simdevices, simlink
 from .simdevices import SimDevice, check_options, float_option, silence_ns
-from ..modbus.crc import crc16
-from ..modbus.framing import FrameError, RtuFramer
+from ..modbus.framing import FrameError, RtuFramer, rtu_adu
 from ..modbus.pdu import (ILLEGAL_DATA_ADDRESS, ExceptionResponse, ModbusDecodeError, ReadCoilsRequest,
                           ReadDiscreteInputsRequest, ReadHoldingRegistersRequest, ReadInputRegistersRequest,
                           WriteMultipleCoilsRequest, WriteMultipleRegistersRequest, WriteSingleCoilRequest,
@@ -221,8 +220,7 @@ class ModbusMaster(SimDevice):
             self._rounds += 1
         request, check = self._queue.pop(0)
         pdu = request.encode()
-        frame = bytes((self.slave_id,)) + pdu  # RtuFramer.encode refuses the over-long PDUs requests= may give
-        frame += crc16(frame).to_bytes(2, "little")
+        frame = rtu_adu(self.slave_id, pdu)  # RtuFramer.encode refuses the over-long PDUs requests= may give
         self.end.send(frame, at)
         self.sent += 1
         self._pending = (frame, check, request) if self.slave_id else None  # a broadcast waits for nothing
