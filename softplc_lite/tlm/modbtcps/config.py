@@ -19,8 +19,6 @@ them before anything runs.
 from __future__ import annotations
 
 import dataclasses
-import ipaddress
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -30,6 +28,8 @@ from ...datatable.filetypes import MAX_ELEMENTS, STRING, STRING_CHARS, WORD_BITS
 from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
+from ..netconfig import (ALLOW, check_allow, check_host, check_status, listen_attributes,
+                         listen_warning)
 from ..xmlcheck import MANY, Attr, XmlChecker, parse_integer
 from ..xmlreader import XmlNode
 
@@ -42,10 +42,7 @@ KIND_ELEMENT = {kind: element for element, kind in ELEMENT_OF_KIND.items()}
 STATUS_WORDS = 16
 MODBUS_ADDRESSES = 65536  # protocol addresses 0..65535 in each table
 WORD_ORDERS = ("high-low", "low-high")
-LOOPBACK = (ipaddress.ip_network("127.0.0.0/8"), ipaddress.ip_network("::1/128"))
-EVERYONE = (ipaddress.ip_network("0.0.0.0/0"), ipaddress.ip_network("::/0"))
 WORD_FILES = ("O", "I", "S", "B", "N")  # registers and bits come from 16-bit words of these files
-STATUS_FILES = ("N", "B")
 READ_ONLY_KINDS = ("discrete_inputs", "input_registers")  # Modbus has no function that writes them
 REGISTERS_PER_ITEM = {"bit": 1, "word": 1, "float": 2, "string": STRING.words_per_element}
 STRING_FORMATS = ("ucs2", "packed")
@@ -117,7 +114,6 @@ class ServerConfig:
 
 # -- attributes ------------------------------------------------------------------------------
 
-_HOST = "an IPv4 or IPv6 address or a host name to listen on"
 _REGION = (Attr("start", 0, MODBUS_ADDRESSES - 1, required=True),
            Attr("count", 1, MODBUS_ADDRESSES, required=True),
            Attr("address", text=True, required=True, what="a data table address"))
@@ -126,17 +122,8 @@ _REGION_WORD_ORDER = Attr("wordOrder", choices=WORD_ORDERS)  # absent: the root'
 _STRING_FORMAT = Attr("stringFormat", choices=STRING_FORMATS, default="ucs2")
 
 ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
-    ROOT: (Attr("address", text=True, default="127.0.0.1", what=_HOST),
-           Attr("port", 1, 65535, default=502),
-           Attr("maxConnections", 1, 1000, default=16),
-           Attr("maxRequestsPerSecond", 1, 100_000, default=100),
-           Attr("idleTimeout", 100, 3_600_000, default=60_000),
-           Attr("status", text=True, what=f"a word address of an N or B file, the first of {STATUS_WORDS} "
-                                           "status words (N40:0)"),
-           Attr("wordOrder", choices=WORD_ORDERS, default="high-low"),
-           Attr("debug", 0, 2, default=0)),
-    "Allow": (Attr("network", text=True, required=True,
-                   what='a client network (192.168.1.0/24), an address (10.0.0.5), or "any"'),),
+    ROOT: (*listen_attributes(502, 16, 100, STATUS_WORDS), Attr("wordOrder", choices=WORD_ORDERS, default="high-low")),
+    "Allow": ALLOW,
     "Unit": (Attr("id", 0, 255, required=True),),
     "Coils": (*_REGION, _WRITABLE),
     "DiscreteInputs": (*_REGION, _WRITABLE),
@@ -144,37 +131,6 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
     "InputRegisters": (*_REGION, _WRITABLE, _REGION_WORD_ORDER, _STRING_FORMAT),
 }
 HINT_NAMES = ("Allow", "Unit", *ELEMENT_OF_KIND)
-
-_LABEL = re.compile(r"^(?!-)[A-Za-z0-9-]{1,63}(?<!-)$")
-
-
-def host_to_listen(text: str) -> str | None:
-    """The host an ``address`` names (an IPv6 literal loses its brackets),
-    or None when it is neither an IP address nor a valid host name
-    (RFC 1123 labels; a last label of digits only is a mistyped IPv4)."""
-    host = text[1:-1] if text.startswith("[") and text.endswith("]") else text
-    try:
-        ipaddress.ip_address(host)
-        return host
-    except ValueError:
-        pass
-    name = host[:-1] if host.endswith(".") else host
-    labels = name.split(".")
-    if not name or len(name) > 253 or not all(_LABEL.match(label) for label in labels) or labels[-1].isdigit():
-        return None
-    return host
-
-
-def allowed_networks(text: str) -> tuple | None:
-    """The networks an <Allow network> names ("any": every IPv4 and IPv6
-    client), or None when it names none."""
-    if text.lower() == "any":
-        return EVERYONE
-    try:
-        return (ipaddress.ip_network(text, strict=False),)
-    except ValueError:
-        return None
-
 
 # -- addresses -------------------------------------------------------------------------------
 
@@ -238,25 +194,6 @@ def _check_address(c: XmlChecker, node: XmlNode, text: str, count: int | None) -
                           f"(elements 0..{MAX_ELEMENTS - 1})", "address")
             return None
     return address, value
-
-
-def _check_status(c: XmlChecker, root: XmlNode, text: str) -> Address | None:
-    problem = None
-    try:
-        address = parse_address(text)
-    except DataTableError as e:
-        c.error(root, f"status={text!r}: {getattr(e, 'message', str(e))}", "status")
-        return None
-    if not address.is_direct or address.type_letter not in STATUS_FILES or address.member is not None \
-            or address.bit is not None:
-        problem = (f"expected a direct word address of an N or B file (N40:0, B3:0): the first of the "
-                   f"{STATUS_WORDS} status words")
-    elif address.element + STATUS_WORDS > MAX_ELEMENTS:
-        problem = f"the {STATUS_WORDS} status words from here run past the end of a file (elements 0..{MAX_ELEMENTS - 1})"
-    if problem:
-        c.error(root, f"status={text!r}: {problem}", "status")
-        return None
-    return address
 
 
 # -- elements --------------------------------------------------------------------------------
@@ -349,25 +286,10 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
     c = XmlChecker(path, ATTRIBUTES, ROOT, HINT_NAMES)
     root = c.read_root(data, "docs/modbtcps.md")
     a = c.attributes(root)
-    host = None
-    if "address" in a:
-        host = host_to_listen(a["address"])
-        if host is None:
-            c.error(root, f"address={a['address']!r}: expected {_HOST} (127.0.0.1: only this machine; "
-                          "0.0.0.0: every IPv4 interface)", "address")
-    status = _check_status(c, root, a["status"]) if "status" in a else None
+    host = check_host(c, root, a)
+    status = check_status(c, root, a["status"], STATUS_WORDS) if "status" in a else None
     allow_nodes, unit_nodes = c.children(root, [("Allow", 0, MANY), ("Unit", 1, MANY)])
-    allow: list = []
-    for node in allow_nodes:
-        n = c.attributes(node)
-        c.children(node, [])
-        if "network" in n:
-            networks = allowed_networks(n["network"])
-            if networks is None:
-                c.error(node, f"network={n['network']!r}: expected a client network (192.168.1.0/24), an address "
-                              '(10.0.0.5), or "any" (every client)', "network")
-            else:
-                allow.extend(networks)
+    allow = check_allow(c, allow_nodes)
     shared = {"word_order": a.get("wordOrder", "high-low"), "status": status, "status_line": root.line}
     units: dict[int, Unit] = {}
     lines: dict[int, int] = {}
@@ -388,26 +310,12 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
                                 "is refused (exception 02)")
     if c.problems:
         raise ModuleErrors(c.found())
-    host = host or "127.0.0.1"
-    if not allow_nodes and not ipaddress_is_loopback(host):
-        warnings.insert(0, f"{path}:{root.line}: listening on {host} but no <Allow> is given: only clients on "
-                           "this machine (127.0.0.0/8, ::1) are served; add <Allow network=\"...\"/> for others")
-    return ServerConfig(path=path, host=host, port=a.get("port", 502), allow=tuple(allow) if allow_nodes
-                        else LOOPBACK, max_connections=a.get("maxConnections", 16),
+    warnings[:0] = listen_warning(path, root, host, bool(allow_nodes))
+    return ServerConfig(path=path, host=host, port=a.get("port", 502), allow=allow, max_connections=a.get("maxConnections", 16),
                         max_requests_per_second=a.get("maxRequestsPerSecond", 100),
                         idle_timeout_ms=a.get("idleTimeout", 60_000), status=status,
                         word_order=a.get("wordOrder", "high-low"), debug=a.get("debug", 0), units=units,
                         warnings=warnings)
-
-
-def ipaddress_is_loopback(host: str) -> bool:
-    """Is ``host`` a loopback address (or "localhost")?"""
-    if host.lower().rstrip(".") == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
 
 
 def config_path(app_dir: Path) -> Path | None:

@@ -1,0 +1,138 @@
+"""What every network server module's XML configuration says the same way
+(MODBTCPS.XML, ENIPS.XML): where to listen, who may connect, the limits,
+the status block, and how each is checked (docs/modbtcps.md, "Safe by
+default"; docs/enips.md, "The configuration file").
+
+The rules are softplc_lite's own choices, one set for every server so that
+an engineer who has configured one has configured them all: listen on
+127.0.0.1 unless told otherwise, serve only this machine's clients unless
+``<Allow>`` names others, and warn when a server listens beyond this machine
+with no ``<Allow>``.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import re
+
+from ..datatable import DataTableError, parse_address
+from ..datatable.address import Address
+from ..datatable.filetypes import MAX_ELEMENTS
+from .xmlcheck import Attr, XmlChecker
+from .xmlreader import XmlNode
+
+LOOPBACK = (ipaddress.ip_network("127.0.0.0/8"), ipaddress.ip_network("::1/128"))
+EVERYONE = (ipaddress.ip_network("0.0.0.0/0"), ipaddress.ip_network("::/0"))
+STATUS_FILES = ("N", "B")
+HOST_WHAT = "an IPv4 or IPv6 address or a host name to listen on"
+ALLOW = (Attr("network", text=True, required=True,
+              what='a client network (192.168.1.0/24), an address (10.0.0.5), or "any"'),)
+
+_LABEL = re.compile(r"^(?!-)[A-Za-z0-9-]{1,63}(?<!-)$")
+
+
+def listen_attributes(port: int, max_connections: int, max_rate: int, status_words: int) -> tuple[Attr, ...]:
+    """The root element's attributes every server has, with its defaults."""
+    return (Attr("address", text=True, default="127.0.0.1", what=HOST_WHAT),
+            Attr("port", 1, 65535, default=port),
+            Attr("maxConnections", 1, 1000, default=max_connections),
+            Attr("maxRequestsPerSecond", 1, 100_000, default=max_rate),
+            Attr("idleTimeout", 100, 3_600_000, default=60_000),
+            Attr("status", text=True, what=f"a word address of an N or B file, the first of {status_words} "
+                                            "status words (N40:0)"),
+            Attr("debug", 0, 2, default=0))
+
+
+def host_to_listen(text: str) -> str | None:
+    """The host an ``address`` names (an IPv6 literal loses its brackets),
+    or None when it is neither an IP address nor a valid host name
+    (RFC 1123 labels; a last label of digits only is a mistyped IPv4)."""
+    host = text[1:-1] if text.startswith("[") and text.endswith("]") else text
+    try:
+        ipaddress.ip_address(host)
+        return host
+    except ValueError:
+        pass
+    name = host[:-1] if host.endswith(".") else host
+    labels = name.split(".")
+    if not name or len(name) > 253 or not all(_LABEL.match(label) for label in labels) or labels[-1].isdigit():
+        return None
+    return host
+
+
+def allowed_networks(text: str) -> tuple | None:
+    """The networks an <Allow network> names ("any": every IPv4 and IPv6
+    client), or None when it names none."""
+    if text.lower() == "any":
+        return EVERYONE
+    try:
+        return (ipaddress.ip_network(text, strict=False),)
+    except ValueError:
+        return None
+
+
+def ipaddress_is_loopback(host: str) -> bool:
+    """Is ``host`` a loopback address (or "localhost")?"""
+    if host.lower().rstrip(".") == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def check_host(c: XmlChecker, root: XmlNode, a: dict) -> str:
+    """The host to listen on (127.0.0.1 when absent or wrong: the error is recorded)."""
+    if "address" not in a:
+        return "127.0.0.1"
+    host = host_to_listen(a["address"])
+    if host is None:
+        c.error(root, f"address={a['address']!r}: expected {HOST_WHAT} (127.0.0.1: only this machine; "
+                      "0.0.0.0: every IPv4 interface)", "address")
+        return "127.0.0.1"
+    return host
+
+
+def check_allow(c: XmlChecker, nodes: list[XmlNode]) -> tuple:
+    """The networks the <Allow> elements name; none given: this machine only."""
+    if not nodes:
+        return LOOPBACK
+    allow: list = []
+    for node in nodes:
+        n = c.attributes(node)
+        c.children(node, [])
+        if "network" in n:
+            networks = allowed_networks(n["network"])
+            if networks is None:
+                c.error(node, f"network={n['network']!r}: expected a client network (192.168.1.0/24), an address "
+                              '(10.0.0.5), or "any" (every client)', "network")
+            else:
+                allow.extend(networks)
+    return tuple(allow)
+
+
+def listen_warning(path: str, root: XmlNode, host: str, allow_given: bool) -> list[str]:
+    if allow_given or ipaddress_is_loopback(host):
+        return []
+    return [f"{path}:{root.line}: listening on {host} but no <Allow> is given: only clients on this machine "
+            "(127.0.0.0/8, ::1) are served; add <Allow network=\"...\"/> for others"]
+
+
+def check_status(c: XmlChecker, root: XmlNode, text: str, words: int) -> Address | None:
+    """The status block's first word, or None (the problem recorded)."""
+    problem = None
+    try:
+        address = parse_address(text)
+    except DataTableError as e:
+        c.error(root, f"status={text!r}: {getattr(e, 'message', str(e))}", "status")
+        return None
+    if not address.is_direct or address.type_letter not in STATUS_FILES or address.member is not None \
+            or address.bit is not None:
+        problem = (f"expected a direct word address of an N or B file (N40:0, B3:0): the first of the "
+                   f"{words} status words")
+    elif address.element + words > MAX_ELEMENTS:
+        problem = f"the {words} status words from here run past the end of a file (elements 0..{MAX_ELEMENTS - 1})"
+    if problem:
+        c.error(root, f"status={text!r}: {problem}", "status")
+        return None
+    return address
