@@ -56,7 +56,17 @@ class LineProtocol(Protocol):
 
 
 class LineHandler(Handler):
+    """``N``: the requests this connection made; ``K``: the connections closed so far."""
+
     busy, failure = "busy", "failed"
+    closed_connections = 0
+
+    def opened(self, link):
+        return {"requests": 0, "peer": link.peername()}
+
+    def closed(self, state):
+        assert state["requests"] >= 0
+        LineHandler.closed_connections += 1
 
     def frame_length(self, data, at):
         end = data.find(b"\n", at)
@@ -66,11 +76,16 @@ class LineHandler(Handler):
             return None
         return end + 1 - at
 
-    def header(self, frame):
-        return None
+    def header(self, frame, state):
+        state["requests"] += 1
+        return state
 
     def decode(self, frame, header):
         words = frame.split()
+        if words == [b"N"]:
+            return ("N", header["requests"])
+        if words == [b"K"]:
+            return ("K", LineHandler.closed_connections)
         if len(words) == 2 and words[0] == b"R" and words[1].isdigit() and int(words[1]) < WORDS:
             return ("R", int(words[1]))
         if len(words) == 3 and words[0] == b"W" and words[1].isdigit() and int(words[1]) < WORDS \
@@ -79,6 +94,8 @@ class LineHandler(Handler):
         return Refusal(BAD, f"not a request: {frame[:20]!r}")
 
     async def serve(self, request):
+        if request[0] in "NK":
+            return b"%d\n" % request[1]
         if request[0] == "R":
             (raw,) = await self.server.read([(2 * request[1], 2)])
             return b"%d\n" % int.from_bytes(raw, "little", signed=True)
@@ -161,6 +178,19 @@ def test_a_second_protocol_reads_the_published_scan_and_its_writes_land_through_
     assert engine.table.read("N40:0") & C.BIT_LISTENING
     status = handle.server_status()
     assert status.up and status.refused == {"bad request": 1} and status.writes == 1
+
+
+def test_a_protocol_keeps_state_per_connection_and_hears_of_each_end(served):
+    engine, handle = served
+    with socket.create_connection(("127.0.0.1", handle.port), timeout=LIMIT_S) as one, \
+            socket.create_connection(("127.0.0.1", handle.port), timeout=LIMIT_S) as two:
+        closed = int(ask(one, b"K\n"))
+        for _ in range(3):
+            ask(one, b"R 0\n")
+        assert ask(one, b"N\n") == b"5\n"  # K, three reads, N: this connection's own count
+        assert ask(two, b"N\n") == b"1\n"
+    with socket.create_connection(("127.0.0.1", handle.port), timeout=LIMIT_S) as three:
+        wait_for(lambda: int(ask(three, b"K\n")) == closed + 2, "both ends told to the protocol")
 
 
 def test_bytes_that_are_not_a_frame_close_their_connection_counted(served):

@@ -29,7 +29,8 @@ What a protocol writes (protocol.py):
   serve (``unusable``: a library missing), the module its process runs as
   (``process_module``: a module that calls ``process.main``), the name of
   its image's file (``segments``: ``softplc-NAME-PID-RANDOM``), and
-- the ``Handler`` it makes in the server process: how long a frame is
+- the ``Handler`` it makes in the server process: the state it keeps per
+  connection, if any (``opened``, ``closed``: an EtherNet/IP session), how long a frame is
   (``frame_length``; ``Malformed`` when it is not one), what a reply needs
   of a frame (``header``), the request a frame holds (``decode``), its
   reply (``serve``: reads of mapped regions through ``Server.read``,

@@ -59,6 +59,7 @@ class Connection:
         self.paused: set[str] = set()  # why reading is paused: "queue" full, "writing" (replies unread)
         self.can_write = asyncio.Event()  # cleared while the client leaves its replies unread
         self.can_write.set()
+        self.state = None  # the protocol's own, per connection (Handler.opened)
 
     def connected(self) -> None:
         owner = self.owner
@@ -79,6 +80,7 @@ class Connection:
             self.link.abort()
             return
         self.counted = True
+        self.state = self.handler.opened(self.link)
         owner.open_connections += 1
         owner.image.add(C.CONNECTIONS)
         owner.image.set(C.CONNECTED, owner.open_connections)
@@ -98,6 +100,7 @@ class Connection:
             self.worker = None
         if self.counted:
             self.counted = False
+            self.handler.closed(self.state)
             self.owner.open_connections -= 1
             self.owner.image.set(C.CONNECTED, self.owner.open_connections)
             self.owner.log(2, f"{self.peer}: disconnected")
@@ -178,7 +181,7 @@ class Connection:
         """Take one frame: queue the request it holds, or the reply that refuses it."""
         owner, handler = self.owner, self.handler
         self._rearm()
-        header = handler.header(frame)
+        header = handler.header(frame, self.state)
         if not owner.rate_ok(self.address):
             self._queue(owner.refused(Refusal(handler.busy, "over maxRequestsPerSecond"), header))
             return

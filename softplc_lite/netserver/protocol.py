@@ -107,10 +107,20 @@ class Handler(abc.ABC):
         """The length of the frame that starts at ``data[at]``, or None
         until it is all received; raises Malformed."""
 
+    def opened(self, link: Link) -> Any:
+        """The state a protocol keeps per connection (an EtherNet/IP session),
+        made when ``link`` is accepted; None for a protocol that keeps none."""
+        return None
+
+    def closed(self, state) -> None:
+        """The connection that held ``state`` ended, however it ended: what
+        the protocol opened for it (a CIP connection) goes with it."""
+
     @abc.abstractmethod
-    def header(self, frame: bytes) -> Any:
-        """What a reply to ``frame`` needs of it (a transaction id), so that
-        a frame refused before it is decoded is answered too."""
+    def header(self, frame: bytes, state) -> Any:
+        """What a reply to ``frame`` needs of it (a transaction id; the
+        connection's ``state`` if the reply needs that too), so that a frame
+        refused before it is decoded is answered too."""
 
     @abc.abstractmethod
     def decode(self, frame: bytes, header) -> Any:

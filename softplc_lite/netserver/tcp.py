@@ -50,6 +50,11 @@ class TcpLink(asyncio.Protocol):
     def peername(self):
         return self.transport.get_extra_info("peername") if self.transport is not None else None
 
+    def sockname(self):
+        """The address the client reached (ours): what an EtherNet/IP
+        ListIdentity reply names."""
+        return self.transport.get_extra_info("sockname") if self.transport is not None else None
+
     def reply(self, response: bytes) -> None:
         if self.transport is not None:
             self.transport.write(response)

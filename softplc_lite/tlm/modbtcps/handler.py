@@ -47,7 +47,7 @@ class ModbusHandler(Handler):
             raise Malformed(f"not a Modbus TCP frame (protocol id {pid}, length {length})")
         return 6 + length if len(data) - at >= 6 + length else None
 
-    def header(self, frame: bytes) -> tuple[int, int, int]:
+    def header(self, frame: bytes, state) -> tuple[int, int, int]:
         """(function, unit, transaction id): what an exception answer needs."""
         return frame[7], frame[6], int.from_bytes(frame[:2], "big")
 
