@@ -20,9 +20,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-from ...netserver import ServerHandle, ServerStatus
-from ...netserver.handle import START_TIMEOUT_S
-from ..api import TLM
+from ...netserver import ServerHandle
+from ..netmodule import NetServerModule
 from . import status as C
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config
 from .layout import Layout
@@ -31,24 +30,11 @@ from .protocol import ModbusProtocol, settings_of
 WHERE = "MODBTCPS.XML address and port; docs/modbtcps.md"
 
 
-def _of_server(name: str, default=None) -> property:
-    """An attribute of the server handle; ``default`` before the engine attaches it."""
-    return property(lambda self: getattr(self.server, name) if self.server is not None else default,
-                    doc=f"The server's ``{name}`` (netserver.ServerHandle).")
-
-
-class ModbTcpServer(TLM):
+class ModbTcpServer(NetServerModule):
     name = "MODBTCPS"
     title = "Modbus TCP server over the data table (for HMIs and SCADA)"
     config_file = CONFIG_FILE
     libraries = ("pymodbus",)  # imported by the server process only: the load checks it is installed (registry)
-
-    image = _of_server("image")
-    process = _of_server("process")
-    port = _of_server("port")
-    failed = _of_server("failed")
-    started = _of_server("started", False)
-    rate = _of_server("rate", 0)
 
     def __init__(self, config: ServerConfig | None = None) -> None:
         self.config = config or ServerConfig()
@@ -76,35 +62,3 @@ class ModbTcpServer(TLM):
                                    WHERE, C.LAYOUT)
         self.server.attach(table, self.config.status)
         return []
-
-    def wait_until_listening(self, timeout: float = START_TIMEOUT_S) -> int | None:
-        """For a caller beside the scan (a test, an example, a benchmark),
-        scanning or not: the port, once the server listens; None if it
-        failed, ended, or did not listen in time."""
-        return self.server.wait_until_listening(timeout) if self.server is not None else None
-
-    @property
-    def listening(self) -> str:
-        return self.server.listening
-
-    # -- each scan ---------------------------------------------------------------------------
-    def on_input(self, engine) -> None:
-        self.server.on_input(engine)
-
-    def on_output(self, engine, outputs_enabled: bool) -> None:
-        self.server.on_output(engine, outputs_enabled)
-
-    def server_status(self) -> ServerStatus | None:
-        """The server as the watch view shows it."""
-        if self.server is None:  # not attached to an engine
-            return None
-        return self.server.server_status()
-
-    def network_servers(self) -> list:
-        status = self.server_status()
-        return [status] if status is not None else []
-
-    # -- the end -----------------------------------------------------------------------------
-    def close(self) -> None:
-        if self.server is not None:
-            self.server.close()
