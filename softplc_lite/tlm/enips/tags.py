@@ -116,10 +116,14 @@ class TagServices(CipObject):
             return CipReply.error(request, st.GENERAL_ERROR, EXT_BEYOND_END)
         if offset % unit or offset >= count * unit:
             return CipReply.error(request, st.GENERAL_ERROR, EXT_OFFSET_OUT_OF_RANGE)
+        if request.service == WRITE_TAG:
+            # Bytes past the count's worth are ignored, as a Logix controller
+            # does: pycomm3 1.2's single-tag write sends its request twice over.
+            if len(payload) < count * unit:
+                return CipReply.error(request, st.NOT_ENOUGH_DATA)
+            payload = payload[:count * unit]
         if len(payload) % unit or not payload:
             return CipReply.error(request, st.NOT_ENOUGH_DATA)
-        if request.service == WRITE_TAG and len(payload) != count * unit:
-            return CipReply.error(request, st.NOT_ENOUGH_DATA if len(payload) < count * unit else st.TOO_MUCH_DATA)
         if offset + len(payload) > count * unit:
             return CipReply.error(request, st.TOO_MUCH_DATA)
         first = offset // unit
