@@ -8,6 +8,7 @@ extended status 0x0312 (link address not valid, Volume 1 Table 3-5.29)."""
 
 from __future__ import annotations
 
+import contextvars
 import struct
 import time
 
@@ -27,29 +28,63 @@ CONNECTION_NOT_FOUND = 0x0107
 LINK_ADDRESS_NOT_VALID = 0x0312
 SERVED_ROUTES = ([], [(1, b"\x00")])
 
+# Whose request is being served (an encapsulation session): a connection
+# belongs to the session that opened it, is used by it alone, and closes
+# with it (CIP Volume 2, 2-5: a connection over TCP lives within its
+# encapsulation session).
+OWNER: contextvars.ContextVar[object | None] = contextvars.ContextVar("cip_connection_owner", default=None)
+
 
 class ConnectionManager(CipObject):
     class_id = CLASS_ID
 
-    def __init__(self):
+    def __init__(self, max_connections: int = MAX_CONNECTIONS):
         self.router = None  # set by the Message Router that serves this object
+        self.max_connections = max_connections
         # our O->T connection id -> (T->O id, connection serial, vendor, originator serial, timeout seconds)
         self.connections: dict[int, tuple[int, int, int, int, float]] = {}
         self._next_id = 0x10000001
         self.last_seen: dict[int, float] = {}
+        self.owners: dict[int, object] = {}
 
-    def alive(self, o_t_id: int):
+    def alive(self, o_t_id: int, owner: object = None):
         """The connection ``o_t_id`` names, its timeout restarted; None if
-        there is none or it timed out (then it is closed)."""
+        there is none, it is another session's, or it timed out (then it is
+        closed)."""
         connection = self.connections.get(o_t_id)
-        if connection is None:
+        if connection is None or self.owners.get(o_t_id) is not owner:
             return None
         now = time.monotonic()
         if now - self.last_seen[o_t_id] > connection[4]:
-            del self.connections[o_t_id], self.last_seen[o_t_id]
+            self._timed_out(o_t_id)
             return None
         self.last_seen[o_t_id] = now
         return connection
+
+    def _close(self, o_t_id: int) -> None:
+        del self.connections[o_t_id], self.last_seen[o_t_id]
+        self.owners.pop(o_t_id, None)
+
+    def _timed_out(self, o_t_id: int) -> None:
+        self._close(o_t_id)
+        if self.router is not None:
+            self.router.count("timeout", f"CIP connection 0x{o_t_id:08X} closed: no message within its RPI "
+                                         "times its multiplier")
+
+    def sweep(self) -> None:
+        """Close every connection past its timeout (before one is opened:
+        a client that vanished must not keep the slots)."""
+        now = time.monotonic()
+        for o_t_id, connection in list(self.connections.items()):
+            if now - self.last_seen[o_t_id] > connection[4]:
+                self._timed_out(o_t_id)
+
+    def close_owned(self, owner: object) -> int:
+        """Close the connections ``owner`` opened (its TCP connection ended); how many."""
+        mine = [k for k, o in self.owners.items() if o is owner]
+        for o_t_id in mine:
+            self._close(o_t_id)
+        return len(mine)
 
     async def serve(self, request, access):
         if request.service == UNCONNECTED_SEND:
@@ -92,12 +127,14 @@ class ConnectionManager(CipObject):
             return CipReply.error(request, status.NOT_ENOUGH_DATA)
         (_, _, _, t_o_id, serial, vendor, orig_serial, multiplier,
          o_t_rpi, _, t_o_rpi, _, _) = struct.unpack_from(fmt, request.data)
-        if len(self.connections) >= MAX_CONNECTIONS:
+        self.sweep()
+        if len(self.connections) >= self.max_connections:
             return CipReply.error(request, status.CONNECTION_FAILURE, OUT_OF_CONNECTIONS)
         o_t_id, self._next_id = self._next_id, self._next_id + 1
         timeout = o_t_rpi / 1e6 * (4 << min(multiplier, 7))
         self.connections[o_t_id] = (t_o_id, serial, vendor, orig_serial, timeout)
         self.last_seen[o_t_id] = time.monotonic()
+        self.owners[o_t_id] = OWNER.get()
         return CipReply.ok(request, struct.pack("<IIHHIIIBx", o_t_id, t_o_id, serial, vendor,
                                                 orig_serial, o_t_rpi, t_o_rpi, 0))
 
@@ -106,7 +143,7 @@ class ConnectionManager(CipObject):
             return CipReply.error(request, status.NOT_ENOUGH_DATA)
         serial, vendor, orig_serial = struct.unpack_from("<HHI", request.data, 2)
         for o_t_id, (_, s, v, o, _) in list(self.connections.items()):
-            if (s, v, o) == (serial, vendor, orig_serial):
-                del self.connections[o_t_id], self.last_seen[o_t_id]
+            if (s, v, o) == (serial, vendor, orig_serial) and self.owners.get(o_t_id) is OWNER.get():
+                self._close(o_t_id)
                 return CipReply.ok(request, struct.pack("<HHIBx", serial, vendor, orig_serial, 0))
         return CipReply.error(request, status.CONNECTION_FAILURE, CONNECTION_NOT_FOUND)

@@ -27,6 +27,19 @@ MULTIPLE_SERVICE_PACKET = 0x0A
 OBJECTS: list[Callable[[], CipObject]] = [IdentityObject, ConnectionManager]
 
 
+# Replies that are no refusal: success; a fragment with more to come; a
+# Multiple Service Packet whose failed services are counted one by one.
+UNCOUNTED = (status.SUCCESS, status.PARTIAL_TRANSFER, status.EMBEDDED_SERVICE_ERROR)
+
+
+def _uncounted(kind: str, why: str) -> None:
+    pass
+
+
+def _service_words(request: MessageRouterRequest) -> str:
+    return f"service 0x{request.service:02X} to path {request.path.hex(' ') or 'none'}"
+
+
 class MessageRouter:
     def __init__(self, objects: list[CipObject] | None = None, identity=None):
         """``identity`` (an ``identity.Identity``) names this server in place
@@ -35,6 +48,7 @@ class MessageRouter:
         if identity is not None:
             built = [obj for obj in built if obj.class_id != IdentityObject.class_id]
             built.append(IdentityObject(identity))
+        self.count: Callable[[str, str], None] = _uncounted  # a refusal's kind and why (the server counts them)
         self.objects: dict[int | None, CipObject] = {}
         for obj in built:
             self.objects[obj.class_id] = obj
@@ -47,8 +61,14 @@ class MessageRouter:
             request = MessageRouterRequest.decode(raw)
         except MessageError:
             service = raw[0] | REPLY if raw else REPLY
+            self.count("cip", f"a request of {len(raw)} bytes that is not a Message Router request: CIP status "
+                              f"{status.describe(status.NOT_ENOUGH_DATA)}")
             return MessageRouterResponse(service, status.NOT_ENOUGH_DATA).encode()
         reply = await self.route(request, access)
+        if reply.status not in UNCOUNTED:
+            self.count("read-only" if reply.status == status.PRIVILEGE_VIOLATION else "cip",
+                       f"{_service_words(request)}: CIP status {status.describe(reply.status)}"
+                       + "".join(f" 0x{word:04X}" for word in reply.extended))
         return MessageRouterResponse(reply.service, reply.status, reply.extended, reply.data).encode()
 
     async def route(self, request: MessageRouterRequest, access: TableAccess) -> CipReply:

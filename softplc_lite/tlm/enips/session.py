@@ -16,7 +16,9 @@ import struct
 from ...cip import cpf, encap
 from ...cip.encap import EncapMessage
 from .access import TableAccess
+from ...cip.mr import MessageRouterResponse
 from .connmgr import CLASS_ID as CONNECTION_MANAGER
+from .connmgr import OWNER
 from .identity import Identity
 from .router import MessageRouter
 
@@ -33,6 +35,44 @@ class EncapSession:
 
     async def reply(self, message: EncapMessage) -> EncapMessage | None:
         """The reply to one message, or None (NOP and UnRegisterSession get none)."""
+        token = OWNER.set(self)  # the CIP connections this message opens are this session's
+        try:
+            return await self._reply(message)
+        finally:
+            OWNER.reset(token)
+
+    def close(self) -> int:
+        """The TCP connection ended: the CIP connections it opened close with
+        it (CIP Volume 2, 2-5.3); how many."""
+        self.session = 0
+        manager = self.router.objects.get(CONNECTION_MANAGER)
+        return manager.close_owned(self) if manager is not None else 0
+
+    def refusal(self, message: EncapMessage, general_status: int) -> EncapMessage:
+        """The reply that refuses ``message`` before it is served (a busy
+        server): a Message Router reply with ``general_status`` where the
+        message carries a CIP request, else the encapsulation status
+        "insufficient memory" (0x0002: the one an encapsulation layer has
+        for a receiver that cannot take a command now)."""
+        items = _items(message) if message.command in (encap.SEND_RR_DATA, encap.SEND_UNIT_DATA) else None
+        if not items or len(items) != 2 or not self.session or message.session != self.session:
+            return message.reply(status=encap.INSUFFICIENT_MEMORY)
+        address, data = items
+        service = (data.data[2 if message.command == encap.SEND_UNIT_DATA else 0:][:1] or b"\x00")[0]
+        response = MessageRouterResponse(service | 0x80, general_status).encode()
+        if message.command == encap.SEND_RR_DATA:
+            return message.reply(message.data[:6] + cpf.encode([cpf.Item(cpf.NULL_ADDRESS),
+                                                                cpf.Item(cpf.UNCONNECTED_DATA, response)]))
+        manager = self.router.objects.get(CONNECTION_MANAGER)
+        o_t_id = struct.unpack("<I", address.data)[0] if len(address.data) == 4 else 0
+        connection = manager.connections.get(o_t_id) if manager is not None else None
+        if connection is None or manager.owners.get(o_t_id) is not self:
+            return message.reply(status=encap.INCORRECT_DATA)
+        return message.reply(message.data[:6] + cpf.encode([
+            cpf.Item(cpf.CONNECTED_ADDRESS, struct.pack("<I", connection[0])),
+            cpf.Item(cpf.CONNECTED_DATA, data.data[:2] + response)]))
+
+    async def _reply(self, message: EncapMessage) -> EncapMessage | None:
         command = message.command
         if command == encap.NOP:
             return None
@@ -78,7 +118,7 @@ class EncapSession:
             return message.reply(status=encap.INCORRECT_DATA)
         manager = self.router.objects.get(CONNECTION_MANAGER)
         o_t_id = struct.unpack("<I", items[0].data)[0]
-        connection = manager.alive(o_t_id) if manager is not None else None
+        connection = manager.alive(o_t_id, self) if manager is not None else None
         if connection is None:
             return message.reply(status=encap.INCORRECT_DATA)
         response = await self.router.handle(items[1].data[2:], self.access)
