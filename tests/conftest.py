@@ -128,6 +128,17 @@ def tcp_apps(tmp_path):
 
 
 @pytest.fixture
+def enips_apps(tmp_path):
+    """ENIPS apps started by the test (tests/helpers/enips_apps.py), each
+    stopped after it with its server process."""
+    from helpers.enips_apps import EnipApps
+
+    apps = EnipApps(tmp_path)
+    yield apps
+    apps.close()
+
+
+@pytest.fixture
 def tcp_plc(tcp_apps):
     """A MODBTCPS runtime of tests/helpers/modbtcps_apps.UNIT_1 on a free port."""
     return tcp_apps.start()

@@ -64,16 +64,17 @@ def raw_request(port: int, pdu: bytes, unit: int = 1) -> bytes:
 class Running:
     """A runner scanning in a background thread until ``stop``."""
 
-    def __init__(self, app_dir: Path, realtime: bool = True, scan_ms: int | None = None) -> None:
+    def __init__(self, app_dir: Path, realtime: bool = True, scan_ms: int | None = None,
+                 module: str = "MODBTCPS") -> None:
         app = load_app(app_dir)
         if scan_ms is not None:
             app.settings.scan_ms = scan_ms
         self.runner = Runner(app, RunOptions(realtime=realtime, save_state=False))
         self.engine = self.runner.engine
-        self.module = next(m for m in self.engine.modules if m.name == "MODBTCPS")
+        self.module = next(m for m in self.engine.modules if m.name == module)
         self.error: BaseException | None = None
         self.stopped = False
-        self.thread = threading.Thread(target=self._run, name="modbtcps-test-runner", daemon=True)
+        self.thread = threading.Thread(target=self._run, name=f"{module.lower()}-test-runner", daemon=True)
         self.thread.start()
         self.module.wait_until_listening(LIMIT_S)  # the first scan starts the server: the test starts with it up
 
@@ -124,10 +125,13 @@ class Apps:
 
     def start(self, xml: str | None = None, ladder: str = "ADD N11:0 1 N11:0\n", **kw) -> Running:
         self.count += 1
-        app = write_app(self.tmp_path / f"app{self.count}", xml or server_xml(), ladder)
+        app = self.write(self.tmp_path / f"app{self.count}", xml, ladder)
         r = Running(app, **kw)
         self.running.append(r)
         return r
+
+    def write(self, directory: Path, xml: str | None, ladder: str) -> Path:
+        return write_app(directory, xml or server_xml(), ladder)
 
     def close(self) -> None:
         for r in self.running:

@@ -1,0 +1,154 @@
+"""ENIPS.XML: the EtherNet/IP server's configuration (docs/enips.md, "The
+configuration file: ENIPS.XML").
+
+There is no SoftPLC manual for this module: the file is softplc_lite's own,
+in MODBTCPS.XML's style and checked by the same machinery (tlm/xmlcheck.py,
+tlm/netconfig.py): every problem at once, each with file, line, column and
+what was expected; unknown elements and attributes are errors.
+
+Every data file is readable (a PLC-5 or SLC on a network serves its whole
+table); a client may write only the elements a ``<Writable>`` names. The
+result is a ``ServerConfig``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ...datatable import DataTableError, parse_address
+from ...datatable.address import Address
+from ...datatable.filetypes import MAX_ELEMENTS
+from ...textfile import read_bytes
+from ..api import find_file
+from ..errors import ModuleError, ModuleErrors
+from ..netconfig import ALLOW, check_allow, check_host, check_status, listen_attributes, listen_warning
+from ..xmlcheck import MANY, Attr, XmlChecker
+
+CONFIG_FILE = "ENIPS.XML"
+ROOT = "EtherNetIpServer"
+PORT = 44818  # EtherNet/IP's registered port (CIP Volume 2, 2-2), TCP and UDP
+STATUS_WORDS = 16
+MAX_CIP_CONNECTIONS = 32  # a ControlLogix L6x's class-3 connection count: a choice
+
+
+@dataclass(frozen=True)
+class Writable:
+    """``count`` elements from ``address`` that clients may write."""
+
+    address: Address  # an element of a file (N7:0, T4:0, ST9:0)
+    count: int
+    line: int
+    column: int
+
+    @property
+    def file(self) -> str:
+        return f"{self.address.type_letter}{self.address.file}"
+
+    @property
+    def last(self) -> int:
+        return self.address.element + self.count - 1
+
+
+@dataclass(frozen=True)
+class ServerConfig:
+    path: str = CONFIG_FILE
+    host: str = "127.0.0.1"
+    port: int = PORT
+    allow: tuple = ()  # ipaddress networks; parse_config fills the default loopback pair
+    max_connections: int = 32
+    max_requests_per_second: int = 1000
+    idle_timeout_ms: int = 60_000
+    max_cip_connections: int = MAX_CIP_CONNECTIONS
+    list_identity_udp: bool = True
+    status: Address | None = None
+    debug: int = 0
+    writable: tuple[Writable, ...] = ()
+    warnings: list[str] = field(default_factory=list)
+
+
+ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
+    ROOT: (*listen_attributes(PORT, 32, 1000, STATUS_WORDS),
+           Attr("maxCipConnections", 1, 1000, default=MAX_CIP_CONNECTIONS),
+           Attr("udpListIdentity", choices=("yes", "no"), default="yes")),
+    "Allow": ALLOW,
+    "Writable": (Attr("address", text=True, required=True,
+                      what="the first element clients may write (N7:0, B3:2, F8:0, T4:0, ST9:0)"),
+                 Attr("count", 1, MAX_ELEMENTS, default=1)),
+}
+
+
+def _check_writable(c: XmlChecker, node, status: Address | None, status_line: int) -> Writable | None:
+    a = c.attributes(node)
+    c.children(node, [])
+    if "address" not in a:
+        return None
+    text = a["address"]
+    try:
+        address = parse_address(text)
+    except DataTableError as e:
+        c.error(node, f"address={text!r}: {getattr(e, 'message', str(e))}", "address")
+        return None
+    if not address.is_direct or address.bit is not None or address.member is not None:
+        c.error(node, f"address={text!r}: expected a whole element (N7:0, T4:0, ST9:0): a client may write every "
+                      "word and bit of the elements a <Writable> names", "address")
+        return None
+    count = a.get("count", 1)
+    if address.element + count > MAX_ELEMENTS:
+        c.error(node, f"count={count}: {count} elements from {address} run past the end of a file (elements "
+                      f"0..{MAX_ELEMENTS - 1})", "count")
+        return None
+    region = Writable(address, count, node.line, node.column)
+    if status is not None and (status.type_letter, status.file) == (address.type_letter, address.file) \
+            and address.element <= status.element + STATUS_WORDS - 1 and status.element <= region.last:
+        c.error(node, f"<Writable> {address}..{address.with_element(region.last)} covers the status words "
+                      f"{status}..{status.with_element(status.element + STATUS_WORDS - 1)} (status= on line "
+                      f"{status_line}): a client must not write the server's counters", "address")
+        return None
+    return region
+
+
+def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
+    """Check ENIPS.XML's bytes; ModuleErrors listing every problem."""
+    c = XmlChecker(path, ATTRIBUTES, ROOT, ("Allow", "Writable"))
+    root = c.read_root(data, "docs/enips.md")
+    a = c.attributes(root)
+    host = check_host(c, root, a)
+    status = check_status(c, root, a["status"], STATUS_WORDS) if "status" in a else None
+    allow_nodes, writable_nodes = c.children(root, [("Allow", 0, MANY), ("Writable", 0, MANY)])
+    allow = check_allow(c, allow_nodes)
+    writable = [w for w in (_check_writable(c, node, status, root.line) for node in writable_nodes) if w]
+    if c.problems:
+        raise ModuleErrors(c.found())
+    return ServerConfig(path=path, host=host, port=a.get("port", PORT), allow=allow,
+                        max_connections=a.get("maxConnections", 32),
+                        max_requests_per_second=a.get("maxRequestsPerSecond", 1000),
+                        idle_timeout_ms=a.get("idleTimeout", 60_000),
+                        max_cip_connections=a.get("maxCipConnections", MAX_CIP_CONNECTIONS),
+                        list_identity_udp=a.get("udpListIdentity", "yes") == "yes", status=status,
+                        debug=a.get("debug", 0), writable=tuple(writable),
+                        warnings=listen_warning(path, root, host, bool(allow_nodes)))
+
+
+def load_config(app_dir: Path) -> ServerConfig:
+    path = find_file(app_dir, CONFIG_FILE)
+    if path is None:
+        raise ModuleError(f"ENIPS is enabled in MODULES.LST but {app_dir / CONFIG_FILE} does not exist: it "
+                          f"holds the <{ROOT}> configuration (the address and port to listen on, the clients "
+                          "allowed, and the elements clients may write; docs/enips.md)")
+    try:
+        data = read_bytes(path)
+    except OSError as e:
+        raise ModuleError(str(e)) from None
+    return parse_config(data, str(path))
+
+
+def config_references(config: ServerConfig) -> list[Address]:
+    """The first and last element of every writable region and of the
+    status block, so that the engine creates them before the first scan."""
+    found: list[Address] = []
+    for w in config.writable:
+        found += [w.address, w.address.with_element(w.last)]
+    if config.status is not None:
+        found += [config.status, config.status.with_element(config.status.element + STATUS_WORDS - 1)]
+    return found

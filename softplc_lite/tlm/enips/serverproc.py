@@ -1,0 +1,10 @@
+"""The ENIPS server process (``python -m softplc_lite.tlm.enips.serverproc
+OUT_FD IMAGE_FD``): the network-server layer's process (netserver/process.py),
+under a name that says whose it is; handler.py serves the requests."""
+
+import sys
+
+from ...netserver.process import main
+
+if __name__ == "__main__":
+    sys.exit(main())

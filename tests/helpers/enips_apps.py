@@ -1,0 +1,94 @@
+"""Building ENIPS apps for tests: an app directory with MODULES.LST,
+ENIPS.XML and a ladder file, scanned by a Runner in a thread of the test
+process (the server is its own process either way), stopped and closed
+after the test; and a few raw EtherNet/IP exchanges on a socket, for what
+no client library sends."""
+
+from __future__ import annotations
+
+import socket
+import struct
+from pathlib import Path
+
+from softplc_lite.cip import cpf, encap
+from softplc_lite.cip.encap import EncapMessage
+from softplc_lite.cip.mr import MessageRouterRequest, MessageRouterResponse
+
+from helpers.apps import make_app
+from helpers.modbtcps_apps import LIMIT_S, Apps, Running
+from helpers.modbus_peer import free_tcp_port
+
+# An HMI-facing table: symbols over N7, F8, T4, ST9, and some of it writable.
+LADDER = """SYMBOL COUNT N7:5
+SYMBOL SPEED F8:1
+SYMBOL NOTE ST9:0
+SYMBOL RUN B3:0/4
+SYMBOL DWELL T4:0
+ADD N7:5 1 N7:5
+XIC B3:0/4 OTE O:0/1
+TON T4:0 0.01 500 0
+MOV N7:1 N11:0
+"""
+WRITABLE = """  <Writable address="N7:0" count="5"/>
+  <Writable address="F8:0" count="4"/>
+  <Writable address="B3:0" count="2"/>
+  <Writable address="ST9:0"/>
+  <Writable address="T4:0"/>
+  <Writable address="L12:0" count="2"/>
+"""
+REFERENCES = "MOV N7:49 N7:45\nMOV F8:9 F8:8\nMOV ST9:3.LEN N7:48\nMOV L12:9 L12:8\nMOV N11:99 N7:47\n"
+
+
+def enips_xml(body: str = WRITABLE, port: int | None = None, **root: object) -> str:
+    attrs = {"port": port or free_tcp_port(), "status": "N40:0", **root}
+    text = " ".join(f'{k}="{v}"' for k, v in attrs.items())
+    return f'<?xml version="1.0"?>\n<EtherNetIpServer {text}>\n{body}</EtherNetIpServer>\n'
+
+
+class EnipApps(Apps):
+    """ENIPS apps started by a test, each stopped after it."""
+
+    def write(self, directory: Path, xml: str | None, ladder: str) -> Path:
+        return make_app(directory, ladder, MODULES_LST="ENIPS\n", ENIPS_XML=xml or enips_xml())
+
+    def start(self, xml: str | None = None, ladder: str = LADDER + REFERENCES, **kw) -> Running:
+        return super().start(xml, ladder, module="ENIPS", **kw)
+
+
+def exchange(sock: socket.socket, message: EncapMessage) -> EncapMessage:
+    """Send one message, receive its whole reply."""
+    sock.sendall(message.encode())
+    return receive(sock)
+
+
+def receive(sock: socket.socket) -> EncapMessage:
+    data = b""
+    while len(data) < encap.HEADER_SIZE or len(data) < encap.HEADER_SIZE + struct.unpack_from("<H", data, 2)[0]:
+        chunk = sock.recv(65536)
+        assert chunk, "the server closed the connection"
+        data += chunk
+    return EncapMessage.decode(data)
+
+
+def register(sock: socket.socket) -> int:
+    reply = exchange(sock, EncapMessage(encap.REGISTER_SESSION, struct.pack("<HH", 1, 0)))
+    assert reply.status == encap.SUCCESS and reply.session
+    return reply.session
+
+
+def unconnected(sock: socket.socket, session: int, service: int, path: bytes,
+                data: bytes = b"") -> tuple[EncapMessage, MessageRouterResponse | None]:
+    """One Message Router request by SendRRData: the encapsulation reply, and
+    the Message Router response it holds (None if it holds none)."""
+    body = struct.pack("<IH", 0, 10) + cpf.encode([cpf.Item(cpf.NULL_ADDRESS), cpf.Item(
+        cpf.UNCONNECTED_DATA, MessageRouterRequest(service, path, data).encode())])
+    reply = exchange(sock, EncapMessage(encap.SEND_RR_DATA, body, session=session))
+    if reply.status != encap.SUCCESS:
+        return reply, None
+    items = cpf.decode(reply.data[6:])
+    return reply, MessageRouterResponse.decode(items[1].data)
+
+
+def connect(port: int, source: str = "127.0.0.1") -> socket.socket:
+    sock = socket.create_connection(("127.0.0.1", port), timeout=LIMIT_S, source_address=(source, 0))
+    return sock
