@@ -92,3 +92,23 @@ def unconnected(sock: socket.socket, session: int, service: int, path: bytes,
 def connect(port: int, source: str = "127.0.0.1") -> socket.socket:
     sock = socket.create_connection(("127.0.0.1", port), timeout=LIMIT_S, source_address=(source, 0))
     return sock
+
+
+def forward_open(sock: socket.socket, session: int, serial: int, rpi_us: int = 2_000_000,
+                 multiplier: int = 1) -> MessageRouterResponse:
+    """A Forward_Open (CIP Vol. 1, 3-5.5.2) to the Message Router by
+    SendRRData, connection serial ``serial``; our O->T id is the reply's
+    first four bytes."""
+    data = struct.pack("<BBIIHHIB3xIHIHB", 0x0A, 0x05, 0, 0x7700 + serial, serial, 1, 9, multiplier, rpi_us, 0x43F4,
+                       rpi_us, 0x43F4, 0xA3)
+    data += bytes((2,)) + bytes.fromhex("20022401")
+    return unconnected(sock, session, 0x54, bytes.fromhex("20062401"), data)[1]
+
+
+def connected(sock: socket.socket, session: int, o_t_id: int, service: int, path: bytes,
+              sequence: int = 1) -> EncapMessage:
+    """One Message Router request by SendUnitData on connection ``o_t_id``."""
+    body = struct.pack("<IH", 0, 0) + cpf.encode([
+        cpf.Item(cpf.CONNECTED_ADDRESS, struct.pack("<I", o_t_id)),
+        cpf.Item(cpf.CONNECTED_DATA, struct.pack("<H", sequence) + MessageRouterRequest(service, path).encode())])
+    return exchange(sock, EncapMessage(encap.SEND_UNIT_DATA, body, session=session))
