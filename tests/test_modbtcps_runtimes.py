@@ -9,7 +9,6 @@ which prints its --print values, and said how many scans were late."""
 from __future__ import annotations
 
 import os
-import re
 import shutil
 import signal
 import subprocess
@@ -23,45 +22,12 @@ from pymodbus.client import ModbusTcpClient
 
 from helpers.modbtcps_apps import LIMIT_S, server_xml, write_app
 from helpers.modbus_peer import free_tcp_port, wait_for_tcp
+from helpers.runtimes import Runtime, late_scans, printed, prints, wait_for_a_client
 
 pytestmark = pytest.mark.timeout(120)
 PROGRAMS = Path(__file__).resolve().parent.parent / "programs"
 CLIENTS = 20
 SECONDS = 10.0
-
-
-class Runtime:
-    """``softplc run APP --realtime`` until ``stop``: (stdout, stderr)."""
-
-    def __init__(self, app: Path, *args: str) -> None:
-        self.proc = subprocess.Popen([sys.executable, "-m", "softplc_lite", "run", str(app), "--realtime",
-                                      "--fresh", *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                                     text=True)
-
-    def stop(self) -> tuple[str, str]:
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGTERM)
-        try:
-            out, err = self.proc.communicate(timeout=LIMIT_S)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            out, err = self.proc.communicate()
-        assert self.proc.returncode == 0, err
-        return out, err
-
-
-def prints(addresses: list[str]) -> list[str]:
-    return [arg for a in addresses for arg in ("--print", a)]
-
-
-def printed(stdout: str) -> dict[str, str]:
-    return dict(line.split(" = ", 1) for line in stdout.splitlines() if " = " in line)
-
-
-def late_scans(stderr: str) -> tuple[int, int]:
-    m = re.search(r": (\d+) late scans? of (\d+),", stderr)
-    assert m, stderr
-    return int(m.group(1)), int(m.group(2))
 
 
 @pytest.mark.alone  # counts late real-time scans (docs/testing.md)
@@ -119,18 +85,6 @@ MBAP_STRINGS = """\
 4 "\\x00\\x01\\x00\\x00\\x00\\x17\\x01\\x03\\x14%.20C"
 5 "\\x00\\x01\\x00\\x00\\x00\\x03\\x01\\x83%c"
 """
-
-
-def wait_for_a_client(port: int) -> None:
-    """Until a connection to 127.0.0.1:``port`` is established (Linux's
-    /proc/net/tcp; elsewhere at once)."""
-    table = Path("/proc/net/tcp")
-    deadline = time.monotonic() + LIMIT_S
-    while table.exists() and time.monotonic() < deadline:
-        rows = [line.split() for line in table.read_text().splitlines()[1:]]
-        if any(row[2] == f"0100007F:{port:04X}" and row[3] == "01" for row in rows):  # remote, ESTABLISHED
-            return
-        time.sleep(0.05)
 
 
 def test_one_runtime_polls_another_with_comgenius_over_socket(tmp_path):
