@@ -230,3 +230,33 @@ def test_softplc_watch_shows_the_server_in_a_real_terminal(tmux, tmp_path, clien
     client.close()
     tmux.keys("q")
     assert tmux.wait_gone(), "q did not end softplc watch"
+
+
+def test_both_servers_of_an_app_each_in_its_row(tmp_path):
+    """An app with MODBTCPS and ENIPS: each server its own row, ENIPS's
+    refusals by EtherNet/IP's kinds."""
+    from pylogix import PLC
+
+    from helpers.apps import make_app
+    from helpers.enips_apps import enips_xml
+
+    app = make_app(tmp_path / "both", "ADD N11:0 1 N11:0\nMOV N7:19 N7:18\n", MODULES_LST="MODBTCPS\nENIPS\n",
+                   MODBTCPS_XML=server_xml(), ENIPS_XML=enips_xml(""))
+    plc = Running(app, module="ENIPS")
+    try:
+        modbus_server = next(m for m in plc.engine.modules if m.name == "MODBTCPS")
+        assert modbus_server.wait_until_listening(LIMIT_S)
+        with PLC("127.0.0.1") as comm:
+            comm.Port = plc.port
+            assert comm.Write("N11[0]", 5).Status == "Privilege violation"
+            plc.wait_for(lambda: plc.module.server_status().refusals == 1 and plc.module.server_status().clients,
+                         "the refusal and the client")
+            plc.wait_for(lambda: "starting" not in shown(plc.engine, 110), "both servers' READY read by the scan")
+            table = shown(plc.engine, 110)
+        (modbus,) = lines_with(table, "MODBTCPS")
+        (enip,) = lines_with(table, "ENIPS")
+        assert f"ENIPS 127.0.0.1:{plc.port} up" in enip and "1 (read-only 1)" in enip
+        assert [c.strip() for c in enip.split("│")][1] == "1"  # pylogix's connection
+        assert "up" in modbus and "refusals" not in modbus
+    finally:
+        plc.stop()
