@@ -12,6 +12,8 @@ from pylogix import PLC
 
 from softplc_lite.tlm.enips import status as S
 
+from helpers.enips_apps import enips_xml
+
 pytestmark = pytest.mark.timeout(120)
 
 
@@ -114,3 +116,39 @@ def test_pylogix_reads_writes_and_browses(plc):
         tags = comm.GetTagList()
         assert tags.Status == "Success"
         assert {"N7", "COUNT"} <= {t.TagName for t in tags.Value}
+
+
+EVERY_FILE = """  <Writable address="O:0"/>
+  <Writable address="I:0"/>
+  <Writable address="S:30"/>
+  <Writable address="B3:1"/>
+  <Writable address="T4:1"/>
+  <Writable address="C5:0"/>
+  <Writable address="R6:0"/>
+  <Writable address="N7:0"/>
+  <Writable address="F8:0"/>
+  <Writable address="ST9:1"/>
+  <Writable address="L12:0"/>
+  <Writable address="A13:0"/>
+  <Writable address="D14:0"/>
+"""
+# (tag, its address in the table, a value to write)
+EVERY_KIND = [("O0[0]", "O:0", 0x55), ("I1[0]", "I:0", -2), ("S2[30]", "S:30", 7), ("B3[1]", "B3:1", 0x0F0F),
+              ("B3[1].9", "B3:1/9", True), ("T4[1].ACC", "T4:1.ACC", 123), ("C5[0].PRE", "C5:0.PRE", 40),
+              ("R6[0].LEN", "R6:0.LEN", 12), ("N7[0]", "N7:0", -32768), ("F8[0]", "F8:0", -0.5),
+              ("ST9[1]", "ST9:1", "ok"), ("L12[0]", "L12:0", -2_000_000), ("A13[0]", "A13:0", 0x4142),
+              ("D14[0]", "D14:0", 0x1234)]
+
+
+def test_every_file_type_is_written_and_read_back_by_pylogix(enips_apps):
+    plc = enips_apps.start(enips_xml(EVERY_FILE),
+                           ladder="DATA A13 4\nDATA D14 4\nDATA C5 2\nDATA R6 2\nDATA L12 2\nDATA ST9 2\n"
+                                  "DATA T4 2\nDATA B3 2\nMOV N7:1 N7:2\n")
+    with PLC("127.0.0.1") as comm:
+        comm.Port = plc.port
+        for tag, address, value in EVERY_KIND:
+            written = comm.Write(tag, value)
+            assert written.Status == "Success", (tag, written.Status)
+            expected = int(value) if isinstance(value, bool) else value
+            assert plc.read(address) == expected, tag
+            assert comm.Read(tag).Value == value, tag
