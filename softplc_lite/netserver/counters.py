@@ -27,6 +27,24 @@ PORT = 10  # the port it listens on
 OWN = 11  # the first of the protocol's own counters
 COUNTERS = 16
 
+# The status words every protocol's block has at the same offsets (its own
+# kinds of refusal take 8..11, and 15).
+W_BITS = 0  # /0 listening, /1 server failed, /2 a client is connected
+W_CONNECTED = 1
+W_RATE = 2  # requests answered in the last whole second
+W_REQUESTS = 3
+W_WRITES_APPLIED = 4
+W_REFUSED_NETWORK = 5
+W_REFUSED_LIMIT = 6
+W_REFUSED_RATE = 7
+W_MALFORMED = 12
+W_IDLE = 13
+W_REFUSALS = 14  # the sum of words 5..13
+STATUS_WORDS = 16
+COMMON_COPIED = ((W_CONNECTED, CONNECTED), (W_REQUESTS, REQUESTS), (W_REFUSED_NETWORK, REFUSED_NETWORK),
+                 (W_REFUSED_LIMIT, REFUSED_LIMIT), (W_REFUSED_RATE, REFUSED_RATE), (W_MALFORMED, MALFORMED),
+                 (W_IDLE, IDLE))
+
 # The bits of a status block's first word.
 BIT_LISTENING = 1
 BIT_FAILED = 2

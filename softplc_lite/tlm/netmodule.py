@@ -5,9 +5,17 @@ builds its handle in ``attach`` and sets ``self.server``."""
 
 from __future__ import annotations
 
-from ..netserver import ServerHandle, ServerStatus
+from ..netserver import Protocol, ServerHandle, ServerStatus, Settings, StatusWords
 from ..netserver.handle import START_TIMEOUT_S
 from .api import TLM
+
+
+def settings_of(config) -> Settings:
+    """The layer's settings from a server module's configuration (the
+    fields tlm/netconfig.py checks)."""
+    return Settings(host=config.host, port=config.port, allow=config.allow, max_connections=config.max_connections,
+                    max_requests_per_second=config.max_requests_per_second,
+                    idle_timeout_ms=config.idle_timeout_ms, debug=config.debug)
 
 
 def _of_server(name: str, default=None) -> property:
@@ -17,7 +25,22 @@ def _of_server(name: str, default=None) -> property:
 
 
 class NetServerModule(TLM):
+    """A module's ``config`` has the listening fields (tlm/netconfig.py) and
+    ``status``; its ``attach`` builds its protocol and calls ``serve``."""
+
     server: ServerHandle | None = None
+    config = None
+
+    def reference_config(self, table) -> None:
+        """Create the words the configuration names before the first scan."""
+        for address in self.config_references():
+            table.reference(address)
+
+    def serve(self, table, protocol: Protocol, where: str, status_words: StatusWords) -> None:
+        """Hold the server of ``protocol`` over ``table`` (started by the
+        first scan); ``where`` names what to check when it cannot listen."""
+        self.server = ServerHandle(protocol, settings_of(self.config), self.log, where, status_words)
+        self.server.attach(table, self.config.status)
 
     image = _of_server("image")
     process = _of_server("process")

@@ -18,12 +18,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-from ...netserver import ServerHandle
 from ..netmodule import NetServerModule
 from . import status as S
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config
 from .identity import Identity
-from .protocol import EnipProtocol, build_slots, settings_of
+from .protocol import EnipProtocol, build_slots
 from .tagnames import symbol_addresses
 
 WHERE = "ENIPS.XML address and port; docs/enips.md"
@@ -38,7 +37,7 @@ class EnipServer(NetServerModule):
         self.config = config or ServerConfig()
         self.app_name = "APP"
         self.engine = None
-        self.server: ServerHandle | None = None
+        self.server = None
 
     # -- configuration ----------------------------------------------------------------------
     def configure(self, app_dir: Path | None) -> list[str]:
@@ -54,11 +53,9 @@ class EnipServer(NetServerModule):
     def attach(self, engine, options: Mapping[str, object]) -> list[str]:
         self.engine = engine
         table = engine.table
-        for address in self.config_references():
-            table.reference(address)
+        self.reference_config(table)
         program = getattr(engine, "program", None)
         symbols = symbol_addresses(program.symbols) if program is not None else {}
         protocol = EnipProtocol(self.config, build_slots(table, self.config), Identity(self.app_name), symbols)
-        self.server = ServerHandle(protocol, settings_of(self.config), self.log, WHERE, S.LAYOUT)
-        self.server.attach(table, self.config.status)
+        self.serve(table, protocol, WHERE, S.LAYOUT)
         return []

@@ -14,7 +14,7 @@ import struct
 from array import array
 from dataclasses import dataclass
 
-from ...netserver import APPLIED, REFUSED, Protocol, Settings
+from ...netserver import APPLIED, REFUSED, Protocol
 from ...netserver.image import Segments
 from .access import FileInfo
 from .config import ServerConfig
@@ -77,12 +77,6 @@ def write_payload(number: int, first: int, items: array) -> bytes:
 
 def mask_payload(number: int, index: int, and_mask: int, or_mask: int) -> bytes:
     return MASK + _MASK.pack(number, index, and_mask & 0xFFFF, or_mask & 0xFFFF)
-
-
-def settings_of(config: ServerConfig) -> Settings:
-    return Settings(host=config.host, port=config.port, allow=config.allow, max_connections=config.max_connections,
-                    max_requests_per_second=config.max_requests_per_second,
-                    idle_timeout_ms=config.idle_timeout_ms, debug=config.debug)
 
 
 class EnipProtocol(Protocol):

@@ -8,7 +8,9 @@ at the same offsets where they mean the same.
 
 from __future__ import annotations
 
-from ...netserver.counters import (  # noqa: F401 - the counters by name, for the tests and the benchmarks
+from ...netserver.counters import (  # noqa: F401 - the counters and words by name, for the tests and the benchmarks
+    COMMON_COPIED, STATUS_WORDS, W_BITS, W_CONNECTED, W_IDLE, W_MALFORMED, W_RATE, W_REFUSALS, W_REFUSED_LIMIT,
+    W_REFUSED_NETWORK, W_REFUSED_RATE, W_REQUESTS, W_WRITES_APPLIED,
     CONNECTED, CONNECTIONS, IDLE, MALFORMED, OWN, REFUSED_LIMIT, REFUSED_NETWORK, REFUSED_RATE, REQUESTS, WRITES,
     StatusWords)
 
@@ -19,29 +21,15 @@ PCCC_ERRORS = OWN + 2  # Execute PCCC replies with a STS other than 0
 READ_ONLY = OWN + 3  # writes refused because no <Writable> covers them (CIP 0x0F, PCCC STS 0xF0 EXT 0x0B)
 TIMED_OUT = OWN + 4  # CIP connections closed by their RPI timeout (not a refusal)
 
-# Status words (offsets in the status block).
-W_BITS = 0  # /0 listening, /1 server failed, /2 a client is connected
-W_CONNECTED = 1
-W_RATE = 2  # requests answered in the last whole second
-W_REQUESTS = 3
-W_WRITES_APPLIED = 4
-W_REFUSED_NETWORK = 5
-W_REFUSED_LIMIT = 6
-W_REFUSED_RATE = 7
+# Status words (offsets in the status block): the layer's (netserver.counters), and these.
 W_ENCAP_ERRORS = 8
 W_CIP_ERRORS = 9
 W_PCCC_ERRORS = 10
 W_READ_ONLY = 11
-W_MALFORMED = 12
-W_IDLE = 13
-W_REFUSALS = 14  # the sum of words 5..13
 W_TIMED_OUT = 15
-STATUS_WORDS = 16
 
-COPIED = ((W_CONNECTED, CONNECTED), (W_REQUESTS, REQUESTS), (W_REFUSED_NETWORK, REFUSED_NETWORK),
-          (W_REFUSED_LIMIT, REFUSED_LIMIT), (W_REFUSED_RATE, REFUSED_RATE), (W_ENCAP_ERRORS, ENCAP_ERRORS),
-          (W_CIP_ERRORS, CIP_ERRORS), (W_PCCC_ERRORS, PCCC_ERRORS), (W_READ_ONLY, READ_ONLY),
-          (W_MALFORMED, MALFORMED), (W_IDLE, IDLE), (W_TIMED_OUT, TIMED_OUT))
+COPIED = COMMON_COPIED + ((W_ENCAP_ERRORS, ENCAP_ERRORS), (W_CIP_ERRORS, CIP_ERRORS), (W_PCCC_ERRORS, PCCC_ERRORS),
+                          (W_READ_ONLY, READ_ONLY), (W_TIMED_OUT, TIMED_OUT))
 REFUSAL_NAMES = (("not allowed", REFUSED_NETWORK), ("connection limit", REFUSED_LIMIT), ("rate limit", REFUSED_RATE),
                  ("encapsulation", ENCAP_ERRORS), ("CIP status", CIP_ERRORS), ("PCCC status", PCCC_ERRORS),
                  ("read-only", READ_ONLY), ("malformed", MALFORMED), ("idle", IDLE))

@@ -20,12 +20,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-from ...netserver import ServerHandle
 from ..netmodule import NetServerModule
 from . import status as C
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config
 from .layout import Layout
-from .protocol import ModbusProtocol, settings_of
+from .protocol import ModbusProtocol
 
 WHERE = "MODBTCPS.XML address and port; docs/modbtcps.md"
 
@@ -40,7 +39,7 @@ class ModbTcpServer(NetServerModule):
         self.config = config or ServerConfig()
         self.engine = None
         self.layout: Layout | None = None
-        self.server: ServerHandle | None = None
+        self.server = None
 
     # -- configuration ----------------------------------------------------------------------
     def configure(self, app_dir: Path | None) -> list[str]:
@@ -55,10 +54,7 @@ class ModbTcpServer(NetServerModule):
     def attach(self, engine, options: Mapping[str, object]) -> list[str]:
         self.engine = engine
         table = engine.table
-        for address in self.config_references():
-            table.reference(address)
+        self.reference_config(table)
         self.layout = Layout.build(self.config, table)
-        self.server = ServerHandle(ModbusProtocol(self.config, self.layout), settings_of(self.config), self.log,
-                                   WHERE, C.LAYOUT)
-        self.server.attach(table, self.config.status)
+        self.serve(table, ModbusProtocol(self.config, self.layout), WHERE, C.LAYOUT)
         return []

@@ -9,7 +9,7 @@ from __future__ import annotations
 import struct
 from array import array
 
-from ...netserver import APPLIED, IGNORED, REFUSED, Protocol, Settings
+from ...netserver import APPLIED, IGNORED, REFUSED, Protocol
 from ...netserver.image import Segments
 from .config import ServerConfig
 from .layout import Layout, string_lengths_fit
@@ -29,12 +29,6 @@ def write_payload(unit: int, kind: str, address: int, values: list[int]) -> byte
 
 def mask_payload(unit: int, address: int, and_mask: int, or_mask: int) -> bytes:
     return MASK + _MASK.pack(unit, address, and_mask, or_mask)
-
-
-def settings_of(config: ServerConfig) -> Settings:
-    return Settings(host=config.host, port=config.port, allow=config.allow, max_connections=config.max_connections,
-                    max_requests_per_second=config.max_requests_per_second,
-                    idle_timeout_ms=config.idle_timeout_ms, debug=config.debug)
 
 
 class ModbusProtocol(Protocol):

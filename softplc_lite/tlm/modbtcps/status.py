@@ -10,7 +10,9 @@ docs/modbtcps.md ("Status words").
 
 from __future__ import annotations
 
-from ...netserver.counters import (  # noqa: F401 - the counters by name, for the benchmarks and the tests
+from ...netserver.counters import (  # noqa: F401 - the counters and words by name, for the benchmarks and the tests
+    COMMON_COPIED, STATUS_WORDS, W_BITS, W_CONNECTED, W_IDLE, W_MALFORMED, W_RATE, W_REFUSALS, W_REFUSED_LIMIT,
+    W_REFUSED_NETWORK, W_REFUSED_RATE, W_REQUESTS, W_WRITES_APPLIED,
     BIT_CLIENT, BIT_FAILED, BIT_LISTENING, CONNECTED, CONNECTIONS, COUNTERS, IDLE, LISTENING, MALFORMED, OWN, PORT,
     REFUSED_LIMIT, REFUSED_NETWORK, REFUSED_RATE, REQUESTS, WRITES, StatusWords)
 
@@ -20,29 +22,15 @@ EXCEPTION_02 = OWN + 1  # illegal data address: outside the map, or not writable
 EXCEPTION_03 = OWN + 2  # illegal data value: a count out of range, a string length over 82
 EXCEPTION_0B = OWN + 3  # unit id not configured (gateway target did not respond)
 
-# Status words (offsets in the status block).
-W_BITS = 0  # /0 listening, /1 server failed, /2 a client is connected
-W_CONNECTED = 1
-W_RATE = 2  # requests answered in the last whole second
-W_REQUESTS = 3
-W_WRITES_APPLIED = 4
-W_REFUSED_NETWORK = 5
-W_REFUSED_LIMIT = 6
-W_REFUSED_RATE = 7
+# Status words (offsets in the status block): the layer's (netserver.counters), and these.
 W_EXCEPTION_02 = 8
 W_EXCEPTION_01 = 9
 W_EXCEPTION_03 = 10
 W_EXCEPTION_0B = 11
-W_MALFORMED = 12
-W_IDLE = 13
-W_REFUSALS = 14  # the sum of words 5..13
-STATUS_WORDS = 16
 
 # status word <- counter
-COPIED = ((W_CONNECTED, CONNECTED), (W_REQUESTS, REQUESTS), (W_REFUSED_NETWORK, REFUSED_NETWORK),
-          (W_REFUSED_LIMIT, REFUSED_LIMIT), (W_REFUSED_RATE, REFUSED_RATE), (W_EXCEPTION_02, EXCEPTION_02),
-          (W_EXCEPTION_01, EXCEPTION_01), (W_EXCEPTION_03, EXCEPTION_03), (W_EXCEPTION_0B, EXCEPTION_0B),
-          (W_MALFORMED, MALFORMED), (W_IDLE, IDLE))
+COPIED = COMMON_COPIED + ((W_EXCEPTION_02, EXCEPTION_02), (W_EXCEPTION_01, EXCEPTION_01),
+                          (W_EXCEPTION_03, EXCEPTION_03), (W_EXCEPTION_0B, EXCEPTION_0B))
 # every refusal, by the name the watch view gives it
 REFUSAL_NAMES = (("not allowed", REFUSED_NETWORK), ("connection limit", REFUSED_LIMIT), ("rate limit", REFUSED_RATE),
                  ("exception 01", EXCEPTION_01), ("exception 02", EXCEPTION_02), ("exception 03", EXCEPTION_03),
