@@ -63,6 +63,7 @@ def test_logix_writes_land_through_the_scan(plc, logix):
     assert plc.read("N7:1") == 42
     plc.wait_for(lambda: plc.read("N11:0") == 42, "the ladder using the written word")
     assert logix.write(("SPEED", 12.5), ("F8[3]", -1.0), ("L12[0]", -5)) and plc.read("F8:1") == 12.5
+    assert logix.write("F8[0]{4}", [0.25, 0.5, 0.75, 1.0]).error is None and plc.read("F8:2") == 0.75
     assert plc.read("F8:3") == -1.0 and plc.read("L12:0") == -5
     assert logix.write("NOTE", "check seal").error is None and plc.read("ST9:0") == "check seal"
     assert logix.write("RUN", True).error is None
@@ -70,15 +71,23 @@ def test_logix_writes_land_through_the_scan(plc, logix):
     assert logix.write("T4[0,1]", 900).error is None and plc.read("T4:0.PRE") == 900
 
 
-def test_a_long_run_is_read_and_written_in_fragments(plc, logix):
-    table = plc.engine.table
-    for k in range(100):
-        table.write(f"N11:{k}", k * 3)
-    plc.wait_for(lambda: logix.read("N11[99]").value == 297, "the published N11")
-    assert logix.read("N11[0]{100}").value == [k * 3 for k in range(100)]
-    floats = [k / 4 for k in range(4)]
-    assert logix.write("F8[0]{4}", floats).error is None
-    assert [plc.read(f"F8:{k}") for k in range(4)] == floats
+def test_a_long_run_is_read_and_written_in_fragments(enips_apps):
+    """3000 words (6000 bytes) are more than a reply holds (480 bytes here, a
+    Large_Forward_Open connection's 4002 bytes for pycomm3): pycomm3 reads
+    them with Read Tag Fragmented and writes them with Write Tag Fragmented,
+    pylogix reads them in pieces."""
+    words = 3000
+    plc = enips_apps.start(enips_xml(f'  <Writable address="N11:0" count="{words}"/>\n'),
+                           ladder=f"DATA N11 {words}\nMOV N7:0 N7:1\n")
+    values = [(k * 7) % 32768 for k in range(words)]
+    with LogixDriver(f"127.0.0.1:{plc.port}") as logix:
+        assert logix.write(f"N11[0]{{{words}}}", values).error is None
+        assert [plc.read(f"N11:{k}") for k in range(0, words, 97)] == values[::97]
+        assert plc.read(f"N11:{words - 1}") == values[-1]
+        assert logix.read(f"N11[0]{{{words}}}").value == values
+    with PLC("127.0.0.1") as comm:
+        comm.Port = plc.port
+        assert comm.Read("N11[2000]", 500).Value == values[2000:2500]
 
 
 def test_refusals_carry_the_status_clients_report(plc, logix):
