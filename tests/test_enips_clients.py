@@ -63,8 +63,8 @@ def test_logix_writes_land_through_the_scan(plc, logix):
     assert plc.read("N7:1") == 42
     plc.wait_for(lambda: plc.read("N11:0") == 42, "the ladder using the written word")
     assert logix.write(("SPEED", 12.5), ("F8[3]", -1.0), ("L12[0]", -5)) and plc.read("F8:1") == 12.5
-    assert logix.write("F8[0]{4}", [0.25, 0.5, 0.75, 1.0]).error is None and plc.read("F8:2") == 0.75
     assert plc.read("F8:3") == -1.0 and plc.read("L12:0") == -5
+    assert logix.write("F8[0]{4}", [0.25, 0.5, 0.75, 1.0]).error is None and plc.read("F8:2") == 0.75
     assert logix.write("NOTE", "check seal").error is None and plc.read("ST9:0") == "check seal"
     assert logix.write("RUN", True).error is None
     plc.wait_for(lambda: plc.read("O:0/1") == 1, "the output of the written bit")
