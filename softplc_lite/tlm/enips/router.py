@@ -18,13 +18,15 @@ from .access import TableAccess
 from .connmgr import ConnectionManager
 from .identity import IdentityObject
 from .objects import REPLY, CipObject, CipReply, CipRequest
+from .pccc_object import PcccObject
 
 MESSAGE_ROUTER_CLASS = 0x02
 MULTIPLE_SERVICE_PACKET = 0x0A
 
-# The served object classes, one factory each; the Identity, Connection
-# Manager, PCCC and tag objects register here as they are built.
-OBJECTS: list[Callable[[], CipObject]] = [IdentityObject, ConnectionManager]
+# The served object classes that need nothing of the app, one factory
+# each (the tag services, built on the app's symbols, are added by the
+# server: tlm/enips/handler.py).
+OBJECTS: list[Callable[[], CipObject]] = [IdentityObject, ConnectionManager, PcccObject]
 
 
 # Replies that are no refusal: success; a fragment with more to come; a
