@@ -2,7 +2,7 @@
 temporary directory without their ``.softplc`` state, so nothing is written
 inside the repository, and with every Modbus TCP server moved to a port
 found free, so a PLC already running on this machine (serving the shipped
-127.0.0.1:5020) does not stand in the way (docs/testing.md, "Isolation")."""
+127.0.0.1:5020, or 44818) does not stand in the way (docs/testing.md, "Isolation")."""
 
 from __future__ import annotations
 
@@ -15,21 +15,25 @@ from helpers.modbus_peer import free_tcp_port
 ROOT = Path(__file__).resolve().parents[2]
 PROGRAMS = ROOT / "programs"
 SHIPPED_PORT = 5020  # programs/hmi_server/MODBTCPS.XML
-SERVER_CONFIG = "MODBTCPS.XML"
-_PORT = re.compile(r'(<ModbusTcpServer\b[^>]*?\bport=")(\d+)(")')
+# Each network server's config file, and its root element (where its port is).
+SERVER_CONFIGS = {"MODBTCPS.XML": "ModbusTcpServer", "ENIPS.XML": "EtherNetIpServer"}
 
 
 def free_server_port(app_dir: Path) -> int | None:
-    """Moves the app's MODBTCPS server to a free port; the port, or None
-    for an app without one."""
-    config = app_dir / SERVER_CONFIG
-    if not config.exists():
-        return None
-    port = free_tcp_port()
-    text, n = _PORT.subn(lambda m: f"{m.group(1)}{port}{m.group(3)}", config.read_text(encoding="utf-8"), count=1)
-    assert n == 1, f"{config}: no port attribute to move"
-    config.write_text(text, encoding="utf-8")
-    return port
+    """Moves the app's network server (MODBTCPS or ENIPS) to a free port;
+    the port, or None for an app without one."""
+    for name, root in SERVER_CONFIGS.items():
+        config = app_dir / name
+        if not config.exists():
+            continue
+        port = free_tcp_port()
+        pattern = re.compile(rf'(<{root}\b[^>]*?\bport=")(\d+)(")')
+        text, n = pattern.subn(lambda m: f"{m.group(1)}{port}{m.group(3)}", config.read_text(encoding="utf-8"),
+                               count=1)
+        assert n == 1, f"{config}: no port attribute to move"
+        config.write_text(text, encoding="utf-8")
+        return port
+    return None
 
 
 def copy_app(name: str, dest: Path) -> Path:
