@@ -27,6 +27,10 @@ GET_ATTRIBUTES_ALL, GET_ATTRIBUTE_LIST, READ_TEMPLATE = 0x01, 0x03, 0x4C
 # follows a ';', and a predefined type's name may stand alone (pycomm3).
 STRING_TEMPLATE = (struct.pack("<HHI", 0, DINT, 0) + struct.pack("<HHI", STRING_CHARS, SINT, 4)
                    + b"ASCIISTRING82\x00LEN\x00DATA\x00")
+# A template's definition is whole 32-bit words, as Logix keeps it: padded,
+# so a client that rounds the definition's size up to words (pylogix) reads
+# it in one request and none past its end.
+STRING_TEMPLATE += bytes(-len(STRING_TEMPLATE) % 4)
 # Attribute 4 counts 32-bit words of the definition plus the 23 bytes a
 # Logix template read adds (pycomm3 asks size * 4 - 21 bytes, so no less).
 DEFINITION_WORDS = (len(STRING_TEMPLATE) + 23) // 4
