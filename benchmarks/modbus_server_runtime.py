@@ -1,7 +1,11 @@
 """The runtime of bench_modbus_server.py: a softplc app with MODBTCPS,
 scanning in real time, every scan timed from inside.
 
-    python benchmarks/modbus_server_runtime.py APP_DIR OUT_JSON [NICE]
+    python benchmarks/modbus_server_runtime.py APP_DIR OUT_JSON [NICE [MODULES]]
+
+MODULES: the server modules whose hooks are timed, comma-separated
+(MODBTCPS by default; bench_enips_server.py times ENIPS and MODBTCPS of one
+app, each apart).
 
 Builds the Runner ``softplc run APP --realtime --fresh`` builds (real-time
 clock, the app's own scan period, no retentive saves), at the priority NICE
@@ -66,36 +70,48 @@ class ScanRecords:
         self.hooks_this_scan = 0
         self.hooks_cpu_this_scan = 0
         self.late_next = 0.0
+        self.by_module: dict[str, array] = {}  # each module's hooks, wall ns, when more than one is timed
+        self.module_this_scan: dict[str, int] = {}
 
     def as_json(self) -> dict:
-        return {name: getattr(self, name).tolist() for name in ("start", "scan_ns", "hooks_ns", "scan_cpu_ns",
-                                                                 "hooks_cpu_ns", "ladder_ms", "late_ms")}
+        out = {name: getattr(self, name).tolist() for name in ("start", "scan_ns", "hooks_ns", "scan_cpu_ns",
+                                                                "hooks_cpu_ns", "ladder_ms", "late_ms")}
+        out.update({f"hooks_ns_{name}": values.tolist() for name, values in self.by_module.items()})
+        return out
 
 
-def instrument(runner: Runner, module, records: ScanRecords) -> None:
+def instrument(runner: Runner, modules: list, records: ScanRecords) -> None:
     engine = runner.engine
     perf = time.perf_counter_ns
     cpu = time.thread_time_ns
+    if len(modules) > 1:
+        records.by_module = {m.name: array("q") for m in modules}
 
-    def timed_input(hook):
+    def timed_input(hook, name):
         def on_input(engine):
             c0, t0 = cpu(), perf()
             hook(engine)
-            records.hooks_this_scan += perf() - t0
+            spent = perf() - t0
+            records.hooks_this_scan += spent
             records.hooks_cpu_this_scan += cpu() - c0
+            records.module_this_scan[name] = records.module_this_scan.get(name, 0) + spent
         return on_input
 
-    def timed_output(hook):
+    def timed_output(hook, name):
         def on_output(engine, enabled):
             c0, t0 = cpu(), perf()
             hook(engine, enabled)
-            records.hooks_this_scan += perf() - t0
+            spent = perf() - t0
+            records.hooks_this_scan += spent
             records.hooks_cpu_this_scan += cpu() - c0
+            records.module_this_scan[name] = records.module_this_scan.get(name, 0) + spent
         return on_output
 
-    engine.input_hooks = [timed_input(h) if getattr(h, "__self__", None) is module else h
-                          for h in engine.input_hooks]
-    engine.output_hooks = [timed_output(h) if getattr(h, "__self__", None) is module else h
+    def owner(hook):
+        return next((m for m in modules if getattr(hook, "__self__", None) is m), None)
+
+    engine.input_hooks = [timed_input(h, owner(h).name) if owner(h) is not None else h for h in engine.input_hooks]
+    engine.output_hooks = [timed_output(h, owner(h).name) if owner(h) is not None else h
                            for h in engine.output_hooks]
     scan = engine.scan
     monotonic = time.monotonic
@@ -115,6 +131,9 @@ def instrument(runner: Runner, module, records: ScanRecords) -> None:
         records.ladder_ms.append(engine.last_scan_ms)
         records.late_ms.append(records.late_next)
         records.late_next = 0.0
+        for name, values in records.by_module.items():
+            values.append(records.module_this_scan.get(name, 0))
+        records.module_this_scan.clear()
 
     engine.scan = timed_scan
     lateness = runner._lateness
@@ -126,7 +145,7 @@ def instrument(runner: Runner, module, records: ScanRecords) -> None:
     runner._lateness = timed_lateness
 
 
-def hot_scans(engine, module, scans: int) -> dict:
+def hot_scans(engine, modules: list, scans: int) -> dict:
     """Medians of ``scans`` scans back to back (no sleep between them, so the
     caches stay warm), timed the same way: what the work costs hot, beside
     what it costs in a real-time scan that follows a sleep."""
@@ -136,9 +155,11 @@ def hot_scans(engine, module, scans: int) -> dict:
     whole, hooks = [], []
     for _ in range(scans):
         t0 = perf()
-        module.on_input(engine)
+        for module in modules:
+            module.on_input(engine)
         t1 = perf()
-        module.on_output(engine, True)
+        for module in modules:
+            module.on_output(engine, True)
         t2 = perf()
         engine.scan()
         t3 = perf()
@@ -148,32 +169,44 @@ def hot_scans(engine, module, scans: int) -> dict:
             "hooks_us_median": statistics.median(hooks) / 1000}
 
 
+def _server_counts(module) -> dict:
+    """A server module's requests, writes and refusals by kind (its own names)."""
+    counters = module.image.counters()
+    return {"requests": counters[C.REQUESTS], "writes": counters[C.WRITES], "failed": module.failed,
+            "refusals": {name: counters[c] for name, c in module.server.words.refusal_names}}
+
+
 def main() -> int:
     app_dir, out = sys.argv[1], sys.argv[2]
     nice = int(sys.argv[3]) if len(sys.argv) > 3 else 0
+    names = sys.argv[4].split(",") if len(sys.argv) > 4 else ["MODBTCPS"]
     if nice:
         os.nice(nice)  # a negative increment needs the privilege to raise priority
     app = load_app(app_dir)
     runner = Runner(app, RunOptions(realtime=True, fresh=True, save_state=False))
     engine = runner.engine
-    module = next(m for m in engine.modules if m.name == "MODBTCPS")
+    modules = [next(m for m in engine.modules if m.name == name) for name in names]
+    module = modules[0]
     engine.scan()  # the first scan starts the server (docs/modbtcps.md): measured with it listening
-    if module.wait_until_listening() is None:
-        print(f"MODBTCPS: {module.failed}", file=sys.stderr)
-        return 1
-    hot = hot_scans(engine, module, HOT_SCANS)
+    for m in modules:
+        if m.wait_until_listening() is None:
+            print(f"{m.name}: {m.failed}", file=sys.stderr)
+            return 1
+    hot = hot_scans(engine, modules, HOT_SCANS)
     records = ScanRecords()
-    instrument(runner, module, records)
+    instrument(runner, modules, records)
 
     def stdin_closed(runner: Runner) -> None:  # between scans: outside the timed scan
         if select.select([0], [], [], 0)[0] and not os.read(0, 4096):
             runner.request_stop()
 
     runner.between_scans.append(stdin_closed)
-    print(f"ready {module.port} {module.process.pid} {os.getpid()}", flush=True)
+    others = "".join(f" {m.port} {m.process.pid}" for m in modules[1:])
+    print(f"ready {module.port} {module.process.pid} {os.getpid()}{others}", flush=True)
     try:
         runner.run(None)
         counters = module.image.counters()
+        servers = {m.name: _server_counts(m) for m in modules}
     finally:
         runner.close()
     state = {
@@ -194,6 +227,7 @@ def main() -> int:
             ("exception_01", C.EXCEPTION_01), ("exception_02", C.EXCEPTION_02), ("exception_03", C.EXCEPTION_03),
             ("exception_0B", C.EXCEPTION_0B), ("malformed", C.MALFORMED), ("idle", C.IDLE))},
         "failed": module.failed,
+        "servers": servers,
     }
     Path(out).write_text(json.dumps({"state": state, "scans": records.as_json()}), encoding="utf-8")
     return 0

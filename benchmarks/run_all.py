@@ -22,7 +22,7 @@ BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_load_cache",
     "bench_comgenius_format",
     "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_modbus_server",
-    "bench_watch", "bench_scenarios", "bench_mutation",
+    "bench_enips_server", "bench_watch", "bench_scenarios", "bench_mutation",
 )
 
 
@@ -173,6 +173,15 @@ def main() -> int:
                      f"{med(row['pymodbus_rates']):,.0f}/s = {row['ratio']:.2f}x; under 50 busy clients "
                      f"{mts['busy']['scans'].get('late_scans', 0)} late scans, the ladder's longest "
                      f"{mts['state']['max_ladder_ms']:.2f} ms")
+
+    enips = load("bench_enips_server")
+    if enips:
+        table = enips["table"]
+        med = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731
+        lines.append(f"enips     reads of 100 (K=4): CIP tag {med(table['cip K=4']['rates']):,.0f}/s = "
+                     f"{med(table['cip K=4']['ratio_to_modbtcps']):.2f}x MODBTCPS, PCCC "
+                     f"{med(table['pccc K=4']['rates']):,.0f}/s = {med(table['pccc K=4']['ratio_to_modbtcps']):.2f}x; "
+                     f"under 50 busy clients {enips['busy'].get('late_scans', 0)} late scans")
 
     watch = load("bench_watch")
     if watch:
