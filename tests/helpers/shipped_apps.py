@@ -1,8 +1,9 @@
 """The shipped apps (programs/) as tests run them: copied into the test's
 temporary directory without their ``.softplc`` state, so nothing is written
-inside the repository, and with every Modbus TCP server moved to a port
-found free, so a PLC already running on this machine (serving the shipped
-127.0.0.1:5020, or 44818) does not stand in the way (docs/testing.md, "Isolation")."""
+inside the repository, and with every network server (MODBTCPS.XML's,
+ENIPS.XML's) moved to a port found free, so a PLC already running on this
+machine (serving the shipped 127.0.0.1:5020, or 44818) does not stand in the
+way (docs/testing.md, "Isolation")."""
 
 from __future__ import annotations
 
