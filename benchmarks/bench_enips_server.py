@@ -45,7 +45,8 @@ import time
 from pathlib import Path
 
 import _common as C
-from bench_modbus_server import RUNTIME, START_LIMIT_S, CheckFailed, Child, ladder, scans_in, server_xml, span
+from bench_modbus_server import (RUNTIME, START_LIMIT_S, CheckFailed, Child, client_results, ladder, scans_in,
+                                 server_xml, span)
 
 from helpers.modbus_peer import free_tcp_port
 
@@ -92,21 +93,7 @@ def load(kind: str, port: int, clients: int, window_s: float, watch: list[int]) 
         spec = {"kind": kind, "port": port, "clients": clients if kind == "raw" else 1, "count": WORDS, "warmup": 3,
                 "start_at": start_at, "window_s": window_s, "watch": watch if k == 0 else []}
         procs.append(subprocess.Popen([sys.executable, LOAD, json.dumps(spec)], stdout=subprocess.PIPE, text=True))
-    results = []
-    try:
-        for p in procs:
-            try:
-                out, _ = p.communicate(timeout=window_s + lead_s + START_LIMIT_S)
-            except subprocess.TimeoutExpired:
-                raise CheckFailed(f"a {kind} client did not finish its {window_s} s window") from None
-            if p.returncode != 0 or not out.strip():
-                raise CheckFailed(f"a {kind} client process failed (exit status {p.returncode})")
-            results.append(json.loads(out))
-    finally:
-        for p in procs:
-            if p.poll() is None:
-                p.kill()
-                p.communicate()
+    results = client_results(procs, window_s + lead_s + START_LIMIT_S)
     errors = sum(r["errors"] for r in results)
     if errors:
         why = next(r["first_error"] for r in results if r["errors"])

@@ -176,6 +176,27 @@ class Child:
         self.proc.stdout.close()
 
 
+def client_results(procs: list[subprocess.Popen], timeout_s: float) -> list[dict]:
+    """Each client process's line of JSON, once all have finished their
+    window; none is left behind when one fails."""
+    results = []
+    try:
+        for p in procs:
+            try:
+                out, _ = p.communicate(timeout=timeout_s)
+            except subprocess.TimeoutExpired:
+                raise CheckFailed(f"a client process did not finish within {timeout_s:.0f} s") from None
+            if p.returncode != 0 or not out.strip():
+                raise CheckFailed(f"a client process failed (exit status {p.returncode})")
+            results.append(json.loads(out))
+    finally:
+        for p in procs:
+            if p.poll() is None:
+                p.kill()
+                p.communicate()
+    return results
+
+
 def load(port: int, clients: int, function: int, window_s: float, watch: list[int], processes: int = 1,
          address: int = 0, raw: bool = False) -> dict:
     """``clients`` clients over ``processes`` processes for one window; the
@@ -192,21 +213,7 @@ def load(port: int, clients: int, function: int, window_s: float, watch: list[in
                 "watch": watch if k == 0 else [], "raw": raw}
         procs.append(subprocess.Popen([sys.executable, LOAD, "clients", json.dumps(spec)], stdout=subprocess.PIPE,
                                       text=True))
-    results = []
-    try:
-        for p in procs:
-            try:
-                out, _ = p.communicate(timeout=window_s + lead_s + START_LIMIT_S)
-            except subprocess.TimeoutExpired:
-                raise CheckFailed(f"a client process did not finish its {window_s} s window") from None
-            if p.returncode != 0 or not out.strip():
-                raise CheckFailed(f"a client process failed (exit status {p.returncode})")
-            results.append(json.loads(out))
-    finally:
-        for p in procs:  # none is left behind when one failed
-            if p.poll() is None:
-                p.kill()
-                p.communicate()
+    results = client_results(procs, window_s + lead_s + START_LIMIT_S)
     first = results[0]
     cpu = dict(first["cpu_s"])
     cpu["clients"] = sum(r["cpu_s"]["clients"] for r in results)
