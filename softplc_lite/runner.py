@@ -142,6 +142,7 @@ class Runner:
         self.replay_differences = 0  # output differences of every replay port (set by ``close``)
         # callables run between two scans, each given this runner (see the module docstring)
         self.between_scans: list[Callable[[Runner], None]] = []
+        self.after_scan: list[Callable[[Engine], None]] = []  # right after each scan, a faulted one too (trends)
         self.stop_requested = False  # request_stop(): end ``run`` at the next scan boundary
         # Real time: scans that started a whole period or more after they were due (they missed
         # their slot, as a periodic task's overlap does), and the latest start seen, in ms.
@@ -242,9 +243,12 @@ class Runner:
         save_at = retentive.due if retentive is not None else float("inf")
         done = 0
         try:
+            after_scan = self.after_scan
             while scans is None or done < scans:
                 engine.scan()
                 done += 1
+                for hook in after_scan:
+                    hook(engine)
                 if on_scan is not None:
                     on_scan(engine)
                 if engine.mode is Mode.FAULTED:

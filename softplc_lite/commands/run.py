@@ -63,11 +63,52 @@ def add_parser(sub) -> argparse.ArgumentParser:
                    help="open logical port N ([MODULE:]N) on DEVICE (a device path or pyserial URL) instead of "
                    "its [PORTS] field (repeatable; docs/serial.md)")
     r.add_argument("--record", metavar="TRACE", help="record every port's traffic to the TRACE file")
+    r.add_argument("--trend", action="append", default=[], metavar="ADDR",
+                   help="record ADDR (an address or symbol) every scan to --trend-file (repeatable, at most "
+                   "20; docs/trends.md)")
+    r.add_argument("--trend-file", metavar="FILE", help="write the --trend addresses to FILE: .csv (a row a scan) "
+                   "or .vcd (a value change dump for GTKWave and other waveform viewers)")
+    r.add_argument("--trend-on-change", action="store_true",
+                   help="record a scan only when a --trend value changed")
     r.add_argument("--replay", metavar="TRACE",
                    help="play every port back from a recorded TRACE file; stops at its end ('# scans: N' "
                    "comment, else the last recorded byte); exit 5 if the output differed")
     r.set_defaults(func=run)
     return r
+
+
+def _trend_recorder(runner: Runner, app, args: argparse.Namespace):
+    """(the Recorder of --trend/--trend-file, added to the runner's
+    after-scan hooks; or None and the problems, every one)."""
+    from ..trends.record import Recorder, TrendFileError, format_of, open_writer
+    from ..trends.series import TrendError, resolve_series
+
+    problems = []
+    if not args.trend:
+        problems.append("--trend-file: name the addresses to record with --trend ADDR (repeatable)")
+    if not args.trend_file:
+        problems.append("--trend: name the file to record to with --trend-file FILE.csv or FILE.vcd (softplc watch "
+                        "--trend draws them instead)")
+    series = []
+    try:
+        series = resolve_series(args.trend, runner.table, app.program.symbols)
+    except TrendError as e:
+        problems += e.problems
+    if args.trend_file:
+        try:
+            format_of(args.trend_file)
+        except TrendFileError as e:
+            problems.append(str(e))
+    if problems:
+        return None, problems
+    clock = "wall clock" if runner.engine.clock.realtime else "simulated"
+    try:
+        writer = open_writer(args.trend_file, series, app.name, clock)
+    except TrendFileError as e:
+        return None, [str(e)]
+    recorder = Recorder(runner.table, series, writer, args.trend_on_change)
+    runner.after_scan.append(lambda engine: recorder.record(engine.scans, engine.clock.now_ms))
+    return recorder, []
 
 
 def run_realtime(args: argparse.Namespace) -> bool:
@@ -89,6 +130,9 @@ def run(args: argparse.Namespace) -> int:
     )
     runner = Runner(app, options)
     problems = address_problems("--print", runner.table, args.print, app.program.symbols)
+    recorder = None
+    if not problems and (args.trend or args.trend_file):
+        recorder, problems = _trend_recorder(runner, app, args)
     if problems:  # before scan 0: nothing ran, nothing is saved
         runner.engine.close()
         for problem in problems:
@@ -109,6 +153,8 @@ def run(args: argparse.Namespace) -> int:
         _scan_until_the_end(runner, app, args)
     finally:
         runner.close()
+        if recorder is not None:
+            recorder.close()
     engine = runner.engine
     if engine.clock.realtime and engine.scans:
         # On the wall clock, whether the scan kept its period (a scan late by a whole period missed its
