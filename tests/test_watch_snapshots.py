@@ -51,6 +51,7 @@ class Case:
     sets: tuple[str, ...] = ()
     forces: tuple[str, ...] = ()
     break_when: tuple[str, ...] = ()
+    trend: tuple[str, ...] = ()
     rung_breaks: tuple[int, ...] = ()  # rungs of the main file with a breakpoint
     back: int = 0  # steps back through history after scanning
     goto: int = 0  # the selected rung (shown first)
@@ -74,6 +75,11 @@ CASES = [
     # stopped by --break-when; a rung breakpoint on rung 3 (marked *, not hit)
     Case("motor-break", "motor", 500, watch=("T4:0.ACC",), sets=("StopOk=1", "Start=1"),
          break_when=("T4:0.ACC >= 2",), rung_breaks=(3,), sizes=((120, 40),)),
+    # the trend panel: the PID loop settling, the lamp coming on at scan 448 (docs/trends.md)
+    Case("tank-trend", "tank", 520, trend=("Level", "Valve", "AtSetpoint"),
+         cli=("--trend", "Level", "--trend", "Valve", "--trend", "AtSetpoint")),
+    # stepped back to scan 440: the marker on the chart
+    Case("tank-trend-history", "tank", 520, trend=("Level", "Valve", "AtSetpoint"), back=80, sizes=((120, 40),)),
 ]
 
 PARAMS = [pytest.param(case, w, h, id=f"{case.name}-{w}x{h}") for case in CASES for w, h in case.sizes]
@@ -82,7 +88,7 @@ PARAMS = [pytest.param(case, w, h, id=f"{case.name}-{w}x{h}") for case in CASES 
 def _session(case: Case, state_dir: Path) -> WatchSession:
     app = load_app(PROGRAMS / case.program, state_dir)
     options = WatchOptions(run=RunOptions(fresh=True, sets=case.sets), watch=case.watch, forces=case.forces,
-                           break_when=case.break_when)
+                           break_when=case.break_when, trend=case.trend)
     session = WatchSession(app, options)
     for rung in case.rung_breaks:
         session.goto(rung)
@@ -141,6 +147,12 @@ def test_goldens_are_what_the_view_shows(tmp_path):
     assert "scan 78 of 80 (history)" in text and "forces: O:0/0=OFF" in text and "0 F" in text
     text = (GOLDENS / "motor-break-120x40.txt").read_text(encoding="utf-8")
     assert "break: T4:0.ACC >= 2 became true at scan 201" in text and " * Rung 3" in text
+    for size in ("80x24", "120x40"):
+        text = (GOLDENS / f"tank-trend-{size}.txt").read_text(encoding="utf-8")
+        assert " Level 1974  Valve 2006  AtSetpoint 1  y auto" in text and "scan 520 5.200 s" in text
+        assert "AtSetpoint│" in text and "▲" not in text
+    text = (GOLDENS / "tank-trend-history-120x40.txt").read_text(encoding="utf-8")
+    assert "scan 440 of 520 (history)" in text and " AtSetpoint 0 " in text and text.count("▲") == 1
 
 
 def test_the_doc_shows_the_golden_view():

@@ -2,7 +2,7 @@
 render one snapshot (no terminal needed) or run the interactive view
 (the watch package, docs/watch.md).
 
-Before scan 0 the --watch addresses are read from the table the session
+Before scan 0 the --watch and --trend addresses are read from the table the session
 starts with: a bad one is an error (exit 1), nothing scanned or saved. A
 snapshot reads the app's retentive state but leaves it as it was unless
 ``--save`` is given; ``--scans N`` is for a snapshot only (usage error
@@ -39,6 +39,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
     w.add_argument("--watch", action="append", default=[], metavar="ADDR",
                    help="add ADDR (address or symbol) to the watch list (repeatable; checked before scan 0)")
     w.add_argument("--watch-file", metavar="FILE", help="a watch file: one address or symbol a line")
+    w.add_argument("--trend", action="append", default=[], metavar="ADDR",
+                   help="draw ADDR (address or symbol) in the trend panel (repeatable, at most 6; checked before "
+                   "scan 0; docs/trends.md)")
     w.add_argument("--force", action="append", default=[], metavar="ADDR=0|1", help="force a bit on or off")
     w.add_argument("--break-when", action="append", default=[], metavar="EXPR",
                    help='stop running when EXPR becomes true, e.g. "N7:0 > 100" or R6:0/ER')
@@ -82,6 +85,7 @@ def _keys_in_the_epilog(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..trends.series import TrendError
     from ..watch.session import WatchOptions, WatchSession
     from ..watch.snapshot import write_snapshot
     from ..watch.watchlist import WATCH_MAX, read_watch_file
@@ -113,8 +117,13 @@ def run(args: argparse.Namespace) -> int:
                              ports=tuple(args.port), replay=args.replay, save_state=save)
     # online: a snapshot renders once, so there is nothing to watch for
     options = WatchOptions(run=run_options, watch=tuple(watch), forces=tuple(args.force),
-                           break_when=tuple(args.break_when), online=not snapshot)
-    session = WatchSession(app, options)
+                           break_when=tuple(args.break_when), trend=tuple(args.trend), online=not snapshot)
+    try:
+        session = WatchSession(app, options)
+    except TrendError as e:  # the session released what it opened; nothing scanned, nothing saved
+        for problem in e.problems:
+            print(f"error: {problem}", file=sys.stderr)
+        return EXIT_ERROR
     problems = address_problems("--watch", session.engine.table, list(args.watch), app.program.symbols) + \
         address_problems(f"--watch-file {args.watch_file}:", session.engine.table, watch[len(args.watch):],
                          app.program.symbols)

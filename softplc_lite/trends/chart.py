@@ -116,12 +116,13 @@ class TrendChart:
     are drawn at its edge); None takes it from the data."""
 
     def __init__(self, traces: list[Trace], x: XAxis, height: int, y_range: tuple[float, float] | None = None,
-                 marker: int | None = None) -> None:
+                 marker: int | None = None, note: str = "") -> None:
         self.traces = traces
         self.x = x
         self.height = height
         self.y_range = y_range
         self.marker = marker
+        self.note = note  # said at the end of the legend (the watch view: the series it had no room for)
 
     def y_bounds(self) -> tuple[float, float]:
         if self.y_range is not None:
@@ -143,12 +144,15 @@ class TrendChart:
             low, high = self.y_bounds()
             how = "set" if self.y_range is not None else "auto"
             text.append(f"  y {how} {number_text(low)}..{number_text(high)}", style="dim")
+        if self.note:
+            text.append(f"  {self.note}", style="dim")
         return text
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         yield from self.lines(options.max_width)
 
-    def lines(self, width: int) -> list[Text]:
+    def _layout(self, width: int):
+        """(the line traces, the bit traces shown, plot rows, y labels, gutter, plot columns)."""
         numeric = [t for t in self.traces if not t.is_bit]
         bits = [t for t in self.traces if t.is_bit]
         plot_rows = max(1, self.height - 2 - len(bits)) if numeric else 0
@@ -156,7 +160,16 @@ class TrendChart:
         low, high = self.y_bounds()
         y_labels = [number_text(high), number_text(low)] if numeric else []
         gutter = max([len(s) for s in y_labels] + [min(len(t.label), LABEL_MAX) for t in bits] + [1])
-        cols = max(1, width - gutter - 1)
+        return numeric, bits, plot_rows, y_labels, gutter, max(1, width - gutter - 1)
+
+    def plot_columns(self, width: int) -> int:
+        """The character columns the samples are drawn over at ``width``
+        (two samples a column fill it)."""
+        return self._layout(width)[-1]
+
+    def lines(self, width: int) -> list[Text]:
+        numeric, bits, plot_rows, y_labels, gutter, cols = self._layout(width)
+        low, high = self.y_bounds()
         dots = cols * 2
         count = max((len(t.values) for t in self.traces), default=0)
         xs = _columns(count, dots)

@@ -19,6 +19,7 @@ from ..ladder.host import Mode
 from .portsview import PortsView
 from .serversview import ServersView
 from .session import WatchSession
+from .trendview import TrendPanel, panel_height
 from .xref import XrefPanel
 
 WIDE = 120  # from this width the side panels go beside the rungs
@@ -28,7 +29,7 @@ FIND_LINES = 8  # the find list's lines at most (its title and seven uses around
 # The keys line at the foot, the longest that fits (from 80 columns "? help" and "q quit" always show);
 # "?" lists every key (terminal.py's table).
 KEY_LINES = ("n step  r run  p pause  +/- speed  ↑↓ rung  g go to  f file  b break  ⌫ back  F/U force  = set  "
-             "t toggle  M mode  C clear fault  ? help  q quit",
+             "t toggle  M mode  C clear fault  T trend  W write trend  ? help  q quit",
              "n step  r run  p pause  ↑↓ rung  b break  ⌫ back  F/U force  = set  t toggle  M mode  C clear fault  "
              "? help  q quit",
              "n step  r run  p pause  ↑↓ rung  b break  ⌫ back  F/U force  = set  t toggle  M mode  ? help  q quit",
@@ -268,12 +269,21 @@ class WatchScreen:
                 self.help_pages = overlay.pages
             return
         side = self.side()
-        if width >= WIDE:
-            body.split_row(Layout(self.rungs), Layout(Padding(side, (0, 0, 0, 1)), size=SIDE_WIDTH))
-        else:  # the side panels below the rungs, all of their lines if the rungs keep 8
+        trend_lines = panel_height(self.session, width, height)
+        trend = TrendPanel(self.session, trend_lines) if trend_lines else None
+        if width >= WIDE:  # the trend across the whole width under the rungs and the side panels
+            top = body
+            if trend is not None:
+                body.split_column(Layout(name="top"), Layout(trend, size=trend_lines))
+                top = body["top"]
+            top.split_row(Layout(self.rungs), Layout(Padding(side, (0, 0, 0, 1)), size=SIDE_WIDTH))
+        else:  # the trend, then the side panels below the rungs, all of their lines if the rungs keep 8
             side_lines = len(console.render_lines(side, options.update(width=width, height=None), pad=False))
-            rung_lines = max(8, height - 3 - side_lines)
-            body.split_column(Layout(self.rungs, size=rung_lines), Layout(side))
+            rung_lines = max(8, height - 3 - side_lines - trend_lines)
+            parts = [Layout(self.rungs, size=rung_lines)]
+            if trend is not None:
+                parts.append(Layout(trend, size=trend_lines))
+            body.split_column(*parts, Layout(side))
         yield from root.__rich_console__(console, options.update(height=height))
 
 

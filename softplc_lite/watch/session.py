@@ -21,6 +21,7 @@ from ..runner import Runner, RunOptions
 from .breakpoints import Breakpoints, Hit
 from .datagrid import DataGrid, grid_for, next_radix
 from .forces import Forces, parse_force
+from . import trendview
 from .history import History
 from .watchlist import WatchList
 from .xref import Finding, XrefIndex
@@ -37,6 +38,7 @@ class WatchOptions:
     watch: tuple[str, ...] = ()
     forces: tuple[str, ...] = ()
     break_when: tuple[str, ...] = ()
+    trend: tuple[str, ...] = ()  # the trend panel's series (watch/trendview.py)
     speed: int = 6  # index into SPEEDS: 100 scans/s
     # online program edit: watch the app's .lad files and put a saved valid version in place
     # (off for a snapshot, which must not depend on a file saved meanwhile)
@@ -61,6 +63,11 @@ class WatchSession:
             for text in options.break_when:
                 self.breaks.add_condition(text, symbols)
             self.watch = WatchList(list(options.watch), symbols)
+            self.trend: list = []  # the trend panel's Series, drawn from the history (trendview.py)
+            self.trend_range: tuple[float, float] | None = None  # its y axis; None: from the data
+            self.trend_cache = trendview.FrameValues()
+            if options.trend:
+                trendview.add(self, list(options.trend), what="--trend")
         except BaseException:
             engine.close()  # a bad --force/--break-when/--watch: release the ports opened
             raise
@@ -303,6 +310,15 @@ class WatchSession:
         else:
             self.finding = None
         self.message = ""
+
+    # -- the trend panel (docs/trends.md, "The trend panel") ----------------------------------
+    def trend_command(self, text: str) -> None:
+        """``ADDR`` adds or removes a series, ``range LO HI`` or ``range auto`` sets the y axis."""
+        trendview.command(self, text)
+
+    def write_trend(self, path: str) -> None:
+        """The history's trend to a .csv or .vcd file."""
+        trendview.write(self, path)
 
     # -- online program edit (docs/engine.md, "Online program edit") ---------------------------
     def poll_online(self) -> None:

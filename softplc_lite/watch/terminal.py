@@ -21,13 +21,14 @@ from rich.live import Live
 
 from ..datatable import DataTableError
 from .screen import WatchScreen
+from . import trendview
 from .session import WatchSession
 
 REDRAW_HZ = 10  # at most
 DRAW_SHARE = 0.04  # of the wall time spent drawing while running, at most
 SLICE_S = 0.02  # scanning time between two looks at the keyboard
 PAUSED_SERVERS_S = 1.0  # while paused, the servers panel is redrawn this often (its counts are live)
-PROMPT_MAX = 200  # characters a prompt (g, F, U, M, =, t, /, d) takes
+PROMPT_MAX = 200  # characters a prompt (g, F, U, M, =, t, /, d, T, W) takes
 
 _ESCAPES = {"\x1b[A": "up", "\x1b[B": "down", "\x1bOA": "up", "\x1bOB": "down",
             "\x1b[5~": "pgup", "\x1b[6~": "pgdown",
@@ -73,6 +74,8 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("d", ("d",), "data_file", "show a data file as a grid (N7, or N7:20 from element 20)"),
     Binding("R", ("R",), "radix", "the grid's radix: decimal, hex, binary, ASCII (cycles)"),
     Binding("Esc", ("esc",), "close", "close the data-file grid, then the find list"),
+    Binding("T", ("T",), "trend", "trend: add or remove ADDR (offers the rung's first operand); range LO HI | auto"),
+    Binding("W", ("W",), "write_trend", "write the history's trend to FILE.csv or FILE.vcd"),
     Binding("E", ("E",), "edit_errors", "every error of the last rejected online program edit"),
     Binding("?", ("?",), "help", "show every key and what it does (pages: space; any other key closes it)"),
     Binding("q", ("q",), "quit", "quit (saves the retentive data table)"),
@@ -83,7 +86,8 @@ _ACTIONS = {k: b.action for b in BINDINGS for k in b.keys}
 # The prompts: kind -> the text before what is typed.
 PROMPTS = {"g": "go to rung: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: ",
            "M": "mode (program, run, test): ", "=": "set ADDR = VALUE: ", "t": "toggle bit: ",
-           "/": "find address or symbol: ", "d": "data file (N7, T4, ST9; N7:20): "}
+           "/": "find address or symbol: ", "d": "data file (N7, T4, ST9; N7:20): ",
+           "T": "trend: ADDR (add/remove), range LO HI | range auto: ", "W": "write trend to FILE.csv|.vcd: "}
 
 
 class RawKeys:
@@ -228,6 +232,12 @@ class Controller:
     def _do_close(self, k: str) -> None:
         self.session.close_panels()
 
+    def _do_trend(self, k: str) -> None:
+        self._ask("T", trendview.offered(self.session))
+
+    def _do_write_trend(self, k: str) -> None:
+        self._ask("W")
+
     def _do_edit_errors(self, k: str) -> None:
         self.session.show_edit_errors()
 
@@ -276,6 +286,10 @@ class Controller:
                 s.find(text)
             elif kind == "d":
                 s.show_file(text)
+            elif kind == "T":
+                s.trend_command(text)
+            elif kind == "W":
+                s.write_trend(text)
         except (ValueError, DataTableError) as e:
             s.message = f"{text}: {e}"
 

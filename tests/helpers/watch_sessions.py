@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 
 from softplc_lite.app import load_app
@@ -15,14 +16,16 @@ def sessions(tmp_path: Path, program: str, files: dict[str, str] | None = None):
     which writes an app (main.lad and ``files``) and opens a fresh session
     on it; every session made is quit at the end."""
     made: list[WatchSession] = []
+    tried = itertools.count()  # a session refused by its options made its directory too
 
     def make(text: str = program, **kw) -> WatchSession:
-        d = tmp_path / f"app{len(made)}"
+        k = next(tried)
+        d = tmp_path / f"app{k}"
         d.mkdir()
         (d / "main.lad").write_text(text)
         for name, content in (files or {}).items():
             (d / name).write_text(content)
-        app = load_app(d, state_dir=tmp_path / f"state{len(made)}")
+        app = load_app(d, state_dir=tmp_path / f"state{k}")
         s = WatchSession(app, WatchOptions(run=RunOptions(fresh=True), **kw))
         made.append(s)
         return s
