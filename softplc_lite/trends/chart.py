@@ -71,8 +71,14 @@ class _Canvas:
             self.styles[row][col] = style
 
     def vline(self, x: int, y0: int, y1: int, style: str) -> None:
-        for y in range(min(y0, y1), max(y0, y1) + 1):
-            self.dot(x, y, style)
+        if not 0 <= x < self.cols * 2:
+            return
+        col, dots = x // 2, _DOT[x % 2]
+        bits, styles = self.bits, self.styles
+        for y in range(max(0, min(y0, y1)), min(self.rows * 4 - 1, max(y0, y1)) + 1):
+            row = y // 4
+            bits[row][col] |= dots[y % 4]
+            styles[row][col] = style
 
     def line(self, x0: int, y0: int, x1: int, y1: int, style: str) -> None:
         """From (x0, y0) to (x1, y1), x0 <= x1: each dot column after the
@@ -92,8 +98,13 @@ class _Canvas:
 
     def row_text(self, row: int) -> Text:
         text = Text(no_wrap=True)
-        for bits, style in zip(self.bits[row], self.styles[row]):
-            text.append(chr(BRAILLE + bits) if bits else " ", style=style or None)
+        cells = [chr(BRAILLE + bits) if bits else " " for bits in self.bits[row]]
+        styles = self.styles[row]
+        start = 0
+        for k in range(1, len(cells) + 1):  # a span a run of one style: far fewer for rich to render
+            if k == len(cells) or styles[k] != styles[start]:
+                text.append("".join(cells[start:k]), style=styles[start] or None)
+                start = k
         return text
 
 
@@ -252,9 +263,10 @@ class TrendChart:
                 row[k] = ch
         if self.marker is not None and 0 <= self.marker < len(xs):
             row[xs[self.marker] // 2] = "▲"
-        line = Text(" " * gutter + "└", style="dim", no_wrap=True)
-        for ch in row:
-            line.append(ch, style=MARKER_STYLE if ch == "▲" else "dim")
+        line = Text(" " * gutter + "└" + "".join(row), style="dim", no_wrap=True)
+        if "▲" in row:
+            at = gutter + 1 + row.index("▲")
+            line.stylize(MARKER_STYLE, at, at + 1)
         return line
 
     @staticmethod
