@@ -14,7 +14,8 @@ from vcdvcd import VCDVCD
 
 from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions, Runner
-from softplc_lite.trends.record import Recorder, format_of, open_writer, vcd_name
+from softplc_lite.trends.background import BackgroundRecorder
+from softplc_lite.trends.record import Recorder, TrendFileError, format_of, open_writer, vcd_name
 from softplc_lite.trends.series import TrendError, resolve_series
 
 from helpers.apps import make_app
@@ -22,6 +23,21 @@ from helpers.cli import softplc_here
 from helpers.shipped_apps import copy_app
 
 TANK = ["Level", "Valve", "Loop[2]", "AtSetpoint", "LevelF"]
+
+
+def recorder_of(how: str, runner: Runner, series, path: Path, on_change: bool = False):
+    """The in-process Recorder (the watch view's), or the BackgroundRecorder
+    (softplc run's: a writer process formats), attached after each scan."""
+    if how.startswith("background"):
+        recorder = BackgroundRecorder(runner.table, series, path, runner.app.name, "simulated", on_change,
+                                      follow=how == "background, following")
+    else:
+        recorder = Recorder(runner.table, series, open_writer(path, series, runner.app.name, "simulated"), on_change)
+    runner.after_scan.append(lambda e: recorder.record(e.scans, e.clock.now_ms))
+    return recorder
+
+
+HOW = pytest.mark.parametrize("how", ["in-process", "background", "background, following"])
 
 
 def tank_runner(tmp_path: Path) -> Runner:
@@ -60,12 +76,12 @@ def test_symbols_keep_their_names_and_repeats_count_once(tmp_path):
     runner.close()
 
 
-def test_csv_rows_are_the_tables_values_after_each_scan(tmp_path):
+@HOW
+def test_csv_rows_are_the_tables_values_after_each_scan(tmp_path, how):
     runner = tank_runner(tmp_path)
     series = resolve_series(TANK, runner.table, runner.app.program.symbols)
     path = tmp_path / "tank.csv"
-    recorder = Recorder(runner.table, series, open_writer(path, series, "tank", "simulated"))
-    runner.after_scan.append(lambda e: recorder.record(e.scans, e.clock.now_ms))
+    recorder = recorder_of(how, runner, series, path)
     expected = table_history(runner, series, 600)
     recorder.close()
     runner.close()
@@ -80,12 +96,12 @@ def test_csv_rows_are_the_tables_values_after_each_scan(tmp_path):
     assert any(int(r[5]) for r in rows[1:]) and any(not int(r[5]) for r in rows[1:])  # the lamp changes
 
 
-def test_vcd_read_by_vcdvcd_has_every_change_at_its_time(tmp_path):
+@HOW
+def test_vcd_read_by_vcdvcd_has_every_change_at_its_time(tmp_path, how):
     runner = tank_runner(tmp_path)
     series = resolve_series(TANK, runner.table, runner.app.program.symbols)
     path = tmp_path / "tank.vcd"
-    recorder = Recorder(runner.table, series, open_writer(path, series, "tank", "simulated"))
-    runner.after_scan.append(lambda e: recorder.record(e.scans, e.clock.now_ms))
+    recorder = recorder_of(how, runner, series, path)
     expected = table_history(runner, series, 500)
     recorder.close()
     runner.close()
@@ -105,13 +121,13 @@ def test_vcd_read_by_vcdvcd_has_every_change_at_its_time(tmp_path):
     assert int(vcd["tank.Level"].size) == 16
 
 
-def test_on_change_writes_only_the_scans_that_changed(tmp_path):
+@HOW
+def test_on_change_writes_only_the_scans_that_changed(tmp_path, how):
     app = make_app(tmp_path / "app", "XIC S:4/6 OTE B3/0\nADD N7:0 1 N7:0\n")  # S:4/6: the free-running clock bit
     runner = Runner(load_app(app), RunOptions(fresh=True, save_state=False))
     series = resolve_series(["B3/0"], runner.table, {})
     path = tmp_path / "b.csv"
-    recorder = Recorder(runner.table, series, open_writer(path, series, "app", "simulated"), on_change=True)
-    runner.after_scan.append(lambda e: recorder.record(e.scans, e.clock.now_ms))
+    recorder = recorder_of(how, runner, series, path, on_change=True)
     expected = table_history(runner, series, 1000)
     recorder.close()
     runner.close()
@@ -139,6 +155,20 @@ def test_softplc_run_records_and_refuses_bad_options(tmp_path):
     assert unwritable.returncode == 1 and "cannot write it" in unwritable.stderr
 
 
+def test_a_writer_that_died_is_said_when_the_recording_closes(tmp_path):
+    runner = tank_runner(tmp_path)
+    series = resolve_series(["Level"], runner.table, runner.app.program.symbols)
+    recorder = recorder_of("background", runner, series, tmp_path / "t.csv")
+    runner.run(10)
+    recorder.proc.kill()
+    recorder.proc.wait()
+    runner.run(2000)  # its pipe is gone: the scans go on
+    with pytest.raises(TrendFileError) as info:
+        recorder.close()
+    assert "status" in str(info.value)
+    runner.close()
+
+
 def test_the_format_comes_from_the_suffix():
     assert format_of("a.CSV") == "csv" and format_of("x/y.vcd") == "vcd"
 
@@ -161,8 +191,7 @@ def test_a_long_recording_of_20_addresses_takes_constant_memory(tmp_path):
     runner = Runner(load_app(app), RunOptions(fresh=True, save_state=False))
     series = resolve_series([f"N7:{k}" for k in range(19)] + ["B3/0"], runner.table, {})
     out = tmp_path / "long.csv"
-    recorder = Recorder(runner.table, series, open_writer(out, series, "app", "simulated"))
-    runner.after_scan.append(lambda e: recorder.record(e.scans, e.clock.now_ms))
+    recorder = recorder_of("background", runner, series, out)
     runner.run(25_000)
     at_25k = _rss_kib()
     runner.run(75_000)

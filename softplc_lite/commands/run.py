@@ -80,7 +80,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
 def _trend_recorder(runner: Runner, app, args: argparse.Namespace):
     """(the Recorder of --trend/--trend-file, added to the runner's
     after-scan hooks; or None and the problems, every one)."""
-    from ..trends.record import Recorder, TrendFileError, format_of, open_writer
+    from ..trends.background import BackgroundRecorder
+    from ..trends.record import TrendFileError, format_of
     from ..trends.series import TrendError, resolve_series
 
     problems = []
@@ -103,11 +104,11 @@ def _trend_recorder(runner: Runner, app, args: argparse.Namespace):
         return None, problems
     clock = "wall clock" if runner.engine.clock.realtime else "simulated"
     try:
-        writer = open_writer(args.trend_file, series, app.name, clock)
+        recorder = BackgroundRecorder(runner.table, series, args.trend_file, app.name, clock, args.trend_on_change,
+                                      follow=runner.engine.clock.realtime)
     except TrendFileError as e:
         return None, [str(e)]
-    recorder = Recorder(runner.table, series, writer, args.trend_on_change)
-    runner.after_scan.append(lambda engine: recorder.record(engine.scans, engine.clock.now_ms))
+    runner.after_scan.append(recorder.after_scan)
     return recorder, []
 
 
@@ -149,12 +150,13 @@ def run(args: argparse.Namespace) -> int:
                 print(edit.summary() if edit.accepted else edit.report(), file=sys.stderr)
 
         runner.between_scans.append(online_edit)
+    trend_problem = None
     try:
         _scan_until_the_end(runner, app, args)
     finally:
         runner.close()
         if recorder is not None:
-            recorder.close()
+            trend_problem = _close_recorder(recorder)
     engine = runner.engine
     if engine.clock.realtime and engine.scans:
         # On the wall clock, whether the scan kept its period (a scan late by a whole period missed its
@@ -183,7 +185,20 @@ def run(args: argparse.Namespace) -> int:
         print(f"softplc: {app.name}: --replay: the program's output differed from the recording "
               f"({count} difference{'s' if count != 1 else ''}, listed above)", file=sys.stderr)
         return EXIT_REPLAY
-    return EXIT_ERROR if storage_problems else EXIT_OK
+    if trend_problem is not None:
+        print(f"error: {trend_problem}", file=sys.stderr)
+    return EXIT_ERROR if storage_problems or trend_problem else EXIT_OK
+
+
+def _close_recorder(recorder) -> str | None:
+    """Finish the trend file; what went wrong writing it, or None."""
+    from ..trends.record import TrendFileError
+
+    try:
+        recorder.close()
+    except TrendFileError as e:
+        return str(e)
+    return None
 
 
 def _scan_until_the_end(runner: Runner, app, args: argparse.Namespace) -> None:

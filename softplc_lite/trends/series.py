@@ -162,5 +162,5 @@ def float32_text(value: float) -> str:
     for digits in range(1, 10):
         text = f"{value:.{digits}g}"
         if struct.pack("<f", float(text)) == packed:
-            return text
+            return repr(float(text))  # 20.0, not 2e+01
     return repr(value)
