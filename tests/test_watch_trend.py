@@ -106,7 +106,7 @@ def test_the_panel_shows_the_last_scans_with_a_legend_and_the_axis_in_scans_and_
     lines = screen.splitlines()
     assert all(cell_len(line) == 120 for line in lines) and len(lines) == 40
     legend = next(line for line in lines if line.startswith(" Count 300"))
-    assert "Ratio 75  Tick 1  y auto" in legend
+    assert "Ratio 75.0  Tick 1  y auto" in legend
     axis = next(line for line in lines if "└scan" in line)
     first = int(axis.split("└scan ")[1].split()[0])
     assert axis.rstrip().endswith("scan 300 3.000 s")
@@ -200,7 +200,7 @@ def test_W_writes_the_history_as_csv_read_back_value_for_value(session, tmp_path
     assert rows[0] == ["scan", "time_s (simulated)", "Count", "Ratio", "Tick"]
     assert len(rows) == 31
     for k, row in enumerate(rows[1:], start=1):
-        assert row == [str(k), f"{k * 10 / 1000:.3f}", str(k), f"{k / 4:g}", str(int(k % 4 == 0))]
+        assert row == [str(k), f"{k * 10 / 1000:.3f}", str(k), repr(k / 4), str(int(k % 4 == 0))]
 
 
 def test_W_writes_a_vcd_an_independent_reader_reads(session, tmp_path):
