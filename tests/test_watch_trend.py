@@ -269,3 +269,17 @@ def test_cli_bad_trends_are_every_one_said_before_scan_0(tmp_path):
     assert len(proc.stderr.splitlines()) == 2
     assert "Traceback" not in proc.stderr and not out.exists()
     assert not (tmp_path / "state" / "datatable.snap").exists()  # nothing ran, nothing saved
+
+
+@pytest.mark.parametrize("width,height", [(40, 12), (80, 12), (80, 16), (120, 12), (200, 60)])
+def test_the_panel_fits_any_size_and_says_when_it_has_no_room(session, width, height):
+    s = session(trend=("Count", "Ratio", "Tick", "B3/1", "B3/2", "B3/3"), online=False)
+    for _ in range(30):
+        s.scan()
+    lines = _text(s, width, height).splitlines()
+    assert len(lines) == height and all(cell_len(line) == width for line in lines)
+    text = "\n".join(lines)
+    if width < 120 and height == 12:  # the rungs keep their 8 lines: one left for the panel
+        assert "trend: no room" in text
+    else:
+        assert "└scan 1 0.010 s" in text

@@ -73,11 +73,17 @@ class _Canvas:
     def vline(self, x: int, y0: int, y1: int, style: str) -> None:
         if not 0 <= x < self.cols * 2:
             return
+        if y0 > y1:
+            y0, y1 = y1, y0
+        if y0 < 0:
+            y0 = 0
+        if y1 >= self.rows * 4:
+            y1 = self.rows * 4 - 1
         col, dots = x // 2, _DOT[x % 2]
         bits, styles = self.bits, self.styles
-        for y in range(max(0, min(y0, y1)), min(self.rows * 4 - 1, max(y0, y1)) + 1):
-            row = y // 4
-            bits[row][col] |= dots[y % 4]
+        for y in range(y0, y1 + 1):
+            row = y >> 2
+            bits[row][col] |= dots[y & 3]
             styles[row][col] = style
 
     def line(self, x0: int, y0: int, x1: int, y1: int, style: str) -> None:
@@ -235,6 +241,9 @@ class TrendChart:
                 for hx in range(lx, x):
                     canvas.dot(hx, ly, style)
                 canvas.vline(x, ly, y, style)
+            elif x == last[0] + 1:  # the next dot column (one sample a column): its dots to this height
+                ly = last[1]
+                canvas.vline(x, ly + (1 if y > ly else -1) if y != ly else y, y, style)
             else:
                 canvas.line(last[0], last[1], x, y, style)
             last = (x, y)

@@ -270,6 +270,8 @@ class WatchScreen:
             return
         side = self.side()
         trend_lines = panel_height(self.session, width, height)
+        if width < WIDE and trend_lines:  # never below the rungs' 8 lines (a line saying so at the least)
+            trend_lines = max(1, min(trend_lines, height - 3 - 8))
         trend = TrendPanel(self.session, trend_lines) if trend_lines else None
         if width >= WIDE:  # the trend across the whole width under the rungs and the side panels
             top = body
