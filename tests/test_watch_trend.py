@@ -83,6 +83,18 @@ def test_the_prompt_adds_removes_and_sets_the_range_and_says_errors_on_the_messa
     assert len(s.trend) == MAX_TRENDS and "at most 6" in s.message
 
 
+def test_add_and_remove_by_method(session):
+    s = session(online=False)
+    s.add_trend("Count", "B3/0")
+    assert [x.label for x in s.trend] == ["Count", "B3/0"] and s.message == "trend: Count, B3/0 added"
+    s.add_trend("N7:0")
+    assert len(s.trend) == 2 and "already shown" in s.message
+    s.remove_trend("Count")
+    assert [x.label for x in s.trend] == ["B3/0"]
+    s.remove_trend("Count")
+    assert s.message == "trend: Count is not trended" and len(s.trend) == 1
+
+
 def test_the_T_key_offers_the_selected_rungs_first_operand_by_its_symbol(session):
     s = session(online=False)
     c = Controller(s)

@@ -316,6 +316,14 @@ class WatchSession:
         """``ADDR`` adds or removes a series, ``range LO HI`` or ``range auto`` sets the y axis."""
         trendview.command(self, text)
 
+    def add_trend(self, *texts: str) -> None:
+        """Add series to the panel (what it did, or why not, on the message line)."""
+        trendview.add(self, list(texts))
+
+    def remove_trend(self, text: str) -> None:
+        if not trendview.remove(self, text):
+            self.message = f"trend: {text.strip()} is not trended"
+
     def write_trend(self, path: str) -> None:
         """The history's trend to a .csv or .vcd file."""
         trendview.write(self, path)

@@ -161,12 +161,19 @@ def command(session, text: str) -> None:
         set_range(session, words[1:])
         return
     name = text.strip()
+    if not remove(session, name):
+        add(session, [name])
+
+
+def remove(session, name: str) -> bool:
+    """Remove the series ``name`` names (as typed, its label or its
+    address); False when none is trended."""
     for one in session.trend:
-        if name in (one.text, one.label, str(one.address)):
+        if name.strip() in (one.text, one.label, str(one.address)):
             session.trend.remove(one)
             session.message = f"trend: {one.label} removed" + ("" if session.trend else " (the panel closes)")
-            return
-    add(session, [name])
+            return True
+    return False
 
 
 def add(session, texts: list[str], what: str = "trend") -> None:
