@@ -59,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
     cov = test_coverage.wanted(args)
     for path in files:
         try:
-            results = run_file(args.app, path, coverage=cov)
+            results = run_file(args.app, path, coverage=cov, trend=True)
         except (ScenarioErrors, AppError) as e:
             print(str(e), file=sys.stderr)
             return EXIT_ERROR

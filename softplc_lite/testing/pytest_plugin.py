@@ -90,7 +90,7 @@ class ScenarioItem(pytest.Item):
 
     def runtest(self) -> None:
         app = self.path.parent.parent
-        result = run_scenario(app, self.file, self.scenario, coverage=_coverage(self.config, app))
+        result = run_scenario(app, self.file, self.scenario, coverage=_coverage(self.config, app), trend=True)
         if result.failure is not None:
             raise ScenarioFailed(result.failure)
 

@@ -37,6 +37,7 @@ class Failure:
     line: int
     address: str
     rungs: RungsAt | None = None  # the rungs that write the address, as they were at the failure
+    trend: object | None = None  # a trends.chart.TrendChart of the address up to the failure (failure_trend.py)
 
     def report(self) -> str:
         return (f"{self.path}:{self.line}: expected {self.expectation}, got {self.actual!r} "
@@ -50,12 +51,29 @@ class Failure:
                 yield Segment("  ")
                 yield from line
                 yield Segment.line()
+        if self.trend is not None:
+            x = self.trend.x
+            yield Text(f"  {self.address} from scan {x.first_scan} to the failure:", style="dim")
+            for line in console.render_lines(self.trend, options.update(width=max(options.max_width - 2, 20)),
+                                             pad=False):
+                yield Segment("  ")
+                yield from _rstripped(line)  # the chart fills its width: no spaces at a line's end in a log
+                yield Segment.line()
 
     def text(self, width: int = 80) -> str:
         """The report (one line) and its rungs (``width`` columns wide) as plain text."""
         out = io.StringIO()
         Console(file=out, width=width, color_system=None, highlight=False, soft_wrap=True).print(self)
         return out.getvalue().rstrip("\n")
+
+
+def _rstripped(segments: list[Segment]) -> list[Segment]:
+    out = list(segments)
+    while out and not out[-1].text.rstrip():
+        out.pop()
+    if out:
+        out[-1] = Segment(out[-1].text.rstrip(), out[-1].style, out[-1].control)
+    return out
 
 
 @dataclass
@@ -194,14 +212,21 @@ def _compare(actual, op, value) -> bool:
 
 
 def run_scenario(app: str | Path, file: ScenarioFile, scenario: Scenario, program: Program | None = None,
-                 coverage: Coverage | None = None, code_cache: tuple | None = None) -> Result:
+                 coverage: Coverage | None = None, code_cache: tuple | None = None, trend: bool = False) -> Result:
     """``program``: a parsed program run in place of the app's (PLC.load);
     ``coverage``: a Coverage the scenario's scans record into;
-    ``code_cache``: PLC.load's (DIRECTORY, KEY) for ``program``."""
+    ``code_cache``: PLC.load's (DIRECTORY, KEY) for ``program``;
+    ``trend``: a failure's report draws its address over the scans before
+    it (failure_trend.py: the scenario runs again for it)."""
     with open_plc(app, file, program=program, coverage=coverage, code_cache=code_cache) as plc:
         check_names(file, plc)
         failure = run_steps(plc, file, scenario)
-        return Result(file.path, scenario.name, failure, _fault(plc))
+        result = Result(file.path, scenario.name, failure, _fault(plc))
+    if failure is not None and trend:
+        from .failure_trend import failure_trend  # it runs the steps this module holds
+
+        failure.trend = failure_trend(app, file, scenario, failure, program, code_cache)
+    return result
 
 
 def _fault(plc: PLC) -> str | None:
@@ -239,6 +264,6 @@ def _edges_expected_after(steps: list[Step]) -> list[tuple[str, ...]]:
 
 
 def run_file(app: str | Path, path: str | Path, program: Program | None = None,
-             coverage: Coverage | None = None) -> list[Result]:
+             coverage: Coverage | None = None, trend: bool = False) -> list[Result]:
     file = load_scenarios(path)
-    return [run_scenario(app, file, sc, program, coverage=coverage) for sc in file.scenarios]
+    return [run_scenario(app, file, sc, program, coverage=coverage, trend=trend) for sc in file.scenarios]
