@@ -108,7 +108,7 @@ def _trend_recorder(runner: Runner, app, args: argparse.Namespace):
                                       follow=runner.engine.clock.realtime)
     except TrendFileError as e:
         return None, [str(e)]
-    runner.after_scan.append(recorder.after_scan)
+    runner.after_scan.append(recorder.hook())
     return recorder, []
 
 

@@ -84,10 +84,19 @@ class PackedSampler:
         self.fmt = "".join(fmt)
         self.width = at
         self.place = [(position[(s.file, s.index)], s.bit) for s in series]
-        source = "def row(scan, now_ms):\n    global buf\n" + "\n".join(lines) + "\n"
-        scope = {"buf": buf, "head": struct.Struct("=qq").pack, **{names[n]: a for n, a in arrays.items()}}
+        self.lines = lines
+        self.scope = {"buf": buf, "head": struct.Struct("=qq").pack, **{names[n]: a for n, a in arrays.items()}}
+        self.row = self.compiled("row(scan, now_ms)")
+
+    def compiled(self, signature: str, time_of: str = "scan, now_ms", after: str = ""):
+        """A function of ``signature`` that appends the row (``time_of``: the
+        scan and time expressions), then runs ``after``."""
+        head = f"    buf += head({time_of})"
+        source = (f"def {signature}:\n    global buf\n" + "\n".join([head] + self.lines[1:])
+                  + "\n" + after)
+        scope = dict(self.scope)
         exec(compile(source, "<trend row>", "exec"), scope)  # noqa: S102 - our own text, from resolved addresses
-        self.row = scope["row"]
+        return scope[signature.split("(")[0]]
 
 
 class BackgroundRecorder:
@@ -137,11 +146,12 @@ class BackgroundRecorder:
         if len(self.buf) >= self.limit:
             self._flush()
 
-    def after_scan(self, engine) -> None:
-        """The Runner's after-scan hook: one call less than a lambda around ``record``."""
-        self._row(engine.scans, engine.clock.now_ms)
-        if len(self.buf) >= self.limit:
-            self._flush()
+    def hook(self):
+        """The Runner's after-scan hook: the row and the flush check in one
+        generated function (a call less a scan than ``record``)."""
+        self.sampler.scope.update(flush=self._flush, limit=self.limit)
+        return self.sampler.compiled("after_scan(engine)", "engine.scans, engine.clock.now_ms",
+                                     "    if len(buf) >= limit:\n        flush()\n")
 
     @property
     def rows(self) -> int:
