@@ -29,6 +29,7 @@ import signal
 import socket
 import sys
 
+from ..fdio import read_exactly
 from ..errors import os_error_words
 from . import counters as C
 from . import messages as msg
@@ -99,16 +100,6 @@ async def serve(init: dict, image, out_fd: int) -> None:
     await server.stop()
 
 
-def _read_exactly(fd: int, n: int) -> bytes:
-    out = bytearray()
-    while len(out) < n:
-        chunk = os.read(fd, n - len(out))
-        if not chunk:
-            break
-        out += chunk
-    return bytes(out)
-
-
 def main() -> int:
     # Ctrl-C reaches the whole terminal's process group: the runtime decides when this process ends
     # (it closes standard input after its final scan), so a Ctrl-C does not end it first.
@@ -124,10 +115,10 @@ def main() -> int:
         return 1
 
     try:
-        header = _read_exactly(0, 4)
+        header = read_exactly(0, 4)
         if len(header) < 4:
             return 1
-        init = pickle.loads(_read_exactly(0, msg.LENGTH.unpack(header)[0]))
+        init = pickle.loads(read_exactly(0, msg.LENGTH.unpack(header)[0]))
         name = init["protocol"].name
         problem = init["protocol"].unusable()
         if problem is not None:

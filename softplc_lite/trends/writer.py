@@ -14,18 +14,9 @@ import pickle
 import struct
 import sys
 
+from ..fdio import read_exactly
 from .background import ROWS_PER_BATCH, SPEC_LENGTH, ignore_interrupts
 from .record import CsvWriter, VcdWriter
-
-
-def _read_exactly(fd: int, n: int) -> bytes:
-    out = bytearray()
-    while len(out) < n:
-        chunk = os.read(fd, n - len(out))
-        if not chunk:
-            break
-        out += chunk
-    return bytes(out)
 
 
 def _stream(fd_in: int, spool: int, batch: int):
@@ -47,10 +38,10 @@ def _stream(fd_in: int, spool: int, batch: int):
 
 
 def write(fd_out: int, spool: int, fd_in: int = 0) -> None:
-    head = _read_exactly(fd_in, SPEC_LENGTH.size)
+    head = read_exactly(fd_in, SPEC_LENGTH.size)
     if len(head) < SPEC_LENGTH.size:
         return
-    spec = pickle.loads(_read_exactly(fd_in, SPEC_LENGTH.unpack(head)[0]))
+    spec = pickle.loads(read_exactly(fd_in, SPEC_LENGTH.unpack(head)[0]))
     series, place = spec["series"], spec["place"]
     row = struct.Struct(spec["fmt"])
     out = os.fdopen(fd_out, "w", encoding="utf-8", newline="")
