@@ -22,7 +22,7 @@ BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_load_cache",
     "bench_comgenius_format",
     "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_modbus_server",
-    "bench_enips_server", "bench_watch", "bench_scenarios", "bench_mutation",
+    "bench_enips_server", "bench_watch", "bench_trend_view", "bench_trends", "bench_scenarios", "bench_mutation",
 )
 
 
@@ -182,6 +182,13 @@ def main() -> int:
                      f"{med(table['cip K=4']['ratio_to_modbtcps']):.2f}x MODBTCPS, PCCC "
                      f"{med(table['pccc K=4']['rates']):,.0f}/s = {med(table['pccc K=4']['ratio_to_modbtcps']):.2f}x; "
                      f"under 50 busy clients {enips['busy'].get('late_scans', 0)} late scans")
+
+    trends = load("bench_trends")
+    if trends:
+        med = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731
+        every = [x for r in trends["ratios"].values() for x in r]
+        lines.append(f"trends    recording 20 addresses / none: {med(every):.3f} (+{max(trends['added_us'].values()):.2f} "
+                     f"us a scan) [{'PASS' if trends['verdict']['both'] else 'MISS'} >= {trends['target']}]")
 
     watch = load("bench_watch")
     if watch:
