@@ -25,6 +25,17 @@ PEER: contextvars.ContextVar[str] = contextvars.ContextVar("peer", default="?") 
 MAX_QUEUED = 64  # requests queued on one connection; past it the connection is not read until served
 
 
+def admitted(address: str, allow) -> bool:
+    """Whether a client at ``address`` (text, an IPv6 scope allowed) is in
+    one of the ``allow`` networks; ::ffff:10.1.2.3 counts as 10.1.2.3."""
+    try:
+        ip = ipaddress.ip_address(address.split("%")[0])
+    except ValueError:
+        return False
+    ip = getattr(ip, "ipv4_mapped", None) or ip
+    return any(ip in net for net in allow)
+
+
 class _ToServe:
     """A decoded request in the queue, with what its reply needs."""
 
@@ -65,12 +76,7 @@ class Connection:
         owner = self.owner
         peer = self.link.peername() or ("?", 0)
         self.peer, self.address = f"{peer[0]}:{peer[1]}", str(peer[0])
-        try:
-            ip = ipaddress.ip_address(self.address.split("%")[0])
-            ip = getattr(ip, "ipv4_mapped", None) or ip  # ::ffff:10.1.2.3 is 10.1.2.3 for the allow-list
-        except ValueError:
-            ip = None
-        if ip is None or not any(ip in net for net in owner.settings.allow):
+        if not admitted(self.address, owner.settings.allow):
             owner.count(C.REFUSED_NETWORK, f"{self.peer}: refused, not in the allow-list")
             self.link.abort()
             return

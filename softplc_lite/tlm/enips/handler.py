@@ -13,7 +13,6 @@ read-only (status.py).
 from __future__ import annotations
 
 import asyncio
-import ipaddress
 import struct
 
 from ...cip import cpf, encap
@@ -21,7 +20,7 @@ from ...cip import status as st
 from ...cip.encap import EncapMessage
 from ...netserver import Handler, Malformed
 from ...netserver import counters as C
-from ...netserver.connection import PEER
+from ...netserver.connection import PEER, admitted
 from ...netserver.tcp import TcpListener
 from .connmgr import ConnectionManager
 from .identity import Identity
@@ -143,18 +142,13 @@ class _ListIdentityOverUdp(asyncio.DatagramProtocol):
         self.transport = transport
 
     def datagram_received(self, data: bytes, addr) -> None:
-        try:
-            ip = ipaddress.ip_address(str(addr[0]).split("%")[0])
-            ip = getattr(ip, "ipv4_mapped", None) or ip
-        except ValueError:
-            return
-        if not any(ip in net for net in self.server.settings.allow):
+        if not admitted(str(addr[0]), self.server.settings.allow):
             self.server.count(C.REFUSED_NETWORK, f"{addr[0]}:{addr[1]}: UDP ListIdentity refused, not in the "
                                                  "allow-list")
             return
         if len(data) < encap.HEADER_SIZE or struct.unpack_from("<H", data)[0] != encap.LIST_IDENTITY:
             return
-        if not self.server.rate_ok(str(ip)):
+        if not self.server.rate_ok(str(addr[0])):
             return
         message = EncapMessage.decode(data[:encap.HEADER_SIZE])
         host = self.server.settings.host

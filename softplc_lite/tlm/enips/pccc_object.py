@@ -168,12 +168,20 @@ def _writable(access: TableAccess, info: FileInfo, first: int, count: int) -> No
                                                            "<Writable> covers them")
 
 
-async def masked_words(access: TableAccess, info: FileInfo, writes: list[tuple[int, int, int]]) -> None:
-    """Masked writes of words (item, AND, OR), all checked before any is sent."""
+def check_masked(access: TableAccess, info: FileInfo, writes: list[tuple[int, int, int]]) -> None:
+    """Refused unless every masked write (item, AND, OR) is of a word a client may write."""
     if info.kind not in WORD_FILES:
         raise Refused(P.STS_EXTENDED, P.EXT_DATA_TYPE, f"{info.name}: a masked write is of 16-bit words only")
     for item, _, _ in writes:
         _writable(access, info, item, 1)
+
+
+async def masked_words(access: TableAccess, info: FileInfo, writes: list[tuple[int, int, int]],
+                       checked: bool = False) -> None:
+    """Masked writes of words (item, AND, OR), all checked (unless
+    ``checked`` already) before any is sent."""
+    if not checked:
+        check_masked(access, info, writes)
     for item, and_mask, or_mask in writes:
         if not await access.write_masked(info.name, item, and_mask & 0xFFFF, or_mask & 0xFFFF):
             raise Refused(P.STS_EXTENDED, P.EXT_ACCESS_DENIED, f"{info.name}: the scan refused the write")
@@ -264,13 +272,10 @@ class PcccObject(CipObject):
         for address, and_mask, or_mask in command.sets:
             info, offset = self._plc5(address, access)
             by_file.setdefault(info.name, (info, []))[1].append((offset // 2, and_mask, or_mask))
+        for info, writes in by_file.values():  # every file's sets checked before any is sent
+            check_masked(access, info, writes)
         for info, writes in by_file.values():
-            if info.kind not in WORD_FILES:
-                raise Refused(P.STS_EXTENDED, P.EXT_DATA_TYPE, f"{info.name}: a masked write is of 16-bit words only")
-            for item, _, _ in writes:
-                _writable(access, info, item, 1)
-        for info, writes in by_file.values():
-            await masked_words(access, info, writes)
+            await masked_words(access, info, writes, checked=True)
         return b""
 
     @staticmethod
