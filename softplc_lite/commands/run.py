@@ -8,6 +8,7 @@ import argparse
 import signal
 import sys
 import time
+from contextlib import nullcontext
 from pathlib import Path
 
 from ..app import SCAN_MS_RANGE, load_app
@@ -145,9 +146,13 @@ def run(args: argparse.Namespace) -> int:
         watcher = ProgramWatcher(app)
 
         def online_edit(runner: Runner) -> None:
-            edit = watcher.apply(runner.engine)
-            if edit is not None:  # stderr: above the status line when rich's Live draws one
-                print(edit.summary() if edit.accepted else edit.report(), file=sys.stderr)
+            edit = watcher.poll()
+            if edit is None:
+                return
+            with recorder.detached() if recorder is not None else nullcontext():  # the edit may grow a file
+                edit = watcher.install(runner.engine, edit)
+            # stderr: above the status line when rich's Live draws one
+            print(edit.summary() if edit.accepted else edit.report(), file=sys.stderr)
 
         runner.between_scans.append(online_edit)
     trend_problem = None

@@ -1,24 +1,27 @@
 """Recording a trend beside the scan (``softplc run --trend-file``): the
-scan only copies the series' raw values into a buffer (about a microsecond
-for 20 addresses); a writer process of its own (trends/writer.py) turns
-them into CSV or VCD text, so formatting never slows the scan, and on a
-machine with two cores runs beside it.
+scan only copies the series' raw values into a buffer (well under a
+microsecond for 20 addresses); a writer process of its own (trends/writer.py)
+turns them into CSV or VCD text, so formatting never slows the scan, and on
+a machine with two cores runs beside it.
 
 The rows travel as raw bytes: the scan number and the engine's time in ms
 (two 64-bit integers), then runs of each involved file's items as the table
-stores them (``PackedSampler``). The buffer holds
-``ROWS_PER_BATCH`` rows and goes on whole. On the wall clock it goes to
-the writer's pipe: the scans leave the machine idle between them, and the
-writer keeps up (a 10 ms scan is 100 rows a second; it formats tens of
-thousands). On simulated time the scans run back to back, faster than rows
-can be formatted, and a writer beside them would take the shared cores from
-them: the rows go to a spool (an unnamed temporary file both processes
-hold, gone when the recording closes) that the writer formats once the run
-ends, while the run waits. Memory stays constant however long the run.
+stores them (``RowViews``). A scan's row is one C-level ``join`` of live
+views of those runs, written into a fixed buffer (``BUFFER_BYTES``) that
+goes on whole when full: no Python work a value, no allocation growing with
+the run. On the wall clock the buffer goes to the writer's pipe: the scans
+leave the machine idle between them, and the writer keeps up (a 10 ms scan
+is 100 rows a second; it formats tens of thousands). On simulated time the
+scans run back to back, faster than rows can be formatted, and a writer
+beside them would take the shared cores from them: the rows go to a spool
+(an unnamed temporary file both processes hold, gone when the recording
+closes) that the writer formats once the run ends, while the run waits.
+Memory stays constant however long the run.
 """
 
 from __future__ import annotations
 
+import io
 import os
 import pickle
 import signal
@@ -26,40 +29,43 @@ import struct
 import subprocess
 import sys
 import tempfile
+from array import array
+from contextlib import contextmanager
 from pathlib import Path
 
 from .record import TrendFileError, format_of
 from .series import Series
 
-ROWS_PER_BATCH = 512
+BUFFER_BYTES = 64 * 1024  # a pipe's capacity: one write the writer reads whole; small enough to stay in cache
 SPEC_LENGTH = struct.Struct("<I")
-
+HEAD = "=qq"  # the scan number and the time in ms, ahead of each row's values
 
 GAP = 32  # items between two trended items of a file above which they are copied as two runs
-WHOLE_FILE = 512  # a file of at most this many items is copied whole each scan
+STRUCT_CODE = {2: "h", 4: "i", 8: "q"}  # standard sizes ('=') of the table's integer items, by item size
 
 
-class PackedSampler:
-    """The series' raw items as bytes, a few slices a scan: each file's
-    trended items in runs (items closer than GAP copied as one run), so a
-    scan's row is the scan and time packed, and one ``tobytes`` a run (about
-    half a microsecond for 20 addresses in four files). ``row(scan,
-    now_ms)`` appends it to the byte buffer; ``fmt`` is the row's struct
-    format (native order: both processes are on this machine) and
-    ``place[k]`` says where series ``k``'s value is in an unpacked row, and
-    its bit."""
+class RowViews:
+    """The series' raw items as live views of the table: each file's
+    trended items in runs (items closer than GAP as one run: a view costs
+    the scan as much as a few items' bytes), fixed when the recording starts. A row is ``join(parts)``: the
+    ``head`` array (scan, time) then each run's current bytes. ``fmt`` is
+    the row's struct format (native order: both processes are on this
+    machine) and ``place[k]`` says where series ``k``'s value is in an
+    unpacked row, and its bit.
 
-    def __init__(self, table, series: list[Series], buf: bytearray) -> None:
+    A view holds its array's buffer, and an array with a view cannot grow:
+    ``detach`` lets go of the views (an online edit may grow a file) and
+    ``attach`` takes them again, of the same runs, so every row keeps the
+    width the writer was told."""
+
+    def __init__(self, table, series: list[Series]) -> None:
         by_file: dict[str, set[int]] = {}
         for s in series:
             by_file.setdefault(s.file, set()).add(s.index)
-        arrays = {name: table.file(name).data for name in by_file}
-        runs: list[tuple[str, int, int]] = []  # (file, first item, items); items None: the whole file
+        self._arrays = {name: table.file(name).data for name in by_file}
+        runs: list[tuple[str, int, int]] = []  # (file, first item, items)
         for name in sorted(by_file):
             items = sorted(by_file[name])
-            if len(arrays[name]) <= WHOLE_FILE:  # copied whole: one memcpy, no slice made
-                runs.append((name, 0, None))
-                continue
             start = last = items[0]
             for item in items[1:]:
                 if item - last > GAP:
@@ -68,40 +74,66 @@ class PackedSampler:
                 last = item
             runs.append((name, start, last - start + 1))
         position: dict[tuple[str, int], int] = {}
-        fmt, at = ["=qq"], 2
-        names = {name: f"d{k}" for k, name in enumerate(sorted(by_file))}
-        lines = ["    buf += head(scan, now_ms)"]
+        fmt, at = [HEAD], 2
         for name, first, count in runs:
-            code = arrays[name].typecode
-            whole = count is None
-            count = len(arrays[name]) if whole else count
-            fmt.append(f"{count}{'i' if code == 'l' else code}")
+            data = self._arrays[name]
+            fmt.append(f"{count}{'f' if data.typecode == 'f' else STRUCT_CODE[data.itemsize]}")
             for k in range(count):
                 position[(name, first + k)] = at + k
             at += count
-            lines.append(f"    buf += {names[name]}" if whole else
-                         f"    buf += {names[name]}[{first}:{first + count}].tobytes()")
+        self.runs = runs
         self.fmt = "".join(fmt)
         self.width = at
         self.place = [(position[(s.file, s.index)], s.bit) for s in series]
-        self.lines = lines
-        self.scope = {"buf": buf, "head": struct.Struct("=qq").pack, **{names[n]: a for n, a in arrays.items()}}
-        self.row = self.compiled("row(scan, now_ms)")
+        self.head = array("q", [0, 0])
+        self.parts: list = []  # the head, then one view a run; changed in place, so a bound hook sees it
+        self.attach()
 
-    def compiled(self, signature: str, time_of: str = "scan, now_ms", after: str = ""):
-        """A function of ``signature`` that appends the row (``time_of``: the
-        scan and time expressions), then runs ``after``."""
-        head = f"    buf += head({time_of})"
-        source = (f"def {signature}:\n    global buf\n" + "\n".join([head] + self.lines[1:])
-                  + "\n" + after)
-        scope = dict(self.scope)
-        exec(compile(source, "<trend row>", "exec"), scope)  # noqa: S102 - our own text, from resolved addresses
-        return scope[signature.split("(")[0]]
+    def attach(self) -> None:
+        self.parts[:] = [self.head] + [memoryview(self._arrays[name])[first:first + count]
+                                       for name, first, count in self.runs]
+
+    def detach(self) -> None:
+        views, self.parts[:] = self.parts[1:], []
+        for view in views:
+            view.release()
+
+
+class _Sink(io.RawIOBase):
+    """Where the full buffer goes (the writer's pipe or the spool), counting
+    the bytes. A failed write is kept, not raised: it would reach the scan.
+    A dead writer is said by close() from its exit status; a full disk from
+    ``error``."""
+
+    def __init__(self, fd: int) -> None:
+        super().__init__()
+        self.fd = fd
+        self.written = 0
+        self.error: str | None = None
+
+    def writable(self) -> bool:
+        return True
+
+    def tell(self) -> int:
+        return self.written
+
+    def write(self, data) -> int:
+        size = len(data)
+        if self.error is None:
+            try:
+                view = memoryview(data)
+                while view:  # a pipe may take part of it
+                    view = view[os.write(self.fd, view):]
+            except OSError as e:
+                self.error = e.strerror or str(e)
+        self.written += size
+        return size
 
 
 class BackgroundRecorder:
-    """``record`` after each scan; ``close`` at the end waits until the
-    writer process has written everything (TrendFileError if it could not)."""
+    """``hook()`` (or ``record``) after each scan; ``close`` at the end
+    waits until the writer process has written everything (TrendFileError
+    if it could not)."""
 
     def __init__(self, table, series: list[Series], path: str | Path, app_name: str, clock: str,
                  on_change: bool = False, follow: bool = True) -> None:
@@ -115,12 +147,8 @@ class BackgroundRecorder:
             fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
         except OSError as e:
             raise TrendFileError(f"--trend-file {str(path)!r}: cannot write it: {e.strerror or e}") from None
-        self.buf = bytearray()
-        self.sampler = PackedSampler(table, series, self.buf)
-        self._row = self.sampler.row
-        self.row_bytes = struct.calcsize(self.sampler.fmt)
-        self.limit = ROWS_PER_BATCH * self.row_bytes
-        self._flushed = 0
+        self.views = RowViews(table, series)
+        self.row_bytes = struct.calcsize(self.views.fmt)
         self.spool = None
         if not follow:
             try:
@@ -137,54 +165,49 @@ class BackgroundRecorder:
         finally:
             os.close(fd)
         spec = pickle.dumps({"kind": kind, "series": series, "app_name": app_name, "clock": clock,
-                             "on_change": on_change, "fmt": self.sampler.fmt, "place": self.sampler.place,
+                             "on_change": on_change, "fmt": self.views.fmt, "place": self.views.place,
                              "path": str(path), "follow": follow})
-        self._send(SPEC_LENGTH.pack(len(spec)) + spec)
+        pipe = _Sink(self.proc.stdin.fileno())
+        pipe.write(SPEC_LENGTH.pack(len(spec)) + spec)
+        self.sink = pipe if self.spool is None else _Sink(spool_fd)
+        self.sink.written = 0  # rows only: the spec is not one
+        self.out = io.BufferedWriter(self.sink, BUFFER_BYTES)
 
     def record(self, scan: int, now_ms: int) -> None:
-        self._row(scan, now_ms)
-        if len(self.buf) >= self.limit:
-            self._flush()
+        head = self.views.head
+        head[0], head[1] = scan, now_ms
+        self.out.write(b"".join(self.views.parts))
 
     def hook(self):
-        """The Runner's after-scan hook: the row and the flush check in one
-        generated function (a call less a scan than ``record``)."""
-        self.sampler.scope.update(flush=self._flush, limit=self.limit)
-        return self.sampler.compiled("after_scan(engine)", "engine.scans, engine.clock.now_ms",
-                                     "    if len(buf) >= limit:\n        flush()\n")
+        """The Runner's after-scan hook: two stores and one C-level copy
+        into the buffer a scan."""
+        head, parts, join, write = self.views.head, self.views.parts, b"".join, self.out.write
+
+        def after_scan(engine) -> None:
+            head[0] = engine.scans
+            head[1] = engine.clock.now_ms
+            write(join(parts))
+        return after_scan
+
+    @contextmanager
+    def detached(self):
+        """No views of the table held inside: for an online edit between
+        scans, which may grow a file (an array with a view cannot)."""
+        self.views.detach()
+        try:
+            yield
+        finally:
+            self.views.attach()
 
     @property
     def rows(self) -> int:
         """Rows recorded so far (the scans sampled)."""
-        return self._flushed + len(self.buf) // self.row_bytes
-
-    def _flush(self) -> None:
-        if self.buf:
-            self._flushed += len(self.buf) // self.row_bytes
-            if self.spool is None:
-                self._send(bytes(self.buf))
-            else:
-                try:
-                    os.write(self.spool.fileno(), self.buf)
-                except OSError as e:  # the disk full: said at the end, the scan goes on
-                    self.spool_error = e.strerror or str(e)
-            del self.buf[:]
-
-    spool_error: str | None = None
-
-    def _send(self, data: bytes) -> None:
-        if self.proc.poll() is not None:  # the writer ended (close() says why): a write would meet SIGPIPE
-            return
-        try:
-            view = memoryview(data)
-            while view:  # unbuffered: nothing is left for a later flush to push into a closed pipe
-                view = view[self.proc.stdin.write(view):]
-        except (BrokenPipeError, OSError, ValueError):
-            pass
+        return self.out.tell() // self.row_bytes
 
     def close(self) -> None:
         """Flush, end the writer's input, and wait for it to finish the file."""
-        self._flush()
+        self.out.flush()
+        self.views.detach()
         try:
             self.proc.stdin.close()
         except (BrokenPipeError, OSError):
@@ -194,11 +217,11 @@ class BackgroundRecorder:
         self.proc.stderr.close()
         if self.spool is not None:
             self.spool.close()
-        if self.spool_error is not None:
-            raise TrendFileError(f"--trend-file: the recording's spool could not be written: {self.spool_error}")
         if self.proc.returncode != 0:
             raise TrendFileError(err.splitlines()[-1] if err else f"the trend writer ended with status "
                                                                   f"{self.proc.returncode}")
+        if self.spool is not None and self.sink.error is not None:
+            raise TrendFileError(f"--trend-file: the recording's spool could not be written: {self.sink.error}")
 
 
 def ignore_interrupts() -> None:

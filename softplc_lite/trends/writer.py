@@ -15,7 +15,7 @@ import struct
 import sys
 
 from ..fdio import read_exactly
-from .background import ROWS_PER_BATCH, SPEC_LENGTH, ignore_interrupts
+from .background import BUFFER_BYTES, SPEC_LENGTH, ignore_interrupts
 from .record import CsvWriter, VcdWriter
 
 
@@ -51,7 +51,7 @@ def write(fd_out: int, spool: int, fd_in: int = 0) -> None:
     bits = [(k, bit) for k, (_, bit) in enumerate(place) if bit is not None]
     on_change, last = spec["on_change"], None
     pending = b""
-    for chunk in _stream(fd_in, spool, ROWS_PER_BATCH * row.size * 8):
+    for chunk in _stream(fd_in, spool, 4 * BUFFER_BYTES):
         pending += chunk
         whole = len(pending) - len(pending) % row.size
         for raw in row.iter_unpack(pending[:whole]):
