@@ -1,0 +1,492 @@
+"""Read a Studio 5000 L5X export (XML) into a ``model.Project``, every
+part with its line and column (1-based) in the file.
+
+The file is parsed by expat, which gives each element's position; a
+rung's, an ST line's and a comment's position is where its text starts
+(inside the CDATA section). Partial exports (TargetType Program, Routine,
+Rung, AddOnInstructionDefinition, DataType, Module) hold their parts under
+``Controller Use="Context"`` and ``Use="Target"`` elements in the same
+places a whole controller does, so one walk reads every kind.
+
+Tag data: a tag's ``Data`` elements are read ``Format="Decorated"`` first
+(members by name), else ``Format="String"`` (a STRING's text), else
+``Format="L5K"`` (positional); ``prefer="positional"`` reads the L5K form
+first instead, which is what an L5K file holds for the same tag.
+
+Module tag names, a choice following what the exports we gathered show
+(rungs of public exports name ``Local:2:I``, ``Local:5:O`` for modules in
+the controller's chassis, and Ethernet devices by their own name): a
+module whose upstream port is a backplane (ICP, PointIO, Compact ...:
+any upstream port not Ethernet, with a numeric Address) sits in its
+parent's chassis at that slot, and its tags are
+``<ParentModule>:<slot>:<suffix>`` (``Local:1:I`` for the controller's
+chassis, ``RemoteAdapter:3:I`` in a remote one); any other module's tags
+are ``<Name>:<suffix>``. The suffix is ``C`` for the ConfigTag, and for a
+Connection's InputTag and OutputTag its ``InputTagSuffix`` and
+``OutputTagSuffix`` when given, else ``I`` and ``O``.
+
+Every problem found is collected and raised at the end as one
+``ExportError``; reading goes on past a bad part.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.parsers.expat as expat
+from dataclasses import dataclass, field
+
+from ..ladder.ast import Pos
+from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
+                    ModuleTag, Problem, Program, Project, Routine, Rung, Tag, Task)
+from .values import ValueSyntax, parse_l5k_value, parse_quoted, typed_scalar
+
+TARGET_TYPES = ("Controller", "Program", "Routine", "Rung", "AddOnInstructionDefinition", "DataType", "Module")
+
+
+@dataclass
+class _Node:
+    tag: str
+    attrs: dict
+    pos: Pos
+    children: list = field(default_factory=list)
+    parts: list = field(default_factory=list)  # character data
+    text_pos: Pos | None = None  # where the first non-blank text starts
+
+    def child(self, tag: str) -> "_Node | None":
+        for c in self.children:
+            if c.tag == tag:
+                return c
+        return None
+
+    def all(self, tag: str) -> list["_Node"]:
+        return [c for c in self.children if c.tag == tag]
+
+    @property
+    def text(self) -> str:
+        return "".join(self.parts)
+
+
+def _parse(data: bytes | str, source: str) -> _Node:
+    parser = expat.ParserCreate()
+    root = _Node("#document", {}, Pos(source, 1, 1))
+    stack = [root]
+
+    def start(tag, attrs):
+        node = _Node(tag, attrs, Pos(source, parser.CurrentLineNumber, parser.CurrentColumnNumber + 1))
+        stack[-1].children.append(node)
+        stack.append(node)
+
+    def end(tag):
+        stack.pop()
+
+    def chars(data):
+        node = stack[-1]
+        if node.text_pos is None:
+            stripped = data.lstrip()
+            if stripped:
+                skipped = data[:len(data) - len(stripped)]
+                line = parser.CurrentLineNumber + skipped.count("\n")
+                if "\n" in skipped:
+                    col = len(skipped) - skipped.rfind("\n")
+                else:
+                    col = parser.CurrentColumnNumber + 1 + len(skipped)
+                node.text_pos = Pos(source, line, col)
+        node.parts.append(data)
+
+    parser.StartElementHandler = start
+    parser.EndElementHandler = end
+    parser.CharacterDataHandler = chars
+    parser.buffer_text = False
+    parser.Parse(data, True)
+    return root
+
+
+def _load(path_or_text, source_name: str | None) -> tuple[bytes | str | None, str, list[Problem]]:
+    if isinstance(path_or_text, str) and path_or_text.lstrip("\ufeff \t\r\n").startswith("<"):
+        return path_or_text, source_name or "<l5x>", []
+    path = os.fspath(path_or_text)
+    source = source_name or str(path)
+    try:
+        with open(path, "rb") as f:
+            return f.read(), source, []
+    except OSError as e:
+        return None, source, [Problem(Pos(source, 0, 0), f"cannot read the export: {e.strerror or e}")]
+
+
+def read_l5x(path_or_text, source_name: str | None = None, prefer: str = "decorated") -> Project:
+    """Read an L5X export (a path, or the XML text itself)."""
+    data, source, problems = _load(path_or_text, source_name)
+    if data is None:
+        raise ExportError(problems)
+    if isinstance(data, str):
+        data = data.lstrip("\ufeff").encode("utf-8")
+    try:
+        root = _parse(data, source)
+    except expat.ExpatError as e:
+        message = expat.ErrorString(e.code)
+        raise ExportError([Problem(Pos(source, e.lineno, e.offset + 1), f"malformed XML: {message}")]) from None
+    reader = _Reader(source, prefer)
+    project = reader.project(root)
+    if reader.problems:
+        raise ExportError(reader.problems)
+    return project
+
+
+def _bool(value: str | None, default: bool = False) -> bool:
+    if value is None:
+        return default
+    return value.strip().lower() in ("true", "1", "yes")
+
+
+def _dims(text: str | None) -> tuple[int, ...]:
+    if not text:
+        return ()
+    parts = text.replace(",", " ").split()
+    dims = tuple(int(p) for p in parts)
+    return () if dims == (0,) else dims
+
+
+class _Reader:
+    def __init__(self, source: str, prefer: str) -> None:
+        self.source = source
+        self.prefer = prefer
+        self.problems: list[Problem] = []
+
+    def problem(self, pos: Pos, message: str) -> None:
+        self.problems.append(Problem(pos, message))
+
+    def name(self, node: _Node, what: str) -> str | None:
+        name = node.attrs.get("Name")
+        if not name:
+            self.problem(node.pos, f"expected a Name attribute on this {what}")
+            return None
+        return name
+
+    def description(self, node: _Node) -> str | None:
+        d = node.child("Description")
+        return d.text.strip() if d is not None else None
+
+    def int_attr(self, node: _Node, attr: str, default=None):
+        text = node.attrs.get(attr)
+        if text is None:
+            return default
+        try:
+            return int(text.replace("_", ""))
+        except ValueError:
+            try:
+                return float(text)
+            except ValueError:
+                self.problem(node.pos, f"expected a number for {attr}, found {text!r}")
+                return default
+
+    # -- the whole file ------------------------------------------------------------------
+
+    def project(self, document: _Node) -> Project:
+        root = document.children[0] if document.children else None
+        project = Project(source=self.source, format="L5X")
+        if root is None or root.tag != "RSLogix5000Content":
+            self.problem(root.pos if root else document.pos, "expected an RSLogix5000Content element at the top of an L5X export")
+            return project
+        project.target_type = root.attrs.get("TargetType", "Controller")
+        project.target_name = root.attrs.get("TargetName")
+        project.software_revision = root.attrs.get("SoftwareRevision")
+        if project.target_type not in TARGET_TYPES:
+            self.problem(root.pos, f"expected a TargetType of {', '.join(TARGET_TYPES)}, found {project.target_type!r}")
+        controller = root.child("Controller")
+        if controller is None and root.child("Module") is None:
+            self.problem(root.pos, "expected a Controller element in the export")
+            return project
+        if controller is not None:
+            project.controller = controller.attrs.get("Name")
+            project.processor_type = controller.attrs.get("ProcessorType")
+        # A module export holds its modules at the top, without a Controller.
+        for section in (controller or root).children + (root.all("Module") if controller else []):
+            if section.tag == "Module":
+                project.modules.append(self.module(section))
+            elif section.tag == "DataTypes":
+                project.data_types += [d for d in map(self.data_type, section.all("DataType")) if d]
+            elif section.tag == "Modules":
+                project.modules += [m for m in map(self.module, section.all("Module")) if m]
+            elif section.tag == "AddOnInstructionDefinitions":
+                project.add_on_instructions += [a for a in map(self.aoi, section.all("AddOnInstructionDefinition")) if a]
+            elif section.tag == "Tags":
+                project.tags += self.tags(section, "Tag")
+            elif section.tag == "Programs":
+                project.programs += [p for p in map(self.program, section.all("Program")) if p]
+            elif section.tag == "Tasks":
+                project.tasks += [t for t in map(self.task, section.all("Task")) if t]
+        return project
+
+    # -- data types ----------------------------------------------------------------------
+
+    def data_type(self, node: _Node) -> DataType | None:
+        name = self.name(node, "DataType")
+        if name is None:
+            return None
+        dt = DataType(name, family=node.attrs.get("Family", "NoFamily"), description=self.description(node), pos=node.pos)
+        members = node.child("Members")
+        for m in members.all("Member") if members is not None else []:
+            mname = self.name(m, "Member")
+            if mname is None:
+                continue
+            dt.members.append(Member(
+                mname, m.attrs.get("DataType", ""), dimension=self.int_attr(m, "Dimension", 0),
+                hidden=_bool(m.attrs.get("Hidden")), target=m.attrs.get("Target"),
+                bit_number=self.int_attr(m, "BitNumber"),
+                external_access=m.attrs.get("ExternalAccess", "Read/Write"),
+                description=self.description(m), radix=m.attrs.get("Radix"), pos=m.pos))
+        return dt
+
+    # -- tags and their data -------------------------------------------------------------
+
+    def tags(self, section: _Node, tag: str) -> list[Tag]:
+        return [t for t in (self.tag(n) for n in section.all(tag)) if t]
+
+    def tag(self, node: _Node) -> Tag | None:
+        name = self.name(node, node.tag)
+        if name is None:
+            return None
+        a = node.attrs
+        tag_type = a.get("TagType", "Base")
+        t = Tag(name, a.get("DataType"), dims=_dims(a.get("Dimensions")), tag_type=tag_type,
+                alias_for=a.get("AliasFor"), external_access=a.get("ExternalAccess", "Read/Write"),
+                constant=_bool(a.get("Constant")), description=self.description(node), radix=a.get("Radix"),
+                usage=a.get("Usage"), required=_bool(a.get("Required")), visible=_bool(a.get("Visible"), True),
+                pos=node.pos)
+        if tag_type == "Alias" and not t.alias_for:
+            self.problem(node.pos, f"expected an AliasFor attribute on alias tag {name}")
+        t.value = self.data(node, "DefaultData" if node.tag in ("Parameter", "LocalTag") else "Data")
+        return t
+
+    def data(self, node: _Node, tag: str) -> InitialValue | None:
+        forms = {d.attrs.get("Format"): d for d in node.all(tag)}
+        order = ("L5K", "Decorated", "String") if self.prefer == "positional" else ("Decorated", "String", "L5K")
+        for fmt in order:
+            d = forms.get(fmt)
+            if d is None:
+                continue
+            try:
+                if fmt == "L5K":
+                    text = d.text.strip()
+                    return InitialValue("positional", parse_l5k_value(text), d.text_pos or d.pos)
+                if fmt == "String":
+                    return InitialValue("decorated", parse_quoted(d.text.strip()), d.text_pos or d.pos)
+                content = [c for c in d.children]
+                if len(content) != 1:
+                    self.problem(d.pos, "expected one DataValue, Array or Structure in decorated data")
+                    return None
+                return InitialValue("decorated", self.decorated(content[0]), d.pos)
+            except ValueSyntax as e:
+                at = d.text_pos or d.pos
+                if fmt in ("L5K", "String") and d.text_pos is not None:
+                    text = d.text.lstrip()
+                    before = text[:e.offset]
+                    line = at.line + before.count("\n")
+                    col = (len(before) - before.rfind("\n")) if "\n" in before else at.column + e.offset
+                    at = Pos(self.source, line, col)
+                self.problem(at, f"bad {fmt} data: {e.message}")
+                return None
+            except _BadValue as e:
+                self.problem(e.node.pos, e.message)
+                return None
+        return None
+
+    def decorated(self, node: _Node):
+        a = node.attrs
+        if node.tag in ("DataValue", "DataValueMember"):
+            if "Value" in a:
+                try:
+                    return typed_scalar(a["Value"], a.get("DataType"), a.get("Radix"))
+                except ValueSyntax as e:
+                    raise _BadValue(node, f"bad Value for {a.get('DataType') or 'a value'}: {e.message}") from None
+            if node.text.strip():  # a string member's text
+                try:
+                    return parse_quoted(node.text.strip())
+                except ValueSyntax as e:
+                    raise _BadValue(node, f"bad string data: {e.message}") from None
+            if (a.get("Radix") or "").upper() == "ASCII":  # an empty string member
+                return ""
+            raise _BadValue(node, f"expected a Value attribute on this {node.tag}")
+        if node.tag in ("Structure", "StructureMember"):
+            out = {}
+            for c in node.children:
+                if c.tag in ("DataValueMember", "StructureMember", "ArrayMember"):
+                    if not c.attrs.get("Name"):
+                        raise _BadValue(c, f"expected a Name attribute on this {c.tag}")
+                    out[c.attrs["Name"]] = self.decorated(c)
+            return out
+        if node.tag in ("Array", "ArrayMember"):
+            dims = None
+            try:
+                dims = _dims(a.get("Dimensions"))
+            except ValueError:
+                raise _BadValue(node, f"expected Dimensions like \"10\" or \"2,3\", found {a.get('Dimensions')!r}") from None
+            elements = []
+            for e in node.all("Element"):
+                index = e.attrs.get("Index", "")
+                try:
+                    idx = tuple(int(i) for i in index.strip("[] ").split(","))
+                except ValueError:
+                    raise _BadValue(e, f"expected an Index like \"[3]\" or \"[1,2]\", found {index!r}") from None
+                if "Value" in e.attrs:
+                    try:
+                        v = typed_scalar(e.attrs["Value"], a.get("DataType"), a.get("Radix"))
+                    except ValueSyntax as err:
+                        raise _BadValue(e, f"bad Value for {a.get('DataType') or 'an element'}: {err.message}") from None
+                elif e.children:
+                    v = self.decorated(e.children[0])
+                else:
+                    raise _BadValue(e, "expected a Value attribute or a Structure in this Element")
+                elements.append((idx, v, e))
+            return _nest(elements, dims, node)
+        raise _BadValue(node, f"expected DataValue, Array or Structure, found {node.tag}")
+
+    # -- modules --------------------------------------------------------------------------
+
+    def module(self, node: _Node) -> Module | None:
+        name = node.attrs.get("Name", "")  # a drive's peripheral modules have no name
+        a = node.attrs
+        m = Module(name, a.get("CatalogNumber"), parent=a.get("ParentModule"), inhibited=_bool(a.get("Inhibited")), pos=node.pos)
+        ports = node.child("Ports")
+        for p in ports.all("Port") if ports is not None else []:
+            address = p.attrs.get("Address", "")
+            if _bool(p.attrs.get("Upstream")) and p.attrs.get("Type") != "Ethernet" and address.isdigit():
+                m.slot = int(address)
+        prefix = f"{m.parent}:{m.slot}" if m.slot is not None and m.parent and m.parent != name else name
+        comms = node.child("Communications")
+        if comms is None or not prefix:
+            return m
+        for c in comms.all("ConfigTag"):
+            m.tags.append(self.module_tag(c, f"{prefix}:C"))
+        connections = comms.child("Connections")
+        for conn in connections.all("Connection") if connections is not None else []:
+            for tag, attr, default in (("InputTag", "InputTagSuffix", "I"), ("OutputTag", "OutputTagSuffix", "O")):
+                for t in conn.all(tag):
+                    m.tags.append(self.module_tag(t, f"{prefix}:{conn.attrs.get(attr) or default}"))
+        return m
+
+    def module_tag(self, node: _Node, name: str) -> ModuleTag:
+        value = self.data(node, "Data")
+        data_type = None
+        for d in node.all("Data"):
+            if d.attrs.get("Format") == "Decorated" and d.children:
+                data_type = d.children[0].attrs.get("DataType")
+        return ModuleTag(name, data_type, value, node.pos)
+
+    # -- AOIs, programs, routines, tasks ---------------------------------------------------
+
+    def aoi(self, node: _Node) -> AddOnInstruction | None:
+        name = self.name(node, "AddOnInstructionDefinition")
+        if name is None:
+            return None
+        aoi = AddOnInstruction(name, revision=node.attrs.get("Revision"), description=self.description(node), pos=node.pos)
+        params = node.child("Parameters")
+        if params is not None:
+            aoi.parameters = self.tags(params, "Parameter")
+        local = node.child("LocalTags")
+        if local is not None:
+            aoi.local_tags = self.tags(local, "LocalTag")
+        routines = node.child("Routines")
+        aoi.routines = [r for r in map(self.routine, routines.all("Routine") if routines is not None else []) if r]
+        return aoi
+
+    def program(self, node: _Node) -> Program | None:
+        name = self.name(node, "Program")
+        if name is None:
+            return None
+        a = node.attrs
+        p = Program(name, a.get("MainRoutineName"), a.get("FaultRoutineName"), _bool(a.get("Disabled")),
+                    description=self.description(node), pos=node.pos)
+        tags = node.child("Tags")
+        if tags is not None:
+            p.tags = self.tags(tags, "Tag")
+        routines = node.child("Routines")
+        p.routines = [r for r in map(self.routine, routines.all("Routine") if routines is not None else []) if r]
+        return p
+
+    def routine(self, node: _Node) -> Routine | None:
+        name = self.name(node, "Routine")
+        if name is None:
+            return None
+        kind = node.attrs.get("Type", "")
+        if not kind:  # a context routine of a rung export names no Type: its content tells
+            kind = next((k for k in ("RLL", "ST", "FBD", "SFC") if node.child(k + "Content") is not None), "")
+        r = Routine(name, kind, description=self.description(node), pos=node.pos)
+        # A routine a partial export only refers to (Use="Reference") may name no Type.
+        if kind not in ("RLL", "ST", "FBD", "SFC") and node.attrs.get("Use") != "Reference":
+            self.problem(node.pos, f"expected a routine Type of RLL, ST, FBD or SFC, found {kind!r}")
+        if kind == "RLL":
+            content = node.child("RLLContent")
+            for n in content.all("Rung") if content is not None else []:
+                rung = self.rung(n)
+                if rung is not None:
+                    r.rungs.append(rung)
+        elif kind == "ST":
+            content = node.child("STContent")
+            for n in content.all("Line") if content is not None else []:
+                number = self.int_attr(n, "Number", len(r.lines))
+                r.lines.append(Line(number, n.text.strip("\r\n"), n.text_pos or n.pos))
+        return r
+
+    def rung(self, node: _Node) -> Rung | None:
+        number = self.int_attr(node, "Number")
+        if number is None:
+            self.problem(node.pos, "expected a Number attribute on this Rung")
+            return None
+        text = node.child("Text")
+        if text is None or not text.text.strip():
+            self.problem(node.pos, f"expected a Text element with the rung's text in rung {number}")
+            return None
+        comment = node.child("Comment")
+        return Rung(number, text.text.strip(), comment.text.strip() if comment is not None else None,
+                    node.attrs.get("Type", "N"), text.text_pos or text.pos)
+
+    def task(self, node: _Node) -> Task | None:
+        name = self.name(node, "Task")
+        if name is None:
+            return None
+        a = node.attrs
+        t = Task(name, a.get("Type", "CONTINUOUS"), priority=self.int_attr(node, "Priority", 10),
+                 watchdog_ms=float(self.int_attr(node, "Watchdog", 500.0)),
+                 inhibited=_bool(a.get("InhibitTask")), pos=node.pos)
+        if t.kind != "CONTINUOUS" and "Rate" in a:
+            t.rate_ms = float(self.int_attr(node, "Rate", 0))
+        scheduled = node.child("ScheduledPrograms")
+        for s in scheduled.all("ScheduledProgram") if scheduled is not None else []:
+            sname = self.name(s, "ScheduledProgram")
+            if sname:
+                t.programs.append(sname)
+        return t
+
+
+class _BadValue(Exception):
+    def __init__(self, node: _Node, message: str) -> None:
+        super().__init__(message)
+        self.node = node
+        self.message = message
+
+
+def _nest(elements: list, dims: tuple[int, ...] | None, node: _Node) -> list:
+    """Decorated array elements (index tuple, value) as nested lists,
+    the first index outermost."""
+    if not elements:
+        return []
+    rank = len(elements[0][0])
+    if dims and len(dims) != rank:
+        dims = None
+    out: list = []
+    for idx, value, e in elements:
+        if len(idx) != rank:
+            raise _BadValue(e, f"expected an Index of {rank} dimension(s), found {len(idx)}")
+        target = out
+        for k, i in enumerate(idx):
+            if i < 0 or (dims and i >= dims[k]):
+                raise _BadValue(e, f"Index {list(idx)} is outside the array's Dimensions")
+            last = k == rank - 1
+            while len(target) <= i:
+                target.append(None if last else [])
+            if last:
+                target[i] = value
+            else:
+                target = target[i]
+    return out

@@ -1,0 +1,236 @@
+"""The Studio 5000 export readers (softplc_lite/logix/l5x.py, l5k.py):
+what each reads out of a hand-written controller, value for value; that the
+L5X and L5K forms of the same controller read the same; every error located
+where it is; and that no damaged input gives anything but a Project or an
+ExportError."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from helpers.located import locate
+from helpers.logix_exports import damaged_copies, without_positions
+from softplc_lite.ladder.ast import Pos
+from softplc_lite.logix.l5x import read_l5x
+from softplc_lite.logix.model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member,
+                                      Module, ModuleTag, Program, Project, Routine, Rung, Tag, Task)
+
+FIXTURES = Path(__file__).parent / "fixtures" / "logix"
+L5X = FIXTURES / "reader_controller.L5X"
+L5K = FIXTURES / "reader_controller.L5K"
+
+
+def _dec(data):
+    return InitialValue("decorated", data)
+
+
+def _expected_l5x() -> Project:
+    """What reader_controller.L5X says, its data read in decorated form."""
+    rw, ro = "Read/Write", "Read Only"
+    return Project(
+        source="reader_controller.L5X", format="L5X", target_type="Controller", target_name="Mixer",
+        controller="Mixer", processor_type="1769-L33ER", software_revision="32.11",
+        data_types=[DataType("Valve", [
+            Member("ZZZZZZZZZZValve0", "SINT", hidden=True, radix="Decimal"),
+            Member("Open", "BIT", target="ZZZZZZZZZZValve0", bit_number=0, description="Command open", radix="Decimal"),
+            Member("Closed", "BIT", target="ZZZZZZZZZZValve0", bit_number=1, external_access=ro, radix="Decimal"),
+            Member("Travel", "DINT", radix="Decimal"),
+            Member("Hist", "INT", dimension=4, external_access="None", radix="Hex"),
+        ], description="One valve")],
+        add_on_instructions=[AddOnInstruction(
+            "Scale",
+            parameters=[
+                Tag("EnableIn", "BOOL", external_access=ro, radix="Decimal", usage="Input", visible=False),
+                Tag("EnableOut", "BOOL", external_access=ro, radix="Decimal", usage="Output", visible=False),
+                Tag("Raw", "DINT", radix="Decimal", value=_dec(0), usage="Input", required=True),
+                Tag("Gain", "REAL", radix="Float", value=_dec(1.5), usage="Input"),
+                Tag("Out", "REAL", external_access=ro, radix="Float", value=_dec(0.0), usage="Output"),
+            ],
+            local_tags=[Tag("Tmp", "REAL", external_access="None", radix="Float", value=_dec(0.0))],
+            routines=[Routine("Logic", "RLL", rungs=[Rung(0, "MUL(Raw,Gain,Tmp)MOV(Tmp,Out);")])],
+            revision="1.2", description="Scale a raw count")],
+        modules=[
+            Module("Local", "1769-L33ER", parent="Local"),
+            Module("DIO", "1769-IQ6XOW4/B", parent="Local", slot=1, tags=[
+                ModuleTag("Local:1:C", "AB:1769_DI6XOW4:C:0", _dec({"ProgToFaultEn": 0, "ProgMode": 0})),
+                ModuleTag("Local:1:I", "AB:1769_DI6XOW4:I:0", _dec({"Fault": 0, "Data": 5})),
+                ModuleTag("Local:1:O", "AB:1769_DI6XOW4:O:0", _dec({"Data": 0})),
+            ]),
+            Module("Drive1", "ETHERNET-MODULE", parent="Local", inhibited=True, tags=[
+                ModuleTag("Drive1:I", "SINT", _dec([0, 0]))]),
+        ],
+        tags=[
+            Tag("FillTimer", "TIMER", description="Fill time",
+                value=_dec({"PRE": 3000, "ACC": 0, "EN": 0, "TT": 0, "DN": 0})),
+            Tag("Batches", "COUNTER", value=_dec({"PRE": 10, "ACC": 7, "CU": 0, "CD": 0, "DN": 0, "OV": 0, "UN": 1})),
+            Tag("Recipe", "STRING", value=_dec("It's $5\n")),
+            Tag("Grid", "DINT", dims=(2, 3), radix="Hex", value=_dec([[1, 2, 3], [4, 5, 255]])),
+            Tag("V1", "Valve", value=_dec({"Open": 0, "Closed": 1, "Travel": -40, "Hist": [1, 2, 0, 0]})),
+            Tag("ValveOpen", None, tag_type="Alias", alias_for="V1.Open", radix="Decimal"),
+            Tag("Mask", "SINT", external_access=ro, constant=True, radix="Binary", value=_dec(0b01011010)),
+            Tag("Perm", "INT", radix="Octal", value=_dec(0o17)),
+            Tag("Letter", "SINT", radix="ASCII", value=_dec(65)),
+            Tag("Ratio", "REAL", radix="Exponential", value=_dec(0.25)),
+            Tag("ScaleIt", "Scale", value=_dec({"EnableIn": 1, "EnableOut": 0, "Raw": 0, "Gain": 1.5, "Out": 0.0})),
+        ],
+        programs=[
+            Program("Batch", "Main", "Fault", tags=[Tag("Step", "DINT", radix="Decimal", value=_dec(3))], routines=[
+                Routine("Main", "RLL", rungs=[
+                    Rung(0, "XIC(V1.Open)TON(FillTimer,?,?);", "Fill; then mix"),
+                    Rung(1, "XIC(FillTimer.DN)[CTU(Batches,?,?),MOV(2,Step)];"),
+                    Rung(2, "Scale(ScaleIt,Grid[1,2],1.5,Ratio)XIC(Local:1:I.Data.0)OTE(Local:1:O.Data.1);"),
+                    Rung(3, "JSR(Calc,0);"),
+                ]),
+                Routine("Calc", "ST", lines=[Line(0, "Step := Step + 1;"), Line(1, "IF Step > 5 THEN Step := 0; END_IF;")]),
+                Routine("Fault", "RLL", rungs=[Rung(0, "NOP();")]),
+            ]),
+            Program("Idle", "Main", disabled=True, routines=[
+                Routine("Main", "RLL", rungs=[Rung(0, "XIO(ValveOpen)OTE(V1.Closed);")])]),
+        ],
+        tasks=[
+            Task("MainTask", "CONTINUOUS", programs=["Batch"]),
+            Task("Slow", "PERIODIC", rate_ms=250.0, priority=8, watchdog_ms=100.0, inhibited=True, programs=["Idle"]),
+        ],
+    )
+
+
+def test_l5x_reads_every_part_value_for_value():
+    project = read_l5x(L5X, "reader_controller.L5X")
+    assert without_positions(project) == without_positions(_expected_l5x())
+
+
+def test_l5x_read_from_text_equals_read_from_the_file():
+    text = L5X.read_text(encoding="utf-8")
+    assert read_l5x(text, "reader_controller.L5X") == read_l5x(L5X, "reader_controller.L5X")
+
+
+def test_l5x_positions_are_where_each_part_starts():
+    text = L5X.read_text(encoding="utf-8")
+    project = read_l5x(L5X, "r.L5X")
+    main = project.programs[0].routines[0]
+    assert main.pos == Pos("r.L5X", *locate(text, '<Routine Name="Main"'))
+    # a rung's position is where its text starts, inside the CDATA section
+    assert main.rungs[1].pos == Pos("r.L5X", *locate(text, "XIC(FillTimer.DN)"))
+    assert project.programs[0].routines[1].lines[1].pos == Pos("r.L5X", *locate(text, "IF Step > 5"))
+    assert project.tags[3].pos == Pos("r.L5X", *locate(text, '<Tag Name="Grid"'))
+    assert project.data_types[0].members[2].pos == Pos("r.L5X", *locate(text, '<Member Name="Closed"'))
+    assert project.tasks[1].pos == Pos("r.L5X", *locate(text, '<Task Name="Slow"'))
+
+
+def test_l5x_positional_data_is_the_l5k_form():
+    project = read_l5x(L5X, "r.L5X", prefer="positional")
+    by_name = {t.name: t.value for t in project.tags}
+    assert by_name["Recipe"].form == "positional"
+    assert by_name["Recipe"].data == [9, "It's $5\n\x00\x00"]
+    assert by_name["Grid"].data == [1, 2, 3, 4, 5, 255]
+    assert by_name["V1"].data == [2, -40, [1, 2, 0, 0]]
+    assert by_name["Batches"].data == [536870912, 10, 7]
+    assert by_name["ValveOpen"] is None
+
+
+def _l5x_problems(text: str) -> list:
+    with pytest.raises(ExportError) as err:
+        read_l5x(text, "bad.L5X")
+    return err.value.problems
+
+
+def _controller(body: str, target: str = "Controller") -> str:
+    return (f'<?xml version="1.0"?>\n<RSLogix5000Content TargetType="{target}" SoftwareRevision="32.11">\n'
+            f'<Controller Use="Target" Name="C">\n{body}\n</Controller>\n</RSLogix5000Content>\n')
+
+
+def test_l5x_malformed_xml_is_located_by_expat():
+    text = _controller("<Tags>\n  <Tag Name=\"A\" DataType=\"DINT\">\n</Tags>")
+    [problem] = _l5x_problems(text)
+    # expat points at the closing tag's name
+    assert problem.pos == Pos("bad.L5X", *locate(text, "Tags>\n</Controller"))
+    assert "malformed XML: mismatched tag" in problem.message
+
+
+def test_l5x_unknown_target_type():
+    text = _controller("", target="Gizmo")
+    [problem] = _l5x_problems(text)
+    assert problem.pos == Pos("bad.L5X", *locate(text, "<RSLogix5000Content"))
+    assert "expected a TargetType of Controller, Program, Routine, Rung" in problem.message
+    assert "found 'Gizmo'" in problem.message
+
+
+def test_l5x_every_problem_at_once_reading_on_past_each():
+    text = _controller(
+        "<Tags>\n"
+        '<Tag TagType="Base" DataType="DINT"/>\n'
+        '<Tag Name="B" TagType="Base" DataType="DINT"><Data Format="L5K"><![CDATA[[1,2]]></Data></Tag>\n'
+        '<Tag Name="C" TagType="Base" DataType="DINT"><Data Format="Decorated">'
+        '<DataValue DataType="DINT" Radix="Hex" Value="16#zz"/></Data></Tag>\n'
+        '<Tag Name="D" TagType="Base" DataType="DINT"/>\n'
+        "</Tags>\n<Programs>\n"
+        '<Program Name="P" MainRoutineName="R"><Routines><Routine Name="R" Type="RLL"><RLLContent>\n'
+        '<Rung Number="0" Type="N"><Comment><![CDATA[no text]]></Comment></Rung>\n'
+        '<Rung Number="1" Type="N"><Text><![CDATA[NOP();]]></Text></Rung>\n'
+        "</RLLContent></Routine></Routines></Program>\n</Programs>")
+    problems = _l5x_problems(text)
+    assert [(p.pos.line, p.pos.column, p.message) for p in problems] == [
+        (*locate(text, '<Tag TagType="Base"'), "expected a Name attribute on this Tag"),
+        (*locate(text, "[1,2]"), "bad L5K data: expected ] to close this ["),
+        (*locate(text, '<DataValue DataType="DINT" Radix="Hex"'),
+         "bad Value for DINT: expected base-16 digits after 16#, found '16#zz'"),
+        (*locate(text, '<Rung Number="0"'), "expected a Text element with the rung's text in rung 0"),
+    ]
+
+
+def test_l5x_a_file_that_cannot_be_read(tmp_path):
+    with pytest.raises(ExportError) as err:
+        read_l5x(tmp_path / "missing.L5X")
+    assert "cannot read the export" in str(err.value)
+
+
+@pytest.mark.parametrize("name", ["whole_controller.L5X", "reader_controller.L5X"])
+def test_l5x_damaged_copies_give_a_project_or_an_export_error(name):
+    text = (FIXTURES / name).read_text(encoding="utf-8")
+    for damaged in damaged_copies(text, seed=len(name), count=150):
+        try:
+            project = read_l5x(damaged, "d.L5X")
+        except ExportError as e:
+            assert e.problems and all(p.pos.source == "d.L5X" for p in e.problems)
+        else:
+            assert isinstance(project, Project)
+
+
+def test_l5x_partial_exports_read_into_the_same_fields():
+    rung = read_l5x(FIXTURES / "public" / "tnunnink__L5Sharp" / "Rung1_from_Main.L5X")
+    assert rung.target_type == "Rung" and rung.controller == "KM_TUS_Skid"
+    [routine] = [r for p in rung.programs for r in p.routines]
+    assert routine.kind == "RLL" and len(routine.rungs) == 1 and routine.rungs[0].text.endswith(";")
+    assert rung.data_types and all(dt.members for dt in rung.data_types)
+    aoi = read_l5x(FIXTURES / "public" / "Alex-OPTIM__rslogix5000-aois" / "DUTY_CYCLE.L5X")
+    assert aoi.target_type == "AddOnInstructionDefinition"
+    # the target and the AOIs it uses (Use="Context"), each with its Logic routine
+    assert [a.name for a in aoi.add_on_instructions] == ["BOOLS_2_DINT", "DINT_2_BOOLS", "DUTY_CYCLE"]
+    assert aoi.target_name == "DUTY_CYCLE"
+    assert all(any(r.name == "Logic" for r in a.routines) for a in aoi.add_on_instructions)
+
+
+def test_l5x_every_public_export_reads():
+    for path in sorted((FIXTURES / "public").glob("*/*.L5X")):
+        project = read_l5x(path)
+        assert project.format == "L5X" and project.target_type, path
+
+
+def test_l5x_not_a_number_and_radix_forms_in_decorated_data():
+    text = _controller(
+        "<Tags>\n"
+        '<Tag Name="N" DataType="REAL"><Data Format="Decorated"><DataValue DataType="REAL" Radix="Float" Value="1.#QNAN"/></Data></Tag>\n'
+        '<Tag Name="M" DataType="REAL"><Data Format="Decorated"><DataValue DataType="REAL" Radix="Float" Value="1.$"/></Data></Tag>\n'
+        '<Tag Name="Z" DataType="SINT"><Data Format="Decorated"><DataValue DataType="SINT" Radix="ASCII" Value="\'$00\'"/></Data></Tag>\n'
+        '<Tag Name="S" DataType="DINT" Dimensions="2"><Data Format="Decorated"><Array DataType="STRING" Dimensions="2">'
+        '<Element Index="[1]"><Structure DataType="STRING"><DataValueMember Name="LEN" DataType="DINT" Value="2"/>'
+        '<DataValueMember Name="DATA" DataType="STRING" Radix="ASCII"><![CDATA[\'$0D$0A\']]></DataValueMember>'
+        "</Structure></Element></Array></Data></Tag>\n"
+        "</Tags>")
+    tags = {t.name: t.value.data for t in read_l5x(text, "t.L5X").tags}
+    assert math.isnan(tags["N"]) and math.isnan(tags["M"])
+    assert tags["Z"] == 0
+    assert tags["S"] == [None, {"LEN": 2, "DATA": "\r\n"}]
