@@ -176,7 +176,8 @@ def addresses(draw) -> Address:
         member = draw(st.sampled_from([m.name for m in ftype.word_members]))
     bit = None
     if ftype.has_bits and draw(st.booleans()):
-        bit = draw(st.one_of(st.integers(0, 15), indirect))
+        top = 15 if member is not None else ftype.element_bits - 1
+        bit = draw(st.one_of(st.integers(0, top), indirect))
     if ftype.bits_across_file and bit is not None and isinstance(element, int) and draw(st.booleans()):
         element = None
         bit = draw(indirect)  # B3/[N7:0]

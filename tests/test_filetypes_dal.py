@@ -49,9 +49,10 @@ def test_l_elements_are_32_bit_and_refuse_what_does_not_fit():
     assert parse_address("L9:0").kind is ValueKind.LONG
 
 
-def test_l_elements_have_no_bit_addresses():
-    with pytest.raises(AddressError, match="no bits"):
-        parse_address("L9:0/3")
+def test_l_elements_take_bits_0_to_31_not_32():
+    assert str(parse_address("L9:0/31")) == "L9:0/31"
+    with pytest.raises(AddressError, match="bit number 32 out of range 0..31"):
+        parse_address("L9:0/32")
 
 
 def test_d_and_a_words_are_16_bit_words_that_also_take_their_text_forms():
@@ -224,7 +225,7 @@ def test_the_compilers_word_fast_paths_leave_longs_alone():
     ("TON L9:0 1.0 10 0\n", "must be timer element"),
     ("AND L9:0 L9:1 F8:0\n", "must be word or long address"),
     ("MOV N7:[L9:0] N7:1\n", "must be a word address"),
-    ("OTE L9:0/1\n", "no bits"),
+    ("OTE L9:0/32\n", "out of range 0..31"),
 ])
 def test_longs_where_they_do_not_belong_are_located_errors(text, message):
     with pytest.raises((ProgramErrors, LadderError)) as e:

@@ -3,6 +3,7 @@
 Forms accepted (see docs/datatable.md for the full table)::
 
     N7:0   N7:0/3   B3/17   B3:1/1   O:0/0   I:012/17   S:1/15   L9:0   D10:0   A11:0
+    L9:0/31   SI12:0/7   LI13:0/63 (bits by the item's width)
     I:1.0/3  O:2.1 (SLC slot.word/bit: word 32*slot + word of the I/O file)
     T4:0.ACC  T4:0/DN  T4:0.DN  C5:0/OV  R6:0.LEN  ST9:0  ST9:0.LEN  F8:2
     #N7:0 (indexed by S:24)   N7:[N7:1]   N[N7:2]:0   N7:0/[N7:3] (indirect)
@@ -29,6 +30,7 @@ from .filetypes import (
     FILE_TYPES,
     MAX_ELEMENTS,
     MAX_FILE_NUMBER,
+    OTHER_INTEGERS,
     WORD_BITS,
     FileType,
 )
@@ -40,7 +42,9 @@ class ValueKind(Enum):
     BIT = "bit"
     WORD = "word"  # a 16-bit signed integer word
     FLOAT = "float"
-    LONG = "long"  # a 32-bit signed integer (L element)
+    # A signed integer element that is not a 16-bit word: L (32-bit), SI
+    # (8-bit), LI (64-bit); its width and range are its file's storage.
+    LONG = "long"
     STRING = "string"  # a whole ST element
     TIMER = "timer"  # a whole T element
     COUNTER = "counter"
@@ -104,7 +108,7 @@ class Address:
             return _STRUCT_KINDS[ftype.letter]
         if ftype.letter == "F":
             return ValueKind.FLOAT
-        if ftype.letter == "L":
+        if ftype.storage in OTHER_INTEGERS:
             return ValueKind.LONG
         return ValueKind.WORD
 
@@ -320,8 +324,10 @@ def _example(ftype: FileType) -> str:
 
 
 def _file_type(letters: str) -> tuple[FileType | None, str]:
-    if letters.startswith("ST") and "ST" in FILE_TYPES:
-        return FILE_TYPES["ST"], letters[2:]
+    if letters in FILE_TYPES:
+        return FILE_TYPES[letters], ""
+    if letters[:2] in FILE_TYPES:
+        return FILE_TYPES[letters[:2]], letters[2:]
     if letters[:1] in FILE_TYPES:
         return FILE_TYPES[letters[:1]], letters[1:]
     return None, letters
@@ -445,7 +451,8 @@ def _bit(sc: _Scanner, ftype: FileType, member: str | None) -> Part:
         named = " ".join(b.name for b in ftype.bit_members)
         hint = f"; status bits are {named}" if named and member is None else ""
         raise sc.error(f"'{name}' is not a bit of {ftype.title} ({ftype.letter}) elements{hint}", pos)
-    top = WORD_BITS - 1
+    # A member (T4:0.ACC/3) is a 16-bit word; an element's bits are its item's.
+    top = (WORD_BITS if member is not None else ftype.element_bits) - 1
     return _number(sc, "bit number", ftype.octal, top)
 
 

@@ -2,7 +2,9 @@
 
 Word-based files (O I S B N T C R ST D A) keep every word in one ``array('h')``:
 element ``e`` starts at word ``e * words_per_element``. F files keep float32
-values in one ``array('f')``, L files 32-bit integers in one 4-byte array. Growing extends the same array object in place,
+values in one ``array('f')``, L files 32-bit integers in one 4-byte array, SI
+files 8-bit integers in one ``array('b')``, LI files 64-bit integers in one
+``array('q')``. Growing extends the same array object in place,
 so compiled rungs may hold a reference to ``DataFile.data`` for the life of the
 table.
 """
@@ -18,7 +20,9 @@ from .filetypes import MAX_ELEMENTS, FileType, Storage, file_name
 # An L element is 4 bytes on every platform: "i" where C int is 32-bit, else "l".
 _LONG_CODE = "i" if array("i").itemsize == 4 else "l"
 assert array(_LONG_CODE).itemsize == 4, "no 4-byte array typecode for L files"
-_TYPECODE = {Storage.WORD: "h", Storage.FLOAT: "f", Storage.LONG: _LONG_CODE}
+assert array("q").itemsize == 8, "no 8-byte array typecode for LI files"
+_TYPECODE = {Storage.WORD: "h", Storage.FLOAT: "f", Storage.LONG: _LONG_CODE,
+             Storage.BYTE: "b", Storage.LONG64: "q"}
 
 
 class DataFile:

@@ -28,6 +28,20 @@ class Storage(Enum):
     WORD = "word"  # 16-bit words in array('h')
     FLOAT = "float"  # IEEE float32 in array('f')
     LONG = "long"  # 32-bit signed integers in a 4-byte array (SLC/MicroLogix L files)
+    BYTE = "byte"  # 8-bit signed integers in array('b') (SI files: Logix SINT)
+    LONG64 = "long64"  # 64-bit signed integers in array('q') (LI files: Logix LINT)
+
+
+#: Bits in one item of each storage: the bit numbers /0../n-1 an element of
+#: an integer file takes, and the range of a signed integer item.
+ITEM_BITS = {Storage.BYTE: 8, Storage.WORD: 16, Storage.LONG: 32, Storage.LONG64: 64, Storage.FLOAT: 32}
+#: Storages whose items are signed integers wider or narrower than a word.
+OTHER_INTEGERS = (Storage.LONG, Storage.BYTE, Storage.LONG64)
+
+
+def int_range(bits: int) -> tuple[int, int]:
+    """The range of a signed integer of ``bits`` bits."""
+    return -(1 << (bits - 1)), (1 << (bits - 1)) - 1
 
 
 @dataclass(frozen=True)
@@ -54,7 +68,7 @@ class FileType:
     letter: str
     title: str
     storage: Storage
-    words_per_element: int  # for FLOAT (LONG) storage: floats (longs) per element, 1
+    words_per_element: int  # items per element: 1 for F, L, SI, LI
     word_members: tuple[WordMember, ...] = ()
     bit_members: tuple[BitMember, ...] = ()
     has_bits: bool = True  # /n bit addressing on the element word
@@ -79,6 +93,16 @@ class FileType:
     @property
     def is_structure(self) -> bool:
         return bool(self.word_members or self.bit_members)
+
+    @property
+    def item_bits(self) -> int:
+        """Bits in one item of the file's array (16 for a word)."""
+        return ITEM_BITS[self.storage]
+
+    @property
+    def element_bits(self) -> int:
+        """The bit numbers /0../n-1 an element (not a member) takes."""
+        return self.item_bits if self.has_bits else 0
 
     @property
     def is_string(self) -> bool:
@@ -139,14 +163,30 @@ STRING = FileType(
 BCD = FileType("D", "BCD", Storage.WORD, 1, radix="bcd")
 ASCII = FileType("A", "ASCII", Storage.WORD, 1, radix="ascii")
 # SLC 5/03+ and MicroLogix long integer file (1747-RM001, 1763-RM001): one
-# 32-bit signed integer an element. No /bit addressing (softplc choice).
-LONG = FileType("L", "long integer", Storage.LONG, 1, has_bits=False)
+# 32-bit signed integer an element. Its bits /0../31 are addressable, as a
+# Logix DINT's are (1756-RM003, bit addressing): L9:0/31 is the sign bit.
+LONG = FileType("L", "long integer", Storage.LONG, 1)
+# Logix SINT and LINT (1756-RM003, data types) as files of their own: no
+# PLC-5 or SLC file type holds them. The two-letter types SI and LI clash
+# with no PLC-5/SLC letter (softplc choice); bits /0../7 and /0../63.
+SINT = FileType("SI", "short integer", Storage.BYTE, 1)
+LINT = FileType("LI", "long long integer", Storage.LONG64, 1)
 
 FILE_TYPES: dict[str, FileType] = {
     t.letter: t
     for t in (OUTPUT, INPUT, STATUS, BINARY, TIMER, COUNTER, CONTROL, INTEGER, FLOAT, STRING,
               BCD, ASCII, LONG)
 }
+
+
+def split_file_name(text: str) -> tuple[FileType | None, str]:
+    """``("N7")`` -> (N, "7"), ``"ST9"`` -> (ST, "9"), ``"SI12"`` -> (SI,
+    "12"): the file type its leading letters name (upper case) and the rest;
+    None when the letters name no type."""
+    n = 0
+    while n < len(text) and text[n].isascii() and text[n].isalpha():
+        n += 1
+    return FILE_TYPES.get(text[:n].upper()), text[n:]
 
 #: The files every data table starts with, in PLC-5 order.
 DEFAULT_FILES: tuple[tuple[FileType, int], ...] = tuple(

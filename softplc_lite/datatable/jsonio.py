@@ -32,13 +32,14 @@ from ..errors import LocatedError
 from ..textfile import DATA_JSON, read_text
 from .errors import DataTableError
 from .files import DataFile
-from .filetypes import FILE_TYPES, LONG_MAX, LONG_MIN, MAX_ELEMENTS, STRING_CHARS, FileType, Storage
+from .filetypes import FILE_TYPES, MAX_ELEMENTS, OTHER_INTEGERS, STRING_CHARS, FileType, split_file_name
 from .table import (
     RAW_MAX,
     DataTable,
     _check_int,
     bit_mask,
     check_float32,
+    check_item,
     member_order,
     read_string,
     to_signed,
@@ -237,10 +238,7 @@ def _copy(table: DataTable) -> DataTable:
 
 
 def _file_key(key: str, source: str) -> tuple[FileType, int]:
-    text = key.strip().upper()
-    letter = "ST" if text.startswith("ST") else text[:1]
-    ftype = FILE_TYPES.get(letter)
-    digits = text[len(letter):]
+    ftype, digits = split_file_name(key.strip())
     if ftype is None:
         raise DataTableJSONError(
             f"{source}: key {key!r}: unknown file type (expected a file name such as N7, ST9, "
@@ -290,8 +288,8 @@ def _load_element(f: DataFile, element: int, value: Any) -> None:
         _load_string(data, start, value, name)
     elif ftype.is_structure:
         _load_struct(data, start, ftype, value, name)
-    elif ftype.storage is Storage.LONG:
-        data[start] = _check_int(value, LONG_MIN, LONG_MAX, name, "a 32-bit signed integer")
+    elif ftype.storage in OTHER_INTEGERS:
+        data[start] = check_item(value, ftype.storage, name)
     elif isinstance(value, str) and ftype.radix != "decimal":
         data[start] = word_from_text(value, ftype, name)
     else:

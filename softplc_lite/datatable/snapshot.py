@@ -7,9 +7,10 @@ File format (little-endian throughout)::
     trailer u32 CRC-32 of header+body   "SPLCEND!"
 
 The data bytes are the file's array items, little-endian: 2 bytes a word
-(every word file, D and A included), 4 a float (F) or a long (L). The L, D
-and A files came later under the same version: an older softplc refuses a
-snapshot holding one as an unknown file type.
+(every word file, D and A included), 4 a float (F) or a long (L), 1 an SI
+item, 8 an LI item. The L, D, A, SI and LI files came later under the same
+version, so every older snapshot loads; an older softplc refuses a snapshot
+holding one as an unknown file type.
 
 A short file, a wrong length, a bad CRC or a missing trailer is reported as
 :class:`SnapshotError`; nothing half-read is ever returned. So is a path

@@ -7,7 +7,9 @@ PLC rules, not Python ones:
   -32768..32767 is refused, a raw word write takes the bit pattern 0..65535
   and reads back signed;
 * F elements are float32 (3.14 reads back as 3.140000104904175);
-* L elements are 32-bit signed (-2147483648..2147483647);
+* L elements are 32-bit signed (-2147483648..2147483647), SI elements 8-bit
+  (-128..127), LI elements 64-bit; their bits are addressable, /0../31,
+  /0../7 and /0../63;
 * D (BCD) and A (ASCII) words are 16-bit words like N; a write also takes
   their text forms: "1234" (four BCD digits, 0x1234) for D, "AB" (two
   characters, high byte first) for A;
@@ -31,13 +33,15 @@ from .filetypes import (
     DEFAULT_FILES,
     FILE_TYPES,
     INDEX_REGISTER_WORD,
+    ITEM_BITS,
+    OTHER_INTEGERS,
     MAX_FILE_NUMBER,
     STRING_CHARS,
     WORD_BITS,
-    LONG_MAX,
-    LONG_MIN,
     FileType,
     Storage,
+    int_range,
+    split_file_name,
 )
 
 AddressLike = Union[str, Address]
@@ -50,6 +54,29 @@ def bit_mask(bit: int) -> int:
     """Mask of ``bit`` in a *signed* 16-bit word: bit 15 is -32768, so ``w |
     mask`` and ``w & ~mask`` stay inside array('h')'s range."""
     return -32768 if bit == WORD_BITS - 1 else 1 << bit
+
+
+def item_bit_mask(bit: int, itemsize: int) -> int:
+    """Mask of ``bit`` in a signed item of ``itemsize`` bytes: the top bit
+    is negative (bit 31 of an L element is -2**31, bit 7 of an SI element
+    -128), so ``v | mask`` and ``v & ~mask`` stay inside the array's range."""
+    top = 8 * itemsize - 1
+    return -(1 << top) if bit == top else 1 << bit
+
+
+def data_bit_mask(data: array, bit: int) -> int:
+    """Mask of ``bit`` in an item of ``data`` (a file's array)."""
+    return item_bit_mask(bit, data.itemsize)
+
+
+_INT_WHAT = {Storage.BYTE: "an 8-bit signed integer", Storage.WORD: "a 16-bit signed integer",
+             Storage.LONG: "a 32-bit signed integer", Storage.LONG64: "a 64-bit signed integer"}
+
+
+def check_item(value: Any, storage: Storage, where: object) -> int:
+    """A value for an integer item of ``storage`` (SI, L, LI), range-checked."""
+    lo, hi = int_range(ITEM_BITS[storage])
+    return _check_int(value, lo, hi, where, _INT_WHAT[storage])
 
 
 def to_signed(raw: int) -> int:
@@ -111,6 +138,10 @@ def check_float32(value: Any, where: object) -> float:
     return float(value)
 
 
+_UNIT = {Storage.WORD: "word", Storage.FLOAT: "float", Storage.LONG: "long",
+         Storage.BYTE: "short integer", Storage.LONG64: "long long"}
+
+
 class WordBlock:
     """Consecutive words (or floats, in an F file) starting at an element.
 
@@ -140,8 +171,9 @@ class WordBlock:
 
     def __setitem__(self, k: int, value: int | float) -> None:
         i = self._index(k)
-        if self.file.ftype.storage is Storage.LONG:
-            self.file.data[i] = _check_int(value, LONG_MIN, LONG_MAX, f"long {k} of {self}", "a 32-bit integer")
+        storage = self.file.ftype.storage
+        if storage in OTHER_INTEGERS:
+            self.file.data[i] = check_item(value, storage, f"{_UNIT[storage]} {k} of {self}")
         elif self.file.is_words:
             raw = _check_int(value, 0, RAW_MAX, f"word {k} of {self}", "a raw word")
             self.file.data[i] = to_signed(raw)
@@ -162,7 +194,7 @@ class WordBlock:
         return iter(self.values())
 
     def __str__(self) -> str:
-        unit = {Storage.WORD: "word", Storage.FLOAT: "float", Storage.LONG: "long"}[self.file.ftype.storage]
+        unit = _UNIT[self.file.ftype.storage]
         return f"{self.count} {unit}{'s' if self.count != 1 else ''} from {self.origin}"
 
 
@@ -219,9 +251,7 @@ class DataTable:
                 raise AddressRangeError(f"there is no data file number {number}")
             return f
         text = ref.strip().upper()
-        letter = "ST" if text.startswith("ST") else text[:1]
-        ftype = FILE_TYPES.get(letter)
-        digits = text[len(letter):]
+        ftype, digits = split_file_name(text)
         if ftype is None or not (digits.isdigit() or (not digits and ftype.fixed_number is not None)):
             raise DataTableError(f"bad file name '{ref}': expected a type and number such as N7 or ST9")
         number = int(digits) if digits else ftype.fixed_number
@@ -287,8 +317,9 @@ class DataTable:
             element, bit = divmod(bit, WORD_BITS)
         else:
             element = a.element if isinstance(a.element, int) else self._word_value(a.element)
-            if bit is not None and not 0 <= bit < WORD_BITS:
-                raise AddressRangeError(f"{a}: bit {bit} (from {a.bit}) is outside 0..15")
+            top = WORD_BITS if a.member is not None else ftype.element_bits
+            if bit is not None and not 0 <= bit < top:
+                raise AddressRangeError(f"{a}: bit {bit} (from {a.bit}) is outside 0..{top - 1}")
         if a.indexed:
             offset = self.index_register()
             element += offset
@@ -340,7 +371,7 @@ class DataTable:
         data = f.data
         if kind is ValueKind.BIT:
             on = _check_int(value, 0, 1, a, "a bit")
-            mask = bit_mask(bit)
+            mask = data_bit_mask(data, bit)
             data[i] = (data[i] | mask) if on else (data[i] & ~mask)
         elif kind is ValueKind.WORD:
             if f.ftype.is_string:  # ST LEN
@@ -352,7 +383,7 @@ class DataTable:
         elif kind is ValueKind.FLOAT:
             data[i] = check_float32(value, a)
         elif kind is ValueKind.LONG:
-            data[i] = _check_int(value, LONG_MIN, LONG_MAX, a, "a 32-bit signed integer")
+            data[i] = check_item(value, f.ftype.storage, a)
         elif kind is ValueKind.STRING:
             write_string(data, i, value, str(a))
         else:
@@ -391,8 +422,9 @@ class DataTable:
     # -- raw words ----------------------------------------------------------------
     def _word_location(self, a: Address) -> Location:
         loc = self.resolve(a)
-        if loc.file.ftype.storage is Storage.LONG:
-            raise DataTableError(f"{a} is a 32-bit long; L files have no raw 16-bit words")
+        if loc.file.ftype.storage in OTHER_INTEGERS:
+            ftype = loc.file.ftype
+            raise DataTableError(f"{a} is a {ftype.item_bits}-bit {ftype.title}; {ftype.letter} files have no raw 16-bit words")
         if not loc.file.is_words:
             raise DataTableError(f"{a} is a float; F files have no raw 16-bit words")
         if loc.bit is not None:
@@ -420,7 +452,7 @@ class DataTable:
             raise DataTableError(f"a block from {a} needs at least one word, not {count}")
         total = len(f.data)
         if i + count > total:
-            unit = "words" if f.is_words else "floats"
+            unit = _UNIT[f.ftype.storage] + "s"
             raise BlockRangeError(
                 f"a block of {count} {unit} from {a} runs past the end of {f.name}: "
                 f"{f.name} has {f.size} element{'s' if f.size != 1 else ''} ({total} {unit}), "
@@ -449,7 +481,7 @@ class DataTable:
         f, i, bit = self.resolve(a)
         if bit is None:
             raise DataTableError(f"{a} is not a bit address")
-        return f.data, i, bit_mask(bit)
+        return f.data, i, data_bit_mask(f.data, bit)
 
     def assign(self, other: "DataTable") -> None:
         """Take ``other``'s values, keeping this table's arrays.

@@ -27,7 +27,7 @@ from collections import Counter
 from functools import cached_property
 
 from ..gcpause import gc_paused
-from ..datatable import DataTable, ValueKind, bit_mask
+from ..datatable import DataTable, ValueKind, data_bit_mask
 from ..datatable.filetypes import Storage
 from . import blocks
 from .ast import AddressRef, Branch, Const, Element, Instruction, Program, Rung, address_refs, instructions_of, walk
@@ -137,7 +137,7 @@ class _FileCompiler:
         a = ref.address
         if a.is_direct:
             f, index, bit = self.resolve(a)
-            return self.array_name(f), repr(index), (repr(bit_mask(bit)) if bit is not None else None)
+            return self.array_name(f), repr(index), (repr(data_bit_mask(f.data, bit)) if bit is not None else None)
         k = self.temp
         self.temp += 1
         name = self.bind_once((id(ref), "loc"), "_loc", lambda: resolver(self.table, a))
@@ -154,7 +154,7 @@ class _FileCompiler:
             if name is not None:  # held in a local (loaded at rung level before this instruction)
                 if (f.number, index) == _FLAGS:
                     self.held.flags_exact(ind)
-                return name if bit is None else f"(1 if {name} & {bit_mask(bit)!r} else 0)"
+                return name if bit is None else f"(1 if {name} & {data_bit_mask(f.data, bit)!r} else 0)"
         d, i, m = self.location(ind, operand)
         if m is not None:
             return f"(1 if {d}[{i}] & {m} else 0)"
@@ -178,7 +178,7 @@ class _FileCompiler:
             f, index, bit = self.resolve(a)
             known = self._bits[id(a)] = (
                 (f.number, index) if _may_hold(f, index) else None, f, index,
-                bit_mask(bit) if bit is not None else None, f"{self.array_name(f)}[{index!r}]")
+                data_bit_mask(f.data, bit) if bit is not None else None, f"{self.array_name(f)}[{index!r}]")
         key, f, index, mask, in_place = known
         if key is not None:
             held = self.held

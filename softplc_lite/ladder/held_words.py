@@ -17,7 +17,7 @@ import re
 from collections import Counter
 from typing import Protocol
 
-from ..datatable import bit_mask
+from ..datatable import data_bit_mask
 from ..datatable.filetypes import Storage
 from .ast import AddressRef, BinOp, Const, Instruction, UnaryOp, address_refs, instructions_of
 
@@ -87,7 +87,7 @@ class HeldWords:
         name = self.word_at(ind, f, index)
         if name is None:
             return None
-        return name, (bit_mask(bit) if bit is not None else None)
+        return name, (data_bit_mask(f.data, bit) if bit is not None else None)
 
     def word_at(self, ind: int, f, index: int, force: bool = False, for_store: bool = False) -> str | None:
         """The local holding word ``index`` of file ``f`` (loaded now if not

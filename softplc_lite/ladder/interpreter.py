@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from typing import Callable
 
-from ..datatable import DataTable, bit_mask
+from ..datatable import DataTable, data_bit_mask
 from ..datatable.errors import AddressRangeError
 from .ast import AddressRef, Branch, Const, Instruction, Program, Rung, address_refs, walk
 from .compiler import RET, TND, EndScan, describe, labels_of
@@ -102,7 +102,7 @@ class Interpreter:
 
     def set_bit(self, ref, on: bool) -> None:
         d, i, bit = self.loc(ref)
-        mask = bit_mask(bit)
+        mask = data_bit_mask(d, bit)
         d[i] = (d[i] | mask) if on else (d[i] & ~mask)
 
     def expr(self, node):
@@ -202,7 +202,7 @@ def _ote(it, ins, c, rung, pfile):
 def _latch(it, ins, c, rung, pfile):
     d, i, bit = it.loc(ins.operands[0])  # resolved even on a false rung, as compiled code does
     if c:
-        mask = bit_mask(bit)
+        mask = data_bit_mask(d, bit)
         d[i] = (d[i] | mask) if ins.mnemonic == "OTL" else (d[i] & ~mask)
     return c
 
@@ -222,7 +222,7 @@ def _one_shot(it, ins, c, rung, pfile):
     od, oi, obit = it.loc(ins.operands[1])
     stored = (sd[si] >> sbit) & 1
     fire = (c and not stored) if ins.mnemonic == "OSR" else (not c and stored)
-    omask, smask = bit_mask(obit), bit_mask(sbit)
+    omask, smask = data_bit_mask(od, obit), data_bit_mask(sd, sbit)
     od[oi] = (od[oi] | omask) if fire else (od[oi] & ~omask)
     sd[si] = (sd[si] | smask) if c else (sd[si] & ~smask)
     return c

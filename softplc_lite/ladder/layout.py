@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..datatable import DataTable, DataTableError, parse_address
+from ..datatable.filetypes import split_file_name
 from .ast import AddressRef, Const, Pos, Program, address_refs, instructions_of, walk
 from .errors import LadderError
 from .instr import BOUND
@@ -24,9 +25,9 @@ def reference_program(program: Program, table: DataTable, problems: list | None 
     With ``problems``, what the table refuses is listed there, located at
     the declaration or instruction (softplc check), instead of raised."""
     for decl in program.data:
-        letter = "ST" if decl.file.startswith("ST") else decl.file[:1]
+        ftype, digits = split_file_name(decl.file)
         with located(decl.pos, problems):
-            table.create_file(letter, int(decl.file[len(letter):]), decl.size)
+            table.create_file(ftype.letter, int(digits), decl.size)
     seen: set[int] = set()  # ids of addresses referenced: the parser makes one Address per text
     for pfile in program.files.values():
         for rung in pfile.rungs:

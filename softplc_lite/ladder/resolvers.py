@@ -7,7 +7,7 @@ paths the compiler binds for the common shapes. A resolver returns
 
 from __future__ import annotations
 
-from ..datatable import Address, DataTable, bit_mask
+from ..datatable import Address, DataTable, data_bit_mask, item_bit_mask
 from ..datatable.errors import AddressRangeError, DataTableError
 from . import status as S
 from .semantics import MajorFault
@@ -18,9 +18,6 @@ def address_fault(addr: Address, error: AddressRangeError) -> MajorFault:
     return MajorFault(code, str(error))
 
 
-_MASKS = tuple(bit_mask(b) for b in range(16))
-
-
 def resolver(table: DataTable, addr: Address):
     resolve = table.resolve
 
@@ -29,7 +26,7 @@ def resolver(table: DataTable, addr: Address):
             f, index, bit = resolve(addr)
         except AddressRangeError as e:
             raise address_fault(addr, e) from None
-        return f.data, index, (bit_mask(bit) if bit is not None else None)
+        return f.data, index, (data_bit_mask(f.data, bit) if bit is not None else None)
 
     return _fast_resolver(table, addr, locate) or locate
 
@@ -56,9 +53,12 @@ def _fast_resolver(table: DataTable, addr: Address, slow):
     data = f.data
     wpe = f.ftype.words_per_element
     offset = f.ftype.members_by_name[addr.member].offset if addr.member is not None else 0
-    masks = _MASKS
+    # The masks of the element's bits, by the item's width (16 for a
+    # word or a member, 32 for an L element, 8 and 64 for SI and LI).
+    masks = tuple(data_bit_mask(data, b) for b in range(16 if addr.member else f.ftype.element_bits))
+    top = len(masks)
     if bd is None:
-        mask = bit_mask(addr.bit) if addr.bit is not None else None
+        mask = data_bit_mask(data, addr.bit) if addr.bit is not None else None
 
         def locate():
             e = ed[ei]
@@ -69,7 +69,7 @@ def _fast_resolver(table: DataTable, addr: Address, slow):
         def locate():
             e = ed[ei]
             b = bd[bi]
-            if e < 0 or (e + 1) * wpe > len(data) or not 0 <= b < 16:
+            if e < 0 or (e + 1) * wpe > len(data) or not 0 <= b < top:
                 return slow()
             return data, e * wpe + offset, masks[b]
     return locate
@@ -83,7 +83,7 @@ def _file_indirect(table: DataTable, addr: Address, slow, fd, fi, ed, ei):
     ftype = addr.ftype
     wpe = ftype.words_per_element
     offset = ftype.members_by_name[addr.member].offset if addr.member is not None else 0
-    mask = bit_mask(addr.bit) if addr.bit is not None else None
+    mask = item_bit_mask(addr.bit, ftype.item_bits // 8) if addr.bit is not None else None
 
     def locate():
         f = files.get(fd[fi])

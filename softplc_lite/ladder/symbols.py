@@ -149,12 +149,14 @@ def apply_suffix(text: str, name: str, address: Address, m: re.Match) -> Address
         if bit.isdigit():
             # octal for a PLC-5 I/O address (I:12/17); an SLC one (I:1.0/8) numbers its bits in decimal
             base = 8 if ftype.octal and not a.slc else 10
+            # An element's bits are its item's (L: 0..31, SI 0..7, LI 0..63); a member word's 0..15.
+            width = WORD_BITS if a.member is not None else ftype.element_bits
             try:
                 number = int(bit, base)
             except ValueError:
-                number = WORD_BITS  # an 8 or 9 in an octal bit number
-            if number >= WORD_BITS:
-                top = "17 (octal)" if base == 8 else str(WORD_BITS - 1)
+                number = width  # an 8 or 9 in an octal bit number
+            if number >= width:
+                top = "17 (octal)" if base == 8 else str(width - 1)
                 raise SymbolError(text, at, f"{what}: bit {bit} is past bit {top}")
         else:
             found = ftype.members_by_name.get(bit.upper())
@@ -178,6 +180,8 @@ def _what(name: str, a: Address) -> str:
 def _members(ftype) -> str:
     if ftype.is_structure and not ftype.is_string:
         return f"members {ftype.member_names()}"
+    if ftype.has_bits and ftype.item_bits != WORD_BITS:
+        return f"{ftype.title} elements have no named members, only bits /0 to /{ftype.item_bits - 1}"
     if ftype.has_bits:
         return "a word has no named members, only bits /0 to /15 (octal /0 to /17 for I and O)"
     return f"{ftype.title} elements have no members or bits"

@@ -16,7 +16,7 @@ from dataclasses import replace
 from ..gcpause import gc_paused
 from ..datatable import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, Address, AddressError, ValueKind, parse_address
 from ..datatable.errors import DataTableError
-from ..datatable.filetypes import LONG_MAX, LONG_MIN
+from ..datatable.filetypes import OTHER_INTEGERS, int_range, split_file_name
 from ..datatable.table import word_from_text
 from .ast import (
     MAIN_FILE,
@@ -440,9 +440,7 @@ class _Checker(SubroutineChecks):
 
     def data(self, decl) -> None:
         text = decl.file
-        letter = "ST" if text.startswith("ST") else text[:1]
-        ftype = FILE_TYPES.get(letter)
-        digits = text[len(letter):]
+        ftype, digits = split_file_name(text)
         if ftype is None or not digits.isdigit():
             self.error(decl.pos, f"DATA {text}: expected a data file name such as N10, F11 or ST12")
             return
@@ -464,9 +462,11 @@ class _Checker(SubroutineChecks):
                 if isinstance(v, str):
                     self.error(decl.pos, f"DATA {text}: float files take numbers")
                     return
-            elif ftype.letter == "L":
-                if not isinstance(v, int) or not LONG_MIN <= v <= LONG_MAX:
-                    self.error(decl.pos, f"DATA {text}: {v!r} does not fit a 32-bit long ({LONG_MIN}..{LONG_MAX})")
+            elif ftype.storage in OTHER_INTEGERS:  # L, SI, LI
+                lo, hi = int_range(ftype.item_bits)
+                if not isinstance(v, int) or not lo <= v <= hi:
+                    self.error(decl.pos, f"DATA {text}: {v!r} does not fit a {ftype.item_bits}-bit "
+                                         f"{ftype.title} ({lo}..{hi})")
                     return
             elif ftype.radix != "decimal" and isinstance(v, str):  # D "1234" (BCD digits), A "AB"
                 try:

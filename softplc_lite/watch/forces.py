@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..datatable import DataTable, DataTableError, bit_mask, parse_address
+from ..datatable import DataTable, DataTableError, data_bit_mask, parse_address
 from ..datatable.address import Address
 from ..ladder.symbols import SymbolError, resolve_name
 from .breakpoints import quoted
@@ -74,7 +74,8 @@ class Forces:
         self.table.reference(force.address)  # forcing B3/40 creates the word, as a write would
         f, index, bit = self.table.resolve(force.address)
         self.forces[key] = force
-        data, mask = f.data, bit_mask(bit)
+        data = f.data
+        mask = data_bit_mask(data, bit)
         self._resolved[key] = (data, index, mask, force.on)
         self._hook(True)
         data[index] = (data[index] | mask) if force.on else (data[index] & ~mask)  # at once, in the table shown
