@@ -14,6 +14,7 @@ import pytest
 from helpers.located import locate
 from helpers.logix_exports import damaged_copies, without_positions
 from softplc_lite.ladder.ast import Pos
+from softplc_lite.logix.l5k import read_l5k
 from softplc_lite.logix.l5x import read_l5x
 from softplc_lite.logix.model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member,
                                       Module, ModuleTag, Program, Project, Routine, Rung, Tag, Task)
@@ -234,3 +235,158 @@ def test_l5x_not_a_number_and_radix_forms_in_decorated_data():
     assert math.isnan(tags["N"]) and math.isnan(tags["M"])
     assert tags["Z"] == 0
     assert tags["S"] == [None, {"LEN": 2, "DATA": "\r\n"}]
+
+
+# -- L5K ---------------------------------------------------------------------------------
+
+
+def _same_facts(project: Project) -> Project:
+    """What both formats say: L5K leaves a type member's Decimal radix
+    unsaid and names no module-defined data type, so both are dropped;
+    the rest is compared as read."""
+    p = without_positions(project)
+    p.format = "-"
+    for dt in p.data_types:
+        for m in dt.members:
+            m.radix = None if m.radix == "Decimal" else m.radix
+    for mod in p.modules:
+        for t in mod.tags:
+            t.data_type = None
+    return p
+
+
+def test_l5k_reads_every_part_value_for_value():
+    expected = _expected_l5x()
+    expected.source, expected.format = "reader_controller.L5K", "L5K"
+    positional = read_l5x(L5X, "x", prefer="positional")  # the L5K-form data the L5X also carries
+    for got, want in zip(positional.tags, expected.tags):
+        want.value = got.value and InitialValue("positional", got.value.data)
+    for param, got in zip(expected.add_on_instructions[0].parameters + expected.add_on_instructions[0].local_tags,
+                          positional.add_on_instructions[0].parameters + positional.add_on_instructions[0].local_tags):
+        param.value = got.value and InitialValue("positional", got.value.data)
+    expected.programs[0].tags[0].value = InitialValue("positional", 3)
+    for m in expected.data_types[0].members:
+        m.radix = None if m.radix == "Decimal" else m.radix
+    expected.data_types[0].members[3].radix = "Decimal"  # written out in this fixture
+    expected.modules[1].tags = [ModuleTag("Local:1:C", None, InitialValue("positional", [0, 0])),
+                                ModuleTag("Local:1:I", None, InitialValue("positional", [0, 0])),
+                                ModuleTag("Local:1:O", None, InitialValue("positional", [0]))]
+    expected.modules[2].tags = [ModuleTag("Drive1:I", None, InitialValue("positional", [0]))]
+    project = read_l5k(L5K, "reader_controller.L5K")
+    assert without_positions(project) == without_positions(expected)
+    # spot checks that do not lean on the L5X reader
+    tags = {t.name: t for t in project.tags}
+    assert tags["Recipe"].value.data == [9, "It's $5\n\x00\x00"]
+    assert tags["Grid"].dims == (2, 3) and tags["Grid"].value.data == [1, 2, 3, 4, 5, 255]
+    assert tags["Mask"].value.data == 0b01011010 and tags["Mask"].constant
+    assert tags["ValveOpen"].tag_type == "Alias" and tags["ValveOpen"].alias_for == "V1.Open"
+
+
+@pytest.mark.parametrize("stem", ["reader_controller", "whole_controller"])
+def test_l5k_and_l5x_of_one_controller_read_the_same(stem):
+    l5x = read_l5x(FIXTURES / f"{stem}.L5X", "same", prefer="positional")
+    l5k = read_l5k(FIXTURES / f"{stem}.L5K", "same")
+    if stem == "whole_controller":
+        # its L5K describes EnableIn and EnableOut, as Studio writes them; its L5X does not
+        for param in l5k.add_on_instructions[0].parameters[:2]:
+            assert param.description.endswith("System Defined Parameter")
+            param.description = None
+    assert _same_facts(l5k) == _same_facts(l5x)
+
+
+def test_l5k_and_l5x_of_a_public_export_have_the_same_routines():
+    folder = FIXTURES / "public" / "iotrustlab__sphere-usecases"
+    l5k, l5x = read_l5k(folder / "Controller_PLC.L5K"), read_l5x(folder / "Controller_PLC.L5X")
+
+    def routines(p):
+        return [(r.name, r.kind, [(g.text, g.comment) for g in r.rungs], [ln.text for ln in r.lines])
+                for x in p.add_on_instructions + p.programs for r in x.routines]
+
+    assert routines(l5k) == routines(l5x) and routines(l5k)
+    assert [[t.name for t in m.tags] for m in l5k.modules] == [[t.name for t in m.tags] for m in l5x.modules]
+    assert [(t.name, t.kind, t.rate_ms, t.programs) for t in l5k.tasks] == [(t.name, t.kind, t.rate_ms, t.programs) for t in l5x.tasks]
+
+
+def test_l5k_positions_are_where_each_part_starts():
+    text = L5K.read_text(encoding="utf-8")
+    project = read_l5k(text, "r.L5K")
+    main = project.programs[0].routines[0]
+    assert main.pos == Pos("r.L5K", *locate(text, "ROUTINE Main", 1))
+    assert main.rungs[1].pos == Pos("r.L5K", *locate(text, "XIC(FillTimer.DN)"))
+    assert project.programs[0].routines[1].lines[1].pos == Pos("r.L5K", *locate(text, "IF Step > 5"))
+    grid = project.tags[3]
+    assert grid.pos == Pos("r.L5K", *locate(text, "Grid : DINT"))
+    assert grid.value.pos == Pos("r.L5K", *locate(text, "[16#0000_0001"))
+    assert project.data_types[0].members[2].pos == Pos("r.L5K", *locate(text, "BIT Closed"))
+    assert project.tasks[1].pos == Pos("r.L5K", *locate(text, "TASK Slow"))
+
+
+def test_l5k_rungs_spanning_lines_strings_with_semicolons_and_comments_in_parts():
+    text = ("CONTROLLER C (ProcessorType := \"1756-L83E\")\n\tPROGRAM P (MAIN := \"R\")\n\t\tROUTINE R \n"
+            "\t\t\t\tRC: \"first; part $N\"\n\t\t\t\t    \"second $\"part$\"\";\n"
+            "\t\t\t\tN: MOV('x;y',s)\n\t\t\t\t   OTE(b);\n"
+            "\t\t\t\tN: NOP();\n"
+            "\t\tEND_ROUTINE\n\t(* a comment; with END_PROGRAM in it *)\n\tEND_PROGRAM\nEND_CONTROLLER\n")
+    [routine] = read_l5k(text, "s.L5K").programs[0].routines
+    assert [(r.number, r.text, r.comment) for r in routine.rungs] == [
+        (0, "MOV('x;y',s)OTE(b);", 'first; part \nsecond "part"'), (1, "NOP();", None)]
+
+
+def _l5k_problems(text: str) -> list[tuple[int, int, str]]:
+    with pytest.raises(ExportError) as err:
+        read_l5k(text, "bad.L5K")
+    assert all(p.pos.source == "bad.L5K" for p in err.value.problems)
+    return [(p.pos.line, p.pos.column, p.message) for p in err.value.problems]
+
+
+def test_l5k_an_unterminated_block_says_which_opened_where():
+    text = ('IE_VER := 2.24;\nCONTROLLER C (ProcessorType := "x")\n\tPROGRAM P (MAIN := "R")\n'
+            "\t\tROUTINE R \n\t\t\t\tN: NOP();\n\t\tEND_ROUTINE\n")
+    assert _l5k_problems(text) == [
+        (*locate(text, "PROGRAM P"), "expected END_PROGRAM to close PROGRAM P (opened here) before the end of the file"),
+        (*locate(text, "CONTROLLER C"), "expected END_CONTROLLER to close CONTROLLER C (opened here) before the end of the file"),
+    ]
+
+
+def test_l5k_every_problem_at_once_reading_on_past_each():
+    text = ("CONTROLLER C ()\n\tTAG\n\t\tA : DINT := 16#zz;\n\t\tB : DINT[2] := [1,\n\t\t\t2;\n"
+            "\t\t: DINT := 3;\n\t\tD : DINT := 4;\n\tEND_TAG\n"
+            "\tPROGRAM P ()\n\t\tROUTINE R \n\t\t\t\tN: ;\n\t\t\t\tN: NOP();\n\t\tEND_ROUTINE\n\tEND_PROGRAM\n"
+            "\tDATATYPE T ()\n\t\tDINT ;\n\tEND_DATATYPE\nEND_CONTROLLER\n")
+    assert _l5k_problems(text) == [
+        (*locate(text, "16#zz"), "bad value: expected base-16 digits after 16#, found '16#zz'"),
+        (*locate(text, "[1,"), "bad value: expected ] to close this ["),
+        (*locate(text, ": DINT := 3"), "expected a tag name, found ': DINT := 3'"),
+        (*locate(text, "N: ;"), "expected the rung's text after N: in rung 0"),
+        (*locate(text, "DINT ;"), "expected a member (TYPE Name[dim] (attributes); or BIT Name Host : bit;), found 'DINT'"),
+    ]
+    # reading went on: the good parts are there when the bad ones are fixed
+    fixed = text.replace("16#zz", "16#ff").replace("2;", "2];").replace(": DINT := 3", "Cx : DINT := 3")
+    fixed = fixed.replace("N: ;", "N: NOP();").replace("DINT ;", "DINT m;")
+    project = read_l5k(fixed, "ok.L5K")
+    assert [(t.name, t.value.data) for t in project.tags] == [("A", 255), ("B", [1, 2]), ("Cx", 3), ("D", 4)]
+    assert len(project.programs[0].routines[0].rungs) == 2
+
+
+def test_l5k_a_missing_semicolon_does_not_swallow_the_next_block():
+    text = ("CONTROLLER C ()\n\tPROGRAM P ()\n\t\tROUTINE R \n\t\t\t\tN: NOP()\n\t\tEND_ROUTINE\n\tEND_PROGRAM\n"
+            "\tTASK T (Type := CONTINUOUS)\n\t\t\tP;\n\tEND_TASK\nEND_CONTROLLER\n")
+    assert _l5k_problems(text) == [(*locate(text, "N: NOP()"), "expected ; to end this N: line")]
+
+
+@pytest.mark.parametrize("name", ["whole_controller.L5K", "reader_controller.L5K"])
+def test_l5k_damaged_copies_give_a_project_or_an_export_error(name):
+    text = (FIXTURES / name).read_text(encoding="utf-8")
+    for damaged in damaged_copies(text, seed=len(name), count=150):
+        try:
+            project = read_l5k(damaged, "d.L5K")
+        except ExportError as e:
+            assert e.problems and all(p.pos.source == "d.L5K" for p in e.problems)
+        else:
+            assert isinstance(project, Project)
+
+
+def test_l5k_every_public_export_reads():
+    for path in sorted((FIXTURES / "public").glob("*/*.L5K")):
+        project = read_l5k(path)
+        assert project.format == "L5K" and project.programs, path

@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 from ..ladder.ast import Pos
 from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
                     ModuleTag, Problem, Program, Project, Routine, Rung, Tag, Task)
-from .values import ValueSyntax, parse_l5k_value, parse_quoted, typed_scalar
+from .values import MAX_DEPTH, ValueSyntax, parse_l5k_value, parse_quoted, typed_scalar
 
 TARGET_TYPES = ("Controller", "Program", "Routine", "Rung", "AddOnInstructionDefinition", "DataType", "Module")
 
@@ -291,8 +291,10 @@ class _Reader:
                 return None
         return None
 
-    def decorated(self, node: _Node):
+    def decorated(self, node: _Node, depth: int = 0):
         a = node.attrs
+        if depth > MAX_DEPTH:
+            raise _BadValue(node, f"expected at most {MAX_DEPTH} levels of nested structures and arrays")
         if node.tag in ("DataValue", "DataValueMember"):
             if "Value" in a:
                 try:
@@ -313,7 +315,7 @@ class _Reader:
                 if c.tag in ("DataValueMember", "StructureMember", "ArrayMember"):
                     if not c.attrs.get("Name"):
                         raise _BadValue(c, f"expected a Name attribute on this {c.tag}")
-                    out[c.attrs["Name"]] = self.decorated(c)
+                    out[c.attrs["Name"]] = self.decorated(c, depth + 1)
             return out
         if node.tag in ("Array", "ArrayMember"):
             dims = None
@@ -334,7 +336,7 @@ class _Reader:
                     except ValueSyntax as err:
                         raise _BadValue(e, f"bad Value for {a.get('DataType') or 'an element'}: {err.message}") from None
                 elif e.children:
-                    v = self.decorated(e.children[0])
+                    v = self.decorated(e.children[0], depth + 1)
                 else:
                     raise _BadValue(e, "expected a Value attribute or a Structure in this Element")
                 elements.append((idx, v, e))

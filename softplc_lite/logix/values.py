@@ -38,6 +38,11 @@ _SPECIAL_REALS = {
 _ESCAPES = {"'": "'", '"': '"', "$": "$", "N": "\n", "L": "\n", "P": "\f", "R": "\r", "T": "\t"}
 
 
+# Deeper nesting than any Logix type allows (a structure's members nest
+# a few levels): a bound so that no input can exhaust Python's stack.
+MAX_DEPTH = 64
+
+
 class ValueSyntax(Exception):
     """Text that is not a value: ``offset`` into the text, ``message``
     what was expected."""
@@ -149,8 +154,10 @@ class _L5K:
         while self.i < len(t) and t[self.i] in " \t\r\n":
             self.i += 1
 
-    def value(self) -> int | float | str | list:
+    def value(self, depth: int = 0) -> int | float | str | list:
         t = self.text
+        if depth > MAX_DEPTH:
+            raise ValueSyntax(self.i, f"expected at most {MAX_DEPTH} levels of nested [ ]")
         if self.i >= len(t):
             raise ValueSyntax(self.i, "expected a value (a number, a 'string' or [...])")
         c = t[self.i]
@@ -164,7 +171,7 @@ class _L5K:
                 return items
             while True:
                 self.skip()
-                items.append(self.value())
+                items.append(self.value(depth + 1))
                 self.skip()
                 if self.i >= len(t):
                     raise ValueSyntax(start, "expected ] to close this [")
