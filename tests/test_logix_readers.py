@@ -390,3 +390,22 @@ def test_l5k_every_public_export_reads():
     for path in sorted((FIXTURES / "public").glob("*/*.L5K")):
         project = read_l5k(path)
         assert project.format == "L5K" and project.programs, path
+
+
+def test_l5x_source_protected_parts_are_kept_and_marked():
+    text = _controller(
+        "<AddOnInstructionDefinitions>\n"
+        '<EncodedData EncodedType="AddOnInstructionDefinition" Name="Locked" Revision="1.0" EncryptionConfig="9">\n'
+        '<Parameters><Parameter Name="In" TagType="Base" DataType="DINT" Usage="Input" Required="true" Visible="true"/>'
+        "</Parameters>\nQmFzZTY0\n</EncodedData>\n</AddOnInstructionDefinitions>\n"
+        '<Programs><Program Name="P" MainRoutineName="R"><Routines>\n'
+        '<Routine Name="R" Type="RLL"><RLLContent><Rung Number="0" Type="N"><Text><![CDATA[JSR(Secret,0);]]></Text>'
+        "</Rung></RLLContent></Routine>\n"
+        '<EncodedData EncodedType="Routine" Name="Secret" Type="RLL" EncryptionConfig="9">QmFzZTY0</EncodedData>\n'
+        "</Routines></Program></Programs>")
+    project = read_l5x(text, "e.L5X")
+    [aoi] = project.add_on_instructions
+    assert (aoi.name, aoi.encoded, [p.name for p in aoi.parameters], aoi.routines) == ("Locked", True, ["In"], [])
+    assert aoi.pos == Pos("e.L5X", *locate(text, '<EncodedData EncodedType="AddOnInstructionDefinition"'))
+    assert [(r.name, r.kind, r.encoded) for r in project.programs[0].routines] == [
+        ("R", "RLL", False), ("Secret", "RLL", True)]

@@ -208,7 +208,9 @@ class _Reader:
             elif section.tag == "Modules":
                 project.modules += [m for m in map(self.module, section.all("Module")) if m]
             elif section.tag == "AddOnInstructionDefinitions":
-                project.add_on_instructions += [a for a in map(self.aoi, section.all("AddOnInstructionDefinition")) if a]
+                defs = [c for c in section.children if c.tag == "AddOnInstructionDefinition"
+                        or (c.tag == "EncodedData" and c.attrs.get("EncodedType") == "AddOnInstructionDefinition")]
+                project.add_on_instructions += [a for a in map(self.aoi, defs) if a]
             elif section.tag == "Tags":
                 project.tags += self.tags(section, "Tag")
             elif section.tag == "Programs":
@@ -381,15 +383,15 @@ class _Reader:
         name = self.name(node, "AddOnInstructionDefinition")
         if name is None:
             return None
-        aoi = AddOnInstruction(name, revision=node.attrs.get("Revision"), description=self.description(node), pos=node.pos)
+        aoi = AddOnInstruction(name, revision=node.attrs.get("Revision"), description=self.description(node),
+                               encoded=node.tag == "EncodedData", pos=node.pos)
         params = node.child("Parameters")
         if params is not None:
             aoi.parameters = self.tags(params, "Parameter")
         local = node.child("LocalTags")
         if local is not None:
             aoi.local_tags = self.tags(local, "LocalTag")
-        routines = node.child("Routines")
-        aoi.routines = [r for r in map(self.routine, routines.all("Routine") if routines is not None else []) if r]
+        aoi.routines = self.routines(node)
         return aoi
 
     def program(self, node: _Node) -> Program | None:
@@ -402,9 +404,25 @@ class _Reader:
         tags = node.child("Tags")
         if tags is not None:
             p.tags = self.tags(tags, "Tag")
-        routines = node.child("Routines")
-        p.routines = [r for r in map(self.routine, routines.all("Routine") if routines is not None else []) if r]
+        p.routines = self.routines(node)
         return p
+
+    def routines(self, node: _Node) -> list[Routine]:
+        """A Routines section's routines, a source-protected one (EncodedData)
+        kept by its name and Type with ``encoded`` set."""
+        section = node.child("Routines")
+        out = []
+        for c in section.children if section is not None else []:
+            if c.tag == "Routine":
+                r = self.routine(c)
+            elif c.tag == "EncodedData" and c.attrs.get("EncodedType") == "Routine":
+                name = self.name(c, "EncodedData")
+                r = name and Routine(name, c.attrs.get("Type", ""), description=self.description(c), encoded=True, pos=c.pos)
+            else:
+                continue
+            if r:
+                out.append(r)
+        return out
 
     def routine(self, node: _Node) -> Routine | None:
         name = self.name(node, "Routine")

@@ -115,6 +115,7 @@ class Routine:
     rungs: list[Rung] = field(default_factory=list)  # RLL
     lines: list[Line] = field(default_factory=list)  # ST
     description: str | None = None
+    encoded: bool = False  # source-protected (L5X EncodedData): its content cannot be read
     pos: Pos = NOWHERE
 
 
@@ -142,6 +143,7 @@ class AddOnInstruction:
     routines: list[Routine] = field(default_factory=list)
     revision: str | None = None
     description: str | None = None
+    encoded: bool = False  # source-protected (L5X EncodedData): parameters only, no routines
     pos: Pos = NOWHERE
 
 
