@@ -409,3 +409,26 @@ def test_l5x_source_protected_parts_are_kept_and_marked():
     assert aoi.pos == Pos("e.L5X", *locate(text, '<EncodedData EncodedType="AddOnInstructionDefinition"'))
     assert [(r.name, r.kind, r.encoded) for r in project.programs[0].routines] == [
         ("R", "RLL", False), ("Secret", "RLL", True)]
+
+
+def test_l5k_source_protected_parts_force_data_and_the_older_parameter_spelling():
+    text = ('CONTROLLER C ()\n'
+            '\tENCODED_DATA (EncodedType := ADD_ON_INSTRUCTION_DEFINITION,\n\t              Name := "Locked",\n'
+            '\t              Revision := "1.0",\n\t              EncryptionConfig := 3)\n'
+            '\t\tHISTORY_ENTRY (User := "a\\b",\n\t\t               Description := "first")\n\t\tEND_HISTORY_ENTRY\n'
+            '\t\tPARAMETERS\n\t\t\tIn : REAL[5] (Type := InOut,\n\t\t\t            Required := Yes);\n'
+            '\t\t\tOut : DINT (Type := Output, DefaultData := "7");\n\t\tEND_PARAMETERS\n'
+            '5PC4UUeSPrD8+QMe30neT5/97J+VmK95qgOApHiZ7VpmkuGyeYVmzDm3ceYND35YMmzC4xyFQfJYld\n'
+            '\tEND_ENCODED_DATA\n'
+            '\tTAG\n\t\tT : UDT_A (ProduceCount := 2) := [0,5],\n\t\t    TagForceData := [0,0,0,0,1,0];\n\tEND_TAG\n'
+            '\tPROGRAM P ()\n\t\tENCODED_DATA (EncodedType := ROUTINE,\n\t\t              Name := "Secret",\n'
+            '\t\t              Type := SFC)\n17r8GxtsZCMLfk3JHFYmU7emZMNhRh90EUUPQb5IKS676d\n\t\tEND_ENCODED_DATA\n'
+            '\tEND_PROGRAM\nEND_CONTROLLER\n')
+    project = read_l5k(text, "e.L5K")
+    [aoi] = project.add_on_instructions
+    assert (aoi.name, aoi.encoded, aoi.revision, aoi.routines) == ("Locked", True, "1.0", [])
+    assert [(t.name, t.dims, t.usage, t.required, t.value and t.value.data) for t in aoi.parameters] == [
+        ("In", (5,), "InOut", True, None), ("Out", (), "Output", False, 7)]
+    assert aoi.pos == Pos("e.L5K", *locate(text, "ENCODED_DATA"))
+    assert [(t.name, t.value.data) for t in project.tags] == [("T", [0, 5])]
+    assert [(r.name, r.kind, r.encoded) for r in project.programs[0].routines] == [("Secret", "SFC", True)]

@@ -10,8 +10,12 @@ value;`` or an alias ``Name OF Target.Path (attributes);``; a ladder
 routine's lines are ``RC: "comment";`` (for the rung after it) and ``N:
 rung text;`` (a rung may span lines, its strings may hold ``;``); a
 Structured Text routine's lines each start with ``'``. ``(* ... *)`` is a
-comment between statements. Blocks this reader has no use for (CONFIG,
-TREND, FBD and SFC routines' content ...) are skipped to their END_ word.
+comment between statements. A source-protected AOI or routine
+(``ENCODED_DATA (EncodedType := ...)``) is kept with ``encoded`` set, an
+AOI with its parameters, which are in clear. Blocks this reader has no use
+for (CONFIG, TREND, HISTORY_ENTRY, FBD and SFC routines' content ...) are
+skipped to their END_ word. A value may be followed by ``, TagForceData :=
+[...]``: forces are not read.
 
 Values are the positional L5K form (``InitialValue(form="positional")``).
 The same choices as the L5X reader, so both give equal Projects for the
@@ -30,16 +34,15 @@ Every problem found is collected and raised at the end as one
 
 from __future__ import annotations
 
-import bisect
 import os
 import re
 
 from ..ladder.ast import Pos
 from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
                     ModuleTag, Problem, Program, Project, Routine, Rung, Tag, Task)
+from .l5k_scan import IDENT, Scanner, split_attrs, split_commas
 from .values import ValueSyntax, parse_l5k_value, parse_number, unescape
 
-_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 _TYPE = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_:]*)\s*(?:\[([^\]]*)\])?")
 _VERSION = re.compile(r"Version\s*:=\s*RSLogix 5000 v([\d.]+)")
 _DATA_SUFFIX = {"configdata": "C", "inputdata": "I", "outputdata": "O"}
@@ -71,178 +74,10 @@ def _bool(value: str | None, default: bool = False) -> bool:
     return value.strip().lower() in ("yes", "1", "true")
 
 
-class _Reader:
-    def __init__(self, text: str, source: str) -> None:
-        self.t = text
-        self.n = len(text)
-        self.i = 0
-        self.source = source
-        self.problems: list[Problem] = []
-        self.lines = [0] + [m.end() for m in re.finditer(r"\n", text)]
-
-    # -- scanning -----------------------------------------------------------------------
-
-    def pos(self, i: int) -> Pos:
-        line = bisect.bisect_right(self.lines, i)
-        return Pos(self.source, line, i - self.lines[line - 1] + 1)
-
-    def problem(self, i: int, message: str) -> None:
-        self.problems.append(Problem(self.pos(i), message))
-
-    def skip(self) -> None:
-        """Whitespace and (* comments *)."""
-        t = self.t
-        while self.i < self.n:
-            c = t[self.i]
-            if c in " \t\r\n":
-                self.i += 1
-            elif t.startswith("(*", self.i):
-                end = t.find("*)", self.i + 2)
-                if end < 0:
-                    self.problem(self.i, "expected *) to close this comment")
-                    self.i = self.n
-                else:
-                    self.i = end + 2
-            else:
-                break
-
-    def word(self) -> tuple[str, int] | None:
-        self.skip()
-        m = _IDENT.match(self.t, self.i)
-        if not m:
-            return None
-        self.i = m.end()
-        return m.group(), m.start()
-
-    def peek_word(self) -> str | None:
-        self.skip()
-        m = _IDENT.match(self.t, self.i)
-        return m.group() if m else None
-
-    def skip_line(self) -> None:
-        end = self.t.find("\n", self.i)
-        self.i = self.n if end < 0 else end + 1
-
-    def statement(self) -> tuple[str, int, bool]:
-        """Text up to the next ``;`` outside quotes (consumed, not
-        returned), its start, and whether the ``;`` was found: a line that
-        starts with an END_ word ends the search, so one missing ``;`` does
-        not swallow the blocks after it."""
-        t = self.t
-        start = i = self.i
-        quote = None
-        while i < self.n:
-            c = t[i]
-            if quote:
-                if c == "$":
-                    i += 2
-                    continue
-                if c == quote:
-                    quote = None
-            elif c in "'\"":
-                quote = c
-            elif c == ";":
-                self.i = i + 1
-                return t[start:i], start, True
-            elif c == "\n" and re.match(r"[ \t]*END_", t[i + 1:i + 40]):
-                break
-            i += 1
-        self.i = i
-        return t[start:i], start, False
-
-    def attrs_at(self, text: str, offset: int) -> tuple[dict, int]:
-        """``(Name := value, ...)`` at the start of ``text`` (after blanks):
-        the attributes by lower-cased name, and the length read."""
-        j = len(text) - len(text.lstrip())
-        if text[j:j + 1] != "(":
-            return {}, 0
-        depth, quote, k = 0, None, j
-        while k < len(text):
-            c = text[k]
-            if quote:
-                if c == "$":
-                    k += 2
-                    continue
-                if c == quote:
-                    quote = None
-            elif c in "'\"":
-                quote = c
-            elif c == "(":
-                depth += 1
-            elif c == ")":
-                depth -= 1
-                if depth == 0:
-                    break
-            k += 1
-        if k >= len(text):
-            self.problem(offset + j, "expected ) to close these attributes")
-            return {}, len(text)
-        return self.attr_list(text[j + 1:k], offset + j + 1), k + 1
-
-    def attr_list(self, body: str, offset: int) -> dict:
-        out: dict = {}
-        for part, at in _split_commas(body):
-            if not part.strip():
-                continue
-            key, sep, value = part.partition(":=")
-            if not sep:
-                self.problem(offset + at + len(part) - len(part.lstrip()), f"expected Name := value, found {part.strip()!r}")
-                continue
-            v = value.strip()
-            if len(v) >= 2 and v[0] == '"' and v[-1] == '"':
-                try:
-                    v = unescape(v[1:-1])
-                except ValueSyntax as e:
-                    self.problem(offset + at, f"bad string in attribute {key.strip()}: {e.message}")
-            out[key.strip().lower()] = v
-        return out
-
-    def block_header(self, kind: str) -> tuple[str, int, dict]:
-        """``KIND name (attributes)``: the keyword is read already."""
-        w = self.word()
-        if w is None:
-            self.problem(self.i, f"expected a name after {kind}")
-            return "", self.i, {}
-        name, at = w
-        rest_start = self.i
-        line_end = self.t.find("\n", rest_start)
-        probe = self.t[rest_start:self.n if line_end < 0 else line_end]
-        if probe.strip().startswith("("):
-            attrs, used = self.attrs_at(self.t[rest_start:], rest_start)
-            self.i = rest_start + used
-        else:
-            attrs = {}
-        return name, at, attrs
-
-    def end_of(self, kind: str, name: str, at: int) -> bool:
-        """True (and the END_ word read) when the block's END_ word is
-        next; at the end of the file, the unterminated block's problem."""
-        self.skip()
-        if self.i >= self.n:
-            self.problem(at, f"expected END_{kind} to close {kind} {name} (opened here) before the end of the file")
-            return True
-        m = _IDENT.match(self.t, self.i)
-        if m and m.group() == f"END_{kind}":
-            self.i = m.end()
-            if self.t[self.i:self.i + 1] == ";":
-                self.i += 1
-            return True
-        return False
-
-    def skip_block(self, kind: str, name: str, at: int) -> None:
-        m = re.compile(rf"\bEND_{kind}\b").search(self.t, self.i)
-        if m is None:
-            opened = f"{kind} {name}" if name else kind
-            self.problem(at, f"expected END_{kind} to close {opened} (opened here) before the end of the file")
-            self.i = self.n
-        else:
-            self.i = m.end()
-
-    def unexpected(self, where: str) -> None:
-        self.problem(self.i, f"expected {where}, found {self.t[self.i:self.i + 20].split(chr(10))[0]!r}")
-        self.skip_line()
-
+class _Reader(Scanner):
     def value(self, text: str, at: int) -> InitialValue | None:
+        # a value may be followed by ", TagForceData := [...]": the value is the first part
+        text = next(split_commas(text))[0]
         lead = len(text) - len(text.lstrip())
         body = text.strip()
         if len(body) >= 2 and body[0] == '"' and body[-1] == '"':  # DefaultData := "[...]"
@@ -298,8 +133,36 @@ class _Reader:
                 p.programs.append(self.program(kat))
             elif kind == "TASK":
                 p.tasks.append(self.task(kat))
+            elif kind == "ENCODED_DATA":
+                self.encoded(kat, p.add_on_instructions, None)
             else:
                 self.skip_block(kind, "", kat)
+
+    def encoded(self, at: int, into_aois: list | None, into_routines: list | None) -> None:
+        """``ENCODED_DATA (EncodedType := ..., Name := ...)``: a
+        source-protected AOI (its parameters in clear, then the encoded
+        logic) or routine, kept with ``encoded`` set."""
+        attrs = self.attrs_here()
+        kind, name = attrs.get("encodedtype", ""), attrs.get("name", "")
+        if kind == "ADD_ON_INSTRUCTION_DEFINITION" and into_aois is not None:
+            aoi = AddOnInstruction(name, revision=attrs.get("revision"), description=attrs.get("description"),
+                                   encoded=True, pos=self.pos(at))
+            into_aois.append(aoi)
+            while not self.end_of("ENCODED_DATA", name, at):
+                word = self.peek_word()
+                if word in ("PARAMETERS", "LOCAL_TAGS"):
+                    wat = self.word()[1]
+                    (aoi.parameters if word == "PARAMETERS" else aoi.local_tags).extend(self.decls(word, wat))
+                elif word == "HISTORY_ENTRY":
+                    self.word()
+                    self.skip_block(word, "", self.i)
+                else:
+                    self.skip_line()  # the encoded logic
+            return
+        if kind == "ROUTINE" and into_routines is not None:
+            into_routines.append(Routine(name, attrs.get("type", "RLL"), description=attrs.get("description"),
+                                         encoded=True, pos=self.pos(at)))
+        self.skip_block("ENCODED_DATA", name, at)
 
     def data_type(self, at: int) -> DataType:
         name, _, attrs = self.block_header("DATATYPE")
@@ -313,7 +176,7 @@ class _Reader:
         return dt
 
     def member(self, text: str, start: int) -> Member | None:
-        head, attr_text = _split_attrs(text)
+        head, attr_text = split_attrs(text)
         attrs = self.attrs_at(attr_text, start + len(head))[0] if attr_text else {}
         m = re.fullmatch(r"\s*BIT\s+(\w+)\s+(\w+)\s*:\s*(\d+)\s*", head) or \
             re.fullmatch(r"\s*([A-Za-z_][\w:]*)\s+(\w+)\s*(?:\[\s*(\d+)\s*\])?\s*", head)
@@ -338,7 +201,7 @@ class _Reader:
         return tags
 
     def decl(self, text: str, start: int) -> Tag | None:
-        m = _IDENT.match(text)
+        m = IDENT.match(text)
         if m is None:
             self.problem(start, f"expected a tag name, found {text.strip()[:30]!r}")
             return None
@@ -346,7 +209,7 @@ class _Reader:
         rest, rat = text[m.end():], start + m.end()
         alias = re.match(r"\s+OF\s+", rest)
         if alias:
-            target, attr_text = _split_attrs(rest[alias.end():])
+            target, attr_text = split_attrs(rest[alias.end():])
             attrs = self.attrs_at(attr_text, rat + alias.end() + len(target))[0] if attr_text else {}
             return self.tag(name, None, (), attrs, None, start, alias_for=target.strip())
         tm = re.match(r"\s*:", rest)
@@ -381,7 +244,7 @@ class _Reader:
         return Tag(name, data_type, dims, tag_type="Alias" if alias_for else attrs.get("tagtype", "Base"),
                    alias_for=alias_for, external_access=attrs.get("externalaccess", "Read/Write"),
                    constant=_bool(attrs.get("constant")), description=attrs.get("description"),
-                   radix=attrs.get("radix"), value=value, usage=attrs.get("usage"),
+                   radix=attrs.get("radix"), value=value, usage=attrs.get("usage") or _usage(attrs.get("type")),
                    required=_bool(attrs.get("required")), visible=_bool(attrs.get("visible"), True), pos=self.pos(start))
 
     # -- modules --------------------------------------------------------------------------
@@ -454,6 +317,8 @@ class _Reader:
             word, wat = w
             if word == "TAG":
                 p.tags += self.decls("TAG", wat)
+            elif word == "ENCODED_DATA":
+                self.encoded(wat, None, p.routines)
             elif not self.routine(word, wat, p.routines):
                 self.skip_block(word, "", wat)
         return p
@@ -549,39 +414,12 @@ class _Reader:
         while not self.end_of("TASK", name, at):
             text, start, ended = self.statement()
             program = text.strip()
-            if not ended or not _IDENT.fullmatch(program):
+            if not ended or not IDENT.fullmatch(program):
                 self.problem(start + len(text) - len(text.lstrip()), f"expected a program name and ; in TASK {name}")
                 continue
             t.programs.append(program)
         return t
 
 
-def _split_commas(body: str):
-    """Top-level comma-separated parts of an attribute list, with their
-    offsets (commas inside quotes and brackets do not split)."""
-    depth, quote, start, k = 0, None, 0, 0
-    while k < len(body):
-        c = body[k]
-        if quote:
-            if c == "$":
-                k += 2
-                continue
-            if c == quote:
-                quote = None
-        elif c in "'\"":
-            quote = c
-        elif c in "([{":
-            depth += 1
-        elif c in ")]}":
-            depth -= 1
-        elif c == "," and depth == 0:
-            yield body[start:k], start
-            start = k + 1
-        k += 1
-    yield body[start:], start
-
-
-def _split_attrs(text: str) -> tuple[str, str]:
-    """A member or alias declaration split at its attribute list's ``(``."""
-    k = text.find("(")
-    return (text, "") if k < 0 else (text[:k], text[k:])
+def _usage(kind: str | None) -> str | None:
+    return kind if kind in ("Input", "Output", "InOut") else None
