@@ -1,0 +1,170 @@
+"""A tag's initial value (an export's data, decorated or positional) written
+into the data table items its leaves take (tags.py), as a download writes
+it. Every value that does not fit its type is a problem at the tag's place.
+
+Positional data (L5K) lists a structure's members in the type's order,
+hidden members included and BOOL members left out: their values are the
+bits of their host, as Logix stores them (1756-RM084, "Tag data in L5K
+format"). An array's elements come in row-major order, flat or nested.
+"""
+
+from __future__ import annotations
+
+from .model import InitialValue, Problem
+from .tags import WORD_BITS, Declared, Leaf
+from .types import LogixType, MemberType
+
+
+class ValueWriter:
+    """Collects the items to write, by file: ``items[(letter, file)][item] =
+    value``; B files by word."""
+
+    def __init__(self) -> None:
+        self.items: dict[tuple[str, int], dict[int, object]] = {}
+
+    def put(self, leaf: Leaf, k: int, value, bit: int | None = None) -> None:
+        cells = self.items.setdefault((leaf.letter, leaf.file), {})
+        item = leaf.first + k
+        if leaf.letter == "B":
+            word, b = divmod(item, WORD_BITS)
+            mask = 1 << b
+            cells[word] = (cells.get(word, 0) & ~mask) | (mask if value else 0)
+        elif bit is not None:
+            mask = 1 << bit
+            cells[item] = (int(cells.get(item, 0)) & ~mask) | (mask if value else 0)
+        else:
+            cells[item] = value
+
+
+def _flat(value) -> list:
+    if isinstance(value, list):
+        out = []
+        for v in value:
+            out += _flat(v) if isinstance(v, list) else [v]
+        return out
+    return [value]
+
+
+def apply_initial(d: Declared, writer: ValueWriter, problems: list[Problem]) -> None:
+    """Write tag ``d``'s initial value, if it has one."""
+    iv: InitialValue | None = d.tag.value
+    if iv is None or d.type is None:
+        return
+    positional = iv.form == "positional"
+
+    def bad(message: str) -> None:
+        problems.append(Problem(iv.pos if iv.pos.line else d.tag.pos, f"tag {d.tag.name}: initial value: {message}"))
+
+    def atomic(t: LogixType, path, k, value, bit=None):
+        leaf = d.leaves.get(path)
+        if leaf is None:
+            return
+        if isinstance(value, str) and t.name != "BOOL":
+            bad(f"{value!r} is not a number for a {t.name}")
+            return
+        if t.name == "REAL":
+            writer.put(leaf, k, float(value))
+            return
+        if not isinstance(value, (int, float, bool)):
+            bad(f"expected a number for a {t.name}, found {value!r}")
+            return
+        v = int(value)
+        if t.name == "BOOL" or bit is not None:
+            writer.put(leaf, k, v & 1, bit)
+            return
+        lo, hi = -(1 << (t.bits - 1)), (1 << (t.bits - 1)) - 1
+        if not lo <= v <= hi:
+            v &= (1 << t.bits) - 1  # a pattern written unsigned (16#FFFF for an INT): its bits
+            v = v - (1 << t.bits) if v > hi else v
+        writer.put(leaf, k, v)
+
+    def string(t: LogixType, path, k, value):
+        leaf = d.leaves.get(path)
+        if isinstance(value, dict):
+            text = value.get("DATA", value.get("Data", ""))
+            length = value.get("LEN", value.get("Len"))
+            value = text[: int(length)] if isinstance(text, str) and isinstance(length, int) else text
+        elif isinstance(value, list) and value and isinstance(value[0], int):
+            length = value[0]
+            text = value[1] if len(value) > 1 and isinstance(value[1], str) else ""
+            value = text[:length]
+        if not isinstance(value, str):
+            bad(f"expected the text of a {t.name}, found {value!r}")
+            return
+        value = value.rstrip("\x00")
+        if len(value) > t.chars:
+            bad(f"{len(value)} characters for a {t.name} of {t.chars}")
+            return
+        writer.put(leaf, k, value)
+
+    def member_value(value, m: MemberType, index: int):
+        if isinstance(value, dict):
+            for key, v in value.items():
+                if key.upper() == m.name.upper():
+                    return v, True
+            return None, False
+        if isinstance(value, list):
+            return (value[index], True) if index < len(value) else (None, False)
+        return None, False
+
+    def one(t: LogixType, path, k, value):
+        if t.kind == "atomic":
+            atomic(t, path, k, value)
+        elif t.kind == "string":
+            string(t, path, k, value)
+        else:
+            struct(t, path, k, value)
+
+    def struct(t: LogixType, path, k, value):
+        if not isinstance(value, (dict, list)):
+            bad(f"expected the members of a {t.name}, found {value!r}")
+            return
+        stored = [m for m in t.members if m.host is None]
+        for index, m in enumerate(stored):
+            v, found = member_value(value, m, index)
+            if not found:
+                continue
+            sub = path + (m.name.upper(),)
+            if m.dim:
+                elems = _flat(v)
+                for j, e in enumerate(elems[:m.dim]):
+                    one(m.type, sub, k * m.dim + j, e)
+            else:
+                one(m.type, sub, k, v)
+        if not positional and isinstance(value, dict):
+            for m in t.members:
+                if m.host is None:
+                    continue
+                v, found = member_value(value, m, 0)
+                if found and v is not None:
+                    atomic(t, path + (m.host.upper(),), k, v, bit=m.bit)
+
+    if d.dims:
+        elems = _flat(iv.data)
+        count = 1
+        for n in d.dims:
+            count *= n
+        if len(elems) > count:
+            bad(f"{len(elems)} values for {count} elements")
+        for k, e in enumerate(elems[:count]):
+            one(d.type, (), k, e)
+    else:
+        one(d.type, (), 0, iv.data)
+
+
+def data_files(writer: ValueWriter, table) -> list[tuple[str, int, list]]:
+    """(letter, file, values) for each file written: the values of items 0
+    to the file's last, the items not written as the table holds them."""
+    out = []
+    for (letter, file), cells in sorted(writer.items.items(), key=lambda x: x[0][1]):
+        f = table.file(f"{letter}{file}")
+        size = len(f.data) // f.ftype.words_per_element
+        values = []
+        for item in range(size):
+            if item in cells:
+                values.append(cells[item])
+            else:
+                values.append("" if letter == "ST" else (0.0 if letter == "F" else 0))
+        out.append((letter, file, values))
+    return out
+

@@ -1,0 +1,206 @@
+"""Logix rungs translated into the ladder's syntax tree: each instruction
+becomes the ladder instruction that has its rules (the PLC-5 one where
+Logix's rules are the same, a Logix one from instructions.py where they
+differ), each operand the data table address of its tag path (tags.py), a
+constant, or an expression. Every problem of a routine is collected with its
+place (the export's line, the column in the rung's text) and what was
+expected; an instruction softplc_lite does not run is one of them, by name.
+
+What each Logix instruction becomes (``PLAN``): the ladder mnemonic and a
+letter an operand: ``b`` a bit, ``v`` a value (number, tag, or a CPT-style
+expression where Logix allows one), ``d`` a destination, ``e`` an
+expression, ``l`` a label, ``r`` a routine, ``T``/``C``/``R`` a TIMER,
+COUNTER or CONTROL (its CTL, and PRE and ACC), ``?`` an operand Logix keeps
+in the structure (``TON(T1,?,?)``: written as ``?`` or a value, not used).
+"""
+
+from __future__ import annotations
+
+from ..ladder.ast import AddressRef, Branch, Const, Instruction, Pos, Rung
+from . import model
+from .expr import ExprError, number, parse_expression
+from .neutral import NBranch, NeutralError, parse_rung
+from .tags import PathError, TagDirectory
+
+PLAN: dict[str, tuple[str, str]] = {
+    "XIC": ("XIC", "b"), "XIO": ("XIO", "b"), "OTE": ("OTE", "b"), "OTL": ("OTL", "b"), "OTU": ("OTU", "b"),
+    "ONS": ("ONS", "b"), "OSR": ("OSR", "bb"), "OSF": ("OSF", "bb"),
+    "NOP": ("NOP", ""), "AFI": ("AFI", ""), "TND": ("TND", ""), "MCR": ("MCR", ""),
+    "MOV": ("MOV", "vd"), "MOVE": ("MOV", "vd"),
+    "ADD": ("ADD", "vvd"), "SUB": ("SUB", "vvd"), "MUL": ("MUL", "vvd"), "DIV": ("LDIV", "vvd"),
+    "MOD": ("MOD", "vvd"), "NEG": ("NEG", "vd"), "ABS": ("ABS", "vd"), "SQR": ("SQR", "vd"),
+    "SQRT": ("SQR", "vd"), "CLR": ("CLR", "d"),
+    "EQU": ("EQU", "vv"), "NEQ": ("NEQ", "vv"), "GRT": ("GRT", "vv"), "LES": ("LES", "vv"),
+    "GEQ": ("GEQ", "vv"), "LEQ": ("LEQ", "vv"), "EQ": ("EQU", "vv"), "NE": ("NEQ", "vv"),
+    "GT": ("GRT", "vv"), "LT": ("LES", "vv"), "GE": ("GEQ", "vv"), "LE": ("LEQ", "vv"),
+    "LIM": ("LIM", "vvv"), "MEQ": ("MEQ", "vvv"),
+    "AND": ("AND", "vvd"), "OR": ("OR", "vvd"), "XOR": ("XOR", "vvd"), "NOT": ("NOT", "vd"),
+    "BAND": ("AND", "vvd"), "BOR": ("OR", "vvd"), "BXOR": ("XOR", "vvd"), "BNOT": ("NOT", "vd"),
+    "CPT": ("CPT", "de"), "CMP": ("CMP", "e"),
+    "JMP": ("JMP", "l"), "LBL": ("LBL", "l"), "JSR": ("JSR", "r"), "RET": ("RET", ""), "SBR": ("SBR", ""),
+    "TON": ("LTON", "T??"), "TOF": ("LTOF", "T??"), "RTO": ("LRTO", "T??"),
+    "CTU": ("LCTU", "C??"), "CTD": ("LCTD", "C??"), "RES": ("LRES", "X"),
+}
+# Instructions Logix has and softplc_lite does not run yet, or cannot (MSG: a message to
+# another device): said by name where they are used.
+NOT_RUN_REASON = {"MSG": "a message to another device; softplc_lite has no network to send it on",
+                  "GSV": "not yet run by softplc_lite", "SSV": "not yet run by softplc_lite"}
+
+
+class RoutineContext:
+    """What translating one routine needs: the directory, the program's
+    scope, the routine numbers by name, and the routine's labels."""
+
+    def __init__(self, directory: TagDirectory, scope: str | None, routines: dict[str, int], source: str,
+                 routine: str) -> None:
+        self.directory = directory
+        self.scope = scope
+        self.routines = routines
+        self.source = source
+        self.routine = routine
+        self.labels: dict[str, int] = {}
+        self.problems: list[model.Problem] = []
+        self.warnings: list[model.Problem] = []
+        self.skip = False  # the rung being translated holds an instruction not run
+
+    def warn(self, pos: Pos, message: str) -> None:
+        self.warnings.append(model.Problem(pos, f"routine {self.routine}: {message}"))
+
+    def label(self, name: str) -> int:
+        return self.labels.setdefault(name.upper(), len(self.labels))
+
+    def problem(self, pos: Pos, message: str) -> None:
+        self.problems.append(model.Problem(pos, f"routine {self.routine}: {message}"))
+
+
+def translate_rung(rung: model.Rung, ctx: RoutineContext) -> Rung | None:
+    """The ladder rung of one Logix rung, or None (its problems added to
+    ``ctx.problems``)."""
+    try:
+        elements = parse_rung(rung.text)
+    except NeutralError as e:
+        ctx.problem(_at(rung.pos, rung.text, e.column), f"rung {rung.number}: {e}")
+        return None
+    before = len(ctx.problems)
+    ctx.skip = False
+    out = _series(elements, rung, ctx)
+    if len(ctx.problems) > before:
+        return None
+    if ctx.skip:  # kept in its place, running nothing (rung numbers stay the export's)
+        out = [Instruction("NOP", [], rung.pos)]
+    elif not out:
+        out = [Instruction("NOP", [], rung.pos)]  # an empty rung of the export: Logix takes it, the ladder NOP
+    return Rung(out, rung.comment, rung.pos)
+
+
+def _at(pos: Pos, text: str, column: int) -> Pos:
+    """The position of ``column`` of a rung's text that starts at ``pos``
+    (a rung may span lines)."""
+    head = text[:column]
+    newlines = head.count("\n")
+    if newlines:
+        return Pos(pos.source, pos.line + newlines, column - head.rfind("\n"))
+    return Pos(pos.source, pos.line, pos.column + column)
+
+
+def _series(elements, rung, ctx) -> list:
+    out = []
+    for el in elements:
+        if isinstance(el, NBranch):
+            legs = [_series(leg, rung, ctx) for leg in el.legs]
+            out.append(Branch(legs, _at(rung.pos, rung.text, el.column)))
+        else:
+            ins = _instruction(el, rung, ctx)
+            if ins is not None:
+                out.append(ins)
+    return out
+
+
+def _instruction(el, rung, ctx) -> Instruction | None:
+    pos = _at(rung.pos, rung.text, el.column)
+    plan = PLAN.get(el.mnemonic)
+    if plan is None:
+        reason = NOT_RUN_REASON.get(el.mnemonic, "not an instruction softplc_lite runs yet")
+        ctx.warn(pos, f"rung {rung.number}: {el.mnemonic}: {reason}; the rung is not run")
+        ctx.skip = True
+        return None
+    mnemonic, letters = plan
+    ops = el.operands
+    if letters == "r":  # JSR(routine, count, parameters...)
+        return _jsr(el, pos, rung, ctx)
+    if len(ops) != len(letters):
+        ctx.problem(pos, f"rung {rung.number}: {el.mnemonic} takes {len(letters)} operand"
+                         f"{'s' if len(letters) != 1 else ''}, found {len(ops)}")
+        return None
+    operands = []
+    for letter, (text, column) in zip(letters, ops):
+        where = _at(rung.pos, rung.text, column)
+        try:
+            operands += _operand(letter, text, where, ctx)
+        except (PathError, ExprError) as e:
+            ctx.problem(_at(rung.pos, rung.text, column + e.offset), f"rung {rung.number}: {el.mnemonic} "
+                                                                     f"operand {text!r}: {e}")
+    return Instruction(mnemonic, operands, pos)
+
+
+def _jsr(el, pos, rung, ctx) -> Instruction | None:
+    if not el.operands:
+        ctx.problem(pos, f"rung {rung.number}: JSR takes the routine's name")
+        return None
+    name, column = el.operands[0]
+    number_of = ctx.routines.get(name.upper())
+    if number_of is None:
+        ctx.problem(_at(rung.pos, rung.text, column), f"rung {rung.number}: JSR to {name!r}: no routine of that "
+                                                      f"name in this program")
+        return None
+    count = number(el.operands[1][0]) if len(el.operands) > 1 else 0
+    if count not in (0, None) or len(el.operands) > 2:
+        ctx.warn(pos, f"rung {rung.number}: JSR with parameters: not yet run by softplc_lite; the rung is not run")
+        ctx.skip = True
+        return None
+    return Instruction("JSR", [Const(number_of, pos)], pos)
+
+
+def _resolve_ref(text: str, pos: Pos, ctx) -> AddressRef:
+    def index_of(index_text: str):
+        r = ctx.directory.resolve(index_text, ctx.scope)
+        if r.address is None or r.type.name not in ("SINT", "INT", "DINT"):
+            raise PathError(f"index {index_text!r}: expected an integer tag (SINT, INT, DINT)")
+        return r.address
+    r = ctx.directory.resolve(text, ctx.scope, index_of)
+    if r.address is None:
+        raise PathError(f"{text} is a {r.type.name}{' array' if r.dims else ''}: expected a single value here")
+    return AddressRef(r.address, pos)
+
+
+def _operand(letter: str, text: str, pos: Pos, ctx) -> list:
+    if letter == "?":
+        return []
+    if letter in "vde":
+        value = number(text)
+        if value is not None:
+            if letter == "d":
+                raise PathError("expected a tag to write, found a number")
+            return [Const(value, pos)]
+        if letter == "d":
+            return [_resolve_ref(text, pos, ctx)]
+        return [parse_expression(text, pos, lambda path, offset: _resolve_ref(path, Pos(
+            pos.source, pos.line, pos.column + offset), ctx))]
+    if letter == "b":
+        ref = _resolve_ref(text, pos, ctx)
+        if ref.address.bit is None:
+            raise PathError("expected a BOOL or a bit (Tag.5)")
+        return [ref]
+    if letter == "l":
+        return [Const(ctx.label(text), pos)]
+    if letter in "TCRX":
+        r = ctx.directory.resolve(text, ctx.scope, lambda t: _resolve_ref(t, pos, ctx).address)
+        kind = r.type.name if r.address is None and not r.dims else None
+        wanted = {"T": ("TIMER",), "C": ("COUNTER",), "R": ("CONTROL",),
+                  "X": ("TIMER", "COUNTER", "CONTROL")}[letter]
+        if kind not in wanted:
+            raise PathError(f"expected a {' or '.join(wanted)}, found "
+                            f"{r.type.name}{' array' if r.dims else ''}")
+        members = ("CTL", "PRE", "ACC") if letter != "X" else ("CTL", "POS" if kind == "CONTROL" else "ACC")
+        return [_resolve_ref(f"{text}.{m}", pos, ctx) for m in members]
+    raise AssertionError(letter)

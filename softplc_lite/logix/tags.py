@@ -1,0 +1,315 @@
+"""Tags laid out over the data table, and tag paths resolved to addresses.
+
+Every atomic leaf of a tag (a DINT tag, a REAL member of a UDT, an INT array,
+the PRE of a TIMER) lives in data table items of its width (types.ATOMIC):
+so the engine, both executors, forces, snapshots, the watch grid and the
+servers, which all work on the data table, see tags without knowing of
+them; ``TagDirectory`` names them. The layout (docs/logix.md, "Tags over the
+data table"; every rule here is a softplc_lite choice):
+
+- A leaf that is one item (a scalar tag, or a member of a scalar structure)
+  takes the next item of a file shared by the scalars of its width (16
+  BOOLs a word of a shared B file).
+- A leaf of an array (an array tag's elements, or a member of an array of
+  structures: ``Tanks[i].Level`` for every i) takes a file of its own, item
+  k for flat index k (row-major over every dimension on the way): a
+  variable index past the array's end is then past the file's end, a major
+  fault with code 20, as Logix faults an out-of-range subscript (major
+  fault type 4, code 20: 1756-PM014, "Major fault codes").
+- A BOOL member of a user-defined type is the bit of its hidden SINT host
+  the export names; TIMER, COUNTER and CONTROL status bits are bits of
+  their CTL DINT (types.PREDEFINED).
+- A string is one ST element.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from ..datatable import Address, DataTable
+from ..datatable.filetypes import MAX_ELEMENTS
+from ..ladder.ast import Pos
+from .model import Problem, Tag
+from .types import LogixType, TypeSystem
+
+FIRST_FILE = 10  # below: the PLC-5 default files (O0 I1 S2 B3 T4 C5 R6 N7 F8)
+WORD_BITS = 16
+
+# Logix's status flags (1756-PM001, "Access status flags"), as PLC-5 status bits:
+# S:0/0..3 are the arithmetic flags, S:1/15 the first pass.
+STATUS_FLAGS = {"S:C": Address("S", 2, 0, None, 0), "S:V": Address("S", 2, 0, None, 1),
+                "S:Z": Address("S", 2, 0, None, 2), "S:N": Address("S", 2, 0, None, 3),
+                "S:FS": Address("S", 2, 1, None, 15), "S:MINOR": Address("S", 2, 10, None, 14)}
+
+
+@dataclass
+class Leaf:
+    """An atomic leaf's storage: ``count`` items of file ``letter`` +
+    ``file`` from item ``first`` (for a B file, ``first`` counts bits)."""
+
+    letter: str
+    file: int
+    first: int
+    count: int
+
+
+@dataclass
+class Declared:
+    """A tag as the directory holds it: its type, dimensions, scope
+    (None: the controller's) and where its leaves are (by member path)."""
+
+    tag: Tag
+    type: LogixType | None
+    dims: tuple[int, ...]
+    scope: str | None
+    leaves: dict[tuple[str, ...], Leaf] = field(default_factory=dict)
+
+
+@dataclass
+class Resolved:
+    """A tag path resolved. For an atomic value: ``address`` (a bit, a word,
+    an element; its element may come from an index tag). For a structure,
+    a string or a whole array: ``address`` None and ``node`` says what it
+    is; ``leaf_addresses`` lists its atomic leaves."""
+
+    text: str
+    type: LogixType
+    dims: tuple[int, ...]
+    address: Address | None
+    declared: Declared | None = None
+    path: tuple[str, ...] = ()
+    flat: int = 0  # the flat index reached (constant indexes)
+    bit: int | None = None
+
+
+class PathError(Exception):
+    def __init__(self, message: str, offset: int = 0) -> None:
+        super().__init__(message)
+        self.offset = offset
+
+
+_STEP = re.compile(r"\s*(?:\.\s*([A-Za-z_][A-Za-z0-9_]*|[0-9]+)|\[([^\]]*)\])")
+_NAME = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*(?::[A-Za-z0-9_]+)*)")
+
+
+def _count(dims) -> int:
+    n = 1
+    for d in dims:
+        n *= d
+    return n
+
+
+class Allocator:
+    """Hands out data table storage: shared files for one-item leaves, a file
+    of its own for each array leaf."""
+
+    def __init__(self, table: DataTable) -> None:
+        self.table = table
+        self.next_file = FIRST_FILE
+        self.shared: dict[str, tuple[int, int]] = {}  # letter -> (file, next item or bit)
+
+    def _new_file(self, letter: str, items: int) -> int:
+        used = {f.number for f in self.table.files()}
+        while self.next_file in used:
+            self.next_file += 1
+        number = self.next_file
+        self.next_file += 1
+        self.table.create_file(letter, number, max(items, 1))
+        return number
+
+    def one(self, letter: str) -> Leaf:
+        limit = MAX_ELEMENTS * (WORD_BITS if letter == "B" else 1)
+        file, at = self.shared.get(letter, (None, limit))
+        if at >= limit:
+            file, at = self._new_file(letter, 1), 0
+        self.shared[letter] = (file, at + 1)
+        if letter == "B":
+            self.table.create_file("B", file, at // WORD_BITS + 1)
+        else:
+            self.table.create_file(letter, file, at + 1)
+        return Leaf(letter, file, at, 1)
+
+    def many(self, letter: str, count: int) -> Leaf:
+        items = -(-count // WORD_BITS) if letter == "B" else count
+        if items > MAX_ELEMENTS:
+            raise PathError(f"{count} elements: an array leaf takes at most {MAX_ELEMENTS} data table items "
+                            f"(a softplc_lite limit)")
+        return Leaf(letter, self._new_file(letter, items), 0, count)
+
+
+class TagDirectory:
+    """Tags by scope and name, laid out in ``table`` as they are declared."""
+
+    def __init__(self, table: DataTable, types: TypeSystem) -> None:
+        self.table = table
+        self.types = types
+        self.alloc = Allocator(table)
+        self.scopes: dict[str | None, dict[str, Declared]] = {None: {}}
+        self.problems: list[Problem] = []
+
+    # -- declaring -------------------------------------------------------------------------
+    def declare(self, tag: Tag, scope: str | None = None) -> Declared | None:
+        names = self.scopes.setdefault(scope.upper() if scope else None, {})
+        key = tag.name.upper()
+        where = f"program {scope}" if scope else "the controller"
+        if key in names:
+            self.problems.append(Problem(tag.pos, f"tag {tag.name} is declared twice in {where}'s tags"))
+            return None
+        if tag.tag_type == "Alias" or tag.alias_for:
+            d = names[key] = Declared(tag, None, (), scope)
+            return d
+        t = self.types.get(tag.data_type)
+        if t is None:
+            self.problems.append(Problem(tag.pos, f"tag {tag.name}: unknown data type {tag.data_type!r}"))
+            return None
+        if len(tag.dims) > 3 or any(d <= 0 for d in tag.dims):
+            self.problems.append(Problem(tag.pos, f"tag {tag.name}: dimensions {list(tag.dims)}: expected 1 to 3 "
+                                                  f"dimensions, each at least 1"))
+            return None
+        d = Declared(tag, t, tuple(tag.dims), scope)
+        try:
+            self._lay_out(d, t, (), _count(d.dims))
+        except PathError as e:
+            self.problems.append(Problem(tag.pos, f"tag {tag.name}: {e}"))
+            return None
+        names[key] = d
+        return d
+
+    def _lay_out(self, d: Declared, t: LogixType, path: tuple[str, ...], count: int) -> None:
+        if t.kind == "atomic":
+            d.leaves[path] = self.alloc.one(t.letter) if count == 1 else self.alloc.many(t.letter, count)
+            return
+        if t.kind == "string":
+            d.leaves[path] = self.alloc.one("ST") if count == 1 else self.alloc.many("ST", count)
+            return
+        for m in t.members:
+            if m.host is not None:
+                continue  # a bit of its host's leaf
+            self._lay_out(d, m.type, path + (m.name.upper(),), count * max(m.dim, 1))
+
+    # -- resolving -------------------------------------------------------------------------
+    def find(self, name: str, scope: str | None) -> Declared | None:
+        if scope:
+            d = self.scopes.get(scope.upper(), {}).get(name.upper())
+            if d is not None:
+                return d
+        return self.scopes[None].get(name.upper())
+
+    def resolve(self, text: str, scope: str | None = None, index_of=None, _depth: int = 0) -> Resolved:
+        """The tag path ``text`` (``Tank.Level``, ``Arr[3,1].5``, ``T1.DN``,
+        ``Tanks[i].Level``) seen from program ``scope``. ``index_of(text)``
+        resolves a non-constant index to the Address of the integer holding
+        it (None: only constant indexes). Raises PathError with the offset
+        in ``text`` of what is wrong and what was expected."""
+        flag = STATUS_FLAGS.get(text.strip().upper())
+        if flag is not None:
+            return Resolved(text, self.types.get("BOOL"), (), flag)
+        m = _NAME.match(text)
+        if not m:
+            raise PathError("expected a tag name", 0)
+        name = m.group(1)
+        d = self.find(name, scope)
+        if d is None:
+            raise PathError(f"unknown tag {name!r}" + (f" (in program {scope} or the controller)" if scope else ""),
+                            m.start(1))
+        if d.type is None:  # an alias: the path goes on from its target
+            if _depth > 8:
+                raise PathError(f"alias {name} leads to itself", m.start(1))
+            target = self.resolve(d.tag.alias_for or "", d.scope, index_of, _depth + 1)
+            rest = text[m.end():]
+            if not rest.strip():
+                return Resolved(text, target.type, target.dims, target.address, target.declared, target.path,
+                                target.flat, target.bit)
+            return self._walk(text, m.end(), target.declared, target.type, target.dims, target.path,
+                              target.flat, index_of, target.bit, var=None)
+        return self._walk(text, m.end(), d, d.type, d.dims, (), 0, index_of, None, var=None)
+
+    def _walk(self, text, at, d, t, dims, path, flat, index_of, bit, var):
+        """Follow ``[..]`` and ``.member``/``.bit`` steps from ``at``."""
+        while at < len(text) and text[at:].strip():
+            m = _STEP.match(text, at)
+            if not m:
+                raise PathError("expected .member, .bit or [index]", at)
+            member, index = m.group(1), m.group(2)
+            if index is not None:
+                if var is not None:
+                    raise PathError("a tag index takes the last array of a path (softplc_lite)", m.start())
+                if not dims:
+                    raise PathError(f"{text[:m.start()].strip()} is not an array", m.start())
+                parts = [p.strip() for p in index.split(",")]
+                if len(parts) != len(dims):
+                    raise PathError(f"{len(parts)} index{'es' if len(parts) != 1 else ''} for an array of "
+                                    f"{len(dims)} dimension{'s' if len(dims) != 1 else ''}", m.start() + 1)
+                for p, size in zip(parts, dims):
+                    flat *= size
+                    if re.fullmatch(r"[0-9]+", p):
+                        k = int(p)
+                        if k >= size:
+                            raise PathError(f"index {k} is past the end of a dimension of {size}", m.start() + 1)
+                        flat += k
+                    else:
+                        if var is not None or index_of is None:
+                            raise PathError(f"index {p!r}: softplc_lite takes one tag as the index of one "
+                                            f"dimension in a path, the others constant", m.start() + 1)
+                        var = (index_of(p), flat)
+                dims = ()
+                at = m.end()
+                continue
+            if dims:
+                raise PathError(f"{text[:m.start()].strip()} is an array: expected [index] before .{member}",
+                                m.start())
+            if member.isdigit():
+                b = int(member)
+                if t.kind != "atomic" or t.name in ("BOOL", "REAL"):
+                    raise PathError(f".{b}: a bit of {t.name}: expected an integer (SINT, INT, DINT, LINT)",
+                                    m.start())
+                if b >= t.bits:
+                    raise PathError(f"bit {b} of a {t.name}: expected 0 to {t.bits - 1}", m.start() + 1)
+                bit = b
+                at = m.end()
+                if text[at:].strip():
+                    raise PathError("nothing may follow a bit number", at)
+                break
+            if t.kind != "struct":
+                raise PathError(f"{t.name} has no member {member}" + (" (a string's LEN and DATA are not yet "
+                                "reached one by one)" if t.kind == "string" else ""), m.start() + 1)
+            mt = t.member(member)
+            if mt is None:
+                names = ", ".join(x.name for x in t.visible_members())
+                raise PathError(f"{t.name} has no member {member} (it has {names})", m.start() + 1)
+            if mt.host is not None:
+                host = t.member(mt.host)
+                path, t, bit = path + (host.name.upper(),), host.type, mt.bit
+                at = m.end()
+                if text[at:].strip():
+                    raise PathError(f"{member} is a BOOL: nothing may follow it", at)
+                return self._finish(text, d, path, flat, bit, var, boolean=True)
+            path = path + (mt.name.upper(),)
+            t = mt.type
+            dims = (mt.dim,) if mt.dim else ()
+            at = m.end()
+        if dims or t.kind != "atomic":
+            return Resolved(text, t, dims, None, d, path, flat, bit)
+        return self._finish(text, d, path, flat, bit, var, t=t)
+
+    def _finish(self, text, d, path, flat, bit, var, t=None, boolean=False) -> Resolved:
+        leaf = d.leaves.get(path)
+        if leaf is None:
+            raise PathError(f"{text}: no storage (a softplc_lite bug)", 0)
+        result_type = self.types.get("BOOL") if boolean or bit is not None else t
+        if var is not None:
+            index_addr, before = var
+            if flat != before or leaf.first != 0:
+                raise PathError("a tag index takes the last array dimension of a path's only array, with "
+                                "no constant index after it (softplc_lite)", 0)
+            if leaf.letter == "B":
+                if bit is not None:
+                    raise PathError("a bit of a BOOL array element", 0)
+                return Resolved(text, result_type, (), Address("B", leaf.file, None, None, index_addr), d, path)
+            return Resolved(text, result_type, (), Address(leaf.letter, leaf.file, index_addr, None, bit), d, path)
+        item = leaf.first + flat
+        if leaf.letter == "B":
+            return Resolved(text, result_type, (), Address("B", leaf.file, item // WORD_BITS, None,
+                                                           item % WORD_BITS), d, path, flat)
+        return Resolved(text, result_type, (), Address(leaf.letter, leaf.file, item, None, bit), d, path, flat, bit)

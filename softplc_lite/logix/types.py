@@ -1,0 +1,186 @@
+"""Logix data types as softplc_lite lays them out: the atomic types, the
+predefined structures (TIMER, COUNTER, CONTROL, STRING) and an export's
+user-defined types, each resolved once into a ``LogixType``.
+
+A structure's members are listed as Logix lists them (1756-PM020, Logix 5000
+Controllers I/O and Tag Data: "Data Types"): a BOOL member of a user-defined
+type is a bit of a hidden SINT host member (the export names the host and the
+bit: ``Target``, ``BitNumber``); the status bits of TIMER, COUNTER and CONTROL
+are bits of their first DINT (EN is bit 31, TT 30, DN 29 ...), which an export
+never names, so softplc_lite calls it ``CTL`` (a choice: hidden, as Logix
+hides it). STRING (and every type of the string family) is LEN and DATA;
+softplc_lite keeps a string whole in an ST element (docs/logix.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..datatable.filetypes import FILE_TYPES
+from .model import DataType, Problem
+
+# Atomic type -> (data table file type letter, bits). BOOL tags are bits of B
+# files, 16 a word; the others one item each of the file type of their width.
+ATOMIC: dict[str, tuple[str, int]] = {
+    "BOOL": ("B", 1),
+    "SINT": ("SI" if "SI" in FILE_TYPES else "N", 8),
+    "INT": ("N", 16),
+    "DINT": ("L", 32),
+    "LINT": ("LI" if "LI" in FILE_TYPES else "L", 64),
+    "REAL": ("F", 32),
+}
+STRING_CHARS = 82  # DATA of the predefined STRING (1756-PM020, "STRING data type")
+
+
+@dataclass
+class MemberType:
+    """One member: ``bit`` set for a BOOL packed in ``host`` (another
+    member's name); ``dim`` a member array's length (0: none)."""
+
+    name: str
+    type: "LogixType"
+    dim: int = 0
+    hidden: bool = False
+    host: str | None = None
+    bit: int | None = None
+    external_access: str = "Read/Write"
+    description: str | None = None
+
+
+@dataclass
+class LogixType:
+    """``kind``: "atomic", "struct" or "string". An atomic type has its
+    file ``letter`` and ``bits``; a structure its members in order (by
+    upper-cased name in ``by_name``); a string type its DATA length."""
+
+    name: str
+    kind: str
+    letter: str | None = None
+    bits: int = 0
+    members: list[MemberType] = field(default_factory=list)
+    by_name: dict[str, MemberType] = field(default_factory=dict)
+    chars: int = 0
+    builtin: bool = False
+
+    def member(self, name: str) -> MemberType | None:
+        return self.by_name.get(name.upper())
+
+    @property
+    def is_atomic(self) -> bool:
+        return self.kind == "atomic"
+
+    def visible_members(self) -> list[MemberType]:
+        return [m for m in self.members if not m.hidden]
+
+
+def _struct(name: str, members: list[MemberType]) -> LogixType:
+    t = LogixType(name, "struct", members=members, builtin=True)
+    t.by_name = {m.name.upper(): m for m in members}
+    return t
+
+
+_ATOMIC_TYPES = {name: LogixType(name, "atomic", letter, bits, builtin=True) for name, (letter, bits) in ATOMIC.items()}
+
+
+def _status(word: str, *bits: tuple[str, int]) -> list[MemberType]:
+    return [MemberType(n, _ATOMIC_TYPES["BOOL"], host=word, bit=b) for n, b in bits]
+
+
+def _dint(name: str, hidden: bool = False) -> MemberType:
+    return MemberType(name, _ATOMIC_TYPES["DINT"], hidden=hidden)
+
+
+# 1756-RM003 (Logix 5000 Controllers General Instructions): TIMER, COUNTER and CONTROL structures.
+PREDEFINED: dict[str, LogixType] = {
+    **_ATOMIC_TYPES,
+    "TIMER": _struct("TIMER", [_dint("CTL", True), _dint("PRE"), _dint("ACC"),
+                               *_status("CTL", ("EN", 31), ("TT", 30), ("DN", 29))]),
+    "COUNTER": _struct("COUNTER", [_dint("CTL", True), _dint("PRE"), _dint("ACC"),
+                                   *_status("CTL", ("CU", 31), ("CD", 30), ("DN", 29), ("OV", 28), ("UN", 27))]),
+    "CONTROL": _struct("CONTROL", [_dint("CTL", True), _dint("LEN"), _dint("POS"),
+                                   *_status("CTL", ("EN", 31), ("EU", 30), ("DN", 29), ("EM", 28), ("ER", 27),
+                                            ("UL", 26), ("IN", 25), ("FD", 24))]),
+    "STRING": LogixType("STRING", "string", chars=STRING_CHARS, builtin=True),
+}
+
+
+class TypeSystem:
+    """The types a project may use: the predefined ones and its user-defined
+    types (and, later, its AOIs' instance types), resolved with every
+    problem said: an unknown member type, a cycle, a BIT member whose host is
+    missing, a string type longer than an ST element holds."""
+
+    def __init__(self) -> None:
+        self.types: dict[str, LogixType] = {k.upper(): v for k, v in PREDEFINED.items()}
+        self.problems: list[Problem] = []
+
+    def get(self, name: str | None) -> LogixType | None:
+        return self.types.get((name or "").upper())
+
+    def add_data_types(self, data_types: list[DataType]) -> None:
+        pending = {d.name.upper(): d for d in data_types}
+        for d in data_types:
+            if d.name.upper() in PREDEFINED:
+                self.problems.append(Problem(d.pos, f"data type {d.name} has the name of a predefined type"))
+                pending.pop(d.name.upper(), None)
+        resolving: list[str] = []
+
+        def resolve(d: DataType) -> LogixType | None:
+            key = d.name.upper()
+            if key in self.types:
+                return self.types[key]
+            if key in resolving:
+                self.problems.append(Problem(d.pos, f"data type {d.name} contains itself "
+                                                    f"({' -> '.join(resolving[resolving.index(key):] + [key])})"))
+                return None
+            resolving.append(key)
+            try:
+                t = self._resolve(d, pending, resolve)
+            finally:
+                resolving.pop()
+            if t is not None:
+                self.types[key] = t
+            return t
+
+        for d in data_types:
+            if d.name.upper() in pending:
+                resolve(d)
+
+    def _resolve(self, d: DataType, pending: dict, resolve) -> LogixType | None:
+        if d.family.lower().startswith("string"):
+            data = next((m for m in d.members if m.name.upper() == "DATA"), None)
+            chars = data.dimension if data is not None else 0
+            if not 0 < chars <= STRING_CHARS:
+                self.problems.append(Problem(d.pos, f"string type {d.name}: DATA of {chars} characters; softplc_lite "
+                                                    f"keeps strings of 1 to {STRING_CHARS} characters"))
+                return None
+            return LogixType(d.name, "string", chars=chars)
+        members: list[MemberType] = []
+        ok = True
+        for m in d.members:
+            if m.data_type.upper() == "BIT":
+                host = next((h for h in d.members if h.name.upper() == (m.target or "").upper()), None)
+                if host is None or m.bit_number is None:
+                    self.problems.append(Problem(m.pos, f"BIT member {m.name} of {d.name}: expected the host member "
+                                                        f"(Target) and BitNumber of a member that exists"))
+                    ok = False
+                    continue
+                members.append(MemberType(m.name, PREDEFINED["BOOL"], host=host.name, bit=m.bit_number,
+                                          external_access=m.external_access, description=m.description))
+                continue
+            t = self.types.get(m.data_type.upper())
+            if t is None and m.data_type.upper() in pending:
+                t = resolve(pending[m.data_type.upper()])
+            if t is None:
+                if m.data_type.upper() not in pending:
+                    self.problems.append(Problem(m.pos, f"member {m.name} of {d.name}: unknown data type "
+                                                        f"{m.data_type}"))
+                ok = False
+                continue
+            members.append(MemberType(m.name, t, dim=m.dimension, hidden=m.hidden,
+                                      external_access=m.external_access, description=m.description))
+        if not ok:
+            return None
+        t = LogixType(d.name, "struct", members=members)
+        t.by_name = {m.name.upper(): m for m in members}
+        return t
