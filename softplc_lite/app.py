@@ -73,6 +73,7 @@ class App:
     cache_key: str | None = None
     program_warnings: list[str] = field(default_factory=list)
     code_cache: CodeCache | None = None
+    logix: object | None = None  # a Studio 5000 export's tag directory and routines (logix/project.py)
 
     @property
     def name(self) -> str:
@@ -328,6 +329,8 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
     the code cache is then used only with ``program_key``, a text that
     names that program among those loaded with the same state directory."""
     path = Path(path)
+    if program is None and path.suffix.lower() in (".l5x", ".l5k") and not path.is_dir():
+        return _load_export_app(path, state_dir)
     if program is not None:  # the cache is keyed by the files: it needs the program's own key
         use_cache = use_cache and program_key is not None
     if not path.exists():
@@ -420,6 +423,35 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
               modules=modules, instructions=instructions, warnings=warnings, display=display)
     app.code, app.cache_key, app.program_warnings = code, key, program_warnings
     app.code_cache = cache
+    return app
+
+
+def _load_export_app(path: Path, state_dir: str | Path | None) -> App:
+    """A Studio 5000 export (.L5X, .L5K) as an app (logix/, docs/logix.md):
+    its ladder program checked as any program is, Logix's integer overflow
+    (wrap, 1756-RM003), no state directory unless --state names one. What
+    it holds that is not run is said in its warnings."""
+    from .logix.load import load_export
+    from .logix.model import ExportError
+
+    if not path.exists():
+        raise AppError(f"{shown_path(path)}: no such export file")
+    try:
+        made = load_export(path, shown_path(path))
+    except ExportError as e:
+        raise AppError([LadderError(p.pos, p.message) for p in e.problems]) from None
+    except OSError as e:
+        raise AppError(f"{shown_path(path)}: cannot read it: {e.strerror or e}") from None
+    resolved, errors = check(made.program)
+    if not errors:
+        _, layout = layout_problems(resolved, [])
+        errors += layout
+    if errors:
+        raise AppError(errors)
+    app = App(path, False, [path], resolved, Settings(overflow="wrap"), made.program,
+              state_dir=Path(state_dir) if state_dir is not None else None,
+              warnings=[str(w) for w in made.warnings])
+    app.logix = made
     return app
 
 

@@ -152,6 +152,9 @@ def apply_initial(d: Declared, writer: ValueWriter, problems: list[Problem]) -> 
         one(d.type, (), 0, iv.data)
 
 
+_BITS = {"SI": 8, "N": 16, "B": 16, "L": 32, "LI": 64}
+
+
 def data_files(writer: ValueWriter, table) -> list[tuple[str, int, list]]:
     """(letter, file, values) for each file written: the values of items 0
     to the file's last, the items not written as the table holds them."""
@@ -160,9 +163,14 @@ def data_files(writer: ValueWriter, table) -> list[tuple[str, int, list]]:
         f = table.file(f"{letter}{file}")
         size = len(f.data) // f.ftype.words_per_element
         values = []
+        bits = _BITS.get(letter)
         for item in range(size):
             if item in cells:
-                values.append(cells[item])
+                v = cells[item]
+                if bits and isinstance(v, int):  # a pattern (a CTL with bit 31 set) as the signed item it is
+                    v &= (1 << bits) - 1
+                    v = v - (1 << bits) if v >> (bits - 1) else v
+                values.append(v)
             else:
                 values.append("" if letter == "ST" else (0.0 if letter == "F" else 0))
         out.append((letter, file, values))

@@ -63,6 +63,7 @@ def build_program(project: model.Project) -> LogixProgram:
         for tag in prog.tags:
             directory.declare(tag, prog.name)
     problems += directory.problems
+    warnings += directory.warnings
 
     writer = ValueWriter()
     for scope in directory.scopes.values():

@@ -20,7 +20,7 @@ from ..ladder.ast import AddressRef, Branch, Const, Instruction, Pos, Rung
 from . import model
 from .expr import ExprError, number, parse_expression
 from .neutral import NBranch, NeutralError, parse_rung
-from .tags import PathError, TagDirectory
+from .tags import NotRun, PathError, TagDirectory
 
 PLAN: dict[str, tuple[str, str]] = {
     "XIC": ("XIC", "b"), "XIO": ("XIO", "b"), "OTE": ("OTE", "b"), "OTL": ("OTL", "b"), "OTU": ("OTU", "b"),
@@ -107,7 +107,9 @@ def _series(elements, rung, ctx) -> list:
     out = []
     for el in elements:
         if isinstance(el, NBranch):
-            legs = [_series(leg, rung, ctx) for leg in el.legs]
+            # An empty leg conducts (Logix takes ``[,]``); the ladder's tree wants an instruction there.
+            legs = [_series(leg, rung, ctx) or [Instruction("NOP", [], _at(rung.pos, rung.text, el.column))]
+                    for leg in el.legs]
             out.append(Branch(legs, _at(rung.pos, rung.text, el.column)))
         else:
             ins = _instruction(el, rung, ctx)
@@ -137,6 +139,9 @@ def _instruction(el, rung, ctx) -> Instruction | None:
         where = _at(rung.pos, rung.text, column)
         try:
             operands += _operand(letter, text, where, ctx)
+        except NotRun as e:
+            ctx.warn(where, f"rung {rung.number}: {el.mnemonic} operand {text!r}: {e}; the rung is not run")
+            ctx.skip = True
         except (PathError, ExprError) as e:
             ctx.problem(_at(rung.pos, rung.text, column + e.offset), f"rung {rung.number}: {el.mnemonic} "
                                                                      f"operand {text!r}: {e}")

@@ -64,6 +64,7 @@ class Declared:
     dims: tuple[int, ...]
     scope: str | None
     leaves: dict[tuple[str, ...], Leaf] = field(default_factory=dict)
+    opaque: str | None = None  # why the tag is not laid out (a type softplc_lite does not hold)
 
 
 @dataclass
@@ -87,6 +88,11 @@ class PathError(Exception):
     def __init__(self, message: str, offset: int = 0) -> None:
         super().__init__(message)
         self.offset = offset
+
+
+class NotRun(PathError):
+    """A path through a tag softplc_lite does not lay out (a type it does
+    not hold yet): not a mistake of the export; the rung is not run."""
 
 
 _STEP = re.compile(r"\s*(?:\.\s*([A-Za-z_][A-Za-z0-9_]*|[0-9]+)|\[([^\]]*)\])")
@@ -147,6 +153,7 @@ class TagDirectory:
         self.alloc = Allocator(table)
         self.scopes: dict[str | None, dict[str, Declared]] = {None: {}}
         self.problems: list[Problem] = []
+        self.warnings: list[Problem] = []
 
     # -- declaring -------------------------------------------------------------------------
     def declare(self, tag: Tag, scope: str | None = None) -> Declared | None:
@@ -161,8 +168,13 @@ class TagDirectory:
             return d
         t = self.types.get(tag.data_type)
         if t is None:
-            self.problems.append(Problem(tag.pos, f"tag {tag.name}: unknown data type {tag.data_type!r}"))
-            return None
+            reason = self.types.not_held.get(tag.data_type or "")
+            if reason is None:
+                self.problems.append(Problem(tag.pos, f"tag {tag.name}: unknown data type {tag.data_type!r}"))
+                return None
+            self.warnings.append(Problem(tag.pos, f"tag {tag.name}: {reason}; rungs that use it are not run"))
+            d = names[key] = Declared(tag, None, (), scope, opaque=reason)
+            return d
         if len(tag.dims) > 3 or any(d <= 0 for d in tag.dims):
             self.problems.append(Problem(tag.pos, f"tag {tag.name}: dimensions {list(tag.dims)}: expected 1 to 3 "
                                                   f"dimensions, each at least 1"))
@@ -213,6 +225,8 @@ class TagDirectory:
         if d is None:
             raise PathError(f"unknown tag {name!r}" + (f" (in program {scope} or the controller)" if scope else ""),
                             m.start(1))
+        if d.opaque is not None:
+            raise NotRun(f"tag {d.tag.name}: {d.opaque}", m.start(1))
         if d.type is None:  # an alias: the path goes on from its target
             if _depth > 8:
                 raise PathError(f"alias {name} leads to itself", m.start(1))

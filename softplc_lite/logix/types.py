@@ -113,9 +113,14 @@ class TypeSystem:
     def __init__(self) -> None:
         self.types: dict[str, LogixType] = {k.upper(): v for k, v in PREDEFINED.items()}
         self.problems: list[Problem] = []
+        self.held_not: dict[str, str] = {}  # a user type softplc_lite does not lay out -> why
 
     def get(self, name: str | None) -> LogixType | None:
         return self.types.get((name or "").upper())
+
+    @property
+    def not_held(self) -> "_NotHeld":
+        return _NotHeld(self)
 
     def add_data_types(self, data_types: list[DataType]) -> None:
         pending = {d.name.upper(): d for d in data_types}
@@ -151,8 +156,8 @@ class TypeSystem:
             data = next((m for m in d.members if m.name.upper() == "DATA"), None)
             chars = data.dimension if data is not None else 0
             if not 0 < chars <= STRING_CHARS:
-                self.problems.append(Problem(d.pos, f"string type {d.name}: DATA of {chars} characters; softplc_lite "
-                                                    f"keeps strings of 1 to {STRING_CHARS} characters"))
+                self.held_not[d.name.upper()] = (f"string type {d.name} holds {chars} characters; softplc_lite "
+                                                 f"holds strings of 1 to {STRING_CHARS}")
                 return None
             return LogixType(d.name, "string", chars=chars)
         members: list[MemberType] = []
@@ -172,9 +177,9 @@ class TypeSystem:
             if t is None and m.data_type.upper() in pending:
                 t = resolve(pending[m.data_type.upper()])
             if t is None:
-                if m.data_type.upper() not in pending:
-                    self.problems.append(Problem(m.pos, f"member {m.name} of {d.name}: unknown data type "
-                                                        f"{m.data_type}"))
+                if d.name.upper() not in self.held_not:
+                    self.held_not[d.name.upper()] = (f"data type {d.name}: its member {m.name} is a "
+                                                     f"{m.data_type}, which softplc_lite does not hold yet")
                 ok = False
                 continue
             members.append(MemberType(m.name, t, dim=m.dimension, hidden=m.hidden,
@@ -184,3 +189,22 @@ class TypeSystem:
         t = LogixType(d.name, "struct", members=members)
         t.by_name = {m.name.upper(): m for m in members}
         return t
+
+
+class _NotHeld:
+    """``not_held.get(type name)``: why a type softplc_lite does not lay out
+    is not held, or None for one it holds. A name neither predefined here
+    nor defined by the export is a type of Logix's or of a module's
+    (MESSAGE, ALARM_DIGITAL, AB:1756_DI:I:0 ...): Studio 5000 wrote the
+    export, so the name is no mistake."""
+
+    def __init__(self, types: TypeSystem) -> None:
+        self.types = types
+
+    def get(self, name: str) -> str | None:
+        if self.types.get(name) is not None:
+            return None
+        known = self.types.held_not.get(name.upper())
+        if known is not None:
+            return known
+        return f"data type {name} is not one softplc_lite holds yet"
