@@ -52,6 +52,8 @@ class SymbolIndex:
     """Declared symbols by upper-cased name (declarations keep their spelling)."""
 
     def __init__(self, symbols: Mapping[str, object] | None) -> None:
+        # A Logix app's symbols are its tags: ``resolve_path(text)`` gives a tag path's address.
+        self.resolve_path = getattr(symbols, "resolve_path", None)
         self.by_upper = {name.upper(): decl for name, decl in (symbols or {}).items()}
         self.names = [getattr(d, "name", n) for n, d in (symbols or {}).items()]
 
@@ -90,6 +92,13 @@ def resolve_name(text: str, symbols=None) -> Address:
     with an optional ``[offset]``, ``.member`` and ``/bit``. Raises
     AddressError (SymbolError for a symbol problem) saying what is wrong."""
     text = text.strip()
+    resolve_path = index(symbols).resolve_path
+    if resolve_path is not None:  # a tag path (Tank.Level, Arr[3].5), else an address of the table
+        try:
+            return resolve_path(text)
+        except SymbolError:
+            if not _ADDRESS_SHAPE.match(text):
+                raise
     if not is_symbol_text(text):
         try:
             return parse_address(text)

@@ -28,7 +28,7 @@ from ..ladder.ast import MAIN_FILE, Const, DataDecl, Instruction, Pos, Program, 
 from . import model
 from .initial import ValueWriter, apply_initial, data_files
 from .rungs import RoutineContext, translate_rung
-from .tags import TagDirectory
+from .tags import TagDirectory, TagSymbols
 from .types import TypeSystem
 
 NOT_RUN_KINDS = {"ST": "Structured Text", "FBD": "Function Block Diagram", "SFC": "Sequential Function Chart"}
@@ -52,7 +52,7 @@ def build_program(project: model.Project) -> LogixProgram:
     types.add_data_types(project.data_types)
     table = DataTable()
     directory = TagDirectory(table, types)
-    result = LogixProgram(Program(), directory)
+    result = LogixProgram(Program(symbols=TagSymbols(directory)), directory)
     problems, warnings = result.problems, result.warnings
     problems += types.problems
     for aoi in project.add_on_instructions:

@@ -96,6 +96,7 @@ class NotRun(PathError):
 
 
 _STEP = re.compile(r"\s*(?:\.\s*([A-Za-z_][A-Za-z0-9_]*|[0-9]+)|\[([^\]]*)\])")
+_PROGRAM_SCOPED = re.compile(r"\s*Program:([A-Za-z_][A-Za-z0-9_]*)\.", re.IGNORECASE)
 _NAME = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*(?::[A-Za-z0-9_]+)*)")
 
 
@@ -217,6 +218,13 @@ class TagDirectory:
         flag = STATUS_FLAGS.get(text.strip().upper())
         if flag is not None:
             return Resolved(text, self.types.get("BOOL"), (), flag)
+        scoped = _PROGRAM_SCOPED.match(text)
+        if scoped:  # Program:Name.Tag, a program's tag named from outside it (as Logix names it)
+            program = scoped.group(1)
+            if program.upper() not in self.scopes:
+                raise PathError(f"no program {program!r}", scoped.start(1))
+            inner = self.resolve(text[scoped.end():], program, index_of, _depth)
+            return inner
         m = _NAME.match(text)
         if not m:
             raise PathError("expected a tag name", 0)
@@ -327,3 +335,29 @@ class TagDirectory:
             return Resolved(text, result_type, (), Address("B", leaf.file, item // WORD_BITS, None,
                                                            item % WORD_BITS), d, path, flat)
         return Resolved(text, result_type, (), Address(leaf.letter, leaf.file, item, None, bit), d, path, flat, bit)
+
+
+class TagSymbols(dict):
+    """A Logix app's ``program.symbols``: no PLC-5 symbols, and every place
+    that takes a name (--print, --set, --force, the watch view, the test
+    runner's scenarios, trends) resolves a tag path through the directory
+    (ladder/symbols.py calls ``resolve_path``)."""
+
+    def __init__(self, directory: TagDirectory) -> None:
+        super().__init__()
+        self.directory = directory
+
+    def resolve_path(self, text: str) -> Address:
+        from ..ladder.symbols import SymbolError
+
+        try:
+            r = self.directory.resolve(text)
+        except PathError as e:
+            raise SymbolError(text, e.offset, str(e)) from None
+        if r.address is None:
+            raise SymbolError(text, len(text), f"{text} is a {r.type.name}{' array' if r.dims else ''}: "
+                                               f"name one of its values")
+        return r.address
+
+    def __reduce__(self):  # a program copy (pickled, deep-copied) keeps the directory
+        return (TagSymbols, (self.directory,))
