@@ -8,7 +8,7 @@ from pylogix import PLC
 
 from softplc_lite.datatable import DataTable
 from softplc_lite.tlm.enips.access import TableAccessOnTable
-from softplc_lite.tlm.enips.tagnames import (BOOL, DINT, INT, REAL, STRUCT, Catalogue, PathError,
+from softplc_lite.tlm.enips.tagnames import (BOOL, DINT, INT, LINT, REAL, SINT, STRUCT, Catalogue, PathError,
                                              parse_path)
 
 SYMBOLS = {"Speed": "N7:3", "Running": "B3:1/4", "Flag": "B3/20", "PollTimer": "T4:1", "Late": "T4:1/DN",
@@ -18,7 +18,7 @@ SYMBOLS = {"Speed": "N7:3", "Running": "B3:1/4", "Flag": "B3/20", "PollTimer": "
 @pytest.fixture(scope="module")
 def catalogue() -> Catalogue:
     t = DataTable()
-    for a in ("N7:9", "F8:3", "L10:3", "B3:3", "T4:2", "ST9:2"):
+    for a in ("N7:9", "F8:3", "L10:3", "B3:3", "T4:2", "ST9:2", "SI12:4", "LI13:1"):
         t.reference(a)
     return Catalogue(TableAccessOnTable(t), SYMBOLS)
 
@@ -32,6 +32,8 @@ def target(catalogue: Catalogue, tag: str, extra: bytes = b""):
     ("N7[4]", "N7", 4, INT, 6, None),
     ("F8[3]", "F8", 3, REAL, 1, None),
     ("L10[1]", "L10", 1, DINT, 3, None),
+    ("SI12[1]", "SI12", 1, SINT, 4, None),
+    ("LI13", "LI13", 0, LINT, 2, None),
     ("T4[1]", "T4", 3, INT, 6, None),
     ("T4[1,2]", "T4", 5, INT, 4, None),
     ("T4[1].ACC", "T4", 5, INT, 1, None),

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from softplc_lite.datatable import DataTable, item_bit_mask, jsonio, parse_address, snapshot
-from softplc_lite.datatable.errors import AddressError, AddressRangeError
+from softplc_lite.datatable import DataTable, ValueKind, ValueRangeError, item_bit_mask, jsonio, parse_address, snapshot
+from softplc_lite.datatable.errors import AddressError, AddressRangeError, DataTableError
 from softplc_lite.ladder import run_text
 from softplc_lite.ladder.semantics import Settings
 
@@ -128,3 +128,195 @@ def test_a_symbol_of_an_l_element_takes_a_bit():
     assert t.read("L9:0") == -2**31
     with pytest.raises(Exception, match="past bit 31"):
         run_text("SYMBOL Flags L9:0\nDATA L9 1\nXIC I:0/0 OTE Flags/32\n")
+
+
+# -- SI and LI files -----------------------------------------------------------------------------
+
+SI_MIN, SI_MAX = -128, 127
+LI_MIN, LI_MAX = -(2**63), 2**63 - 1
+
+
+@pytest.mark.parametrize("letter, typecode, lo, hi, top", [
+    ("SI", "b", SI_MIN, SI_MAX, 7), ("LI", "q", LI_MIN, LI_MAX, 63)])
+def test_si_and_li_files_hold_their_range_and_bits(letter, typecode, lo, hi, top):
+    t = DataTable()
+    f = t.create_file(letter, 12, 3)
+    assert (f.data.typecode, f.name, t.file(f"{letter.lower()}12") is f) == (typecode, f"{letter}12", True)
+    t.write(f"{letter}12:0", hi)
+    t.write(f"{letter}12:1", lo)
+    assert (t.read(f"{letter}12:0"), t.read(f"{letter}12:1")) == (hi, lo)
+    for bad in (hi + 1, lo - 1, 2.0):
+        with pytest.raises(ValueRangeError, match=f"{top + 1}-bit"):
+            t.write(f"{letter}12:2", bad)
+    assert t.read(f"{letter}12:2") == 0
+    t.write(f"{letter}12:2/{top}", 1)
+    assert t.read(f"{letter}12:2") == lo and t.read(f"{letter}12:2/{top}") == 1
+    t.write(f"{letter}12:2/{top}", 0)
+    t.write(f"{letter}12:2/0", 1)
+    assert t.read(f"{letter}12:2") == 1
+    with pytest.raises(AddressError, match=f"out of range 0..{top}"):
+        parse_address(f"{letter}12:0/{top + 1}")
+    a = parse_address(f"{letter.lower()}12:0/{top}")
+    assert str(a) == f"{letter}12:0/{top}" and a.kind is ValueKind.BIT
+    assert parse_address(f"{letter}12:1").kind is ValueKind.LONG
+    with pytest.raises(DataTableError, match="no raw 16-bit words"):
+        t.read_word(f"{letter}12:0")
+
+
+def test_si_and_li_do_not_clash_with_s_and_l():
+    t = DataTable()
+    t.create_file("SI", 12, 1)
+    t.create_file("LI", 13, 1)
+    t.write("S:1/15", 1)
+    t.write("L9:0", 5) if "L9" in t else t.create_file("L", 9, 1)
+    assert str(parse_address("S:1/15")) == "S:1/15"
+    with pytest.raises(DataTableError, match="file number 12 is already SI12"):
+        t.create_file("N", 12, 1)
+    with pytest.raises(AddressError, match="unknown file type 'SX'"):
+        parse_address("SX12:0")
+
+
+def test_snapshot_and_json_round_trip_si_and_li():
+    t = DataTable()
+    t.create_file("SI", 12, 3)
+    t.create_file("LI", 13, 3)
+    t.create_file("L", 9, 1)
+    for address, value in (("SI12:0", SI_MIN), ("SI12:2", SI_MAX), ("LI13:0", LI_MIN), ("LI13:2", LI_MAX),
+                           ("L9:0", -2**31)):
+        t.write(address, value)
+    back = snapshot.decode(snapshot.encode(t))
+    assert back == t and back.file("SI12").data.typecode == "b"
+    assert back.read("LI13:0") == LI_MIN and back.read("SI12:2") == SI_MAX
+    text = jsonio.dumps(t)
+    assert '"SI12":[-128,0,127]' in text.replace(" ", "")
+    again = jsonio.table_from_json(text)
+    assert again == t and again.read("LI13:2") == LI_MAX
+    with pytest.raises(DataTableError, match=r"SI12\[0\].*8-bit"):
+        jsonio.table_from_json('{"SI12": [128]}')
+
+
+def test_a_snapshot_without_logix_files_is_the_same_bytes():
+    """The format did not change: a table of PLC-5 files encodes as before
+    (the type letters, padded to two bytes, then the items)."""
+    t = DataTable()
+    raw = snapshot.encode(t)
+    assert b"N \x07\x00" in raw and snapshot.decode(raw) == t
+
+
+DEST_MATH = """DATA SI12 8 = 100 -100 {si_big}
+DATA LI13 6
+DATA L9 1
+ADD SI12:0 SI12:0 SI12:3
+SUB SI12:1 100 SI12:4
+MUL SI12:2 2 SI12:5
+MOV 300 SI12:6
+CPT SI12:7 "SI12:0 + 27"
+MOV 32767 LI13:0
+MUL LI13:0 32767 LI13:1
+MUL LI13:1 LI13:1 LI13:2
+SUB 0 LI13:2 LI13:3
+CPT LI13:4 "LI13:1 * 4"
+MOV L9:0 LI13:5
+"""
+
+
+@pytest.mark.parametrize("overflow", ["clamp", "wrap"])
+def test_math_into_si_and_li_on_both_executors(overflow):
+    t = run_both(DEST_MATH.format(si_big=100), settings=Settings(overflow=overflow), values={"L9:0": -2**31})
+    clamp = overflow == "clamp"
+    si = [t.read(f"SI12:{k}") for k in range(3, 8)]
+    assert si == ([127, -128, 127, 127, 127] if clamp else [-56, 56, -56, 44, 127])
+    square = 32767 * 32767
+    assert t.read("LI13:1") == square
+    big = square * square  # 1.15e18: fits 64 bits
+    assert (t.read("LI13:2"), t.read("LI13:3"), t.read("LI13:4")) == (big, -big, 4 * square)
+    assert t.read("LI13:5") == -2**31
+    assert t.read("S:10/14") == 1  # the SI overflows set the minor fault
+
+
+@pytest.mark.parametrize("overflow", ["clamp", "wrap"])
+def test_li_overflow_wraps_or_clamps_at_64_bits(overflow):
+    text = "DATA LI13 4\nMOV 32767 LI13:0\nMUL LI13:0 LI13:0 LI13:0\nMUL LI13:0 LI13:0 LI13:1\n" \
+           "MUL LI13:1 16 LI13:2\nADD LI13:2 LI13:2 LI13:3\n"
+    t = run_both(text, settings=Settings(overflow=overflow))
+    b = 32767 ** 4
+    assert t.read("LI13:1") == b
+    if overflow == "clamp":
+        assert (t.read("LI13:2"), t.read("LI13:3")) == (LI_MAX, LI_MAX)
+    else:
+        wrap = lambda v: (v + 2**63) % 2**64 - 2**63  # noqa: E731
+        assert (t.read("LI13:2"), t.read("LI13:3")) == (wrap(16 * b), wrap(2 * wrap(16 * b)))
+    assert t.read("S:10/14") == 1  # the overflow minor fault
+
+
+def test_bit_instructions_on_si_and_li_bits_on_both_executors():
+    text = ("DATA SI12 3\nDATA LI13 2\nDATA N10 1 = 7\nXIC I:0/0 OTE SI12:0/7\nXIC I:0/0 OTL LI13:0/63\n"
+            "XIC I:0/0 OTE SI12:1/[N10:0]\nXIC SI12:0/7 OTE LI13:1/31\nXIC LI13:0/63 OTE B3/0\n"
+            "XIC I:0/0 ONS SI12:2/6 OTE B3/1\n")
+    for inputs in (0, 1):
+        t = run_both(text, 2, values={"I:0": inputs})
+        assert t.read("SI12:0") == (-128 if inputs else 0)
+        assert t.read("SI12:1") == (-128 if inputs else 0)
+        assert t.read("LI13:0") == (LI_MIN if inputs else 0)
+        assert t.read("LI13:1") == (2**31 if inputs else 0)
+        assert t.read("B3/0") == inputs
+
+
+def test_fll_and_cop_with_si_and_li_on_both_executors():
+    text = ("DATA SI12 4\nDATA LI13 2\nDATA N10 2\nFLL 300 #SI12:0 2\nFLL -5 #LI13:0 2\n"
+            "MOV 0x0102 N10:0\nCOP #N10:0 #SI12:2 2\n")
+    t = run_both(text)
+    assert [t.read(f"SI12:{k}") for k in range(4)] == [127, 127, 2, 1]  # a word's bytes, low first
+    assert t.read("LI13:1") == -5
+
+
+def test_check_says_what_does_not_fit_a_si_data_value():
+    with pytest.raises(Exception, match="does not fit a 8-bit short integer"):
+        run_text("DATA SI12 1 = 200\n")
+
+
+def test_cli_sets_and_prints_si_and_li(tmp_path):
+    from helpers.cli import softplc_here
+
+    app = tmp_path / "app.lad"
+    app.write_text("DATA SI12 2\nDATA LI13 2\nADD SI12:0 100 SI12:1\nMUL LI13:0 4 LI13:1\n"
+                   "XIC SI12:0/7 OTE LI13:1/63\n")
+    out = softplc_here("run", str(app), "--scans", "1", "--set", "SI12:0=-100", "--set", "LI13:0=1000000000000",
+                       "--print", "SI12:1", "--print", "LI13:1", "--print", "SI12:0/7", cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines() == ["SI12:1 = 0", f"LI13:1 = {4 * 10**12 - 2**63}", "SI12:0/7 = 1"]
+    bad = softplc_here("run", str(app), "--scans", "1", "--set", "SI12:0=200", cwd=tmp_path)
+    assert bad.returncode == 1 and "8-bit signed integer (-128..127)" in bad.stderr
+
+
+def test_the_data_grid_shows_si_and_li_at_their_width():
+    from rich.console import Console
+
+    from softplc_lite.watch.datagrid import DataGrid
+
+    t = DataTable()
+    t.create_file("SI", 12, 2)
+    t.create_file("LI", 13, 1)
+    t.write("SI12:0", -1)
+    t.write("LI13:0", LI_MIN)
+    console = Console(width=100, record=True, color_system=None)
+    for name, radix in (("SI12", "hex"), ("LI13", "decimal"), ("LI13", "hex")):
+        console.print(DataGrid(t, name, radix=radix, height=4))
+    text = console.export_text()
+    assert "FF" in text and str(LI_MIN) in text and "8000000000000000" in text
+
+
+def test_trends_record_si_and_li_items(tmp_path):
+    from helpers.cli import softplc_here
+
+    app = tmp_path / "app.lad"
+    app.write_text("DATA SI12 1\nDATA LI13 1\nADD SI12:0 50 SI12:0\nMUL LI13:0 2 LI13:0\nADD LI13:0 1 LI13:0\n")
+    out = softplc_here("run", str(app), "--scans", "3", "--trend", "SI12:0", "--trend", "LI13:0",
+                       "--trend", "SI12:0/7", "--trend-file", str(tmp_path / "t.csv"), cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    rows = (tmp_path / "t.csv").read_text().splitlines()
+    assert [r.split(",")[2:] for r in rows[1:]] == [["50", "1", "0"], ["100", "3", "0"], ["127", "7", "0"]]
+    out = softplc_here("run", str(app), "--scans", "1", "--trend", "SI12:0", "--trend", "LI13:0",
+                       "--trend-file", str(tmp_path / "t.vcd"), cwd=tmp_path)
+    vcd = (tmp_path / "t.vcd").read_text()
+    assert "$var integer 8 " in vcd and "$var integer 64 " in vcd

@@ -138,6 +138,9 @@ def test_refusals_each_with_its_status_and_counted():
     assert t.read("L12:0") == 0 and t.read("F8:0") == 0.0
     assert [kind for kind, _ in pccc.counted] == ["pccc"] * 4 + ["read-only"] + ["pccc"] * 2
     assert refused(pccc(0x0F, 0x99, b"")) == (P.STS_ILLEGAL, None)
+    t.create_file("SI", 15, 2)  # a Logix SINT file: no PCCC type, its tag serves it
+    assert refused(pccc.command(P.WordRangeRead(0, 1, P.Plc5Address(15, 0), 1))) == (P.STS_EXTENDED,
+                                                                                     P.EXT_NOT_USABLE)
     response = route(pccc.router, 0x4C, PCCC_PATH, b"", pccc.access)  # not Execute PCCC
     assert response.status == cip_status.SERVICE_NOT_SUPPORTED
 

@@ -402,7 +402,7 @@ def test_register_regions_take_words_floats_and_strings(element, address, value,
 
 @pytest.mark.parametrize("element", ["HoldingRegisters", "InputRegisters"])
 @pytest.mark.parametrize("address", ["N7:0/3", "B3/17", "T4:0", "T4:0.ACC", "C5:0", "R6:0.POS", "ST9:0.LEN",
-                                     "L9:0", "D10:0", "A11:0", "T4:0/DN"])
+                                     "L9:0", "D10:0", "A11:0", "T4:0/DN", "SI12:0", "LI13:0"])
 def test_register_regions_refuse_other_addresses(element, address):
     text = in_unit(tag(element, address=address))
     problem = only_problem(text)

@@ -175,7 +175,7 @@ LINT = FileType("LI", "long long integer", Storage.LONG64, 1)
 FILE_TYPES: dict[str, FileType] = {
     t.letter: t
     for t in (OUTPUT, INPUT, STATUS, BINARY, TIMER, COUNTER, CONTROL, INTEGER, FLOAT, STRING,
-              BCD, ASCII, LONG)
+              BCD, ASCII, LONG, SINT, LINT)
 }
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..datatable import DataTable, DataTableError, parse_address
-from ..datatable.filetypes import split_file_name
+from ..datatable.filetypes import Storage, split_file_name
 from .ast import AddressRef, Const, Pos, Program, address_refs, instructions_of, walk
 from .errors import LadderError
 from .instr import BOUND
@@ -91,7 +91,7 @@ def write_data_value(table: DataTable, address, value) -> None:
     """One DATA value written as a download writes it: an integer above
     32767 for a word file is stored as its 16 bits (0xFFFF, as RSLogix
     shows a word in hex), any other value as the table converts it."""
-    if isinstance(value, int) and address.type_letter not in ("F", "L") and value > 32767:
+    if isinstance(value, int) and address.ftype.storage is Storage.WORD and value > 32767:
         table.write_word(address, value)
     else:
         table.write(address, value)

@@ -16,7 +16,7 @@ from array import array
 from dataclasses import dataclass
 
 from ..datatable import DataTable
-from ..datatable.filetypes import LONG_MAX, LONG_MIN, Storage
+from ..datatable.filetypes import ITEM_BITS, LONG_MAX, LONG_MIN
 from ..datatable.table import STRING_CHARS, read_string
 from . import status as S
 from .rounding import round_half_even
@@ -42,6 +42,22 @@ def signed32(v: int) -> int:
 def signed16(v: int) -> int:
     v &= 0xFFFF
     return v - 0x10000 if v & 0x8000 else v
+
+
+def signed8(v: int) -> int:
+    v &= 0xFF
+    return v - 0x100 if v & 0x80 else v
+
+
+def signed64(v: int) -> int:
+    v &= 0xFFFFFFFFFFFFFFFF
+    return v - 0x10000000000000000 if v & 0x8000000000000000 else v
+
+
+# An integer item's range and wrap by its array's itemsize: an SI (1), a
+# word (2), an L (4) or an LI (8) element, the same rules at each width.
+INT_ITEMS = {1: (-128, 127, signed8), 2: (-32768, 32767, signed16), 4: (LONG_MIN, LONG_MAX, signed32),
+             8: (-(2 ** 63), 2 ** 63 - 1, signed64)}
 
 
 # The deepest JSR nesting a jsr_depth setting may ask for: deep enough for any
@@ -136,12 +152,13 @@ class Machine:
             self.flags(False, over, stored == 0, stored < 0)
             return
         over = False
-        # A 16-bit word, or a 32-bit L element (1747-RM001/1763-RM001 L file range).
-        # (Two plain assignments, not a tuple built per call: store() runs for most math.)
+        # A 16-bit word, or a 32-bit L element (1747-RM001/1763-RM001 L file
+        # range), an 8-bit SI or a 64-bit LI one (Logix SINT, LINT: 1756-RM003).
+        # (Plain assignments for a word, not a lookup: store() runs for most math.)
         if d.itemsize == 2:
             lo, hi, wrap = -32768, 32767, signed16
         else:
-            lo, hi, wrap = LONG_MIN, LONG_MAX, signed32
+            lo, hi, wrap = INT_ITEMS[d.itemsize]
         if isinstance(value, float):
             if math.isnan(value):
                 value, over = 0, True
@@ -202,14 +219,14 @@ class Machine:
     def add(self, a, b, d: array, i: int) -> None:
         carry = False
         if isinstance(a, int) and isinstance(b, int):
-            mask = 0xFFFF if d.itemsize == 2 else 0xFFFFFFFF  # the carry out of an L element is bit 32's
+            mask = 0xFFFF if d.itemsize == 2 else (1 << 8 * d.itemsize) - 1  # the carry out of the item's top bit
             carry = (a & mask) + (b & mask) > mask
         self.store(a + b, d, i, carry)
 
     def sub(self, a, b, d: array, i: int) -> None:
         carry = False
         if isinstance(a, int) and isinstance(b, int):
-            mask = 0xFFFF if d.itemsize == 2 else 0xFFFFFFFF
+            mask = 0xFFFF if d.itemsize == 2 else (1 << 8 * d.itemsize) - 1
             carry = (a & mask) < (b & mask)  # borrow
         self.store(a - b, d, i, carry)
 
@@ -244,7 +261,8 @@ class Machine:
     def neg(self, v, d: array, i: int) -> None:
         """NEG: dest = -source. Carry is set unless the source is 0 or the
         result overflows (-(-32768)), as SLC 500 / MicroLogix NEG say."""
-        carry = isinstance(v, int) and v != 0 and v != -32768
+        lowest = INT_ITEMS[d.itemsize][0] if d.typecode != "f" else None
+        carry = isinstance(v, int) and v != 0 and v != lowest
         self.store(-v, d, i, carry)
 
     def sqr(self, v, d: array, i: int) -> None:
@@ -260,7 +278,7 @@ class Machine:
             if value > 0x7FFF:
                 value -= 0x10000
         else:
-            value = signed32(value)
+            value = INT_ITEMS[d.itemsize][2](value)
         d[i] = value
         s = self.s
         s[0] = (s[0] & -16) | ((value == 0) << 2) | ((value < 0) << 3)
@@ -425,15 +443,16 @@ class Machine:
     def fll(self, value, dd: array, di: int, n: int) -> None:
         if dd.typecode == "f":
             dd[di:di + n] = array("f", [float(value)]) * n
-        elif dd.itemsize == 4:  # an L file: the 32-bit range, the same rules as words
+        elif dd.itemsize != 2:  # an L, SI or LI file: its range, the same rules as words
+            lo, hi, wrap = INT_ITEMS[dd.itemsize]
             if isinstance(value, float):
                 if math.isnan(value):
                     value = 0
                 elif math.isinf(value):
-                    value = LONG_MAX if value > 0 else LONG_MIN
+                    value = hi if value > 0 else lo
                 else:
                     value = round_half_even(value)
-            value = max(LONG_MIN, min(LONG_MAX, value)) if self.clamp else signed32(value)
+            value = max(lo, min(hi, value)) if self.clamp else wrap(value)
             dd[di:di + n] = array(dd.typecode, [value]) * n
         else:
             if isinstance(value, float):
@@ -522,7 +541,7 @@ class Machine:
 def source_units(count: int, src_ftype, dest_ftype) -> int:
     """COP between a float file and a word file copies memory: the number
     of source array units holding as many bytes as ``count`` destination units."""
-    sb, db = (2 if f.storage is Storage.WORD else 4 for f in (src_ftype, dest_ftype))
+    sb, db = (ITEM_BITS[f.storage] // 8 for f in (src_ftype, dest_ftype))
     return count if sb == db else -(-count * db // sb)
 
 

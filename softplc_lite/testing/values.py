@@ -34,6 +34,12 @@ _HOLDS = {ValueKind.BIT: "a bit (0 or 1)", ValueKind.WORD: "a 16-bit signed inte
           ValueKind.FLOAT: "a float", ValueKind.LONG: "a 32-bit signed integer", ValueKind.STRING: "a string"}
 
 
+def _holds(a: Address) -> str:
+    if a.kind is ValueKind.LONG:  # an L, SI or LI element: its file's width
+        return f"a {a.ftype.item_bits}-bit signed integer"
+    return _HOLDS[a.kind]
+
+
 def value_errors(file: ScenarioFile, plc) -> list[LocatedError]:
     """The value-kind problems of every step of ``file``, in file order,
     tried on a copy of ``plc``'s data table (the PLC's own is left as it
@@ -73,7 +79,7 @@ def _problem(step: Step, a: Address, table: DataTable) -> tuple[str, int] | None
         if a.kind in (ValueKind.STRING, ValueKind.BIT):
             word = f'expect {name} == "text"' if a.kind is ValueKind.STRING else f"expect {name} == 1"
             return (f"expected a number address for {'within' if k == 'expect_within' else 'between'}: "
-                    f"{shown} holds {_HOLDS[a.kind]}; use {word}"), 0
+                    f"{shown} holds {_holds(a)}; use {word}"), 0
         if k == "expect_within" and step.args[1] < 0:
             return f"expected a tolerance of 0 or more, not {_value(step.args[1])}", 1
         if k == "expect_between" and step.args[1] > step.args[2]:
@@ -83,7 +89,7 @@ def _problem(step: Step, a: Address, table: DataTable) -> tuple[str, int] | None
     at = 1 if k == "set" else 2  # set NAME = V; expect/wait NAME OP V
     value = step.args[at]
     if k != "set" and isinstance(value, str) and a.kind is not ValueKind.STRING:
-        return f"expected a number to compare {shown} with: it holds {_HOLDS[a.kind]}, not a string", at
+        return f"expected a number to compare {shown} with: it holds {_holds(a)}, not a string", at
     if not a.is_direct:
         return None  # where it points is known only at run time
     missing = _exists(a, table)

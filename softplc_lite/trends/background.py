@@ -41,7 +41,7 @@ SPEC_LENGTH = struct.Struct("<I")
 HEAD = "=qq"  # the scan number and the time in ms, ahead of each row's values
 
 GAP = 32  # items between two trended items of a file above which they are copied as two runs
-STRUCT_CODE = {2: "h", 4: "i", 8: "q"}  # standard sizes ('=') of the table's integer items, by item size
+STRUCT_CODE = {1: "b", 2: "h", 4: "i", 8: "q"}  # standard sizes ('=') of the table's integer items, by item size
 
 
 class RowViews:

@@ -89,7 +89,7 @@ class VcdWriter:
             elif s.kind == FLOAT:
                 var = self.writer.register_var(vcd_name(app_name), name, "real")
             else:
-                var = self.writer.register_var(vcd_name(app_name), name, "integer", size=32 if s.kind == LONG else 16)
+                var = self.writer.register_var(vcd_name(app_name), name, "integer", size=s.address.ftype.item_bits if s.kind == LONG else 16)
             self.vars.append(var)
 
     def row(self, scan: int, now_ms: int, values: list) -> None:

@@ -3,7 +3,7 @@ resolved once to where its value lives (docs/trends.md, "What can be
 trended").
 
 A series is a bit (``B3/4``, ``T4:0/DN``), a word (``N7:0``, ``T4:0.ACC``),
-a long (``L10:0``) or a float (``F8:0``) at a direct address; a symbol
+a long (``L10:0``, or an 8-bit ``SI`` or 64-bit ``LI`` integer: numbers like words) or a float (``F8:0``) at a direct address; a symbol
 names its address and gives the series its label. A whole timer, counter
 or control element, a string, and an indirect or indexed address are
 refused with what to name instead (a choice: a trend is one number a scan,

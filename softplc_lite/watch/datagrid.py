@@ -47,7 +47,7 @@ def float_text(value: float) -> str:
 
 
 def word_in_radix(word: int, radix: str, bits: int = 16) -> str:
-    """One signed word (or a 32-bit L element) in ``radix``."""
+    """One signed word (or an L, SI or LI element, ``bits`` wide) in ``radix``."""
     raw = word & ((1 << bits) - 1)
     if radix == "hex":
         return format(raw, f"0{bits // 4}X")
@@ -63,7 +63,10 @@ def word_in_radix(word: int, radix: str, bits: int = 16) -> str:
 
 
 def _cell_width(radix: str, bits: int) -> int:
-    return {"hex": bits // 4, "binary": bits, "ascii": bits // 8}.get(radix, 6 if bits == 16 else 11)
+    return {"hex": bits // 4, "binary": bits, "ascii": bits // 8}.get(radix, _DECIMAL_WIDTH[bits])
+
+
+_DECIMAL_WIDTH = {8: 4, 16: 6, 32: 11, 64: 20}  # the most negative value's digits and sign
 
 
 def grid_for(table: DataTable, text: str) -> DataGrid:
@@ -130,7 +133,7 @@ class DataGrid:
 
     def _words(self, rows: int, width: int) -> list[Text]:
         f = self.file
-        bits = 32 if f.ftype.storage is Storage.LONG else 16
+        bits = f.ftype.item_bits  # 16 a word, 32 an L, 8 an SI, 64 an LI element
         is_float = f.ftype.storage is Storage.FLOAT
         cell = 13 if is_float else _cell_width(self.radix, bits)
         label = max(cell_len(self._label(f.size - 1)), 4) + 1

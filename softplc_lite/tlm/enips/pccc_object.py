@@ -24,6 +24,9 @@ from .objects import CipObject, CipReply, CipRequest
 
 CLASS_ID = 0x67
 ELEMENT_BYTES = {"ST": 84, "T": 6, "C": 6, "R": 6, "F": 4, "L": 4}  # every other file: 2
+# SI and LI files (Logix SINT, LINT) have no PCCC file type (1770-6.5.16):
+# PCCC commands naming one are refused, the CIP tag services serve them.
+NO_PCCC_TYPE = {"SI": "SINT", "LI": "LINT"}
 WORD_FILES = frozenset("OISBNADTCR")  # 16-bit items: any word may be addressed and masked
 MAX_DATA = 244  # bytes of data one reply carries (a choice: a PLC-5 typed read's most, 1770-6.5.16 ch. 7)
 ST_CHARS = 82
@@ -53,6 +56,10 @@ def _file(access: TableAccess, kind: str | None, number: int) -> FileInfo:
     if info is None:
         named = f"{kind or ''} file {number}"
         raise Refused(P.STS_EXTENDED, P.EXT_NOT_USABLE, f"there is no {named.strip()} in the table")
+    if info.kind in NO_PCCC_TYPE:
+        raise Refused(P.STS_EXTENDED, P.EXT_NOT_USABLE,
+                      f"{info.name} is a Logix {NO_PCCC_TYPE[info.kind]} file: PCCC has no type for it "
+                      "(its tag serves it)")
     return info
 
 

@@ -24,7 +24,7 @@ from .access import FileInfo, TableAccess
 
 # CIP elementary data type codes (CIP Vol. 1 appendix C; the codes pylogix
 # and pycomm3 decode).
-BOOL, SINT, INT, DINT, REAL = 0xC1, 0xC2, 0xC3, 0xC4, 0xCA
+BOOL, SINT, INT, DINT, LINT, REAL = 0xC1, 0xC2, 0xC3, 0xC4, 0xC5, 0xCA
 STRUCT = 0xA0
 # Logix's STRING structure handle, the one pylogix (``StringID``) and
 # pycomm3 recognise a STRING reply by; a STRING is DINT LEN + SINT[82] DATA,
@@ -33,13 +33,13 @@ STRING_HANDLE = 0x0FCE
 STRING_BYTES = 88
 STRING_CHARS = 82
 
-UNIT_BYTES = {BOOL: 1, SINT: 1, INT: 2, DINT: 4, REAL: 4, STRUCT: STRING_BYTES}
-UNIT_FORMATS = {BOOL: "B", INT: "h", DINT: "i", REAL: "f"}  # struct codes of the elementary units
+UNIT_BYTES = {BOOL: 1, SINT: 1, INT: 2, DINT: 4, LINT: 8, REAL: 4, STRUCT: STRING_BYTES}
+UNIT_FORMATS = {BOOL: "B", SINT: "b", INT: "h", DINT: "i", LINT: "q", REAL: "f"}  # struct codes of the elementary units
 ST_ITEMS = 83  # storage items of an ST element: .LEN, then 82 characters
 
 # The CIP type of one item of each file type.
 FILE_TYPES = {letter: INT for letter in "OISBTCRNDA"}
-FILE_TYPES.update({"F": REAL, "L": DINT, "ST": STRUCT})
+FILE_TYPES.update({"F": REAL, "L": DINT, "ST": STRUCT, "SI": SINT, "LI": LINT})
 # T, C and R elements are 3 words: served as INT[elements, 3].
 _ROWS = {"T": 3, "C": 3, "R": 3}
 
