@@ -16,17 +16,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..datatable.filetypes import FILE_TYPES
 from .model import DataType, Problem
 
 # Atomic type -> (data table file type letter, bits). BOOL tags are bits of B
 # files, 16 a word; the others one item each of the file type of their width.
 ATOMIC: dict[str, tuple[str, int]] = {
     "BOOL": ("B", 1),
-    "SINT": ("SI" if "SI" in FILE_TYPES else "N", 8),
+    "SINT": ("SI", 8),
     "INT": ("N", 16),
     "DINT": ("L", 32),
-    "LINT": ("LI" if "LI" in FILE_TYPES else "L", 64),
+    "LINT": ("LI", 64),
     "REAL": ("F", 32),
 }
 STRING_CHARS = 82  # DATA of the predefined STRING (1756-PM020, "STRING data type")
