@@ -14,6 +14,7 @@ import pytest
 from helpers.located import locate
 from helpers.logix_exports import damaged_copies, without_positions
 from softplc_lite.ladder.ast import Pos
+from softplc_lite.logix.exportfile import EXPORT
 from softplc_lite.logix.l5k import read_l5k
 from softplc_lite.logix.l5x import read_l5x
 from softplc_lite.logix.model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member,
@@ -182,10 +183,15 @@ def test_l5x_every_problem_at_once_reading_on_past_each():
     ]
 
 
-def test_l5x_a_file_that_cannot_be_read(tmp_path):
+@pytest.mark.parametrize("reader", [read_l5x, read_l5k])
+def test_a_file_that_cannot_be_read_is_the_one_problem(tmp_path, reader):
     with pytest.raises(ExportError) as err:
-        read_l5x(tmp_path / "missing.L5X")
-    assert "cannot read the export" in str(err.value)
+        reader(tmp_path / "missing.L5X", "m.L5X")
+    [problem] = err.value.problems
+    assert problem.pos.source == "m.L5X" and "cannot read" in problem.message and "missing.L5X" in problem.message
+    with pytest.raises(ExportError) as err:
+        reader(tmp_path)  # a directory: refused before it is opened (softplc_lite/textfile.py)
+    assert "a directory" in str(err.value) or "not a regular file" in str(err.value)
 
 
 @pytest.mark.parametrize("name", ["whole_controller.L5X", "reader_controller.L5X"])
@@ -432,3 +438,40 @@ def test_l5k_source_protected_parts_force_data_and_the_older_parameter_spelling(
     assert aoi.pos == Pos("e.L5K", *locate(text, "ENCODED_DATA"))
     assert [(t.name, t.value.data) for t in project.tags] == [("T", [0, 5])]
     assert [(r.name, r.kind, r.encoded) for r in project.programs[0].routines] == [("Secret", "SFC", True)]
+
+
+def test_l5x_pretty_printed_text_is_the_cdata_alone():
+    text = _controller(
+        '  <Programs>\n    <Program Name="P">\n      <Routines>\n        <Routine Name="S" Type="ST">\n'
+        '          <STContent>\n            <Line Number="0">\n              <![CDATA[  IF a THEN]]>\n'
+        '            </Line>\n          </STContent>\n        </Routine>\n'
+        '        <Routine Name="R" Type="RLL">\n          <RLLContent>\n            <Rung Number="0" Type="N">\n'
+        '              <Text>\n                <![CDATA[\n  NOP();]]>\n              </Text>\n'
+        '            </Rung>\n          </RLLContent>\n        </Routine>\n      </Routines>\n    </Program>\n  </Programs>\n'
+        '  <Tags>\n    <Tag Name="A" DataType="DINT">\n      <Data Format="L5K">\n        <![CDATA[ [1,\n 2 3]]]>\n'
+        "      </Data>\n    </Tag>\n  </Tags>")
+    [problem] = _l5x_problems(text)
+    assert (problem.pos.line, problem.pos.column) == locate(text, "3]]]>")
+    fixed = read_l5x(text.replace("2 3", "2,3"), "p.L5X")
+    [st, rll] = fixed.programs[0].routines
+    assert st.lines[0].text == "  IF a THEN"  # the line's own indentation is kept
+    assert st.lines[0].pos == Pos("p.L5X", *locate(text, "  IF a THEN"))
+    assert rll.rungs[0].text == "NOP();" and rll.rungs[0].pos == Pos("p.L5X", *locate(text, "NOP();"))
+    assert fixed.tags[0].value.data == [1, 2, 3]
+
+
+def test_l5x_an_unknown_encoding_is_a_problem_not_a_crash():
+    [problem] = _l5x_problems('<?xml version="1.0" encoding="UTF-F-8"?>\n<RSLogix5000Content/>\n')
+    assert problem.pos == Pos("bad.L5X", 1, 1) and "unknown encoding: UTF-F-8" in problem.message
+
+
+@pytest.mark.parametrize("reader", [read_l5x, read_l5k])
+def test_an_export_over_its_limit_is_refused_before_it_is_read(tmp_path, reader):
+    big = tmp_path / "big.L5X"
+    with open(big, "wb") as f:
+        f.truncate(EXPORT.size + 1)  # sparse: no disk used
+    with pytest.raises(ExportError) as err:
+        reader(big, "big.L5X")
+    [problem] = err.value.problems
+    assert problem.message.startswith("cannot read ") and problem.message.endswith(
+        "big.L5X: 67,108,865 bytes, over the 64 MiB limit for a Studio 5000 export (L5X, L5K)")

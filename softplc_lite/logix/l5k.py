@@ -34,12 +34,11 @@ Every problem found is collected and raised at the end as one
 
 from __future__ import annotations
 
-import os
 import re
 
-from ..ladder.ast import Pos
+from .exportfile import read_export
 from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
-                    ModuleTag, Problem, Program, Project, Routine, Rung, Tag, Task)
+                    ModuleTag, Program, Project, Routine, Rung, Tag, Task)
 from .l5k_scan import IDENT, Scanner, split_attrs, split_commas
 from .values import ValueSyntax, parse_l5k_value, parse_number, unescape
 
@@ -49,17 +48,12 @@ _DATA_SUFFIX = {"configdata": "C", "inputdata": "I", "outputdata": "O"}
 
 
 def read_l5k(path_or_text, source_name: str | None = None) -> Project:
-    """Read an L5K export (a path, or the text itself)."""
+    """Read an L5K export: a path, or the text itself (a str with a line
+    break); ``source_name`` names it in positions (the path by default)."""
     if isinstance(path_or_text, str) and "\n" in path_or_text:
         text, source = path_or_text, source_name or "<l5k>"
     else:
-        path = os.fspath(path_or_text)
-        source = source_name or str(path)
-        try:
-            with open(path, "rb") as f:
-                data = f.read()
-        except OSError as e:
-            raise ExportError([Problem(Pos(source, 0, 0), f"cannot read the export: {e.strerror or e}")]) from None
+        data, source = read_export(path_or_text, source_name)
         text = data.decode("utf-8-sig", errors="replace")
     reader = _Reader(text.lstrip("\ufeff"), source)
     project = reader.file()

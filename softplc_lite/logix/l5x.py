@@ -31,11 +31,11 @@ Every problem found is collected and raised at the end as one
 
 from __future__ import annotations
 
-import os
 import xml.parsers.expat as expat
 from dataclasses import dataclass, field
 
 from ..ladder.ast import Pos
+from .exportfile import read_export
 from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
                     ModuleTag, Problem, Program, Project, Routine, Rung, Tag, Task)
 from .values import MAX_DEPTH, ValueSyntax, parse_l5k_value, parse_quoted, typed_scalar
@@ -49,8 +49,10 @@ class _Node:
     attrs: dict
     pos: Pos
     children: list = field(default_factory=list)
-    parts: list = field(default_factory=list)  # character data
-    text_pos: Pos | None = None  # where the first non-blank text starts
+    parts: list = field(default_factory=list)  # character data outside CDATA sections
+    cdata: list | None = None  # character data inside CDATA sections, once one is seen
+    text_pos: Pos | None = None  # where the text starts: a CDATA section's first character,
+    # else the first non-blank character
 
     def child(self, tag: str) -> "_Node | None":
         for c in self.children:
@@ -63,7 +65,9 @@ class _Node:
 
     @property
     def text(self) -> str:
-        return "".join(self.parts)
+        """The CDATA sections' text when there are any (the blanks of a
+        pretty-printed file around them are not the text), else all text."""
+        return "".join(self.cdata if self.cdata is not None else self.parts)
 
 
 def _parse(data: bytes | str, source: str) -> _Node:
@@ -79,8 +83,26 @@ def _parse(data: bytes | str, source: str) -> _Node:
     def end(tag):
         stack.pop()
 
+    in_cdata = False
+
+    def cdata_start():
+        nonlocal in_cdata
+        in_cdata = True
+        node = stack[-1]
+        if node.cdata is None:
+            node.cdata = []
+            # the text starts after "<![CDATA[", which expat reports at its "<"
+            node.text_pos = Pos(source, parser.CurrentLineNumber, parser.CurrentColumnNumber + 10)
+
+    def cdata_end():
+        nonlocal in_cdata
+        in_cdata = False
+
     def chars(data):
         node = stack[-1]
+        if in_cdata:
+            node.cdata.append(data)
+            return
         if node.text_pos is None:
             stripped = data.lstrip()
             if stripped:
@@ -96,35 +118,28 @@ def _parse(data: bytes | str, source: str) -> _Node:
     parser.StartElementHandler = start
     parser.EndElementHandler = end
     parser.CharacterDataHandler = chars
+    parser.StartCdataSectionHandler = cdata_start
+    parser.EndCdataSectionHandler = cdata_end
     parser.buffer_text = False
     parser.Parse(data, True)
     return root
 
 
-def _load(path_or_text, source_name: str | None) -> tuple[bytes | str | None, str, list[Problem]]:
-    if isinstance(path_or_text, str) and path_or_text.lstrip("\ufeff \t\r\n").startswith("<"):
-        return path_or_text, source_name or "<l5x>", []
-    path = os.fspath(path_or_text)
-    source = source_name or str(path)
-    try:
-        with open(path, "rb") as f:
-            return f.read(), source, []
-    except OSError as e:
-        return None, source, [Problem(Pos(source, 0, 0), f"cannot read the export: {e.strerror or e}")]
-
-
 def read_l5x(path_or_text, source_name: str | None = None, prefer: str = "decorated") -> Project:
-    """Read an L5X export (a path, or the XML text itself)."""
-    data, source, problems = _load(path_or_text, source_name)
-    if data is None:
-        raise ExportError(problems)
-    if isinstance(data, str):
-        data = data.lstrip("\ufeff").encode("utf-8")
+    """Read an L5X export: a path, or the XML text itself (a str starting
+    with ``<``); ``source_name`` names it in positions (the path by
+    default). ``prefer="positional"`` reads tag data in its L5K form first."""
+    if isinstance(path_or_text, str) and path_or_text.lstrip("\ufeff \t\r\n").startswith("<"):
+        data, source = path_or_text.lstrip("\ufeff").encode("utf-8"), source_name or "<l5x>"
+    else:
+        data, source = read_export(path_or_text, source_name)
     try:
         root = _parse(data, source)
     except expat.ExpatError as e:
         message = expat.ErrorString(e.code)
         raise ExportError([Problem(Pos(source, e.lineno, e.offset + 1), f"malformed XML: {message}")]) from None
+    except (LookupError, UnicodeError, ValueError) as e:  # an encoding Python does not know, bytes not in it
+        raise ExportError([Problem(Pos(source, 1, 1), f"expected UTF-8 (or the encoding the XML declaration names): {e}")]) from None
     reader = _Reader(source, prefer)
     project = reader.project(root)
     if reader.problems:
@@ -281,11 +296,8 @@ class _Reader:
             except ValueSyntax as e:
                 at = d.text_pos or d.pos
                 if fmt in ("L5K", "String") and d.text_pos is not None:
-                    text = d.text.lstrip()
-                    before = text[:e.offset]
-                    line = at.line + before.count("\n")
-                    col = (len(before) - before.rfind("\n")) if "\n" in before else at.column + e.offset
-                    at = Pos(self.source, line, col)
+                    lead = len(d.text) - len(d.text.lstrip())
+                    at = _advance(at, d.text[:lead + e.offset])
                 self.problem(at, f"bad {fmt} data: {e.message}")
                 return None
             except _BadValue as e:
@@ -445,7 +457,8 @@ class _Reader:
             content = node.child("STContent")
             for n in content.all("Line") if content is not None else []:
                 number = self.int_attr(n, "Number", len(r.lines))
-                r.lines.append(Line(number, n.text.strip("\r\n"), n.text_pos or n.pos))
+                text = n.text if n.cdata is not None else n.text.strip()
+                r.lines.append(Line(number, text, n.text_pos or n.pos))
         return r
 
     def rung(self, node: _Node) -> Rung | None:
@@ -458,8 +471,10 @@ class _Reader:
             self.problem(node.pos, f"expected a Text element with the rung's text in rung {number}")
             return None
         comment = node.child("Comment")
-        return Rung(number, text.text.strip(), comment.text.strip() if comment is not None else None,
-                    node.attrs.get("Type", "N"), text.text_pos or text.pos)
+        body = text.text
+        at = _advance(text.text_pos, body[:len(body) - len(body.lstrip())]) if text.text_pos else text.pos
+        return Rung(number, body.strip(), comment.text.strip() if comment is not None else None,
+                    node.attrs.get("Type", "N"), at)
 
     def task(self, node: _Node) -> Task | None:
         name = self.name(node, "Task")
@@ -477,6 +492,13 @@ class _Reader:
             if sname:
                 t.programs.append(sname)
         return t
+
+
+def _advance(pos: Pos, text: str) -> Pos:
+    """The position just after ``text``, which starts at ``pos``."""
+    if "\n" not in text:
+        return Pos(pos.source, pos.line, pos.column + len(text))
+    return Pos(pos.source, pos.line + text.count("\n"), len(text) - text.rfind("\n"))
 
 
 class _BadValue(Exception):
