@@ -436,7 +436,7 @@ def test_l5k_source_protected_parts_force_data_and_the_older_parameter_spelling(
     assert [(t.name, t.dims, t.usage, t.required, t.value and t.value.data) for t in aoi.parameters] == [
         ("In", (5,), "InOut", True, None), ("Out", (), "Output", False, 7)]
     assert aoi.pos == Pos("e.L5K", *locate(text, "ENCODED_DATA"))
-    assert [(t.name, t.value.data) for t in project.tags] == [("T", [0, 5])]
+    assert [(t.name, t.tag_type, t.value.data) for t in project.tags] == [("T", "Produced", [0, 5])]
     assert [(r.name, r.kind, r.encoded) for r in project.programs[0].routines] == [("Secret", "SFC", True)]
 
 

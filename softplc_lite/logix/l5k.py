@@ -235,7 +235,7 @@ class _Reader(Scanner):
         return self.tag(name, typ.group(1), dims, attrs, value, start)
 
     def tag(self, name, data_type, dims, attrs, value, start, alias_for=None) -> Tag:
-        return Tag(name, data_type, dims, tag_type="Alias" if alias_for else attrs.get("tagtype", "Base"),
+        return Tag(name, data_type, dims, tag_type=_tag_type(attrs, alias_for),
                    alias_for=alias_for, external_access=attrs.get("externalaccess", "Read/Write"),
                    constant=_bool(attrs.get("constant")), description=attrs.get("description"),
                    radix=attrs.get("radix"), value=value, usage=attrs.get("usage") or _usage(attrs.get("type")),
@@ -417,3 +417,13 @@ class _Reader(Scanner):
 
 def _usage(kind: str | None) -> str | None:
     return kind if kind in ("Input", "Output", "InOut") else None
+
+
+def _tag_type(attrs: dict, alias_for: str | None) -> str:
+    """L5X's TagType from what L5K writes: an alias is ``OF`` a target, a
+    consumed tag names its Producer, a produced one its ProduceCount."""
+    if alias_for:
+        return "Alias"
+    if "producer" in attrs:
+        return "Consumed"
+    return "Produced" if "producecount" in attrs else "Base"

@@ -6,7 +6,11 @@ rung's, an ST line's and a comment's position is where its text starts
 (inside the CDATA section). Partial exports (TargetType Program, Routine,
 Rung, AddOnInstructionDefinition, DataType, Module) hold their parts under
 ``Controller Use="Context"`` and ``Use="Target"`` elements in the same
-places a whole controller does, so one walk reads every kind.
+places a whole controller does, so one walk reads every kind. A
+source-protected AOI or routine (``EncodedData``) is kept with ``encoded``
+set, an AOI with its parameters, which are in clear. An element's text is
+its CDATA sections' text when it has any, so a pretty-printed file's
+indentation is never part of a rung or an ST line.
 
 Tag data: a tag's ``Data`` elements are read ``Format="Decorated"`` first
 (members by name), else ``Format="String"`` (a STRING's text), else
