@@ -271,7 +271,7 @@ def test_fll_and_cop_with_si_and_li_on_both_executors():
 
 
 def test_check_says_what_does_not_fit_a_si_data_value():
-    with pytest.raises(Exception, match="does not fit a 8-bit short integer"):
+    with pytest.raises(Exception, match="does not fit an 8-bit short integer"):
         run_text("DATA SI12 1 = 200\n")
 
 
@@ -320,3 +320,29 @@ def test_trends_record_si_and_li_items(tmp_path):
                        "--trend-file", str(tmp_path / "t.vcd"), cwd=tmp_path)
     vcd = (tmp_path / "t.vcd").read_text()
     assert "$var integer 8 " in vcd and "$var integer 64 " in vcd
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_forces_hold_l_si_and_li_bits(executor):
+    from softplc_lite.ladder import Engine, Mode, load_text
+    from softplc_lite.watch.forces import Forces, parse_force
+
+    text = ("DATA L9 1\nDATA SI12 1\nDATA LI13 1\nXIC L9:0/31 OTE B3/0\nXIO I:0/0 OTU L9:0/31\n"
+            "XIO I:0/0 OTU SI12:0/7\nXIO I:0/0 OTU LI13:0/63\n")
+    engine = Engine(load_text(text), executor=executor)
+    forces = Forces(engine)
+    for force in ("L9:0/31=1", "SI12:0/7=1", "LI13:0/63=1"):
+        forces.set(parse_force(force))
+    engine.set_mode(Mode.RUN)
+    engine.run(2)
+    t = engine.table
+    assert (t.read("L9:0"), t.read("SI12:0"), t.read("LI13:0"), t.read("B3/0")) == (-2**31, -128, LI_MIN, 1)
+
+
+def test_an_l_bit_as_a_bit_shifts_source_bit_on_both_executors():
+    """BSL's source bit is read through the bound instructions' access."""
+    text = ("DATA L9 1 = -2147483648\nDATA N10 1\nADD N10:0 1 N10:0\nXIC N10:0/0 BSL #B3:1 R6:0 L9:0/31 16\n"
+            "XIC N10:0/0 BSR #B3:2 R6:1 SI12:0/7 16\nDATA SI12 1 = -128\n")
+    t = run_both(text, 5)
+    assert t.read("B3:1") == 0b111  # three rising edges, each shifting bit 31's 1 in
+    assert t.read("B3:2") == -32768 + 16384 + 8192  # BSR shifts in at the top

@@ -465,7 +465,8 @@ class _Checker(SubroutineChecks):
             elif ftype.storage in OTHER_INTEGERS:  # L, SI, LI
                 lo, hi = int_range(ftype.item_bits)
                 if not isinstance(v, int) or not lo <= v <= hi:
-                    self.error(decl.pos, f"DATA {text}: {v!r} does not fit a {ftype.item_bits}-bit "
+                    article = "an" if ftype.item_bits == 8 else "a"
+                    self.error(decl.pos, f"DATA {text}: {v!r} does not fit {article} {ftype.item_bits}-bit "
                                          f"{ftype.title} ({lo}..{hi})")
                     return
             elif ftype.radix != "decimal" and isinstance(v, str):  # D "1234" (BCD digits), A "AB"
