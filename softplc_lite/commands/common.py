@@ -19,7 +19,7 @@ import threading
 
 from ..datatable import DataTable, DataTableError
 from ..datatable.display import format_read
-from ..ladder.symbols import SymbolIndex, is_symbol_text, resolve_name
+from ..ladder.symbols import SymbolIndex, is_name, is_symbol_text, resolve_name
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT, EXIT_INTERNAL = 0, 1, 2, 3, 4
 EXIT_REPLAY = 5  # --replay: the program wrote bytes other than the recording's
@@ -55,7 +55,7 @@ def print_values(table: DataTable, addresses: list[str], symbols=None) -> None:
     names = SymbolIndex(symbols)
     for text in addresses:
         a = resolve_name(text, names)
-        name = f"{text} ({a})" if is_symbol_text(text.strip()) else str(a)
+        name = f"{text} ({a})" if is_name(text.strip(), names) else str(a)
         print(f"{name} = {format_read(table, a)}")
 
 

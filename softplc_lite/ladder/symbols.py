@@ -75,6 +75,20 @@ def index(symbols) -> SymbolIndex:
     return symbols if isinstance(symbols, SymbolIndex) else SymbolIndex(symbols)
 
 
+def is_name(text: str, symbols=None) -> bool:
+    """True when ``text`` names something by a name (a program symbol, or a
+    tag path of a Logix app), not by its data table address: what labels
+    show the name beside the address."""
+    names = index(symbols)
+    if names.resolve_path is not None:
+        try:
+            names.resolve_path(text)
+            return True
+        except AddressError:
+            return False
+    return is_symbol_text(text)
+
+
 def is_symbol_text(text: str) -> bool:
     """True when ``text`` is taken as a symbol (with or without a suffix),
     not as an address."""

@@ -311,9 +311,9 @@ class TagDirectory:
             t = mt.type
             dims = (mt.dim,) if mt.dim else ()
             at = m.end()
-        if dims or t.kind != "atomic":
+        if dims or t.kind == "struct":
             return Resolved(text, t, dims, None, d, path, flat, bit)
-        return self._finish(text, d, path, flat, bit, var, t=t)
+        return self._finish(text, d, path, flat, bit, var, t=t)  # an atomic value, or a string's ST element
 
     def _finish(self, text, d, path, flat, bit, var, t=None, boolean=False) -> Resolved:
         leaf = d.leaves.get(path)
@@ -361,3 +361,66 @@ class TagSymbols(dict):
 
     def __reduce__(self):  # a program copy (pickled, deep-copied) keeps the directory
         return (TagSymbols, (self.directory,))
+
+
+def _unflatten(flat: int, dims: list[int]) -> list[int]:
+    out = []
+    for size in reversed(dims):
+        flat, k = divmod(flat, size)
+        out.append(k)
+    return out[::-1]
+
+
+class TagNames:
+    """Addresses back to tag paths: what the watch view, fmt and messages
+    show for an operand of a Logix app (``Tanks[1].Level`` for F12:1,
+    ``SettleTimer.DN`` for a bit of its CTL, ``Tanks[0].Fill`` for a bit of
+    its hidden host)."""
+
+    def __init__(self, directory: TagDirectory) -> None:
+        self.by_file: dict[int, list[tuple[Declared, tuple[str, ...], Leaf]]] = {}
+        for scope in directory.scopes.values():
+            for d in scope.values():
+                for path, leaf in d.leaves.items():
+                    self.by_file.setdefault(leaf.file, []).append((d, path, leaf))
+
+    def name_of(self, address: Address, scope: str | None = None) -> str | None:
+        """The tag path ``address`` is, or None (not a tag's item; an
+        indirect element). A program's tag is ``Program:Name.Tag`` unless
+        ``scope`` is that program (as Logix names it from outside)."""
+        if not isinstance(address.file, int) or not isinstance(address.element, int) or address.member:
+            return None
+        if address.bit is not None and not isinstance(address.bit, int):
+            return None
+        b_file = address.type_letter == "B"
+        item = address.element * WORD_BITS + (address.bit or 0) if b_file else address.element
+        for d, path, leaf in self.by_file.get(address.file, ()):
+            if leaf.letter == address.type_letter and leaf.first <= item < leaf.first + leaf.count:
+                text = _path_text(d, path, item - leaf.first, None if b_file else address.bit)
+                if d.scope and (scope or "").upper() != d.scope.upper():
+                    text = f"Program:{d.scope}.{text}"
+                return text
+        return None
+
+
+def _path_text(d: Declared, path: tuple[str, ...], flat: int, bit: int | None) -> str:
+    steps: list[tuple[str | None, list[int]]] = [(None, list(d.dims))]
+    t, parent = d.type, None
+    for key in path:
+        m = t.member(key)
+        steps.append((m.name, [m.dim] if m.dim else []))
+        parent, t = t, m.type
+    dims = [n for _, ds in steps for n in ds]
+    indexes = _unflatten(flat, dims)
+    hosted = None
+    if bit is not None and parent is not None:  # a BOOL member kept in this bit of its host
+        hosted = next((m.name for m in parent.members if m.host and m.host.upper() == path[-1] and m.bit == bit),
+                      None)
+    text, at = d.tag.name, 0
+    for name, ds in steps:
+        if name is not None:
+            text += f".{hosted if hosted and name.upper() == path[-1] else name}"
+        if ds:
+            text += "[" + ",".join(str(i) for i in indexes[at:at + len(ds)]) + "]"
+            at += len(ds)
+    return text if bit is None or hosted else f"{text}.{bit}"

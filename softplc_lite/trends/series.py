@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from ..datatable import DataTableError
 from ..datatable.address import Address, ValueKind
-from ..ladder.symbols import SymbolIndex, is_symbol_text, resolve_name
+from ..ladder.symbols import SymbolIndex, is_name, is_symbol_text, resolve_name
 
 BIT, WORD, LONG, FLOAT = "bit", "word", "long", "float"
 KIND_OF = {ValueKind.BIT: BIT, ValueKind.WORD: WORD, ValueKind.LONG: LONG, ValueKind.FLOAT: FLOAT}
@@ -63,7 +63,7 @@ def resolve_series(texts: list[str], table, symbols: dict | None = None, what: s
             message = str(e)
             problems.append(f"{what} {message}" if message.startswith((name, repr(name))) else f"{what} {name}: {message}")
             continue
-        label = name if is_symbol_text(name) else str(address)
+        label = name if is_name(name, names) else str(address)
         problem = _untrendable(address)
         if problem is not None:
             problems.append(f"{what} {text!r}: {problem}")
