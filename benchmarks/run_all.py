@@ -23,6 +23,7 @@ BENCHMARKS = (
     "bench_comgenius_format",
     "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_modbus_server",
     "bench_enips_server", "bench_watch", "bench_trend_view", "bench_trends", "bench_scenarios", "bench_mutation",
+    "bench_logix",
 )
 
 
@@ -182,6 +183,12 @@ def main() -> int:
                      f"{med(table['cip K=4']['ratio_to_modbtcps']):.2f}x MODBTCPS, PCCC "
                      f"{med(table['pccc K=4']['rates']):,.0f}/s = {med(table['pccc K=4']['ratio_to_modbtcps']):.2f}x; "
                      f"under 50 busy clients {enips['busy'].get('late_scans', 0)} late scans")
+
+    logix = load("bench_logix")
+    if logix:
+        med = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731
+        lines.append(f"logix     {logix['export']} ({logix['rungs']} rungs): scan / its rungs as PLC-5 text "
+                     f"{med(logix['ratio']):.2f} [{'PASS' if logix['verdict'] else 'MISS'} <= {logix['target']}]")
 
     trends = load("bench_trends")
     if trends:

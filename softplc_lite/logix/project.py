@@ -45,6 +45,9 @@ class LogixProgram:
     problems: list[model.Problem] = field(default_factory=list)
     warnings: list[model.Problem] = field(default_factory=list)
     routine_files: dict[tuple[str, str], int] = field(default_factory=dict)  # (program, routine) -> file
+    # RLL rungs of the export: how many, how many were made into ladder rungs that run, how many are
+    # kept as a NOP (a warning says why), how many have errors (benchmarks/logix_corpus.py counts them)
+    rungs: dict[str, int] = field(default_factory=lambda: {"total": 0, "run": 0, "not run": 0, "errors": 0})
 
 
 def build_program(project: model.Project) -> LogixProgram:
@@ -79,7 +82,8 @@ def build_program(project: model.Project) -> LogixProgram:
             number += 1
         for routine in prog.routines:
             file_number = routines[routine.name.upper()]
-            rungs = _routine_rungs(routine, prog, directory, routines, project.source, problems, warnings)
+            rungs = _routine_rungs(routine, prog, directory, routines, project.source, problems, warnings,
+                                   result.rungs)
             result.program.files[file_number] = ProgramFile(file_number, f"{prog.name}.{routine.name}", rungs,
                                                             routine.pos)
     result.program.files[MAIN_FILE] = ProgramFile(MAIN_FILE, "continuous task",
@@ -93,7 +97,7 @@ def build_program(project: model.Project) -> LogixProgram:
     return result
 
 
-def _routine_rungs(routine, prog, directory, routines, source, problems, warnings) -> list[Rung]:
+def _routine_rungs(routine, prog, directory, routines, source, problems, warnings, counts) -> list[Rung]:
     if routine.kind != "RLL":
         kind = NOT_RUN_KINDS.get(routine.kind, routine.kind)
         warnings.append(model.Problem(routine.pos, f"routine {prog.name}.{routine.name} is {kind}: not yet run "
@@ -103,8 +107,12 @@ def _routine_rungs(routine, prog, directory, routines, source, problems, warning
     rungs = []
     for rung in routine.rungs:
         translated = translate_rung(rung, ctx)
+        counts["total"] += 1
         if translated is None:  # its problems are errors: the program does not run
             translated = Rung([Instruction("NOP", [], rung.pos)], rung.comment, rung.pos)
+            counts["errors"] += 1
+        else:
+            counts["not run" if ctx.skip else "run"] += 1
         rungs.append(translated)
     problems += ctx.problems
     warnings += ctx.warnings

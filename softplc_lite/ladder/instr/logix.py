@@ -70,17 +70,13 @@ LOGIX_NAMES = {s.mnemonic: s.mnemonic[1:] for s in SPECS}
 
 
 def _timer(kind: str, ctl, pre, acc, machine):
-    def check(p: int, a: int) -> None:
-        if p < 0 or a < 0:
-            raise MajorFault(FAULT_NEGATIVE_TIMER, f"timer with a negative {'PRE' if p < 0 else 'ACC'} "
-                                                   f"({p if p < 0 else a}): major fault type 4, code 34")
-
     def run(c: bool) -> bool:
         cd, ci, _ = ctl()
         pd, pi, _ = pre()
         ad, ai, _ = acc()
         w, p, a = cd[ci], pd[pi], ad[ai]
-        check(p, a)
+        if p < 0 or a < 0:
+            raise _negative(p, a)
         if kind == "TOF":
             if c:
                 w = (w | EN | DN) & ~TT
@@ -116,13 +112,70 @@ def _timer(kind: str, ctl, pre, acc, machine):
     return run
 
 
+def _negative(p: int, a: int) -> MajorFault:
+    return MajorFault(FAULT_NEGATIVE_TIMER, f"timer with a negative {'PRE' if p < 0 else 'ACC'} "
+                                            f"({p if p < 0 else a}): major fault type 4, code 34")
+
+
+def _ton_fixed(cd, ci, pd, pi, ad, ai, machine):
+    """TON on three items resolved at load (the common case): the same rules
+    as ``_timer``'s, with its steady states (false and reset, done) cheap."""
+    held = EN | DN
+
+    def run(c: bool) -> bool:
+        w, p, a = cd[ci], pd[pi], ad[ai]
+        if p < 0 or a < 0:
+            raise _negative(p, a)
+        if c:
+            if a >= p:
+                if w & (held | TT) != held:
+                    cd[ci] = (w | held) & ~TT
+                return c
+            if w & TT:
+                a = a + machine.dt
+            w |= EN | TT
+            if a >= p:
+                w = (w | DN) & ~TT
+                a = p
+            cd[ci] = w
+            ad[ai] = a
+        elif w & (EN | TT | DN) or a:
+            cd[ci] = w & ~(EN | TT | DN)
+            ad[ai] = 0
+        return c
+    return run
+
+
 def _counter(up: bool, ctl, pre, acc):
-    edge = CU if up else CD
+    step = _count_step(up)
 
     def run(c: bool) -> bool:
         cd, ci, _ = ctl()
         pd, pi, _ = pre()
         ad, ai, _ = acc()
+        return step(c, cd, ci, pd, pi, ad, ai)
+    return run
+
+
+def _counter_fixed(up: bool, cd, ci, pd, pi, ad, ai):
+    """CTU/CTD on three items resolved at load: a rung held as it was and a
+    DN already right cost a few reads."""
+    step = _count_step(up)
+    edge = CU if up else CD
+
+    def run(c: bool) -> bool:
+        w = cd[ci]
+        if (c and w & edge) or (not c and not w & edge):  # no edge: only DN to keep right
+            if (ad[ai] >= pd[pi]) == bool(w & DN):
+                return c
+        return step(c, cd, ci, pd, pi, ad, ai)
+    return run
+
+
+def _count_step(up: bool):
+    edge = CU if up else CD
+
+    def step(c, cd, ci, pd, pi, ad, ai) -> bool:
         w, p, a = cd[ci], pd[pi], ad[ai]
         if c and not w & edge:
             if up:
@@ -144,7 +197,7 @@ def _counter(up: bool, ctl, pre, acc):
         cd[ci] = w
         ad[ai] = a
         return c
-    return run
+    return step
 
 
 def _reset(ctl, acc):
@@ -180,10 +233,17 @@ def _bind(instr, access):
     if m == "LDIV":
         a, b, dest = instr.operands
         return _divide(access.value(a), access.value(b), access.location(dest), machine)
+    fixed = [access.fixed(op) for op in instr.operands]
+    if m == "LTON" and all(f is not None for f in fixed):
+        (cd, ci, _), (pd, pi, _), (ad, ai, _) = fixed
+        return _ton_fixed(cd, ci, pd, pi, ad, ai, machine)
     ops = [access.location(op) for op in instr.operands]
     if m in ("LTON", "LTOF", "LRTO"):
         return _timer(m[1:], *ops, machine)
     if m in ("LCTU", "LCTD"):
+        if all(f is not None for f in fixed):
+            (cd, ci, _), (pd, pi, _), (ad, ai, _) = fixed
+            return _counter_fixed(m == "LCTU", cd, ci, pd, pi, ad, ai)
         return _counter(m == "LCTU", *ops)
     return _reset(*ops)
 

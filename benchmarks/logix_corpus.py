@@ -1,0 +1,168 @@
+"""How much of the Studio 5000 exports out there softplc_lite runs: over a
+set of exports, the share of files that load, the share of their RLL rungs
+that are made into rungs that run, and the share of files that run 1,000
+scans without a major fault; with the causes of the rest, counted.
+
+    python benchmarks/logix_corpus.py                       # the exports in this repository
+    python benchmarks/logix_corpus.py --list FILES.txt      # a gathered corpus: one path a line
+    python benchmarks/logix_corpus.py DIR_OR_FILE ...
+
+The repository holds the public exports whose licences allow it
+(tests/fixtures/logix/public/, their sources in its README) and the
+project's own (programs/logix/, tests/fixtures/logix/). The wider corpus
+the figures in docs/logix.md come from was gathered from public
+repositories with tools/logix_census.py's help (not shipped: most of it
+may not be redistributed). Each file runs in a process of its own, with
+a time limit, so one export that hangs or exhausts memory is a cause in
+the table, not the end of the measurement. Writes
+benchmarks/results/logix_corpus.json unless --no-save.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing
+import re
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+import _common as C
+
+SCANS = 1000
+TIME_LIMIT_S = 120
+
+
+def _exports(paths: list[str], listed: str | None) -> list[Path]:
+    found: list[Path] = []
+    if listed:
+        base = Path(listed).parent
+        for line in Path(listed).read_text(encoding="utf-8").splitlines():
+            if line.strip():
+                p = Path(line.strip())
+                found.append(p if p.is_absolute() else base / p)
+    for text in paths or ([] if listed else [str(C.REPO / "programs" / "logix"), str(C.REPO / "tests" / "fixtures" / "logix")]):
+        p = Path(text)
+        found += sorted(x for x in p.rglob("*") if x.suffix.lower() in (".l5x", ".l5k")) if p.is_dir() else [p]
+    return found
+
+
+def _cause(text: str) -> str:
+    """A problem's message reduced to its kind: names, numbers and places
+    taken out, so that like problems count together."""
+    text = re.sub(r"^.*?:\d+:\d+: ", "", text)
+    text = re.sub(r"routine \S+: rung \d+: ", "", text)
+    text = re.sub(r"'[^']*'|\"[^\"]*\"", "'…'", text)
+    text = re.sub(r"\b(tag|program|routine|task|data type|string type|member|Add-On Instruction) \S+", r"\1 …", text)
+    text = re.sub(r"\d+", "N", text)
+    return text[:110]
+
+
+def measure_one(path: str) -> dict:
+    """One export: read, made into a program, checked, run; what happened."""
+    from softplc_lite.app import AppError, load_app
+    from softplc_lite.logix.load import read_export
+    from softplc_lite.logix.model import ExportError
+    from softplc_lite.logix.project import build_program
+    from softplc_lite.runner import RunOptions, Runner
+
+    out: dict = {"file": path, "rungs": {"total": 0, "run": 0, "not run": 0, "errors": 0}}
+    t0 = time.perf_counter()
+    try:
+        project = read_export(path)
+    except ExportError as e:
+        out.update(stage="read", causes=[_cause(p.message) for p in e.problems][:20])
+        return out
+    made = build_program(project)
+    out["rungs"] = dict(made.rungs)
+    out["warnings"] = [_cause(w.message) for w in made.warnings]
+    try:
+        app = load_app(path)
+    except AppError as e:
+        out.update(stage="load", causes=[_cause(getattr(x, "message", str(x))) for x in (e.errors or [str(e)])][:50])
+        return out
+    out["load_s"] = time.perf_counter() - t0
+    runner = Runner(app, RunOptions(fresh=True, save_state=False))
+    try:
+        t1 = time.perf_counter()
+        runner.run(SCANS)
+        out["scan_us"] = (time.perf_counter() - t1) / max(runner.engine.scans, 1) * 1e6
+        fault = runner.engine.fault
+        out.update(stage="ran" if fault is None else "faulted", scans=runner.engine.scans,
+                   causes=[] if fault is None else [_cause(str(fault))])
+    finally:
+        runner.close()
+    return out
+
+
+def _worker(path: str, queue) -> None:
+    try:
+        queue.put(measure_one(path))
+    except BaseException as e:  # noqa: BLE001 - a bug of softplc_lite is a finding of the measurement
+        queue.put({"file": path, "stage": "crashed", "causes": [f"{type(e).__name__}: {_cause(str(e))}"],
+                   "rungs": {"total": 0, "run": 0, "not run": 0, "errors": 0}})
+
+
+def measure(path: Path) -> dict:
+    queue = multiprocessing.get_context("fork").Queue()
+    proc = multiprocessing.get_context("fork").Process(target=_worker, args=(str(path), queue))
+    proc.start()
+    proc.join(TIME_LIMIT_S)
+    if proc.is_alive():
+        proc.kill()
+        proc.join()
+        return {"file": str(path), "stage": "timed out", "causes": [f"over {TIME_LIMIT_S} s"],
+                "rungs": {"total": 0, "run": 0, "not run": 0, "errors": 0}}
+    try:
+        return queue.get(timeout=5)
+    except Exception:  # noqa: BLE001
+        return {"file": str(path), "stage": "crashed", "causes": [f"exit status {proc.exitcode}"],
+                "rungs": {"total": 0, "run": 0, "not run": 0, "errors": 0}}
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("paths", nargs="*")
+    ap.add_argument("--list", help="a file listing exports, one path a line (relative to the list's directory)")
+    ap.add_argument("--no-save", action="store_true")
+    ap.add_argument("--json")
+    args = ap.parse_args()
+    files = _exports(args.paths, args.list)
+    results = []
+    for k, f in enumerate(files, 1):
+        r = measure(f)
+        results.append(r)
+        print(f"[{k}/{len(files)}] {r['stage']:9} {f}", file=sys.stderr)
+    n = len(results)
+    stages = Counter(r["stage"] for r in results)
+    loaded = sum(1 for r in results if r["stage"] in ("ran", "faulted"))
+    rungs = Counter()
+    for r in results:
+        rungs.update(r["rungs"])
+    print(f"{n} exports")
+    print(f"  load: {loaded} ({100 * loaded / max(n, 1):.1f}%)   (read but not loaded: {stages['load']}, "
+          f"not read: {stages['read']}, crashed: {stages['crashed']}, timed out: {stages['timed out']})")
+    total = rungs["total"]
+    print(f"  RLL rungs: {total}: made into rungs that run {rungs['run']} ({100 * rungs['run'] / max(total, 1):.1f}%), "
+          f"kept as NOP (not run yet) {rungs['not run']} ({100 * rungs['not run'] / max(total, 1):.1f}%), "
+          f"with errors {rungs['errors']} ({100 * rungs['errors'] / max(total, 1):.1f}%)")
+    print(f"  ran {SCANS} scans without a major fault: {stages['ran']} ({100 * stages['ran'] / max(n, 1):.1f}% of all, "
+          f"{100 * stages['ran'] / max(loaded, 1):.1f}% of those loaded); faulted: {stages['faulted']}")
+    for title, key, stage_set in (("why files do not load (files with the cause)", "causes", ("load", "read", "crashed", "timed out")),
+                                  ("why loaded files fault", "causes", ("faulted",)),
+                                  ("what is not run (files with the warning)", "warnings", ("ran", "faulted", "load"))):
+        counted = Counter(c for r in results if r["stage"] in stage_set for c in set(r.get(key, [])))
+        if counted:
+            print(f"  {title}:")
+            for cause, count in counted.most_common(25):
+                print(f"    {count:4}  {cause}")
+    figures = {"files": n, "stages": dict(stages), "rungs": dict(rungs), "results": results}
+    if not args.no_save:
+        C.save_figures("logix_corpus", figures, False, args.json)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
