@@ -64,6 +64,12 @@ def _expected_l5x() -> Project:
             Module("Drive1", "ETHERNET-MODULE", parent="Local", inhibited=True, tags=[
                 ModuleTag("Drive1:I", "SINT", _dec([0, 0]))]),
         ],
+        module_types=[
+            DataType("AB:1769_DI6XOW4:C:0", [Member("ProgToFaultEn", "BOOL"), Member("ProgMode", "INT", radix="Binary")]),
+            DataType("AB:1769_DI6XOW4:I:0", [Member("Fault", "DINT", radix="Binary"),
+                                            Member("Data", "INT", radix="Binary")]),
+            DataType("AB:1769_DI6XOW4:O:0", [Member("Data", "INT", radix="Binary")]),
+        ],
         tags=[
             Tag("FillTimer", "TIMER", description="Fill time",
                 value=_dec({"PRE": 3000, "ACC": 0, "EN": 0, "TT": 0, "DN": 0})),
@@ -252,6 +258,7 @@ def _same_facts(project: Project) -> Project:
     the rest is compared as read."""
     p = without_positions(project)
     p.format = "-"
+    p.module_types = []
     for dt in p.data_types:
         for m in dt.members:
             m.radix = None if m.radix == "Decimal" else m.radix
@@ -278,6 +285,7 @@ def test_l5k_reads_every_part_value_for_value():
                                 ModuleTag("Local:1:I", None, InitialValue("positional", [0, 0])),
                                 ModuleTag("Local:1:O", None, InitialValue("positional", [0]))]
     expected.modules[2].tags = [ModuleTag("Drive1:I", None, InitialValue("positional", [0]))]
+    expected.module_types = []  # L5K describes no module-defined type
     project = read_l5k(L5K, "reader_controller.L5K")
     assert without_positions(project) == without_positions(expected)
     # spot checks that do not lean on the L5X reader

@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 
 from ..ladder.ast import Pos
 from .exportfile import read_export
+from .modules import describe_structure
 from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
                     ModuleTag, Problem, Program, Project, Routine, Rung, Tag, Task)
 from .values import MAX_DEPTH, ValueSyntax, parse_l5k_value, parse_quoted, typed_scalar
@@ -170,6 +171,7 @@ class _Reader:
         self.source = source
         self.prefer = prefer
         self.problems: list[Problem] = []
+        self.module_types: list[DataType] = []
 
     def problem(self, pos: Pos, message: str) -> None:
         self.problems.append(Problem(pos, message))
@@ -236,6 +238,7 @@ class _Reader:
                 project.programs += [p for p in map(self.program, section.all("Program")) if p]
             elif section.tag == "Tasks":
                 project.tasks += [t for t in map(self.task, section.all("Task")) if t]
+        project.module_types = self.module_types
         return project
 
     # -- data types ----------------------------------------------------------------------
@@ -391,6 +394,8 @@ class _Reader:
         for d in node.all("Data"):
             if d.attrs.get("Format") == "Decorated" and d.children:
                 data_type = d.children[0].attrs.get("DataType")
+                if d.children[0].tag == "Structure" and value is not None:  # its depth is bounded
+                    describe_structure(d.children[0], self.module_types)
         return ModuleTag(name, data_type, value, node.pos)
 
     # -- AOIs, programs, routines, tasks ---------------------------------------------------

@@ -201,6 +201,9 @@ class Project:
     data_types: list[DataType] = field(default_factory=list)
     add_on_instructions: list[AddOnInstruction] = field(default_factory=list)
     modules: list[Module] = field(default_factory=list)
+    # The module-defined types (AB:1756_DI:I:0 ...) the modules' decorated data shows, one per
+    # name and shape, nested ones included: an export names them but never defines them.
+    module_types: list[DataType] = field(default_factory=list)
     tags: list[Tag] = field(default_factory=list)  # controller scope
     programs: list[Program] = field(default_factory=list)
     tasks: list[Task] = field(default_factory=list)

@@ -27,6 +27,7 @@ from ..datatable import DataTable
 from ..ladder.ast import MAIN_FILE, Const, DataDecl, Instruction, Pos, Program, ProgramFile, Rung
 from . import model
 from .initial import ValueWriter, apply_initial, data_files
+from .modules import declare_module_tags
 from .rungs import RoutineContext, translate_rung
 from .tags import TagDirectory, TagSymbols
 from .types import TypeSystem
@@ -62,6 +63,7 @@ def build_program(project: model.Project) -> LogixProgram:
         warnings.append(model.Problem(aoi.pos, f"Add-On Instruction {aoi.name}: not yet run by softplc_lite"))
     for tag in project.tags:
         directory.declare(tag)
+    declare_module_tags(project, directory, problems, warnings)
     for prog in project.programs:
         for tag in prog.tags:
             directory.declare(tag, prog.name)
