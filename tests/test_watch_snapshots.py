@@ -80,6 +80,9 @@ CASES = [
          cli=("--trend", "Level", "--trend", "Valve", "--trend", "AtSetpoint")),
     # stepped back to scan 440: the marker on the chart
     Case("tank-trend-history", "tank", 520, trend=("Level", "Valve", "AtSetpoint"), back=80, sizes=((120, 40),)),
+    # a Studio 5000 export: tag paths, Logix names, routines (docs/logix.md, "Watching a Logix app")
+    Case("tank_line", "logix/tank_line.L5X", 300, watch=("Tanks[0].Level", "Tanks[1].Level", "Batches.ACC"),
+         sets=("Start=1",)),
 ]
 
 PARAMS = [pytest.param(case, w, h, id=f"{case.name}-{w}x{h}") for case in CASES for w, h in case.sizes]

@@ -54,23 +54,28 @@ def _prec(node) -> int:
     return _ATOM
 
 
-def format_expression(node) -> str:
+def format_expression(node, name_of=None, operators=None) -> str:
+    """The expression as rung text; ``name_of(address)`` (optional) gives
+    the name an address shows by (None: its address) and ``operators`` the
+    text an operator shows as (Logix writes ``/`` for PLC-5's ``|``), so a
+    view can show an expression its own way (a Logix app's) without the
+    ladder core knowing how."""
     if isinstance(node, Const):
         return _constant(node)
     if isinstance(node, AddressRef):
-        return str(node.address)
+        return (name_of(node.address) if name_of else None) or str(node.address)
     if isinstance(node, SymbolRef):
         return node.name
     if isinstance(node, Call):
-        return f"{node.func}({format_expression(node.arg)})"
+        return f"{node.func}({format_expression(node.arg, name_of, operators)})"
     if isinstance(node, UnaryOp):
-        inner = format_expression(node.operand)
+        inner = format_expression(node.operand, name_of, operators)
         if _prec(node.operand) < _UNARY:
             inner = f"({inner})"
         return f"-{inner}" if node.op == "NEG" else f"NOT {inner}"
     assert isinstance(node, BinOp)
     p = _PREC[node.op]
-    left, right = format_expression(node.left), format_expression(node.right)
+    left, right = format_expression(node.left, name_of, operators), format_expression(node.right, name_of, operators)
     if node.op == "**":
         # power takes unary operands on both sides and does not chain
         if _prec(node.left) < _UNARY:
@@ -82,7 +87,7 @@ def format_expression(node) -> str:
             left = f"({left})"
         if _prec(node.right) <= p:
             right = f"({right})"
-    return f"{left} {node.op} {right}"
+    return f"{left} {operators.get(node.op, node.op) if operators else node.op} {right}"
 
 
 def format_operand(op, style: str, file_operand: bool = False) -> str:

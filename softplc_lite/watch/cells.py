@@ -7,7 +7,7 @@ rungs.py has the picture and the rules; this module draws the pieces.
 from __future__ import annotations
 
 import json
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable
 
 from rich.cells import cell_len
 from rich.style import Style
@@ -23,8 +23,9 @@ from ..ladder.ast import (
     address_refs,
 )
 from ..ladder.ast import Text as TextOperand
-from ..ladder.fmt import format_expression
 from ..ladder.instructions import InstructionSet, K
+from ..ladder.instr.logix import CD, CU, DN, EN, OV, TT, UN
+from .naming import SymbolNames
 from .power import READ_FAILURES, Power
 
 ENERGIZED = Style(color="green", bold=True)  # wires with power, true instructions, energized outputs
@@ -47,6 +48,10 @@ _MOVES = {"MOV", "NEG", "ABS", "SQR", "NOT", "ACI", "AIC"}  # source -> dest
 _LIVE_PRESETS = {"TON": (2, 3), "TOF": (2, 3), "RTO": (2, 3), "CTU": (1, 2), "CTD": (1, 2)}  # shown from the table
 _STATUS_BITS = {"T": ("EN", "TT", "DN"), "C": ("CU", "CD", "DN", "OV", "UN"), "R": ("EN", "DN", "ER", "EM")}
 _STRUCTS = (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL)
+# A Logix TIMER or COUNTER is three DINTs (CTL, PRE, ACC): its status bits are bits of CTL.
+_LOGIX_BITS = {"LTON": ("EN", "TT", "DN"), "LTOF": ("EN", "TT", "DN"), "LRTO": ("EN", "TT", "DN"),
+               "LCTU": ("CU", "CD", "DN", "OV", "UN"), "LCTD": ("CU", "CD", "DN", "OV", "UN")}
+_LOGIX_MASKS = {"EN": EN, "TT": TT, "DN": DN, "CU": CU, "CD": CD, "OV": OV, "UN": UN}
 
 Run = tuple[str, "Style | None"]
 Line = list  # of Runs, and of Lines: composing blocks nests their lines instead of copying them
@@ -158,28 +163,7 @@ def _stacked(blocks: list[_Block]) -> _Block:
 # -- what the view needs to know ---------------------------------------------------------------
 
 
-class _SymbolNames:
-    """Address -> symbol name; a bit or word of a named element is named
-    after it (``Reply/DN`` for R6:1/DN when Reply is R6:1)."""
-
-    def __init__(self, symbols: Mapping[str, object] | None) -> None:
-        self.by_address: dict[str, str] = {}
-        for name, target in (symbols or {}).items():
-            address = getattr(target, "address", target)
-            self.by_address.setdefault(str(address), name)
-
-    def name(self, address: Address) -> str | None:
-        if not self.by_address or not address.is_direct:
-            return None
-        text = str(address)
-        found = self.by_address.get(text)
-        if found is not None or (address.bit is None and address.member is None) or address.element is None:
-            return found
-        element = str(Address(address.type_letter, address.file, address.element))
-        owner = self.by_address.get(element)
-        if owner is not None and text.startswith(element):
-            return owner + text[len(element):]
-        return None
+_SymbolNames = SymbolNames  # the names a rung is drawn with: naming.py (a Logix app's are TagPathNames)
 
 
 class _Context:
@@ -250,7 +234,8 @@ def _bit_cell(ins: Instruction, ctx: _Context) -> _Block:
         name = ctx.names.name(address)
         if name:
             rows_above.append([(name, None)])
-        rows_above.append([(str(address), None)])
+        if not (name and ctx.names.replaces_address):
+            rows_above.append([(str(address), None)])
         value = [ctx.value(address)]
         if str(address) in ctx.forced:
             value += [(" F", FORCED)]
@@ -272,7 +257,7 @@ def _box_cell(ins: Instruction, budget: int, ctx: _Context) -> _Block:
     state = ctx.state(ins)
     p_in, p_out = (state.power_in, state.power_out) if state else (False, False)
     title_style = FAULT if state is not None and state.fault else _power_style(state is not None and state.is_true)
-    return _box(ins.mnemonic, title_style, _box_items(ins, ctx), budget, p_in, p_out)
+    return _box(ctx.names.mnemonic(ins.mnemonic), title_style, _box_items(ins, ctx), budget, p_in, p_out)
 
 
 def _box(title: str, title_style: Style | None, groups: list[list[Line]], budget: int, p_in: bool,
@@ -317,6 +302,12 @@ def _box_items(ins: Instruction, ctx: _Context) -> list[list[Line]]:
     elif m == "CMP" and len(ops) == 1:
         formula, *reads = _expression_items(ops[0], ctx)
         return [[formula], reads]
+    elif m in _LOGIX_BITS and len(ops) == 3:
+        return [[_structure_item(ops[0], ctx)], [_logix_status(m, ops, ctx)]]
+    elif m == "LRES" and len(ops) == 1:
+        return [[_structure_item(ops[0], ctx)]]
+    elif m == "JSR" and ops and isinstance(ops[0], Const) and ctx.names.file_name(ops[0].value):
+        main = [[(ctx.names.file_name(ops[0].value), None)], *(item(i) for i in range(1, len(ops)))]
     else:
         skip = _LIVE_PRESETS.get(m, ())
         main = [item(i) for i in range(len(ops)) if i not in skip]
@@ -345,7 +336,10 @@ def _operand_item(op, name: str | None, kind: K | None, ctx: _Context) -> Line:
     if kind in (K.FILE, K.FILE_SOURCE):
         return [("#" + str(address), None)]
     name_text = ctx.names.name(address)
-    shown = f"{name_text}({address})" if name_text else str(address)
+    if name_text and ctx.names.replaces_address:
+        shown = name_text
+    else:
+        shown = f"{name_text}({address})" if name_text else str(address)
     if address.kind in _STRUCTS:
         return [(shown, None)]
     line: Line = [(shown + "=", None), ctx.value(address)]
@@ -356,14 +350,40 @@ def _operand_item(op, name: str | None, kind: K | None, ctx: _Context) -> Line:
 
 def _expression_items(node, ctx: _Context) -> list[Line]:
     """The expression's text, then each address it reads with its value."""
-    items: list[Line] = [[(format_expression(node), None)]]
+    names = ctx.names if ctx.names.replaces_address else None
+    items: list[Line] = [[(ctx.names.expression(node), None)]]
     seen = set()
     for ref in address_refs(node):
-        text = str(ref.address)
+        text = (names and names.name(ref.address)) or str(ref.address)
         if text not in seen:
             seen.add(text)
             items.append([(text + "=", None), ctx.value(ref.address)])
     return items
+
+
+def _structure_item(op, ctx: _Context) -> Line:
+    """A Logix TIMER or COUNTER operand (its CTL DINT) by its tag's name."""
+    if not isinstance(op, AddressRef):
+        return _operand_item(op, None, None, ctx)
+    name = ctx.names.name(op.address)
+    if name and name.upper().endswith(".CTL"):
+        return [(name[:-4], None)]
+    return [(name or str(op.address), None)]
+
+
+def _logix_status(m: str, ops, ctx: _Context) -> Line:
+    """``EN TT . PRE 2000 ACC 170``: a Logix timer's or counter's status
+    bits (bits of its CTL) and its PRE and ACC, live from the table."""
+    try:
+        words = [ctx.table.read(op.address) if isinstance(op, AddressRef) else op.value for op in ops]
+    except (*READ_FAILURES, AttributeError):
+        return [("?", FAULT)]
+    line: Line = []
+    for bit in _LOGIX_BITS[m]:
+        on = bool(words[0] & _LOGIX_MASKS[bit])
+        line += [(bit if on else ".", ENERGIZED if on else None), _blank(1)]
+    line.append((f"PRE {words[1]} ACC {words[2]}", None))
+    return line
 
 
 def _struct_status(address: Address, ctx: _Context) -> Line:

@@ -141,7 +141,7 @@ class RungView:
         self.number = number
         self.table = table
         self.power = power
-        self.names = symbols if isinstance(symbols, _SymbolNames) else _SymbolNames(symbols)
+        self.names = symbols if hasattr(symbols, "replaces_address") else _SymbolNames(symbols)
         self.selected = selected
         self.breakpoint = breakpoint
         self.forced = forced
@@ -217,7 +217,7 @@ class ProgramFileView:
                  power_of: Callable[[Rung, DataTable], Power] = rung_power, comments: str = "full") -> None:
         self.pfile = pfile
         self.table = table
-        self.names = symbols if isinstance(symbols, _SymbolNames) else _SymbolNames(symbols)
+        self.names = symbols if hasattr(symbols, "replaces_address") else _SymbolNames(symbols)
         self.first = first
         self.selected = selected
         self.breakpoints = breakpoints

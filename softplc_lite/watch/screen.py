@@ -210,16 +210,13 @@ class RungsPanel:
             line.append(" no program file", style="bold underline")
             return line
         files = s.app.program.files
-        line.append(f" program file {_file_label(files[s.file])}", style="bold underline")
+        label, labels = s.naming.what_files
+        line.append(f" {label} {s.naming.file_label(files[s.file])}", style="bold underline")
         line.append(f"  rung {s.selected} of {len(s.rungs)}", style="bold")
         line.append(f"  comments {s.comments}" if s.comments != "full" else "", style="dim")
         if len(files) > 1:
-            line.append("  files: " + "  ".join(_file_label(files[n]) for n in s.files), style="dim")
+            line.append(f"  {labels}: " + "  ".join(s.naming.file_label(files[n]) for n in s.files), style="dim")
         return line
-
-
-def _file_label(pfile) -> str:
-    return f"{pfile.number} {pfile.name}" if pfile.name else str(pfile.number)
 
 
 class WatchScreen:
@@ -296,7 +293,7 @@ def rung_view(session: WatchSession, height: int):
 
     s = session
     pfile = s.app.program.files[s.file] if s.file is not None else ProgramFile(2, None, [])  # none: "(no rungs)"
-    return ProgramFileView(pfile, s.engine.table, symbols=s.app.program.symbols,
+    return ProgramFileView(pfile, s.engine.table, symbols=s.naming.for_file(s.file),
                            first=s.top, selected=s.selected, breakpoints=frozenset(s.breaks.rungs),
                            forced=frozenset(s.forces.forces), height=height, instructions=s.app.instructions,
                            comments=s.comments)

@@ -23,6 +23,7 @@ from .datagrid import DataGrid, grid_for, next_radix
 from .forces import Forces, parse_force
 from . import trendview
 from .history import History
+from .naming import Naming
 from .watchlist import WatchList
 from .xref import Finding, XrefIndex
 
@@ -76,8 +77,9 @@ class WatchSession:
         self.running = False
         self.speed = min(max(options.speed, 0), len(SPEEDS) - 1)
         self.files = sorted(app.program.files)
+        self.naming = Naming(app)  # how operands, instructions and files are named (naming.py)
         # the shown program file: 2 (the main one), else the first; None when there is none
-        self.file: int | None = 2 if 2 in self.files else self.files[0] if self.files else None
+        self.file: int | None = self.naming.first_file(self.files)
         self.selected = 0  # selected rung of the shown file
         self.top = 0  # first rung shown
         self.message = ""

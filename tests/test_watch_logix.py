@@ -1,0 +1,108 @@
+"""The watch view of a Studio 5000 export (docs/logix.md, "Watching a Logix
+app"): operands by tag path in the routine's scope, Logix instruction names,
+timers and counters with their status bits, routines as the files, rung
+comments from the export. The goldens (tests/data/watch/tank_line-*.txt)
+are checked by test_watch_snapshots.py; here each rule on its own."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from softplc_lite.app import load_app
+from softplc_lite.datatable import Address
+from softplc_lite.runner import RunOptions
+from softplc_lite.watch.naming import Naming
+from softplc_lite.watch.session import WatchOptions, WatchSession
+from softplc_lite.watch.snapshot import render
+
+ROOT = Path(__file__).resolve().parent.parent
+TANK_LINE = ROOT / "programs" / "logix" / "tank_line.L5X"
+GOLDENS = Path(__file__).resolve().parent / "data" / "watch"
+
+
+@pytest.fixture
+def session(tmp_path):
+    app = load_app(TANK_LINE, tmp_path / "state")
+    s = WatchSession(app, WatchOptions(run=RunOptions(fresh=True, sets=("Start=1",)), online=False))
+    yield s
+    s.quit()
+
+
+def _screen(s: WatchSession, width: int = 120, height: int = 40) -> list[str]:
+    return [line.rstrip() for line in render(s, width, height).export_text().splitlines()]
+
+
+def test_operands_are_named_by_tag_path_in_the_routines_scope(tmp_path):
+    app = load_app(TANK_LINE, tmp_path)
+    naming = Naming(app)
+    main = app.logix.routine_files[("MAINPROGRAM", "MAINROUTINE")]
+    names = naming.for_file(main)
+    settled = app.program.symbols.resolve_path("Program:MainProgram.Settled")
+    assert names.name(settled) == "Settled"  # the program's own tag, from its routine
+    assert naming.for_file(2).name(settled) == "Program:MainProgram.Settled"  # from the continuous task
+    assert names.name(app.program.symbols.resolve_path("SettleTimer.DN")) == "SettleTimer.DN"
+    assert names.name(app.program.symbols.resolve_path("Tanks[1].Level")) == "Tanks[1].Level"
+    # an element an index tag picks: the tag's name as the subscript
+    level = app.program.symbols.resolve_path("Tanks[1].Level")
+    active = app.program.symbols.resolve_path("Active")
+    indexed = Address(level.type_letter, level.file, active)
+    assert names.name(indexed) == "Tanks[Active].Level"
+    fill = app.program.symbols.resolve_path("Tanks[1].Fill")
+    assert names.name(Address(fill.type_letter, fill.file, active, None, fill.bit)) == "Tanks[Active].Fill"
+    assert names.name(Address("N", 7, 0)) is None  # not a tag's: the address is shown
+    assert names.mnemonic("LTON") == "TON" and names.mnemonic("LCTU") == "CTU" and names.mnemonic("XIC") == "XIC"
+
+
+def test_a_plc5_app_keeps_addresses_and_symbols(tmp_path):
+    app = load_app(ROOT / "programs" / "motor", tmp_path)
+    naming = Naming(app)
+    assert not naming.is_logix and naming.what_files == ("program file", "files")
+    assert naming.for_file(2).replaces_address is False
+    assert naming.for_file(2).mnemonic("TON") == "TON"
+    assert naming.first_file(sorted(app.program.files)) == 2
+
+
+def test_the_view_starts_at_the_routine_the_task_runs_and_lists_routines(session):
+    lines = _screen(session)
+    header = lines[2]
+    assert header.startswith(" routine MainProgram.MainRoutine  rung 0 of 6  routines: continuous task")
+    assert "program file" not in "\n".join(lines) and "B10/" not in "\n".join(lines)
+    assert "Start and stop the line: a seal-in" in lines[4]  # the export's rung comment
+    session.next_file()
+    assert _screen(session)[2].startswith(" routine MainProgram.FillTank  rung 0 of 3")
+    session.next_file()
+    text = "\n".join(_screen(session))
+    assert " routine continuous task" in text and "|MainProgram.MainRoutine|" in text  # its JSR, by routine
+
+
+def test_boxes_show_logix_names_tag_values_and_status_bits(session):
+    for _ in range(150):  # tank 0 full at scan 80: the settle timer is timing
+        session.scan()
+    text = "\n".join(_screen(session))
+    assert "+-TON" in text and "+-CTU" in text and "LTON" not in text and "LCTU" not in text
+    assert "|SettleTimer " in text and "|Batches " in text
+    acc = session.engine.table.read(session.app.program.symbols.resolve_path("SettleTimer.ACC"))
+    assert 0 < acc < 2000
+    assert f"|EN TT . PRE 2000 ACC {acc}|" in text
+    assert "|. . . . . PRE 3 ACC 0|" in text
+    assert "+-JSR" in text and "|FillTank|" in text  # a JSR in the program names its routine
+    session.goto(5)
+    text = "\n".join(_screen(session))
+    # CPT: the expression as Logix writes it, by tag path; each read with its value
+    assert "(Tanks[0].Level + Tanks[1].Level)" in text and "/ 2.0" in text and "|" + " 2.0" not in text
+    assert "-> Overview=" in text and "Tanks[0].Level=40.0" in text
+    assert "Batches.ACC=0 -> Flags=0" in text
+
+
+def test_goldens_show_the_tank_line_by_name():
+    """Spot checks of the goldens, so one regenerated by mistake does not pass unread."""
+    for size in ("120x40", "80x24"):
+        text = (GOLDENS / f"tank_line-{size}.txt").read_text(encoding="utf-8")
+        assert " tank_line  RUN  scan 300  3.000 s sim" in text
+        assert " routine MainProgram.MainRoutine  rung 0 of 6" in text
+        assert "Tanks[0].Level 0.0" in text and "Tanks[1].Level 9.5" in text and "Batches.ACC      1" in text
+        assert "Batches.DN" in text and "Running" in text and "B10/" not in text
+    text = (GOLDENS / "tank_line-120x40.txt").read_text(encoding="utf-8")
+    assert "|. . . . . PRE 3 ACC 1|" in text and "Tanks[Active].Drain" in text and "Active=1 XOR 1" in text
