@@ -4,15 +4,12 @@ values as DATA declarations, each RLL routine a program file, and the
 continuous task a main file that calls each scheduled program's main
 routine in order. docs/logix.md says it for users; the rules:
 
-- Program file 2 is the continuous task: one rung a scheduled program, a
-  JSR to its main routine, in the task's order (1756-PM005, "Tasks,
-  programs and routines": the programs of a task run in the order they are
-  scheduled). An inhibited program's rung is left out, as an inhibited
-  program is not scanned. An export without a task (a program or routine
-  export) runs each program's main routine, or its only routine.
-- Each routine is a program file from 3 up, in the export's order; JSR
-  names a routine of its own program.
-- A periodic or event task, a routine in ST, FBD or SFC, and an instruction
+- Program file 2 runs the tasks (tasks.py): the periodic tasks that are
+  due, then the continuous task, one rung a scheduled program, a JSR to its
+  main routine; an inhibited program or task is not run.
+- Each routine is a program file from 3 up, in the export's order, then a
+  file for each periodic task; JSR names a routine of its own program.
+- An event task, a routine in ST, FBD or SFC, and an instruction
   softplc_lite does not run yet are not run: each is a warning at its place
   (``softplc check`` lists them; a run says them before scan 0), and a rung
   holding such an instruction is kept as an empty rung. Wrong exports (an
@@ -24,12 +21,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..datatable import DataTable
-from ..ladder.ast import MAIN_FILE, Const, DataDecl, Instruction, Pos, Program, ProgramFile, Rung
+from ..ladder.ast import MAIN_FILE, DataDecl, Instruction, Program, ProgramFile, Rung, walk
 from . import model
 from .initial import ValueWriter, apply_initial, data_files
 from .modules import declare_module_tags
 from .rungs import RoutineContext, translate_rung
 from .tags import TagDirectory, TagSymbols
+from .tasks import Schedule
 from .types import TypeSystem
 
 NOT_RUN_KINDS = {"ST": "Structured Text", "FBD": "Function Block Diagram", "SFC": "Sequential Function Chart"}
@@ -74,6 +72,7 @@ def build_program(project: model.Project) -> LogixProgram:
     for scope in directory.scopes.values():
         for declared in scope.values():
             apply_initial(declared, writer, problems)
+    schedule = Schedule(project, directory, writer, warnings)
 
     number = MAIN_FILE + 1
     for prog in project.programs:
@@ -82,14 +81,15 @@ def build_program(project: model.Project) -> LogixProgram:
             routines[routine.name.upper()] = number
             result.routine_files[(prog.name.upper(), routine.name.upper())] = number
             number += 1
+        not_passed: set[int] = set()  # routines whose SBR or RET has a parameter not passed
         for routine in prog.routines:
             file_number = routines[routine.name.upper()]
             rungs = _routine_rungs(routine, prog, directory, routines, project.source, problems, warnings,
-                                   result.rungs)
+                                   result.rungs, not_passed, file_number)
             result.program.files[file_number] = ProgramFile(file_number, f"{prog.name}.{routine.name}", rungs,
                                                             routine.pos)
-    result.program.files[MAIN_FILE] = ProgramFile(MAIN_FILE, "continuous task",
-                                                  _task_rungs(project, result, warnings))
+        _calls_not_run(prog, routines, result.program.files, not_passed, warnings, result.rungs)
+    result.program.files.update(schedule.files(result.routine_files, number))
     for letter, file, values in data_files(writer, table):
         result.program.data.append(DataDecl(f"{letter}{file}", len(values), values))
     written = {d.file for d in result.program.data}
@@ -99,7 +99,8 @@ def build_program(project: model.Project) -> LogixProgram:
     return result
 
 
-def _routine_rungs(routine, prog, directory, routines, source, problems, warnings, counts) -> list[Rung]:
+def _routine_rungs(routine, prog, directory, routines, source, problems, warnings, counts, not_passed,
+                   file_number) -> list[Rung]:
     if routine.kind != "RLL":
         kind = NOT_RUN_KINDS.get(routine.kind, routine.kind)
         warnings.append(model.Problem(routine.pos, f"routine {prog.name}.{routine.name} is {kind}: not yet run "
@@ -118,31 +119,27 @@ def _routine_rungs(routine, prog, directory, routines, source, problems, warning
         rungs.append(translated)
     problems += ctx.problems
     warnings += ctx.warnings
+    if ctx.parameters_not_run:
+        not_passed.add(file_number)
     return rungs
 
 
-def _task_rungs(project: model.Project, result: LogixProgram, warnings) -> list[Rung]:
-    programs = {p.name.upper(): p for p in project.programs}
-    continuous = [t for t in project.tasks if t.kind.upper() == "CONTINUOUS" and not t.inhibited]
-    for t in project.tasks:
-        if t.kind.upper() != "CONTINUOUS":
-            warnings.append(model.Problem(t.pos, f"{t.kind.lower()} task {t.name}: not yet scheduled by "
-                                                 f"softplc_lite; its programs ({', '.join(t.programs) or 'none'}) "
-                                                 f"do not run"))
-    if project.tasks:
-        names = [n for t in continuous for n in t.programs]
-    else:
-        names = [p.name for p in project.programs]
-    rungs = []
-    for name in names:
-        prog = programs.get(name.upper())
-        if prog is None or prog.disabled:
-            continue
-        main = prog.main_routine or (prog.routines[0].name if len(prog.routines) == 1 else None)
-        file_number = result.routine_files.get((prog.name.upper(), (main or "").upper()))
-        if file_number is None:
-            warnings.append(model.Problem(prog.pos, f"program {prog.name} has no main routine: not run"))
-            continue
-        pos = prog.pos if prog.pos.line else Pos(project.source, 0, 0)
-        rungs.append(Rung([Instruction("JSR", [Const(file_number, pos)], pos)], f"program {prog.name}", pos))
-    return rungs
+def _calls_not_run(prog, routines, files, not_passed, warnings, counts) -> None:
+    """A JSR with parameters to a routine whose SBR or RET is not run (a
+    parameter softplc_lite does not pass) is not run either: the call and
+    the subroutine are said together, never half run."""
+    if not not_passed:
+        return
+    names = {routines[r.name.upper()]: r.name for r in prog.routines}
+    for number in routines.values():
+        rungs = files[number].rungs
+        for k, rung in enumerate(rungs):
+            for ins in walk(rung.elements):
+                if ins.mnemonic == "JSR" and len(ins.operands) > 1 and ins.operands[0].value in not_passed:
+                    warnings.append(model.Problem(ins.pos, f"routine {prog.name}.{names[number]}: JSR to "
+                                                           f"{names[ins.operands[0].value]}: its SBR or RET has a "
+                                                           f"parameter not passed; the rung is not run"))
+                    rungs[k] = Rung([Instruction("NOP", [], rung.pos)], rung.comment, rung.pos)
+                    counts["run"] -= 1
+                    counts["not run"] += 1
+                    break

@@ -9,8 +9,8 @@ expected; an instruction softplc_lite does not run is one of them, by name.
 What each Logix instruction becomes (``PLAN``): the ladder mnemonic and a
 letter an operand: ``b`` a bit, ``v`` a value (number, tag, or a CPT-style
 expression where Logix allows one), ``d`` a destination, ``e`` an
-expression, ``l`` a label, ``r`` a routine, ``T``/``C``/``R`` a TIMER,
-COUNTER or CONTROL (its CTL, and PRE and ACC), ``?`` an operand Logix keeps
+expression, ``l`` a label, ``r`` a routine, ``p`` parameters (SBR, RET),
+``T``/``C``/``R`` a TIMER, COUNTER or CONTROL (its CTL, and PRE and ACC), ``?`` an operand Logix keeps
 in the structure (``TON(T1,?,?)``: written as ``?`` or a value, not used).
 """
 
@@ -37,7 +37,7 @@ PLAN: dict[str, tuple[str, str]] = {
     "AND": ("AND", "vvd"), "OR": ("OR", "vvd"), "XOR": ("XOR", "vvd"), "NOT": ("NOT", "vd"),
     "BAND": ("AND", "vvd"), "BOR": ("OR", "vvd"), "BXOR": ("XOR", "vvd"), "BNOT": ("NOT", "vd"),
     "CPT": ("CPT", "de"), "CMP": ("CMP", "e"),
-    "JMP": ("JMP", "l"), "LBL": ("LBL", "l"), "JSR": ("JSR", "r"), "RET": ("RET", ""), "SBR": ("SBR", ""),
+    "JMP": ("JMP", "l"), "LBL": ("LBL", "l"), "JSR": ("JSR", "r"), "RET": ("RET", "p"), "SBR": ("SBR", "p"),
     "TON": ("LTON", "T??"), "TOF": ("LTOF", "T??"), "RTO": ("LRTO", "T??"),
     "CTU": ("LCTU", "C??"), "CTD": ("LCTD", "C??"), "RES": ("LRES", "X"),
 }
@@ -62,6 +62,7 @@ class RoutineContext:
         self.problems: list[model.Problem] = []
         self.warnings: list[model.Problem] = []
         self.skip = False  # the rung being translated holds an instruction not run
+        self.parameters_not_run = False  # a JSR, SBR or RET of this routine has a parameter not passed
 
     def warn(self, pos: Pos, message: str) -> None:
         self.warnings.append(model.Problem(pos, f"routine {self.routine}: {message}"))
@@ -130,6 +131,9 @@ def _instruction(el, rung, ctx) -> Instruction | None:
     ops = el.operands
     if letters == "r":  # JSR(routine, count, parameters...)
         return _jsr(el, pos, rung, ctx)
+    if letters == "p":  # SBR(parameters...) receives, RET(values...) returns
+        params = _parameters(el, rung, ctx, 0, len(el.operands) if mnemonic == "RET" else 0)
+        return None if params is None else Instruction(mnemonic, params, pos)
     if len(ops) != len(letters):
         ctx.problem(pos, f"rung {rung.number}: {el.mnemonic} takes {len(letters)} operand"
                          f"{'s' if len(letters) != 1 else ''}, found {len(ops)}")
@@ -149,6 +153,9 @@ def _instruction(el, rung, ctx) -> Instruction | None:
 
 
 def _jsr(el, pos, rung, ctx) -> Instruction | None:
+    """JSR(routine, input count, inputs..., returns...): the ladder's JSR with
+    the routine's file number, its operands in Logix's order (1756-RM003,
+    JSR; docs/logix.md, "Subroutines with parameters")."""
     if not el.operands:
         ctx.problem(pos, f"rung {rung.number}: JSR takes the routine's name")
         return None
@@ -158,21 +165,63 @@ def _jsr(el, pos, rung, ctx) -> Instruction | None:
         ctx.problem(_at(rung.pos, rung.text, column), f"rung {rung.number}: JSR to {name!r}: no routine of that "
                                                       f"name in this program")
         return None
-    count = number(el.operands[1][0]) if len(el.operands) > 1 else 0
-    if count not in (0, None) or len(el.operands) > 2:
-        ctx.warn(pos, f"rung {rung.number}: JSR with parameters: not yet run by softplc_lite; the rung is not run")
-        ctx.skip = True
+    if len(el.operands) < 2:
+        return Instruction("JSR", [Const(number_of, pos)], pos)
+    count_text, count_column = el.operands[1]
+    count = number(count_text)
+    if not isinstance(count, int) or not 0 <= count <= len(el.operands) - 2:
+        ctx.problem(_at(rung.pos, rung.text, count_column), f"rung {rung.number}: JSR's input count "
+                    f"{count_text!r}: expected a whole number from 0 to {len(el.operands) - 2}, the "
+                    f"parameters listed")
         return None
-    return Instruction("JSR", [Const(number_of, pos)], pos)
+    if len(el.operands) == 2:
+        return Instruction("JSR", [Const(number_of, pos)], pos)
+    params = _parameters(el, rung, ctx, 2, count)
+    return None if params is None else Instruction("JSR", [Const(number_of, pos), Const(count, pos)] + params, pos)
 
 
-def _resolve_ref(text: str, pos: Pos, ctx) -> AddressRef:
+def _parameters(el, rung, ctx, first: int, inputs: int) -> list | None:
+    """The operands of JSR, SBR or RET from ``first``: the first ``inputs``
+    of them values (a number or a tag), the rest tags that receive. An
+    atomic number tag (SINT, INT, DINT, LINT, REAL) is passed; a BOOL, a
+    string, a structure or an array is not yet (the rung is not run)."""
+    out = []
+    for k, (text, column) in enumerate(el.operands[first:]):
+        where = _at(rung.pos, rung.text, column)
+        value = number(text)
+        try:
+            if value is not None:
+                if k >= inputs:
+                    raise PathError("expected a tag to receive the parameter, found a number")
+                out.append(Const(value, where))
+                continue
+            r = _resolve(text, where, ctx)
+            if r.address is None or r.address.bit is not None or r.type.name == "BOOL":
+                kind = "BOOL" if r.address is not None else (f"{r.type.name} array" if r.dims else r.type.name)
+                raise NotRun(f"a {kind} parameter is not yet passed by softplc_lite (numbers are)")
+            out.append(AddressRef(r.address, where))
+        except NotRun as e:
+            ctx.warn(where, f"rung {rung.number}: {el.mnemonic} parameter {text!r}: {e}; the rung is not run")
+            ctx.skip = True
+            ctx.parameters_not_run = True
+        except (PathError, ExprError) as e:
+            ctx.problem(_at(rung.pos, rung.text, column + e.offset), f"rung {rung.number}: {el.mnemonic} "
+                                                                     f"parameter {text!r}: {e}")
+            return None
+    return out
+
+
+def _resolve(text: str, pos: Pos, ctx):
     def index_of(index_text: str):
         r = ctx.directory.resolve(index_text, ctx.scope)
         if r.address is None or r.type.name not in ("SINT", "INT", "DINT"):
             raise PathError(f"index {index_text!r}: expected an integer tag (SINT, INT, DINT)")
         return r.address
-    r = ctx.directory.resolve(text, ctx.scope, index_of)
+    return ctx.directory.resolve(text, ctx.scope, index_of)
+
+
+def _resolve_ref(text: str, pos: Pos, ctx) -> AddressRef:
+    r = _resolve(text, pos, ctx)
     if r.address is None:
         raise PathError(f"{text} is a {r.type.name}{' array' if r.dims else ''}: expected a single value here")
     return AddressRef(r.address, pos)

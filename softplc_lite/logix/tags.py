@@ -155,6 +155,9 @@ class TagDirectory:
         self.scopes: dict[str | None, dict[str, Declared]] = {None: {}}
         self.problems: list[Problem] = []
         self.warnings: list[Problem] = []
+        # (class, instance, attribute), upper case -> the item that holds it: the task and program
+        # attributes a program reads and writes with GSV/SSV (logix/tasks.py lays them out)
+        self.objects: dict[tuple[str, str, str], Address] = {}
 
     # -- declaring -------------------------------------------------------------------------
     def declare(self, tag: Tag, scope: str | None = None) -> Declared | None:
