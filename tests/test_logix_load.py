@@ -101,13 +101,13 @@ def test_what_is_not_run_is_a_warning_by_name_and_place_and_the_rest_runs(tmp_pa
     def add_unrun(text: str) -> str:
         text = text.replace('<![CDATA[XIC(Running)JSR(FillTank,0);]]>',
                             '<![CDATA[XIC(Running)JSR(FillTank,0)GSV(WallClockTime,,CurrentValue,Now);]]>')
-        return text.replace("</Tasks>", '<Task Name="Slow" Type="PERIODIC" Rate="100" Priority="5" Watchdog="500">'
+        return text.replace("</Tasks>", '<Task Name="Slow" Type="EVENT" Priority="5" Watchdog="500">'
                                          '<ScheduledPrograms/></Task>\n</Tasks>')
     app = load_app(tank_line(tmp_path, add_unrun))
     warnings = "\n".join(app.warnings)
     assert "GSV: not yet run by softplc_lite; the rung is not run" in warnings
     assert "routine MainProgram.MainRoutine: rung 1" in warnings
-    assert "periodic task Slow: not yet scheduled" in warnings
+    assert "event task Slow: not run: softplc_lite raises no event to trigger it" in warnings
     p = softplc_here("run", str(tmp_path / "tank_line.L5X"), "--scans", "3", "--set", "Start=1", "--print", "Running")
     assert p.returncode == 0 and "warning:" in p.stderr and p.stdout.strip().endswith("= 1")
 
