@@ -329,8 +329,8 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
     the code cache is then used only with ``program_key``, a text that
     names that program among those loaded with the same state directory."""
     path = Path(path)
-    if program is None and path.suffix.lower() in (".l5x", ".l5k") and not path.is_dir():
-        return _load_export_app(path, state_dir)
+    if path.suffix.lower() in (".l5x", ".l5k") and not path.is_dir():
+        return _load_export_app(path, state_dir, program)
     if program is not None:  # the cache is keyed by the files: it needs the program's own key
         use_cache = use_cache and program_key is not None
     if not path.exists():
@@ -426,11 +426,13 @@ def load_app(path: str | Path, state_dir: str | Path | None = None, use_cache: b
     return app
 
 
-def _load_export_app(path: Path, state_dir: str | Path | None) -> App:
+def _load_export_app(path: Path, state_dir: str | Path | None, program: Program | None = None) -> App:
     """A Studio 5000 export (.L5X, .L5K) as an app (logix/, docs/logix.md):
     its ladder program checked as any program is, Logix's integer overflow
     (wrap, 1756-RM003), no state directory unless --state names one. What
-    it holds that is not run is said in its warnings."""
+    it holds that is not run is said in its warnings. ``program``: a
+    program made from the export's (a mutant) checked in its place, over
+    the export's tags."""
     from .logix.load import load_export
     from .logix.model import ExportError
 
@@ -442,6 +444,8 @@ def _load_export_app(path: Path, state_dir: str | Path | None) -> App:
         raise AppError([LadderError(p.pos, p.message) for p in e.problems]) from None
     except OSError as e:
         raise AppError(f"{shown_path(path)}: cannot read it: {e.strerror or e}") from None
+    if program is not None:
+        made.program = program
     resolved, errors = check(made.program)
     if not errors:
         _, layout = layout_problems(resolved, [])

@@ -14,7 +14,7 @@ from ..app import AppError
 from ..errors import shown_path
 from ..testing.mutation import DEFAULT_BUDGET_S
 from ..testing.mutation_report import OK, UNDER, mutate_and_report
-from ..testing.runner import SCENARIO_GLOB, run_file, scenario_files
+from ..testing.runner import SCENARIO_GLOB, run_file, scenario_files, scenario_glob
 from ..testing.scenario import ScenarioErrors
 from . import test_coverage
 from .common import EXIT_ERROR, EXIT_OK, EXIT_USAGE
@@ -27,7 +27,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
     c = sub.add_parser(NAME, help="run an app's scenario files",
                        description=f"Run the scenario files of an app ({SCENARIO_GLOB}): exit 0 when every "
                                    "scenario passes, 1 when one fails or a file has problems. See docs/testing.md.")
-    c.add_argument("app", metavar="APP", help="app directory")
+    c.add_argument("app", metavar="APP", help="app directory, or a Studio 5000 export (.L5X, .L5K) whose "
+                                               "scenario files are beside it in NAME.tests/")
     test_coverage.add_arguments(c)
     m = c.add_argument_group("mutation testing (docs/testing.md, \"Mutation testing\")")
     m.add_argument("--mutate", action="store_true",
@@ -53,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
         return EXIT_USAGE
     files = scenario_files(args.app)
     if not files:
-        print(f"{shown_path(args.app)}: no scenario files ({SCENARIO_GLOB})", file=sys.stderr)
+        print(f"{shown_path(args.app)}: no scenario files ({scenario_glob(args.app)})", file=sys.stderr)
         return EXIT_ERROR
     passed = failed = 0
     cov = test_coverage.wanted(args)

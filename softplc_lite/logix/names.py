@@ -9,19 +9,27 @@ app", says what the view shows."""
 from __future__ import annotations
 
 from ..datatable import Address
-from .project import LogixProgram
-from .tags import TagNames, _path_text
-
-MAIN_FILE = 2  # the continuous task (project.py)
+from ..ladder.ast import Program
+from .tags import TagDirectory, TagNames, TagSymbols, _path_text
 
 
 class OperandNames:
-    """Addresses of ``made``'s program back to tag paths, per scope."""
+    """Addresses of a Logix app's program back to tag paths, per scope:
+    ``directory`` its tags, ``routines`` {program file: "Program.Routine"}."""
 
-    def __init__(self, made: LogixProgram) -> None:
-        self.names = TagNames(made.directory)
-        self.routines = {number: name for (_, _), number in made.routine_files.items()
-                         for name in [made.program.files[number].name] if number in made.program.files}
+    def __init__(self, directory: TagDirectory, routines: dict[int, str]) -> None:
+        self.names = TagNames(directory)
+        self.routines = routines
+
+    @classmethod
+    def of(cls, program: Program) -> "OperandNames | None":
+        """The names of ``program``, a Logix app's (its symbols are the tag
+        directory's: tags.TagSymbols); None for another program. Its
+        routines are the files project.py names ``Program.Routine``."""
+        if not isinstance(program.symbols, TagSymbols):
+            return None
+        routines = {n: f.name for n, f in program.files.items() if f.name and "." in f.name}
+        return cls(program.symbols.directory, routines)
 
     def scope_of(self, file_number: int | None) -> str | None:
         """The program whose tags a file's rungs name without ``Program:``

@@ -29,6 +29,7 @@ from ..datatable import DataTable
 from ..datatable.snapshot import decode, encode
 from ..ladder.ast import Program, Rung
 from ..ladder.instructions import InstructionSet
+from ..watch.naming import names_in_file, routines_of
 from ..watch.rungs import COMMENT, HEADER, RungView
 from ..watch.xref import XrefIndex
 
@@ -51,6 +52,7 @@ class RungsAt:
     instructions: InstructionSet | None = field(default=None, compare=False)
     more: tuple[tuple[int, int], ...] = ()
     why_none: str = ""
+    routines: tuple[tuple[int, str], ...] = ()  # a Logix app's: its rungs drawn by tag path (watch/naming.py)
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         if not self.rungs:
@@ -58,11 +60,13 @@ class RungsAt:
             return
         table = decode(self.table)
         file = None
+        names = None
         for number, k, rung in self.rungs:
             if number != file:
                 file = number
-                yield Text(f"program file {number}, rungs that write {self.title}:", style=HEADER)
-            yield RungView(rung, k, table, symbols=self.symbols, forced=self.forced,
+                names, label = names_in_file(self.symbols, self.routines, number)
+                yield Text(f"{label}, rungs that write {self.title}:", style=HEADER)
+            yield RungView(rung, k, table, symbols=names, forced=self.forced,
                            instructions=self.instructions)
         if self.more:
             where = ", ".join(f"file {f} rung {r}" for f, r in self.more)
@@ -91,7 +95,7 @@ def draw_rungs(program: Program, table: DataTable, places: Iterable[tuple[int, i
     if instructions is not None:  # its specs only: an app's set holds functions that do not pickle
         instructions = InstructionSet([s for s in instructions.all_specs() if s.module])
     return RungsAt(title, rungs, encode(table), program.symbols, frozenset(forced), instructions,
-                   tuple(places[len(rungs):]), why_none)
+                   tuple(places[len(rungs):]), why_none, routines_of(program))
 
 
 def writers_at(program: Program, table: DataTable, name: str, forced: Iterable[str] = (),

@@ -88,8 +88,25 @@ class Result:
         return self.failure is None
 
 
+EXPORT_SCENARIO_GLOB = "STEM.tests/*.plctest"  # beside a Studio 5000 export (docs/logix.md)
+_EXPORT_SUFFIXES = (".l5x", ".l5k")
+
+
+def scenario_glob(app: str | Path) -> str:
+    """Where an app's scenario files are, as the messages say it: APP/tests/
+    for an app directory; beside an export, a directory named after it
+    (``tank_line.tests/`` for ``tank_line.L5X``: a choice, the export being
+    Studio's file, one project's L5X and L5K share their tests)."""
+    path = Path(app)
+    if path.suffix.lower() in _EXPORT_SUFFIXES:
+        return f"{path.stem}.tests/*.plctest"
+    return SCENARIO_GLOB
+
+
 def scenario_files(app: str | Path) -> list[Path]:
     base = Path(app)
+    if base.suffix.lower() in _EXPORT_SUFFIXES and not base.is_dir():
+        return sorted(base.parent.glob(scenario_glob(base)))
     return sorted(base.glob(SCENARIO_GLOB)) if base.is_dir() else []
 
 

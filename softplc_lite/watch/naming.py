@@ -15,6 +15,8 @@ from ..datatable import Address
 from ..ladder.ast import MAIN_FILE
 from ..ladder.fmt import format_expression
 from ..ladder.instr.logix import LOGIX_NAMES
+from ..logix.names import OperandNames
+from ..logix.tags import TagSymbols
 
 LOGIX_OPERATORS = {"|": "/"}  # the ladder's operators Logix writes otherwise (1756-RM003, "CPT")
 
@@ -88,6 +90,27 @@ class TagPathNames:
         return name if (program or "").upper() == (self.scope or "").upper() else routine
 
 
+def routines_of(program) -> tuple[tuple[int, str], ...]:
+    """A Logix app's routines, (program file, ``Program.Routine``): what a
+    report keeps to name a few rungs later (names_in_file); () for another
+    app."""
+    operands = OperandNames.of(program)
+    return tuple(sorted(operands.routines.items())) if operands is not None else ()
+
+
+def names_in_file(symbols, routines: tuple[tuple[int, str], ...], number: int | None):
+    """The operand names of program file ``number`` for a report's drawing
+    of a few rungs, and what the file is called: a Logix app's (its
+    ``routines``, routines_of) by tag path in its routine's scope, another's
+    by symbol and address."""
+    if routines and isinstance(symbols, TagSymbols):
+        operands = OperandNames(symbols.directory, dict(routines))
+        names = TagPathNames(operands, operands.scope_of(number))
+        routine = operands.routine_of(number) if number is not None else None
+        return names, (f"routine {routine}" if routine else f"program file {number}")
+    return SymbolNames(symbols), f"program file {number}"
+
+
 class Naming:
     """The names of one app: ``for_file(n)`` the operand names of program
     file ``n``'s rungs; ``file_label`` what the file list calls a file;
@@ -95,15 +118,10 @@ class Naming:
 
     def __init__(self, app) -> None:
         self.app = app
-        self.logix = getattr(app, "logix", None)
-        self.operands = None
         self.symbols = app.program.symbols
         self.plain = SymbolNames(self.symbols)
         self.by_file: dict[int | None, TagPathNames] = {}
-        if self.logix is not None:
-            from ..logix.names import OperandNames
-
-            self.operands = OperandNames(self.logix)
+        self.operands = OperandNames.of(app.program)
 
     @property
     def is_logix(self) -> bool:
@@ -134,8 +152,9 @@ class Naming:
         """The file shown at start: the main file (2); for a Logix app the
         routine the continuous task runs first, where its rungs are (a
         choice: file 2 holds only the task's JSRs)."""
-        if self.logix is not None and MAIN_FILE in self.logix.program.files:
-            for rung in self.logix.program.files[MAIN_FILE].rungs:
+        program = self.app.program
+        if self.operands is not None and MAIN_FILE in program.files:
+            for rung in program.files[MAIN_FILE].rungs:
                 for el in rung.elements:
                     target = getattr(el, "operands", [None])[0] if getattr(el, "mnemonic", None) == "JSR" else None
                     if target is not None and getattr(target, "value", None) in files:

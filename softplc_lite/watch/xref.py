@@ -32,7 +32,7 @@ from ..datatable.filetypes import FILE_TYPES, INDEX_REGISTER_WORD, WORD_BITS
 from ..ladder.ast import AddressRef, Const, Program, address_refs, instructions_of
 from ..ladder.instructions import BUILTIN, InstructionSet
 from ..ladder.specs import InstructionSpec, K
-from ..ladder.symbols import is_symbol_text, resolve_name
+from ..ladder.symbols import is_name, is_symbol_text, resolve_name
 
 
 class Access(Enum):
@@ -264,7 +264,7 @@ class XrefIndex:
             number = int(m.group(2)) if m.group(2) else (ftype.fixed_number if ftype else None)
             if ftype is not None and number is not None:
                 return _Target(letter, number, None, None, None), f"file {letter}{number}"
-        if is_symbol_text(text):
+        if is_symbol_text(text) or is_name(text, symbols):  # a symbol, or a Logix app's tag path (Tanks[1].Level)
             address = resolve_name(text, symbols)
             return _Target.of(address), f"{text} ({address})"
         address = parse_address(text)
