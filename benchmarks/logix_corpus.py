@@ -106,20 +106,24 @@ def _worker(path: str, queue) -> None:
 
 
 def measure(path: Path) -> dict:
-    queue = multiprocessing.get_context("fork").Queue()
-    proc = multiprocessing.get_context("fork").Process(target=_worker, args=(str(path), queue))
+    """``measure_one`` in a process of its own: its result is taken from the
+    queue before the process is joined (a child cannot end while what it
+    put is unread), within the time limit."""
+    import queue as queues
+
+    ctx = multiprocessing.get_context("fork")
+    queue = ctx.Queue()
+    proc = ctx.Process(target=_worker, args=(str(path), queue))
     proc.start()
-    proc.join(TIME_LIMIT_S)
-    if proc.is_alive():
-        proc.kill()
-        proc.join()
-        return {"file": str(path), "stage": "timed out", "causes": [f"over {TIME_LIMIT_S} s"],
-                "rungs": {"total": 0, "run": 0, "not run": 0, "errors": 0}}
     try:
-        return queue.get(timeout=5)
-    except Exception:  # noqa: BLE001
-        return {"file": str(path), "stage": "crashed", "causes": [f"exit status {proc.exitcode}"],
-                "rungs": {"total": 0, "run": 0, "not run": 0, "errors": 0}}
+        result = queue.get(timeout=TIME_LIMIT_S)
+    except queues.Empty:
+        result = {"file": str(path), "stage": "timed out" if proc.is_alive() else "crashed",
+                  "causes": [f"over {TIME_LIMIT_S} s" if proc.is_alive() else f"exit status {proc.exitcode}"],
+                  "rungs": {"total": 0, "run": 0, "not run": 0, "errors": 0}}
+    proc.kill()
+    proc.join()
+    return result
 
 
 def main() -> int:
