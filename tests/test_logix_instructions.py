@@ -123,3 +123,12 @@ def test_ldiv_by_zero_is_a_minor_fault_and_the_scan_goes_on(engine):
     e.scan()
     assert e.fault is None and e.table.read("L9:0") == 8
     assert e.table.read(f"S:{S.MINOR_FAULT_BITS}") >> S.MINOR_DIV_ZERO_BIT & 1
+
+
+def test_lidx_sums_the_strided_terms_and_faults_outside_a_dimension(engine):
+    e = engine("DATA L9 3\nLIDX L9:0 1 L9:1 3 4 L9:2 4 1\n", {"L9:1": 2, "L9:2": 3})
+    e.scan()
+    assert e.table.read("L9:0") == 1 + 2 * 4 + 3
+    e.table.write("L9:2", 4)
+    e.scan()
+    assert e.fault is not None and e.fault.code == 20

@@ -62,6 +62,7 @@ class RoutineContext:
         self.problems: list[model.Problem] = []
         self.warnings: list[model.Problem] = []
         self.skip = False  # the rung being translated holds an instruction not run
+        self.before: list[Instruction] = []  # LIDXs the instruction being translated needs before it
         self.parameters_not_run = False  # a JSR, SBR or RET of this routine has a parameter not passed
 
     def warn(self, pos: Pos, message: str) -> None:
@@ -113,8 +114,10 @@ def _series(elements, rung, ctx) -> list:
                     for leg in el.legs]
             out.append(Branch(legs, _at(rung.pos, rung.text, el.column)))
         else:
+            ctx.before = []
             ins = _instruction(el, rung, ctx)
             if ins is not None:
+                out += ctx.before
                 out.append(ins)
     return out
 
@@ -211,13 +214,33 @@ def _parameters(el, rung, ctx, first: int, inputs: int) -> list | None:
     return out
 
 
+def _indexer(pos: Pos, ctx):
+    """How a path's run-time index is made (tags.py's ``index_of``): one tag
+    that is the whole index of an array in a file of its own is that tag's
+    item (the file's end checks it); anything else (an expression, several
+    dimensions, a constant part) is a hidden DINT that an LIDX, put just
+    before the instruction, computes and checks dimension by dimension."""
+    def index_of(terms, constant, count):
+        if len(terms) == 1 and constant == 0 and terms[0][2] == 1 and terms[0][1] == count:
+            try:
+                r = ctx.directory.resolve(terms[0][0], ctx.scope)
+            except PathError:
+                r = None
+            if r is not None and r.address is not None and r.type.name in ("SINT", "INT", "DINT") \
+                    and r.address.is_direct:
+                return r.address
+        hidden = ctx.directory.hidden_index()
+        operands = [AddressRef(hidden, pos), Const(constant, pos)]
+        for text, size, stride in terms:
+            operands += [parse_expression(text, pos, lambda path, offset: _resolve_ref(path, pos, ctx)),
+                         Const(size, pos), Const(stride, pos)]
+        ctx.before.append(Instruction("LIDX", operands, pos))
+        return hidden
+    return index_of
+
+
 def _resolve(text: str, pos: Pos, ctx):
-    def index_of(index_text: str):
-        r = ctx.directory.resolve(index_text, ctx.scope)
-        if r.address is None or r.type.name not in ("SINT", "INT", "DINT"):
-            raise PathError(f"index {index_text!r}: expected an integer tag (SINT, INT, DINT)")
-        return r.address
-    return ctx.directory.resolve(text, ctx.scope, index_of)
+    return ctx.directory.resolve(text, ctx.scope, _indexer(pos, ctx))
 
 
 def _resolve_ref(text: str, pos: Pos, ctx) -> AddressRef:
@@ -248,7 +271,7 @@ def _operand(letter: str, text: str, pos: Pos, ctx) -> list:
     if letter == "l":
         return [Const(ctx.label(text), pos)]
     if letter in "TCRX":
-        r = ctx.directory.resolve(text, ctx.scope, lambda t: _resolve_ref(t, pos, ctx).address)
+        r = _resolve(text, pos, ctx)
         kind = r.type.name if r.address is None and not r.dims else None
         wanted = {"T": ("TIMER",), "C": ("COUNTER",), "R": ("CONTROL",),
                   "X": ("TIMER", "COUNTER", "CONTROL")}[letter]

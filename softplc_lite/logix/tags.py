@@ -82,6 +82,7 @@ class Resolved:
     path: tuple[str, ...] = ()
     flat: int = 0  # the flat index reached (constant indexes)
     bit: int | None = None
+    terms: list = field(default_factory=list)  # indexes made at run time: [text, dimension, stride]
 
 
 class PathError(Exception):
@@ -95,7 +96,7 @@ class NotRun(PathError):
     not hold yet): not a mistake of the export; the rung is not run."""
 
 
-_STEP = re.compile(r"\s*(?:\.\s*([A-Za-z_][A-Za-z0-9_]*|[0-9]+)|\[([^\]]*)\])")
+_STEP = re.compile(r"\s*(?:\.\s*([A-Za-z_][A-Za-z0-9_]*|[0-9]+)|\[((?:[^\[\]]|\[[^\[\]]*\])*)\]|\.\s*\[((?:[^\[\]]|\[[^\[\]]*\])*)\])")
 _PROGRAM_SCOPED = re.compile(r"\s*Program:([A-Za-z_][A-Za-z0-9_]*)\.", re.IGNORECASE)
 _NAME = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*(?::[A-Za-z0-9_]+)*)")
 
@@ -204,6 +205,11 @@ class TagDirectory:
                 continue  # a bit of its host's leaf
             self._lay_out(d, m.type, path + (m.name.upper(),), count * max(m.dim, 1))
 
+    def hidden_index(self) -> Address:
+        """A DINT of its own for an index made at run time (LIDX writes it)."""
+        leaf = self.alloc.one("L")
+        return Address("L", leaf.file, leaf.first)
+
     # -- resolving -------------------------------------------------------------------------
     def find(self, name: str, scope: str | None) -> Declared | None:
         if scope:
@@ -247,58 +253,70 @@ class TagDirectory:
                 return Resolved(text, target.type, target.dims, target.address, target.declared, target.path,
                                 target.flat, target.bit)
             return self._walk(text, m.end(), target.declared, target.type, target.dims, target.path,
-                              target.flat, index_of, target.bit, var=None)
+                              target.flat, index_of, target.bit, var=target.terms)
         return self._walk(text, m.end(), d, d.type, d.dims, (), 0, index_of, None, var=None)
 
     def _walk(self, text, at, d, t, dims, path, flat, index_of, bit, var):
-        """Follow ``[..]`` and ``.member``/``.bit`` steps from ``at``."""
+        """Follow ``[..]``, ``.member``, ``.bit`` and ``.[bit]`` steps from
+        ``at``. An index that is not a constant is a term of the flat index
+        (its text, its dimension, its stride), made at run time (``_finish``)."""
+        terms: list[list] = list(var or [])
+        bit_term = None
         while at < len(text) and text[at:].strip():
             m = _STEP.match(text, at)
             if not m:
                 raise PathError("expected .member, .bit or [index]", at)
-            member, index = m.group(1), m.group(2)
+            member, index, bit_index = m.group(1), m.group(2), m.group(3)
             if index is not None:
-                if var is not None:
-                    raise PathError("a tag index takes the last array of a path (softplc_lite)", m.start())
                 if not dims:
                     raise PathError(f"{text[:m.start()].strip()} is not an array", m.start())
-                parts = [p.strip() for p in index.split(",")]
+                parts = _split_indexes(index)
                 if len(parts) != len(dims):
                     raise PathError(f"{len(parts)} index{'es' if len(parts) != 1 else ''} for an array of "
                                     f"{len(dims)} dimension{'s' if len(dims) != 1 else ''}", m.start() + 1)
                 for p, size in zip(parts, dims):
                     flat *= size
+                    for term in terms:
+                        term[2] *= size
                     if re.fullmatch(r"[0-9]+", p):
                         k = int(p)
                         if k >= size:
                             raise PathError(f"index {k} is past the end of a dimension of {size}", m.start() + 1)
                         flat += k
                     else:
-                        if var is not None or index_of is None:
-                            raise PathError(f"index {p!r}: softplc_lite takes one tag as the index of one "
-                                            f"dimension in a path, the others constant", m.start() + 1)
-                        var = (index_of(p), flat)
+                        terms.append([p, size, 1])
                 dims = ()
                 at = m.end()
                 continue
             if dims:
-                raise PathError(f"{text[:m.start()].strip()} is an array: expected [index] before .{member}",
-                                m.start())
-            if member.isdigit():
-                b = int(member)
+                raise PathError(f"{text[:m.start()].strip()} is an array: expected [index] before "
+                                f".{member or '[' + (bit_index or '') + ']'}", m.start())
+            if bit_index is not None or (member is not None and member.isdigit()):
                 if t.kind != "atomic" or t.name in ("BOOL", "REAL"):
-                    raise PathError(f".{b}: a bit of {t.name}: expected an integer (SINT, INT, DINT, LINT)",
-                                    m.start())
-                if b >= t.bits:
-                    raise PathError(f"bit {b} of a {t.name}: expected 0 to {t.bits - 1}", m.start() + 1)
-                bit = b
+                    raise PathError(f"a bit of {t.name}: expected an integer (SINT, INT, DINT, LINT)", m.start())
+                if bit_index is not None:
+                    bit_term = (bit_index.strip(), t.bits)
+                else:
+                    b = int(member)
+                    if b >= t.bits:
+                        raise PathError(f"bit {b} of a {t.name}: expected 0 to {t.bits - 1}", m.start() + 1)
+                    bit = b
                 at = m.end()
                 if text[at:].strip():
                     raise PathError("nothing may follow a bit number", at)
                 break
+            if t.kind == "string" and member.upper() == "LEN":
+                leaf_path, at = path, m.end()
+                if text[at:].strip():
+                    raise PathError("nothing may follow LEN", at)
+                r = self._finish(text, d, leaf_path, flat, None, terms, None, t=t, index_of=index_of)
+                r.address = Address(r.address.type_letter, r.address.file, r.address.element, "LEN")
+                r.type = self.types.get("DINT")
+                return r
             if t.kind != "struct":
-                raise PathError(f"{t.name} has no member {member}" + (" (a string's LEN and DATA are not yet "
-                                "reached one by one)" if t.kind == "string" else ""), m.start() + 1)
+                raise (NotRun if t.kind == "string" else PathError)(
+                    f"{t.name} has no member {member}" + (" (a string's DATA is not yet reached character by "
+                                                          "character)" if t.kind == "string" else ""), m.start() + 1)
             mt = t.member(member)
             if mt is None:
                 names = ", ".join(x.name for x in t.visible_members())
@@ -309,35 +327,53 @@ class TagDirectory:
                 at = m.end()
                 if text[at:].strip():
                     raise PathError(f"{member} is a BOOL: nothing may follow it", at)
-                return self._finish(text, d, path, flat, bit, var, boolean=True)
+                return self._finish(text, d, path, flat, bit, terms, None, boolean=True, index_of=index_of)
             path = path + (mt.name.upper(),)
             t = mt.type
             dims = (mt.dim,) if mt.dim else ()
             at = m.end()
         if dims or t.kind == "struct":
-            return Resolved(text, t, dims, None, d, path, flat, bit)
-        return self._finish(text, d, path, flat, bit, var, t=t)  # an atomic value, or a string's ST element
+            r = Resolved(text, t, dims, None, d, path, flat, bit)
+            r.terms = terms
+            return r
+        # an atomic value, or a string's ST element
+        return self._finish(text, d, path, flat, bit, terms, bit_term, t=t, index_of=index_of)
 
-    def _finish(self, text, d, path, flat, bit, var, t=None, boolean=False) -> Resolved:
+    def _finish(self, text, d, path, flat, bit, terms, bit_term, t=None, boolean=False, index_of=None) -> Resolved:
         leaf = d.leaves.get(path)
         if leaf is None:
             raise PathError(f"{text}: no storage (a softplc_lite bug)", 0)
-        result_type = self.types.get("BOOL") if boolean or bit is not None else t
-        if var is not None:
-            index_addr, before = var
-            if flat != before or leaf.first != 0:
-                raise PathError("a tag index takes the last array dimension of a path's only array, with "
-                                "no constant index after it (softplc_lite)", 0)
-            if leaf.letter == "B":
-                if bit is not None:
-                    raise PathError("a bit of a BOOL array element", 0)
-                return Resolved(text, result_type, (), Address("B", leaf.file, None, None, index_addr), d, path)
-            return Resolved(text, result_type, (), Address(leaf.letter, leaf.file, index_addr, None, bit), d, path)
+        result_type = self.types.get("BOOL") if boolean or bit is not None or bit_term else t
+        if (terms or bit_term) and index_of is None:
+            raise PathError("an index or bit computed at run time: name a constant one here", 0)
         item = leaf.first + flat
+        if bit_term is not None:
+            bit = index_of([(bit_term[0], bit_term[1], 1)], 0, bit_term[1])
+        if terms:
+            element = index_of([tuple(term) for term in terms], item, leaf.count)
+            if leaf.letter == "B":
+                return Resolved(text, result_type, (), Address("B", leaf.file, None, None, element), d, path)
+            return Resolved(text, result_type, (), Address(leaf.letter, leaf.file, element, None, bit), d, path)
         if leaf.letter == "B":
             return Resolved(text, result_type, (), Address("B", leaf.file, item // WORD_BITS, None,
                                                            item % WORD_BITS), d, path, flat)
         return Resolved(text, result_type, (), Address(leaf.letter, leaf.file, item, None, bit), d, path, flat, bit)
+
+
+def _split_indexes(text: str) -> list[str]:
+    """``i, j+1`` -> ["i", "j+1"]: commas at the top level only (an index
+    expression may hold brackets of its own)."""
+    parts, depth, begin = [], 0, 0
+    for k, ch in enumerate(text):
+        if ch in "([":
+            depth += 1
+        elif ch in ")]":
+            depth -= 1
+        elif ch == "," and depth == 0:
+            parts.append(text[begin:k].strip())
+            begin = k + 1
+    parts.append(text[begin:].strip())
+    return parts
 
 
 class TagSymbols(dict):

@@ -64,9 +64,13 @@ SPECS = [
     _spec("LCTD", "Logix count down", "CTL", "PRE", "ACC"),
     _spec("LRES", "Logix reset", "CTL", "ACC or POS"),
     _spec("LDIV", "Logix divide", "source A", "source B", "dest"),
+    InstructionSpec("LIDX", "Logix array index", (OperandSpec("dest", K.ANY), OperandSpec("offset", K.ANY),
+                                                  OperandSpec("term", K.ANY)), False, repeat=3 * 8),
 ]
-# The Logix name each shows as (the watch view, fmt, messages).
-LOGIX_NAMES = {s.mnemonic: s.mnemonic[1:] for s in SPECS}
+# The Logix name each shows as (the watch view, fmt, messages); LIDX is no Logix instruction: it
+# computes an index Logix computes inside the instruction that uses it.
+LOGIX_NAMES = {s.mnemonic: s.mnemonic[1:] for s in SPECS if s.mnemonic != "LIDX"}
+FAULT_SUBSCRIPT = 20  # major fault type 4 code 20: an array subscript out of range (1756-PM014)
 
 
 def _timer(kind: str, ctl, pre, acc, machine):
@@ -227,9 +231,37 @@ def _divide(a, b, dest, machine):
     return run
 
 
+def _index(instr, access):
+    """LIDX dest offset (expression size stride)...: dest = offset + the sum
+    of each expression times its stride, whatever the rung (the index of an
+    operand is taken where the instruction is, true rung or false); an
+    expression outside 0..size-1 is major fault 20."""
+    ops = instr.operands
+    dest = access.location(ops[0])
+    offset = ops[1].value
+    terms = [(access.expression(ops[k]), ops[k + 1].value, ops[k + 2].value) for k in range(2, len(ops), 3)]
+
+    def run(c: bool) -> bool:
+        v = offset
+        for get, size, stride in terms:
+            k = get()
+            if not isinstance(k, int):
+                k = int(k)
+            if not 0 <= k < size:
+                raise MajorFault(FAULT_SUBSCRIPT, f"array subscript {k} outside 0..{size - 1}: major fault type 4, "
+                                                  f"code 20")
+            v += k * stride
+        d, i, _ = dest()
+        d[i] = v
+        return c
+    return run
+
+
 def _bind(instr, access):
     m = instr.mnemonic
     machine = access.machine
+    if m == "LIDX":
+        return _index(instr, access)
     if m == "LDIV":
         a, b, dest = instr.operands
         return _divide(access.value(a), access.value(b), access.location(dest), machine)
