@@ -193,3 +193,65 @@ def test_public_exports_load_their_module_tags(path):
     assert "unknown tag 'Local:" not in out and "module" not in out.lower(), out
     result = load_export(path)
     assert result.directory.resolve("Local:3:O.Data.8").address is not None
+
+
+def _with_rung(text: str, rung: str) -> str:
+    """The example with ``rung`` as the last rung of its routine."""
+    last = '<![CDATA[MOV(Local:4:C.Ch2Config.HighEngineering,Span);]]>\n</Text>\n</Rung>\n'
+    assert last in text
+    return text.replace(last, last + f'<Rung Number="5" Type="N">\n<Text>\n<![CDATA[{rung}]]>\n</Text>\n</Rung>\n')
+
+
+def test_a_module_tag_the_modules_have_no_data_for_is_not_run_a_name_of_no_module_is_unknown(tmp_path):
+    path = tmp_path / "io.L5X"
+    path.write_text(_with_rung(EXPORT.read_text(), "XIC(Local:0:I.Data.1)OTE(Local:7:O.Data.0);"))
+    result = load_export(path)
+    assert not result.problems
+    assert [w.message for w in result.warnings] == [
+        "routine MainProgram.MainRoutine: rung 5: XIC operand 'Local:0:I.Data.1': module tag Local:0:I: "
+        "the export's modules have no data for it; the rung is not run",
+        "routine MainProgram.MainRoutine: rung 5: OTE operand 'Local:7:O.Data.0': module tag Local:7:O: "
+        "the export's modules have no data for it; the rung is not run"]
+    path.write_text(_with_rung(EXPORT.read_text(), "XIC(Locl:1:I.Data.1)OTE(HighPressure);"))
+    r = softplc_here("check", str(path))
+    assert r.returncode == 1 and "unknown tag 'Locl:1:I'" in r.stdout + r.stderr
+
+
+def test_a_type_shown_differently_by_two_modules_takes_the_first_with_a_warning(tmp_path):
+    text = EXPORT.read_text()
+    spare = text.index('<Module Name="SpareInputs"')
+    text = text[:spare] + text[spare:].replace(
+        '<DataValueMember Name="Fault" DataType="DINT"', '<DataValueMember Name="Faults" DataType="DINT"', 1)
+    path = tmp_path / "io.L5X"
+    path.write_text(text)
+    result = load_export(path)
+    assert not result.problems
+    assert any(w.message.startswith("module-defined type AB:1756_DI:I:0 is shown with other members than at ")
+               for w in result.warnings), result.warnings
+    assert result.directory.resolve("Local:5:I.Data.3").address is not None  # the first description: Fault, Data
+    with pytest.raises(Exception, match="has no member Faults"):
+        result.directory.resolve("Local:5:I.Faults")
+
+
+def test_an_array_member_of_no_element_holds_nothing(tmp_path):
+    text = EXPORT.read_text().replace(
+        '<DataValueMember Name="ProgToFaultEn" DataType="BOOL" Value="0"/>',
+        '<DataValueMember Name="ProgToFaultEn" DataType="BOOL" Value="0"/>\n'
+        '<ArrayMember Name="Spare" DataType="SINT" Dimensions="0" Radix="Hex"></ArrayMember>', 1)
+    path = tmp_path / "io.L5X"
+    path.write_text(text)
+    result = load_export(path)
+    assert not result.problems and not result.warnings
+    assert result.directory.resolve("Local:2:C.ProgToFaultEn").address is not None
+
+
+def test_an_export_without_modules_runs_the_rungs_that_use_none(tmp_path):
+    text = EXPORT.read_text()
+    text = text[:text.index("<Modules>")] + "<Modules/>" + text[text.index("</Modules>") + len("</Modules>"):]
+    path = tmp_path / "io.L5X"
+    path.write_text(text)
+    result = load_export(path)
+    assert not result.problems
+    not_run = sorted({w.message.split(":")[1].strip() for w in result.warnings})
+    assert not_run == ["rung 0", "rung 1", "rung 2", "rung 3", "rung 4"], result.warnings
+    assert all("the export holds no modules; the rung is not run" in w.message for w in result.warnings)

@@ -8,18 +8,23 @@ softplc_lite choice:
 
 - A module-defined type (``AB:1756_IF4_Float:I:0``) is what the tag's
   decorated data shows: each ``DataValueMember`` a member of its DataType,
-  each ``ArrayMember`` an array member of its Dimensions, each
-  ``StructureMember`` (and each structure element of an ``ArrayMember``) a
-  member of a module-defined type described the same way. The export names
-  these types but never defines them (Rockwell's module profiles do), so
-  the decorated data is the only description there is. A BOOL member is a
+  each ``ArrayMember`` an array member of its Dimensions (one of none is
+  left out: it holds nothing), each ``StructureMember`` (and each structure
+  element of an ``ArrayMember``) a member of a module-defined type
+  described the same way. The export names these types but never defines
+  them (Rockwell's module profiles do), so the decorated data is the only
+  description there is. A BOOL member is a
   stand-alone BOOL, as the decorated view shows it (``Ch0Fault``): it is
   reached by name; Logix also shows many of them as a bit of another
   member (``ChannelFaults.0``), a link softplc_lite does not keep.
 - A tag whose type the export does not describe (an L5K export, whose
   module data is positional without member names; an L5X tag with L5K data
   only) is not laid out: one warning for its module, and a rung that uses
-  the tag is not run (a warning), never an error.
+  the tag is not run (a warning), never an error. So is a rung that uses a
+  module tag the export has no data for: a name whose first part is one of
+  the export's modules or chassis (``Local:0:O`` where slot 0 holds no
+  output module), or any module tag of an export without modules (a
+  program or routine export).
 - An inhibited module's tags exist and behave as any other module's: the
   I/O is simulated, so there is no connection to inhibit.
 - A type described twice alike is one type; described differently (two
@@ -56,6 +61,8 @@ def describe_structure(node, out: list[DataType]) -> str | None:
             dim = 1
             for part in (c.attrs.get("Dimensions") or "0").split(","):
                 dim *= int(part) if part.strip().isdigit() else 0
+            if dim == 0:  # no element (a generic module's empty config Data): nothing to hold
+                continue
             element = next((e.children[0] for e in c.children if e.tag == "Element" and e.children), None)
             if element is not None and element.tag == "Structure":
                 mtype = describe_structure(element, out) or mtype
@@ -96,6 +103,7 @@ def declare_module_tags(project: model.Project, directory: TagDirectory,
                  for p in types.problems[before:]]
     del types.problems[before:]
     controller = directory.scopes[None]
+    directory.absent = _absent(project)
     for module in project.modules:
         undescribed = []
         for mt in module.tags:
@@ -116,6 +124,28 @@ def declare_module_tags(project: model.Project, directory: TagDirectory,
             warnings.append(Problem(module.pos, f"module {module.name or module.catalog_number}: "
                                                 f"{_why(project, undescribed[0])}, so its tags ({names}) are not "
                                                 f"laid out; rungs that use them are not run"))
+
+
+def _absent(project: model.Project):
+    """Why a module tag name (``Local:0:O``) that the export does not
+    hold is used, or None for a name that is no module's: the export holds
+    its modules without that tag's data (a slot with no module, a
+    connection with no output), or no modules at all (a partial export)."""
+    modules = {m.name.upper() for m in project.modules if m.name}
+    modules |= {(m.parent or "").upper() for m in project.modules if m.parent}
+    partial = not project.modules
+
+    def why(name: str) -> str | None:
+        head, colon, _ = name.partition(":")
+        if not colon:
+            return None
+        if partial:
+            return f"module tag {name}: the export holds no modules"
+        if head.upper() in modules:
+            return f"module tag {name}: the export's modules have no data for it"
+        return None
+
+    return why
 
 
 def _why(project: model.Project, mt: model.ModuleTag) -> str:

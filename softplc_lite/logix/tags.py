@@ -159,6 +159,7 @@ class TagDirectory:
         # (class, instance, attribute), upper case -> the item that holds it: the task and program
         # attributes a program reads and writes with GSV/SSV (logix/tasks.py lays them out)
         self.objects: dict[tuple[str, str, str], Address] = {}
+        self.absent = None  # name -> why an undeclared name is not the export's mistake, or None
 
     # -- declaring -------------------------------------------------------------------------
     def declare(self, tag: Tag, scope: str | None = None) -> Declared | None:
@@ -240,6 +241,9 @@ class TagDirectory:
         name = m.group(1)
         d = self.find(name, scope)
         if d is None:
+            why = self.absent(name) if self.absent is not None else None
+            if why is not None:  # a name the export does not hold but Logix would (modules.py)
+                raise NotRun(why, m.start(1))
             raise PathError(f"unknown tag {name!r}" + (f" (in program {scope} or the controller)" if scope else ""),
                             m.start(1))
         if d.opaque is not None:
