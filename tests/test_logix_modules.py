@@ -255,3 +255,24 @@ def test_an_export_without_modules_runs_the_rungs_that_use_none(tmp_path):
     not_run = sorted({w.message.split(":")[1].strip() for w in result.warnings})
     assert not_run == ["rung 0", "rung 1", "rung 2", "rung 3", "rung 4"], result.warnings
     assert all("the export holds no modules; the rung is not run" in w.message for w in result.warnings)
+
+
+def test_scenarios_set_force_and_expect_module_tags(tmp_path):
+    export = tmp_path / "io_rack.L5X"
+    export.write_text(EXPORT.read_text())
+    (tmp_path / "io_rack.tests").mkdir()
+    (tmp_path / "io_rack.tests" / "io.plctest").write_text(
+        'scenario "simulated I/O":\n'
+        '    force Local:1:I.Data.0 = 1\n'
+        '    set Local:4:I.Ch2Data = 55.5\n'
+        '    scan 1\n'
+        '    expect Local:2:O.Data.5 == 1\n'
+        '    expect HighPressure == 1\n'
+        '    expect PT102_PV == 55.5\n'
+        '    unforce Local:1:I.Data.0\n'
+        '    set Local:1:I.Data = 0\n'
+        '    scan 1\n'
+        '    expect Local:2:O.Data.5 == 0\n', encoding="utf-8")
+    r = softplc_here("test", str(export))
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert r.stdout.splitlines()[-1] == "1 passed, 0 failed"
