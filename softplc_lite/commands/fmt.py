@@ -11,6 +11,9 @@ plus the modules MODULES.LST enables) and printed by
   written, not even the files that were fine.
 * ``--check``: exit 1 naming each file whose text is not what fmt prints
   ("would reformat PATH"), 0 when all are; nothing else is printed.
+* A Studio 5000 export (``.L5X``, ``.L5K``) is printed as the text of its
+  routines (fmt_export.py), never rewritten: ``--check`` and ``--write``
+  refuse one.
 * ``--write``: each file that changes is replaced atomically (a temporary
   file in the same directory, then a rename; its permission bits kept).
   fmt writes UTF-8 without a BOM and LF line ends, whatever it read.
@@ -36,6 +39,7 @@ from ..ladder.parser import parse_program, syntax_problems
 from ..ladder.validate import check
 from ..textfile import PROGRAM, decode_text, read_bytes
 from .common import EXIT_ERROR, EXIT_OK
+from .fmt_export import export_text, is_export
 
 NAME = "fmt"
 STDIN = "-"
@@ -46,7 +50,9 @@ def add_parser(sub) -> argparse.ArgumentParser:
                        description="Print each .lad file (an app directory: each of its .lad files; -: standard "
                                    "input) canonically, keeping every comment; what does not parse is refused "
                                    "(exit 1, every problem listed). See docs/language.md.")
-    f.add_argument("paths", nargs="+", metavar="PATH", help=".lad file, app directory, or - for standard input")
+    f.add_argument("paths", nargs="+", metavar="PATH",
+                   help=".lad file, app directory, or - for standard input; a Studio 5000 export (.L5X, .L5K) "
+                        "is printed as its routines' rungs, never rewritten")
     f.add_argument("--style", choices=STYLES, default="mnemonic",
                    help="mnemonic (XIC B3/0 OTE O:0/0; the default) or neutral text (XIC(B3/0)OTE(O:0/0);)")
     mode = f.add_mutually_exclusive_group()
@@ -156,8 +162,20 @@ def fmt_command(paths: Sequence[str], style: str = "mnemonic", check: bool = Fal
     stderr = stderr if stderr is not None else sys.stderr
     if style not in STYLES:
         raise ValueError(f"style must be one of {', '.join(STYLES)}")
-    sources, problems = _sources(paths, stdin)
+    exports = [p for p in paths if p != STDIN and is_export(p)]  # Studio's files: printed, never rewritten
+    sources, problems = _sources([p for p in paths if p == STDIN or not is_export(p)], stdin)
     results: list[Formatted] = []
+    printed: list[Formatted] = []
+    for given in exports:
+        if check or write:
+            problems.append(LocatedError(f"{shown_path(given)}: a Studio 5000 export is Studio's file: fmt "
+                                         f"--{'check' if check else 'write'} takes .lad files (softplc fmt "
+                                         f"{shown_path(given)} prints its routines)"))
+            continue
+        after, found = export_text(given)
+        problems += found
+        if after is not None:
+            printed.append(Formatted(given, None, b"", after))
     instruction_sets: dict[Path, object] = {}
     texts: dict[Path, list[tuple[str, str]]] = {}  # app directory -> (name, text) of its files being formatted
     for name, path, raw, app_dir in sources:
@@ -180,6 +198,7 @@ def fmt_command(paths: Sequence[str], style: str = "mnemonic", check: bool = Fal
         texts.setdefault(key, []).append((name, text))
     if not problems:
         problems = _invalid(texts, instruction_sets)
+    results += printed
     if problems:
         for p in problems:
             print(p.report(), file=stderr)
