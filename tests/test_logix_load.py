@@ -135,3 +135,28 @@ def test_addresses_name_their_tag_paths_back(tmp_path):
         assert names.name_of(symbols.resolve_path(path)) == path
     assert names.name_of(symbols.resolve_path("LineDone")) == "Batches.DN"  # an alias names its target
     assert names.name_of(symbols.resolve_path("Program:MainProgram.Settled"), "MainProgram") == "Settled"
+
+
+@pytest.mark.parametrize("export", ["tank_line.L5X", "io_rack.L5X"])
+def test_the_shipped_exports_run_the_same_on_both_executors(tmp_path, export):
+    """Scan by scan, with their BOOL inputs pulsed now and then, the two
+    executors keep equal tables (tests/test_differential.py does this for
+    the .lad apps)."""
+    path = tmp_path / export
+    shutil.copy(ROOT / "programs" / "logix" / export, path)
+    pair = [runner_of(path, executor) for executor in ("compiled", "reference")]
+    app = pair[0].app
+    bools = [d.tag.name for scope in app.logix.directory.scopes.values() for d in scope.values()
+             if d.type is not None and d.type.name == "BOOL" and not d.dims and d.scope is None]
+    assert bools
+    for scan in range(600):
+        for r in pair:
+            if scan % 97 == 3:
+                tag = bools[scan % len(bools)]
+                address = r.app.program.symbols.resolve_path(tag)
+                r.table.write(address, 1 - r.table.read(address))
+            r.run(1)
+        assert pair[0].table == pair[1].table, f"scan {scan}"
+        assert (pair[0].engine.fault is None) == (pair[1].engine.fault is None)
+    for r in pair:
+        r.close()

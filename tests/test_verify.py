@@ -12,6 +12,7 @@ from softplc_lite.ladder.validate import check
 from softplc_lite.ladder.verify import verify
 
 from helpers.cli import softplc_here
+from helpers.shipped_apps import shipped_app_names, shipped_exports
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -111,7 +112,7 @@ def test_check_prints_the_warnings_located_and_exits_0(tmp_path):
     assert p.stdout == "warned: ok (1 program file, 3 rungs, 3 warnings)\n"
 
 
-@pytest.mark.parametrize("name", sorted(p.name for p in (ROOT / "programs").iterdir() if p.is_dir()))
+@pytest.mark.parametrize("name", shipped_app_names() + [f"logix/{p.name}" for p in shipped_exports()])
 def test_shipped_programs_have_no_warnings(name):
     p = softplc_here("check", str(ROOT / "programs" / name))
     assert p.returncode == 0 and "warning" not in p.stderr, p.stderr

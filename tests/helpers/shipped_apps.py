@@ -55,3 +55,15 @@ def copy_programs(dest: Path) -> dict[str, int]:
         if (port := free_server_port(app)) is not None:
             ports[app.name] = port
     return ports
+
+
+def shipped_app_names() -> list[str]:
+    """The shipped apps that are app directories (programs/NAME with .lad
+    files), by name."""
+    return sorted(p.name for p in PROGRAMS.iterdir() if p.is_dir() and any(p.glob("*.lad")))
+
+
+def shipped_exports() -> list[Path]:
+    """The shipped Studio 5000 exports (programs/logix/*.L5X, *.L5K): apps
+    of one file each (docs/logix.md)."""
+    return sorted(p for p in (PROGRAMS / "logix").iterdir() if p.suffix.lower() in (".l5x", ".l5k"))
