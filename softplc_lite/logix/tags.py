@@ -98,6 +98,7 @@ class NotRun(PathError):
 
 _STEP = re.compile(r"\s*(?:\.\s*([A-Za-z_][A-Za-z0-9_]*|[0-9]+)|\[((?:[^\[\]]|\[[^\[\]]*\])*)\]|\.\s*\[((?:[^\[\]]|\[[^\[\]]*\])*)\])")
 _PROGRAM_SCOPED = re.compile(r"\s*Program:([A-Za-z_][A-Za-z0-9_]*)\.", re.IGNORECASE)
+_OBJECT_ATTRIBUTE = re.compile(r"(Task|Program):([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)", re.IGNORECASE)
 _NAME = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*(?::[A-Za-z0-9_]+)*)")
 
 
@@ -384,7 +385,10 @@ class TagSymbols(dict):
     """A Logix app's ``program.symbols``: no PLC-5 symbols, and every place
     that takes a name (--print, --set, --force, the watch view, the test
     runner's scenarios, trends) resolves a tag path through the directory
-    (ladder/symbols.py calls ``resolve_path``)."""
+    (ladder/symbols.py calls ``resolve_path``). A task's or program's
+    attribute (``directory.objects``) is named ``Task:Name.Attribute`` or
+    ``Program:Name.Attribute`` (``Program:Service.DisableFlag``), where no
+    tag has that path."""
 
     def __init__(self, directory: TagDirectory) -> None:
         super().__init__()
@@ -396,6 +400,10 @@ class TagSymbols(dict):
         try:
             r = self.directory.resolve(text)
         except PathError as e:
+            m = _OBJECT_ATTRIBUTE.fullmatch(text.strip())
+            found = m and self.directory.objects.get((m.group(1).upper(), m.group(2).upper(), m.group(3).upper()))
+            if found:
+                return found
             raise SymbolError(text, e.offset, str(e)) from None
         if r.address is None:
             raise SymbolError(text, len(text), f"{text} is a {r.type.name}{' array' if r.dims else ''}: "
