@@ -432,7 +432,9 @@ def _load_export_app(path: Path, state_dir: str | Path | None, program: Program 
     (wrap, 1756-RM003), no state directory unless --state names one. What
     it holds that is not run is said in its warnings. ``program``: a
     program made from the export's (a mutant) checked in its place, over
-    the export's tags."""
+    the export's tags. An export is one file, so its one module is found
+    beside it: ``<stem>.ENIPS.XML`` serves its tags over EtherNet/IP
+    (docs/logix.md, "EtherNet/IP: Logix tags")."""
     from .logix.load import load_export
     from .logix.model import ExportError
 
@@ -452,11 +454,32 @@ def _load_export_app(path: Path, state_dir: str | Path | None, program: Program 
         errors += layout
     if errors:
         raise AppError(errors)
+    # a mutant is checked over the export's tags, and serves no client
+    modules, warnings = _export_modules(path, made) if program is None else ([], [])
     app = App(path, False, [path], resolved, Settings(overflow="wrap"), made.program,
               state_dir=Path(state_dir) if state_dir is not None else None,
-              warnings=[str(w) for w in made.warnings])
+              warnings=warnings + [str(w) for w in made.warnings], modules=modules)
     app.logix = made
     return app
+
+
+EXPORT_ENIPS = ".ENIPS.XML"
+
+
+def _export_modules(path: Path, made) -> tuple[list[TLM], list[str]]:
+    """ENIPS configured from ``<stem>.ENIPS.XML`` beside the export (any
+    case), or no module."""
+    config = find_file(path.parent, path.stem + EXPORT_ENIPS)
+    if config is None:
+        return [], []
+    try:
+        module = load_module("ENIPS")
+        warnings = module.configure_export(config, shown_path(path.stem), made.directory)
+    except ModuleErrors as e:
+        raise AppError(list(e.problems)) from None
+    except ModuleError as e:
+        raise AppError([e]) from None
+    return [module], warnings
 
 
 def _settings_problems(path: Path | None) -> list:

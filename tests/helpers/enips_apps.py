@@ -112,3 +112,26 @@ def connected(sock: socket.socket, session: int, o_t_id: int, service: int, path
         cpf.Item(cpf.CONNECTED_ADDRESS, struct.pack("<I", o_t_id)),
         cpf.Item(cpf.CONNECTED_DATA, struct.pack("<H", sequence) + MessageRouterRequest(service, path).encode())])
     return exchange(sock, EncapMessage(encap.SEND_UNIT_DATA, body, session=session))
+
+
+TANK_LINE = Path(__file__).resolve().parents[2] / "programs" / "logix" / "tank_line.L5X"
+TANK_LINE_WRITABLE = """  <Writable tag="Start"/>
+  <Writable tag="Stop"/>
+  <Writable tag="Tanks"/>
+  <Writable tag="SettleTimer"/>
+  <Writable tag="Banner"/>
+  <Writable tag="Program:MainProgram.Overview"/>
+"""
+
+
+def tank_line(directory: Path, body: str = TANK_LINE_WRITABLE, edit=None) -> Path:
+    """programs/logix/tank_line.L5X copied into ``directory`` (``edit``
+    changes its text), with ``tank_line.ENIPS.XML`` beside it serving on a
+    free port; the export's path."""
+    directory.mkdir(parents=True, exist_ok=True)
+    text = TANK_LINE.read_text(encoding="utf-8")
+    export = directory / "tank_line.L5X"
+    export.write_text(edit(text) if edit else text, encoding="utf-8")
+    xml = f'<?xml version="1.0"?>\n<EtherNetIpServer port="{free_tcp_port()}">\n{body}</EtherNetIpServer>\n'
+    (directory / "tank_line.ENIPS.XML").write_text(xml, encoding="utf-8")
+    return export

@@ -78,9 +78,15 @@ class TableAccess(abc.ABC):
 
     @abc.abstractmethod
     async def write_masked(self, name: str, index: int, and_mask: int, or_mask: int) -> bool:
-        """Read-modify-write of one 16-bit item at the scan's input point:
-        ``new = (old & and_mask) | or_mask`` (masks as unsigned 16-bit), so
-        the bits a client leaves alone keep what the scan gave them."""
+        """Read-modify-write of one integer item at the scan's input point:
+        ``new = (old & and_mask) | or_mask`` (masks unsigned, of the item's
+        width: 16 bits for a word, 8 for SI, 32 for L, 64 for LI), so the
+        bits a client leaves alone keep what the scan gave them."""
+
+    async def write_group(self, writes: list[tuple[str, int, list]]) -> bool:
+        """Several writes (file name, first item, items) applied at one
+        input point, all or none; the caller checked ``writable``."""
+        return all([await self.write(name, first, items) for name, first, items in writes])
 
 
 def file_infos(table: DataTable, writable_names: frozenset[str] = frozenset()) -> list[FileInfo]:
@@ -129,6 +135,10 @@ class TableAccessOnTable(TableAccess):
         if not self.writable(name, index, 1):
             return False
         data = self.table.file(name).data
-        new = ((data[index] & 0xFFFF) & and_mask) | or_mask
-        data[index] = new - 0x10000 if new & 0x8000 else new
+        if data.typecode not in "bhiq":
+            return False
+        bits = data.itemsize * 8
+        full = (1 << bits) - 1
+        new = ((data[index] & full) & and_mask | or_mask) & full
+        data[index] = new - (1 << bits) if new >> (bits - 1) else new
         return True

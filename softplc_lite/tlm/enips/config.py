@@ -34,12 +34,14 @@ MAX_CIP_CONNECTIONS = 32  # a ControlLogix L6x's class-3 connection count: a cho
 
 @dataclass(frozen=True)
 class Writable:
-    """``count`` elements from ``address`` that clients may write."""
+    """``count`` elements from ``address`` that clients may write; or, in a
+    Logix app's configuration, the tag path ``tag`` (logixconfig.py)."""
 
-    address: Address  # an element of a file (N7:0, T4:0, ST9:0)
+    address: Address | None  # an element of a file (N7:0, T4:0, ST9:0); None with ``tag``
     count: int
     line: int
     column: int
+    tag: str | None = None  # a Logix tag path (Tanks, Tanks[1].Setpoint, SettleTimer.PRE)
 
     @property
     def file(self) -> str:
@@ -47,7 +49,7 @@ class Writable:
 
     @property
     def last(self) -> int:
-        return self.address.element + self.count - 1
+        return self.address.element + self.count - 1 if self.address is not None else 0
 
 
 @dataclass(frozen=True)
@@ -72,8 +74,10 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
            Attr("maxCipConnections", 1, 1000, default=MAX_CIP_CONNECTIONS),
            Attr("udpListIdentity", choices=("yes", "no"), default="yes")),
     "Allow": ALLOW,
-    "Writable": (Attr("address", text=True, required=True,
+    "Writable": (Attr("address", text=True,
                       what="the first element clients may write (N7:0, B3:2, F8:0, T4:0, ST9:0)"),
+                 Attr("tag", text=True, extension=True,
+                      what="a Logix app's tag clients may write (Tanks, Tanks[1].Setpoint, SettleTimer.PRE)"),
                  Attr("count", 1, MAX_ELEMENTS, default=1)),
 }
 
@@ -81,8 +85,17 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
 def _check_writable(c: XmlChecker, node, status: Address | None, status_line: int) -> Writable | None:
     a = c.attributes(node)
     c.children(node, [])
-    if "address" not in a:
+    if ("address" in node.attrs) == ("tag" in node.attrs):
+        c.error(node, "<Writable> needs the attribute address (a data table element: N7:0) or, in a Logix "
+                      "app's configuration, tag (a tag path: Tanks[1].Setpoint), one of them")
         return None
+    if "address" not in a and "tag" not in a:
+        return None  # its value was refused, and said
+    if "tag" in a:
+        if "count" in node.attrs:
+            c.error(node, "<Writable tag=...> takes no count: the tag path names what clients may write", "count")
+            return None
+        return Writable(None, 1, node.line, node.column, tag=a["tag"])
     text = a["address"]
     try:
         address = parse_address(text)
@@ -148,7 +161,8 @@ def config_references(config: ServerConfig) -> list[Address]:
     status block, so that the engine creates them before the first scan."""
     found: list[Address] = []
     for w in config.writable:
-        found += [w.address, w.address.with_element(w.last)]
+        if w.address is not None:
+            found += [w.address, w.address.with_element(w.last)]
     if config.status is not None:
         found += [config.status, config.status.with_element(config.status.element + STATUS_WORDS - 1)]
     return found

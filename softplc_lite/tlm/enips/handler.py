@@ -49,8 +49,9 @@ def served_objects(protocol: EnipProtocol) -> list:
     program name."""
     objects = [make() for make in OBJECTS if make not in (ConnectionManager,)]
     objects.append(ConnectionManager(protocol.config.max_cip_connections))
-    objects += [TagServices(protocol.symbols), SymbolObject(protocol.symbols), TemplateObject(),
-                ProgramName(protocol.identity.app_name)]
+    logix = protocol.logix
+    objects += [TagServices(protocol.symbols, logix=logix), SymbolObject(protocol.symbols, logix=logix),
+                TemplateObject(logix), ProgramName(protocol.identity.app_name)]
     return objects
 
 
@@ -62,7 +63,7 @@ class EnipHandler(Handler):
         super().__init__(server)
         self.protocol = protocol
         self.identity = protocol.identity
-        self.access = ImageAccess(server, protocol.slots)
+        self.access = ImageAccess(server, protocol.slots, files_served=protocol.logix is None)
         self.router = MessageRouter(served_objects(protocol), identity=protocol.identity)
         self.router.count = self.count
 

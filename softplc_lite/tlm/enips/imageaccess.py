@@ -8,14 +8,17 @@ from __future__ import annotations
 from array import array
 
 from .access import FileInfo, TableAccess
-from .protocol import FileSlot, mask_payload, write_payload
+from .protocol import FileSlot, group_payload, mask_payload, write_payload
 
 
 class ImageAccess(TableAccess):
-    def __init__(self, server, slots: tuple[FileSlot, ...]) -> None:
+    """``files_served`` False: no file is served as a file (a Logix app's
+    table, reached through its tags only); reads and writes by name still are."""
+
+    def __init__(self, server, slots: tuple[FileSlot, ...], files_served: bool = True) -> None:
         self.server = server
         self.slots = {s.info.name: s for s in slots}
-        self._files = [s.info for s in slots]
+        self._files = [s.info for s in slots] if files_served else []
 
     def files(self) -> list[FileInfo]:
         return self._files
@@ -50,3 +53,12 @@ class ImageAccess(TableAccess):
         if slot is None or not slot.may_write(index, 1):
             return False
         return await self.server.through_scan(mask_payload(slot.info.number, index, and_mask, or_mask))
+
+    async def write_group(self, writes: list[tuple[str, int, list]]) -> bool:
+        payloads = []
+        for name, first, items in writes:
+            slot = self.slots.get(name)
+            if slot is None or not slot.may_write(first, len(items)):
+                return False
+            payloads.append(write_payload(slot.info.number, first, array(slot.typecode, items)))
+        return await self.server.through_scan(group_payload(payloads))

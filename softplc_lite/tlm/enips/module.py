@@ -6,7 +6,10 @@ Registered like any third-party module, in pyproject.toml::
     [project.entry-points."softplc_lite.tlms"]
     ENIPS = "softplc_lite.tlm.enips:EnipServer"
 
-It reads ENIPS.XML (config.py). An engine that takes it (``attach``) only
+It reads ENIPS.XML (config.py): an app directory's, or for a Studio 5000
+export the ``<export stem>.ENIPS.XML`` beside it (``configure_export``),
+which serves the export's tags (logixview.py, logixconfig.py) in place of
+the data files. An engine that takes it (``attach``) only
 lays out the image of its data table: a program that is compiled, checked
 or rendered starts no server. The server is the network-server layer's
 (its process, the shared image, writes applied at the input point, the
@@ -18,10 +21,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
+from ...textfile import read_bytes
+from ..errors import ModuleError, ModuleErrors
 from ..netmodule import NetServerModule
 from . import status as S
-from .config import CONFIG_FILE, ServerConfig, config_references, load_config
+from .config import CONFIG_FILE, ServerConfig, config_references, load_config, parse_config
 from .identity import Identity
+from .logixconfig import closed_ranges, tag_ranges
+from .logixview import build_view
 from .protocol import EnipProtocol, build_slots
 from .tagnames import symbol_addresses
 
@@ -38,12 +45,37 @@ class EnipServer(NetServerModule):
         self.app_name = "APP"
         self.engine = None
         self.server = None
+        self.logix = None  # a Logix app's tags (logixview.LogixView)
+        self.open_ranges: dict = {}  # items <Writable tag> opens; items the export keeps Read Only
+        self.closed: dict = {}
 
     # -- configuration ----------------------------------------------------------------------
     def configure(self, app_dir: Path | None) -> list[str]:
         if app_dir is not None:
             self.config = load_config(app_dir)
             self.app_name = Path(app_dir).resolve().name
+            tagged = [ModuleError(f"<Writable tag={w.tag!r}>: tag= names a tag of a Studio 5000 export's app; "
+                                  "this app's data table elements are named by address=", self.config.path,
+                                  w.line, w.column) for w in self.config.writable if w.tag is not None]
+            if tagged:
+                raise ModuleErrors(tagged)
+        return list(self.config.warnings)
+
+    def configure_export(self, config_path: Path, app_name: str, directory) -> list[str]:
+        """A Studio 5000 export's server: ``config_path`` its ENIPS.XML
+        (``<export stem>.ENIPS.XML``), ``directory`` its tag directory
+        (logix/tags.py). ModuleErrors lists every problem of the file."""
+        try:
+            data = read_bytes(config_path)
+        except OSError as e:
+            raise ModuleError(f"{config_path}: cannot read it: {e.strerror or e}") from None
+        self.config = parse_config(data, str(config_path))
+        self.app_name = app_name
+        self.logix = build_view(directory)
+        self.open_ranges, problems = tag_ranges(self.logix, self.config)
+        if problems:
+            raise ModuleErrors(problems)
+        self.closed = closed_ranges(self.logix)
         return list(self.config.warnings)
 
     def config_references(self) -> list:
@@ -55,7 +87,8 @@ class EnipServer(NetServerModule):
         table = engine.table
         self.reference_config(table)
         program = getattr(engine, "program", None)
-        symbols = symbol_addresses(program.symbols) if program is not None else {}
-        protocol = EnipProtocol(self.config, build_slots(table, self.config), Identity(self.app_name), symbols)
+        symbols = symbol_addresses(program.symbols) if program is not None and self.logix is None else {}
+        slots = build_slots(table, self.config, self.open_ranges, self.closed)
+        protocol = EnipProtocol(self.config, slots, Identity(self.app_name), symbols, self.logix)
         self.serve(table, protocol, WHERE, S.LAYOUT)
         return []

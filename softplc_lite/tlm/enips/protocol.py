@@ -20,9 +20,11 @@ from .access import FileInfo
 from .config import ServerConfig
 from .identity import Identity
 
-WRITE, MASK = b"W", b"M"
+WRITE, MASK, GROUP = b"W", b"M", b"G"
 _WRITE = struct.Struct("=HII")  # file number, first item, count; the items follow in the file's storage
-_MASK = struct.Struct("=HIHH")  # file number, item, and-mask, or-mask (unsigned 16-bit)
+_MASK = struct.Struct("=HIQQ")  # file number, item, and-mask, or-mask (unsigned, the item's width)
+_PART = struct.Struct("=I")  # a group's part: its length, then a WRITE payload
+MASKABLE = "bhiq"  # the typecodes of integer items: a masked write keeps their width
 SEGMENTS = Segments("enips")  # the shared images' files: softplc-enips-PID-RANDOM
 ST_LEN_MAX = 82
 
@@ -41,17 +43,22 @@ class FileSlot:
         return count > 0 and any(lo <= first and first + count <= hi for lo, hi in self.writable)
 
 
-def build_slots(table, config: ServerConfig) -> tuple[FileSlot, ...]:
+def build_slots(table, config: ServerConfig, extra: dict | None = None,
+                closed: dict | None = None) -> tuple[FileSlot, ...]:
     """The table's files as the image lays them out, with the items each
-    ``<Writable>`` opens to clients."""
-    ranges: dict[str, list[tuple[int, int]]] = {}
+    ``<Writable>`` opens to clients: its address's elements, and the item
+    ranges in ``extra`` (a Logix app's tags, logixconfig.py), less those in
+    ``closed`` (the storage of Read Only tags)."""
+    ranges: dict[str, list[tuple[int, int]]] = {k: list(v) for k, v in (extra or {}).items()}
     for w in config.writable:
+        if w.address is None:
+            continue
         per = table.file(w.file).ftype.words_per_element
         ranges.setdefault(w.file, []).append((w.address.element * per, (w.last + 1) * per))
     slots, offset = [], 0
     for f in table.files():
         per = f.ftype.words_per_element
-        writable = tuple(sorted(_merged(ranges.get(f.name, []))))
+        writable = tuple(sorted(_less(_merged(ranges.get(f.name, [])), (closed or {}).get(f.name, []))))
         info = FileInfo(f.name, f.ftype.letter, f.number, len(f.data) // per, per, bool(writable))
         slots.append(FileSlot(info, f.data.typecode, f.data.itemsize, offset, writable))
         offset += len(f.data) * f.data.itemsize
@@ -71,13 +78,42 @@ def _merged(ranges: list[tuple[int, int]]) -> list[tuple[int, int]]:
     return [(lo, hi) for lo, hi in out]
 
 
+def _less(ranges: list[tuple[int, int]], closed: list[tuple[int, int]]) -> list[tuple[int, int]]:
+    """``ranges`` without the items of ``closed``."""
+    for c_lo, c_hi in closed:
+        out = []
+        for lo, hi in ranges:
+            if c_hi <= lo or hi <= c_lo:
+                out.append((lo, hi))
+                continue
+            if lo < c_lo:
+                out.append((lo, c_lo))
+            if c_hi < hi:
+                out.append((c_hi, hi))
+        ranges = out
+    return ranges
+
+
 def write_payload(number: int, first: int, items: array) -> bytes:
     return WRITE + _WRITE.pack(number, first, len(items)) + items.tobytes()
 
 
 def mask_payload(number: int, index: int, and_mask: int, or_mask: int) -> bytes:
-    return MASK + _MASK.pack(number, index, and_mask & 0xFFFF, or_mask & 0xFFFF)
+    full = (1 << 64) - 1
+    return MASK + _MASK.pack(number, index, and_mask & full, or_mask & full)
 
+
+def group_payload(writes: list[bytes]) -> bytes:
+    """Several WRITE payloads applied together at one input point, or none
+    of them (a structure a client writes whole)."""
+    return GROUP + b"".join(_PART.pack(len(w)) + w for w in writes)
+
+
+def masked(old: int, and_mask: int, or_mask: int, bits: int) -> int:
+    """``(old & and_mask) | or_mask`` on an item of ``bits`` bits, signed as it is stored."""
+    full = (1 << bits) - 1
+    new = ((old & full) & and_mask | or_mask) & full
+    return new - (1 << bits) if new >> (bits - 1) else new
 
 class EnipProtocol(Protocol):
     name = "ENIPS"
@@ -85,11 +121,12 @@ class EnipProtocol(Protocol):
     segments = SEGMENTS
 
     def __init__(self, config: ServerConfig, slots: tuple[FileSlot, ...], identity: Identity,
-                 symbols: dict[str, str]) -> None:
+                 symbols: dict[str, str], logix=None) -> None:
         self.config = config
         self.slots = slots
         self.identity = identity
         self.symbols = symbols  # symbol name -> address text: the CIP tags the app's symbols become
+        self.logix = logix  # a Logix app's tags (logixview.LogixView): served in place of the files and symbols
         self._by_number = {s.info.number: s for s in slots}
 
     # -- the runtime's side --------------------------------------------------------------------------
@@ -106,28 +143,47 @@ class EnipProtocol(Protocol):
         writable regions again (the server checked it against the same), a
         string's LEN kept within 82."""
         tag, rest = payload[:1], payload[1:]
+        if tag == GROUP:
+            parts, at = [], 0
+            while at < len(rest):
+                (size,) = _PART.unpack_from(rest, at)
+                part = self._checked_write(rest[at + _PART.size + 1:at + _PART.size + size])
+                if part is None:
+                    return REFUSED
+                parts.append(part)
+                at += _PART.size + size
+            for slot, first, items in parts:
+                table.file(slot.info.name).data[first:first + len(items)] = items
+            return APPLIED
         if tag == WRITE:
-            number, first, count = _WRITE.unpack_from(rest)
-            slot = self._by_number.get(number)
-            if slot is None or not slot.may_write(first, count):
+            part = self._checked_write(rest)
+            if part is None:
                 return REFUSED
-            items = array(slot.typecode)
-            items.frombytes(rest[_WRITE.size:_WRITE.size + count * slot.itemsize])
-            if len(items) != count or not _string_lengths_fit(slot, first, items):
-                return REFUSED
-            table.file(slot.info.name).data[first:first + count] = items
+            slot, first, items = part
+            table.file(slot.info.name).data[first:first + len(items)] = items
             return APPLIED
         number, index, and_mask, or_mask = _MASK.unpack(rest)
         slot = self._by_number.get(number)
-        if slot is None or slot.typecode != "h" or not slot.may_write(index, 1):
+        if slot is None or slot.typecode not in MASKABLE or not slot.may_write(index, 1):
             return REFUSED
         data = table.file(slot.info.name).data
-        new = ((data[index] & 0xFFFF) & and_mask) | or_mask  # TableAccess.write_masked's rule
-        new = new - 0x10000 if new & 0x8000 else new
-        if not _string_lengths_fit(slot, index, array("h", [new])):
+        new = masked(data[index], and_mask, or_mask, slot.itemsize * 8)  # TableAccess.write_masked's rule
+        if not _string_lengths_fit(slot, index, array(slot.typecode, [new])):
             return REFUSED
         data[index] = new
         return APPLIED
+
+    def _checked_write(self, rest: bytes):
+        """A WRITE payload's (slot, first item, items), or None if it may not be applied."""
+        number, first, count = _WRITE.unpack_from(rest)
+        slot = self._by_number.get(number)
+        if slot is None or not slot.may_write(first, count):
+            return None
+        items = array(slot.typecode)
+        items.frombytes(rest[_WRITE.size:_WRITE.size + count * slot.itemsize])
+        if len(items) != count or not _string_lengths_fit(slot, first, items):
+            return None
+        return slot, first, items
 
     # -- the server process's side -------------------------------------------------------------------
     def handler(self, server):

@@ -19,9 +19,11 @@ import struct
 
 from ...cip import status as st
 from .access import TableAccess
+from .logixtags import LogixCatalogue, StructTarget, read_struct, write_struct
+from .logixview import LogixView
 from .objects import REPLY, CipObject, CipReply, CipRequest
-from .tagnames import (INT, ST_ITEMS, STRING_BYTES, STRING_CHARS, STRUCT, UNIT_BYTES, UNIT_FORMATS, Catalogue,
-                       PathError, Target, parse_path)
+from .tagnames import (BOOL, DINT, INT, LINT, SINT, ST_ITEMS, STRING_BYTES, STRING_CHARS, STRUCT, UNIT_BYTES,
+                       UNIT_FORMATS, Catalogue, PathError, Target, parse_path)
 
 READ_TAG, WRITE_TAG, RMW_TAG = 0x4C, 0x4D, 0x4E
 READ_FRAGMENTED, WRITE_FRAGMENTED = 0x52, 0x53
@@ -40,6 +42,11 @@ EXT_TYPE_MISMATCH = 0x2107
 # more fragments).
 REPLY_BYTES = 480
 BASE_TAG_BIT = 1 << 26
+# Bits of one item by the file type letters; a word (16) for the others.
+ITEM_BITS = {"SI": 8, "L": 32, "LI": 64}
+# A Read-Modify-Write's mask size (bytes) for each integer type, and its format.
+MASK_SIZES = {SINT: (1, "B"), INT: (2, "H"), DINT: (4, "I"), LINT: (8, "Q")}
+WRITES = (0x4D, 0x53, 0x4E)
 
 
 class TagServices(CipObject):
@@ -47,33 +54,50 @@ class TagServices(CipObject):
 
     class_id = None
 
-    def __init__(self, symbols: dict[str, str] | None = None, reply_bytes: int = REPLY_BYTES) -> None:
+    def __init__(self, symbols: dict[str, str] | None = None, reply_bytes: int = REPLY_BYTES,
+                 logix: LogixView | None = None) -> None:
         self.symbols = dict(symbols or {})
         self.reply_bytes = reply_bytes
+        self.logix = logix  # a Logix app's tags: served in place of the files and symbols
         self._catalogue: tuple[tuple, Catalogue] | None = None  # (the files it was built on, it)
 
-    def catalogue(self, access: TableAccess) -> Catalogue:
+    def catalogue(self, access: TableAccess) -> Catalogue | LogixCatalogue:
         """The tags of ``access``'s table, built again only when its files
         change (a file grown, one added): not at every request."""
         files = tuple(access.files())
         if self._catalogue is None or self._catalogue[0] != files or self._catalogue[1].access is not access:
-            self._catalogue = (files, Catalogue(access, self.symbols))
+            made = LogixCatalogue(access, self.logix) if self.logix is not None else Catalogue(access, self.symbols)
+            self._catalogue = (files, made)
         return self._catalogue[1]
 
     async def serve(self, request: CipRequest, access: TableAccess) -> CipReply:
         catalogue = self.catalogue(access)
         try:
-            target = catalogue.target(parse_path(request.path))
+            segments = parse_path(request.path)
+            if ("class", SYMBOL_CLASS) in segments[1:2]:  # Program:Name, then the Symbol object: a program's symbols
+                return await symbol_request(self, request, access, segments)
+            target = catalogue.target(segments)
         except PathError as e:
             return CipReply.error(request, e.status)
         return await self.serve_target(request, access, target)
 
-    async def serve_target(self, request: CipRequest, access: TableAccess, target: Target) -> CipReply:
+    async def serve_target(self, request: CipRequest, access: TableAccess, target) -> CipReply:
         handler = {READ_TAG: self._read, READ_FRAGMENTED: self._read, WRITE_TAG: self._write,
                    WRITE_FRAGMENTED: self._write, RMW_TAG: self._rmw}.get(request.service)
         if handler is None:
             return CipReply.error(request, st.SERVICE_NOT_SUPPORTED)
         try:
+            if isinstance(target, StructTarget):  # a Logix structure, whole
+                catalogue = self.catalogue(access)
+                if request.service in (READ_TAG, READ_FRAGMENTED):
+                    return await read_struct(request, access, target, catalogue, self.reply_bytes)
+                if request.service == RMW_TAG:
+                    return CipReply.error(request, st.GENERAL_ERROR, EXT_TYPE_MISMATCH)
+                return await write_struct(request, access, target, catalogue)
+            if not isinstance(target, Target):  # a Logix tag's value and its External Access
+                if request.service in WRITES and target.access != "rw":
+                    return CipReply.error(request, st.PRIVILEGE_VIOLATION)
+                target = target.target
             return await handler(request, access, target)
         except (struct.error, IndexError):
             return CipReply.error(request, st.NOT_ENOUGH_DATA)
@@ -132,7 +156,8 @@ class TagServices(CipObject):
             mask = 1 << target.bit
             if not access.writable(target.file, target.item, 1):
                 return CipReply.error(request, st.PRIVILEGE_VIOLATION)
-            ok = await access.write_masked(target.file, target.item, 0xFFFF & ~mask, mask if payload[0] else 0)
+            full = (1 << ITEM_BITS.get(target.kind, 16)) - 1
+            ok = await access.write_masked(target.file, target.item, full & ~mask, mask if payload[0] else 0)
             return _done(request, ok)
         try:
             items = _decode_units(target, payload, units)
@@ -148,10 +173,11 @@ class TagServices(CipObject):
         size = struct.unpack_from("<H", data, 0)[0]
         if len(data) < 2 + 2 * size:
             return CipReply.error(request, st.NOT_ENOUGH_DATA)
-        if target.ctype != INT or size != 2:
-            # masks for a 16-bit word only: the table's masked write is one word's
+        width = MASK_SIZES.get(target.ctype) if target.bit is None else None
+        if width is None or size != width[0]:
+            # masks of the target's own integer width: the table's masked write is one item's
             return CipReply.error(request, st.GENERAL_ERROR, EXT_TYPE_MISMATCH)
-        or_mask, and_mask = struct.unpack_from("<HH", data, 2)
+        or_mask, and_mask = struct.unpack_from(f"<{width[1]}{width[1]}", data, 2)
         if not access.writable(target.file, target.item, 1):
             return CipReply.error(request, st.PRIVILEGE_VIOLATION)
         return _done(request, await access.write_masked(target.file, target.item, and_mask, or_mask))
@@ -203,73 +229,96 @@ def _decode_units(target: Target, payload: bytes, units: int) -> list:
 class SymbolObject(CipObject):
     """Class 0x6B: Get_Instance_Attribute_List (the tag browse of pylogix's
     GetTagList and pycomm3's get_tag_list) and the tag services addressed
-    by symbol instance (pycomm3 at revision 21 and later)."""
+    by symbol instance (pycomm3 at revision 21 and later). A path that
+    starts with ``Program:Name`` names that program's symbols (a Logix
+    app's; the data table's tags have no program)."""
 
     class_id = SYMBOL_CLASS
 
-    def __init__(self, symbols: dict[str, str] | None = None, reply_bytes: int = REPLY_BYTES) -> None:
-        self.tags = TagServices(symbols, reply_bytes)
+    def __init__(self, symbols: dict[str, str] | None = None, reply_bytes: int = REPLY_BYTES,
+                 logix: LogixView | None = None) -> None:
+        self.tags = TagServices(symbols, reply_bytes, logix)
         self.reply_bytes = reply_bytes
 
     async def serve(self, request: CipRequest, access: TableAccess) -> CipReply:
-        catalogue = self.tags.catalogue(access)
         try:
             segments = parse_path(request.path)
         except PathError as e:
             return CipReply.error(request, e.status)
-        # a program-scope prefix (Program:Name) names no program here
+        return await symbol_request(self.tags, request, access, segments)
+
+
+async def symbol_request(tags: TagServices, request: CipRequest, access: TableAccess, segments: list) -> CipReply:
+    """A request to the Symbol object: the browse, or a tag service on a
+    symbol instance; after ``Program:Name``, of that program's symbols."""
+    catalogue = tags.catalogue(access)
+    scope = None
+    try:
         if segments and segments[0][0] == "name":
-            return CipReply.error(request, st.PATH_DESTINATION_UNKNOWN)
+            if not isinstance(catalogue, LogixCatalogue):
+                return CipReply.error(request, st.PATH_DESTINATION_UNKNOWN)
+            scope = catalogue.scope_of(str(segments[0][1]))
+            segments = segments[1:]
         segments = [s for s in segments if s[0] != "class"]
         if request.service == GET_INSTANCE_ATTRIBUTE_LIST:
             first = segments[0][1] if segments and segments[0][0] == "instance" else 0
-            return _browse(request, catalogue, first, self.reply_bytes)
-        try:
+            return _browse(request, _entries(catalogue, scope), first, tags.reply_bytes)
+        if isinstance(catalogue, LogixCatalogue) and segments:
+            target = catalogue.resolve(segments, scope)
+        else:
             target = catalogue.target(segments)
-        except PathError as e:
-            return CipReply.error(request, e.status)
-        return await self.tags.serve_target(request, access, target)
+    except PathError as e:
+        return CipReply.error(request, e.status)
+    return await tags.serve_target(request, access, target)
+
+
+def _entries(catalogue, scope) -> list[tuple]:
+    """Each listed symbol: (name, symbol type, element bytes, dims, external
+    access code, base tag); its instance is its place in the list, from 1."""
+    if isinstance(catalogue, LogixCatalogue):
+        return catalogue.entries(scope)
+    access = catalogue.access
+    return [(t.name, t.symbol_type(), UNIT_BYTES[t.ctype], t.dims,
+             0 if access.writable(t.file.name, t.item, 1) else 2, True) for t in catalogue.tags]
 
 
 # Symbol object instance attributes a browse may ask (1756-PM020 "Symbol
 # Object"; 3 and 5 are addresses a Logix controller has and this table has
 # not: served as 0; 6, software control, has bit 26 set, which pycomm3 reads
 # as "a base tag, not an alias").
-def _attribute(tag, number: int, access: TableAccess) -> bytes | None:
+def _attribute(entry: tuple, number: int) -> bytes | None:
+    name, symbol_type, size, dims, external, base = entry
     if number == 1:
-        name = tag.name.encode("ascii")
-        return struct.pack("<H", len(name)) + name
+        text = name.encode("ascii")
+        return struct.pack("<H", len(text)) + text
     if number == 2:
-        return struct.pack("<H", tag.symbol_type())
+        return struct.pack("<H", symbol_type)
     if number in (3, 5):
         return struct.pack("<I", 0)
     if number == 6:
-        return struct.pack("<I", BASE_TAG_BIT)
+        return struct.pack("<I", BASE_TAG_BIT if base else 0)
     if number == 7:
-        return struct.pack("<H", UNIT_BYTES[tag.ctype])
+        return struct.pack("<H", size)
     if number == 8:
-        dims = list(tag.dims) + [0] * (3 - len(tag.dims))
-        return struct.pack("<3I", *dims)
-    if number == 10:  # external access: 0 read/write, 2 read only (pycomm3's EXTERNAL_ACCESS)
-        return bytes([0 if access.writable(tag.file.name, tag.item, 1) else 2])
+        return struct.pack("<3I", *(list(dims) + [0] * (3 - len(dims))))
+    if number == 10:  # external access: 0 read/write, 2 read only, 3 none (pycomm3's EXTERNAL_ACCESS)
+        return bytes([external])
     return None
 
 
-def _browse(request: CipRequest, catalogue: Catalogue, first: int, budget: int) -> CipReply:
+def _browse(request: CipRequest, entries: list[tuple], first: int, budget: int) -> CipReply:
     data = request.data
     try:
         count = struct.unpack_from("<H", data, 0)[0]
         numbers = struct.unpack_from(f"<{count}H", data, 2)
     except struct.error:
         return CipReply.error(request, st.NOT_ENOUGH_DATA)
-    access = catalogue.access
     out = bytearray()
     status = st.SUCCESS
-    for instance in range(max(first, 1), len(catalogue.tags) + 1):
-        tag = catalogue.tags[instance - 1]
+    for instance in range(max(first, 1), len(entries) + 1):
         entry = bytearray(struct.pack("<I", instance))
         for number in numbers:
-            value = _attribute(tag, number, access)
+            value = _attribute(entries[instance - 1], number)
             if value is None:
                 return CipReply.error(request, st.ATTRIBUTE_NOT_SUPPORTED)
             entry += value

@@ -1,10 +1,11 @@
 """What pycomm3's LogixDriver asks of a controller at connect besides its
 identity and tag list (docs/enips.md, "CIP tags"): the controller's program
 name (class 0x64, Rockwell KB 23341 as pycomm3 cites it) and the template
-of each structure type a tag has (Template object, class 0x6C). The only
-structure served is Logix's STRING (ST files), so the only template is its:
+of each structure type a tag has (Template object, class 0x6C). The data
+table's only structure is Logix's STRING (ST files), whose template is
 DINT LEN at offset 0 and SINT[82] DATA at offset 4, 88 bytes, which pycomm3
-recognises as a string by those two member names and types.
+recognises as a string by those two member names and types; a Logix app
+adds its structure types' (logixview.py).
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import struct
 from ...cip import status as st
 from .access import TableAccess
 from .objects import REPLY, CipObject, CipReply, CipRequest
+from .logixview import LogixView
 from .tagnames import DINT, SINT, STRING_BYTES, STRING_CHARS, STRING_HANDLE
 from .tags import EXT_OFFSET_OUT_OF_RANGE, REPLY_BYTES
 
@@ -39,38 +41,49 @@ DEFINITION_WORDS = (len(STRING_TEMPLATE) + 23) // 4
 class TemplateObject(CipObject):
     """Class 0x6C: Get_Attribute_List (attributes 1 handle, 2 member count,
     4 definition size, 5 structure size) and Read (0x4C: UDINT offset, UINT
-    byte count) of the STRING template, instance 0x0FCE. Attribute 3 is
-    served as a UINT (the handle again): pylogix asks 4, 3, 2, 1 and finds
-    the member count where a 2-byte attribute 3 puts it."""
+    byte count) of each template: STRING's, instance 0x0FCE, and a Logix
+    app's structure types'. Attribute 3 is served as a UINT (the handle
+    again): pylogix asks 4, 3, 2, 1 and finds the member count where a
+    2-byte attribute 3 puts it."""
 
     class_id = 0x6C
 
+    def __init__(self, logix: LogixView | None = None) -> None:
+        # instance -> (handle, member count, structure bytes, definition)
+        self.templates = {STRING_HANDLE: (STRING_HANDLE, 2, STRING_BYTES, STRING_TEMPLATE)}
+        for instance, t in (logix.templates.items() if logix is not None else ()):
+            self.templates[instance] = (t.handle, len(t.members), t.size, t.definition())
+
     async def serve(self, request: CipRequest, access: TableAccess) -> CipReply:
         instance = request.logical[1] if request.logical else None
-        if instance != STRING_HANDLE:
+        template = self.templates.get(instance)
+        if template is None:
             return CipReply.error(request, st.PATH_DESTINATION_UNKNOWN)
+        definition = template[3]
         try:
             if request.service == GET_ATTRIBUTE_LIST:
-                return _attributes(request)
+                return _attributes(request, template)
             if request.service == READ_TEMPLATE:
                 offset, count = struct.unpack_from("<IH", request.data)
-                if offset >= len(STRING_TEMPLATE):
+                if offset >= len(definition):
                     return CipReply.error(request, st.GENERAL_ERROR, EXT_OFFSET_OUT_OF_RANGE)
-                end = min(len(STRING_TEMPLATE), offset + count)
+                end = min(len(definition), offset + count)
                 status = st.SUCCESS
                 if end - offset > REPLY_BYTES:
                     end, status = offset + REPLY_BYTES, st.PARTIAL_TRANSFER
-                return CipReply(request.service | REPLY, status, (), STRING_TEMPLATE[offset:end])
+                return CipReply(request.service | REPLY, status, (), definition[offset:end])
         except struct.error:
             return CipReply.error(request, st.NOT_ENOUGH_DATA)
         return CipReply.error(request, st.SERVICE_NOT_SUPPORTED)
 
 
-def _attributes(request: CipRequest) -> CipReply:
+def _attributes(request: CipRequest, template: tuple) -> CipReply:
+    handle, members, size, definition = template
     count = struct.unpack_from("<H", request.data)[0]
     numbers = struct.unpack_from(f"<{count}H", request.data, 2)
-    values = {1: struct.pack("<H", STRING_HANDLE), 2: struct.pack("<H", 2), 3: struct.pack("<H", STRING_HANDLE),
-              4: struct.pack("<I", DEFINITION_WORDS), 5: struct.pack("<I", STRING_BYTES)}
+    words = (len(definition) + 23) // 4
+    values = {1: struct.pack("<H", handle), 2: struct.pack("<H", members), 3: struct.pack("<H", handle),
+              4: struct.pack("<I", words), 5: struct.pack("<I", size)}
     out = bytearray(struct.pack("<H", count))
     for number in numbers:
         if number in values:
