@@ -106,3 +106,44 @@ def test_goldens_show_the_tank_line_by_name():
         assert "Batches.DN" in text and "Running" in text and "B10/" not in text
     text = (GOLDENS / "tank_line-120x40.txt").read_text(encoding="utf-8")
     assert "|. . . . . PRE 3 ACC 1|" in text and "Tanks[Active].Drain" in text and "Active=1 XOR 1" in text
+
+
+def test_the_tag_monitor_lists_tags_and_opens_structures_and_arrays(session):
+    for _ in range(150):
+        session.scan()
+    session.show_file("")
+    assert session.message.startswith("tags: name a structure or an array to open it")
+    text = "\n".join(_screen(session, 100, 24))
+    assert " tags  13 tags  radix decimal  1..13" in text
+    rows = {line.split()[0]: line.split()[1:] for line in text.splitlines()[3:-1] if line.strip()}
+    assert rows["Running"] == ["BOOL", "1"] and rows["Tanks"] == ["Tank[2]"]
+    assert rows["SettleTimer"] == ["TIMER", "{...}"] and rows["Banner"] == ["STRING", '"idle"']
+    assert rows["LineDone"] == ["BOOL", "0", "->", "Batches.DN"]  # an alias, its target's value
+    assert rows["Program:MainProgram.Overview"] == ["REAL", "20.0"]
+    session.show_file("Tanks")
+    text = "\n".join(_screen(session, 100, 24))
+    assert "Tanks[0]  Tank  {...}" in text and "Tanks[1]  Tank  {...}" in text
+    session.show_file("Tanks[0]")
+    lines = _screen(session, 100, 24)
+    members = [line.split() for line in lines[3:8]]
+    assert members == [["Tanks[0].Fill", "BOOL", "0"], ["Tanks[0].Drain", "BOOL", "1"],
+                       ["Tanks[0].Level", "REAL", "40.0"], ["Tanks[0].Setpoint", "REAL", "40.0"],
+                       ["Tanks[0].Fills", "DINT", "0"]]  # the hidden host of Fill and Drain left out
+    session.show_file("SettleTimer")
+    acc = session.engine.table.read(session.app.program.symbols.resolve_path("SettleTimer.ACC"))
+    assert f"SettleTimer.ACC  DINT  {acc}" in "\n".join(_screen(session, 100, 24))
+    session.scan()  # the values are the table's at each drawing
+    assert f"SettleTimer.ACC  DINT  {acc + 10}" in "\n".join(_screen(session, 100, 24))
+    session.cycle_radix()
+    assert session.message == "SettleTimer: radix hex (REAL values show in decimal)"
+    assert f"SettleTimer.PRE  DINT  {2000:08X}" in "\n".join(_screen(session, 100, 24))
+
+
+def test_the_monitor_still_shows_data_files_and_says_what_it_expected(session):
+    session.show_file("F12")
+    assert session.message.startswith("data file F12:")
+    assert "F12:0" in "\n".join(_screen(session, 100, 24))
+    session.show_file("Tanks[7]")
+    assert session.message.startswith("Tanks[7]: ") and "expected a tag (Tanks, Tanks[1]" in session.message
+    session.close_panels()
+    assert session.grid is None

@@ -143,6 +143,15 @@ class Naming:
             return pfile.name
         return f"{pfile.number} {pfile.name}" if pfile.name else str(pfile.number)
 
+    def tag_grid(self, table, text: str):
+        """The tag monitor ``d TEXT`` shows in a Logix app (tagbrowser.py);
+        None when TEXT names no tag (or the app is not a Logix app)."""
+        if self.operands is None:
+            return None
+        from .tagbrowser import tag_grid_for
+
+        return tag_grid_for(self.app.program.symbols.directory, table, text)
+
     @property
     def what_files(self) -> tuple[str, str]:
         """The shown file's title and the list's: a Logix app's files are routines."""

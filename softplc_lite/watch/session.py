@@ -289,19 +289,25 @@ class WatchSession:
         self.message = f"{f.title} {f.current + 1} of {len(f.uses)}: {f.uses[f.current].describe()}"
 
     def show_file(self, text: str) -> None:
-        """Show a data file as a grid (``N7``, or ``N7:20`` from element 20)."""
+        """Show a data file as a grid (``N7``, or ``N7:20`` from element 20);
+        a Logix app's tags by name (tagbrowser.py) when ``text`` is empty, ``tags``
+        or a tag path."""
         try:
-            self.grid = grid_for(self.engine.table, text)
+            tags = self.naming.tag_grid(self.engine.table, text)
+            self.grid = tags or grid_for(self.engine.table, text)
         except DataTableError as e:
             self.message = str(e)
             return
-        self.message = f"data file {self.grid.file.name}: R radix, PgUp/PgDn page, Esc closes"
+        self.message = tags.opened() if tags else f"data file {self.grid.file.name}: R radix, PgUp/PgDn page, Esc closes"
 
     def cycle_radix(self) -> None:
         if self.grid is None:
             self.message = "R is the data-file grid's radix: d shows a data file"
             return
         self.grid.radix = next_radix(self.grid.radix)
+        if hasattr(self.grid, "radix_said"):  # the tag monitor
+            self.message = self.grid.radix_said()
+            return
         floats = " (an F file shows floats in any radix)" if self.grid.file.ftype.letter == "F" else ""
         self.message = f"data file {self.grid.file.name}: radix {self.grid.radix}{floats}"
 
