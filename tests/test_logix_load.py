@@ -160,3 +160,29 @@ def test_the_shipped_exports_run_the_same_on_both_executors(tmp_path, export):
         assert (pair[0].engine.fault is None) == (pair[1].engine.fault is None)
     for r in pair:
         r.close()
+
+
+def test_logix_own_types_in_an_export_and_a_date_time_lint(tmp_path):
+    """Studio writes Logix's own types into some exports (ProductDefined:
+    STRING with its members, UINT with none): the predefined layout stands,
+    a type with no members is not held (its tags not laid out, a warning),
+    and a LINT's DT# value is its microseconds since 1970."""
+    from helpers.logix_l5x import Prog, Task, l5x_text
+
+    text = l5x_text([("Stamp", "LINT"), ("Count", "UINT"), ("Name", "STRING")],
+                    [Prog("P", {"Main": ["NOP();"]})], [Task("T", ["P"])])
+    text = text.replace("<DataTypes/>", '<DataTypes><DataType Name="STRING" Family="StringFamily" '
+                        'Class="ProductDefined"><Members><Member Name="LEN" DataType="DINT" Dimension="0"/>'
+                        '<Member Name="DATA" DataType="SINT" Dimension="82"/></Members></DataType>'
+                        '<DataType Name="UINT" Family="NoFamily" Class="ProductDefined"/></DataTypes>')
+    text = text.replace('<Tag Name="Stamp" TagType="Base" DataType="LINT" Constant="false" ExternalAccess="Read/Write"/>',
+                        '<Tag Name="Stamp" TagType="Base" DataType="LINT" Radix="Date/Time" Constant="false" '
+                        'ExternalAccess="Read/Write"><Data Format="Decorated"><DataValue DataType="LINT" '
+                        'Radix="Date/Time" Value="DT#2022-02-22-06:00:00.000_250Z"/></Data></Tag>')
+    path = tmp_path / "types.L5X"
+    path.write_text(text, encoding="utf-8")
+    app = load_app(path)
+    assert any("tag Count: data type UINT is not one softplc_lite holds yet" in w for w in app.warnings)
+    r = Runner(app, RunOptions(fresh=True, save_state=False))
+    assert r.table.read(app.program.symbols.resolve_path("Stamp")) == 1_645_509_600_000_250
+    r.close()

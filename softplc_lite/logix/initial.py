@@ -10,6 +10,9 @@ format"). An array's elements come in row-major order, flat or nested.
 
 from __future__ import annotations
 
+import re
+from datetime import datetime, timezone
+
 from .model import InitialValue, Problem
 from .tags import WORD_BITS, Declared, Leaf
 from .types import LogixType, MemberType
@@ -36,6 +39,27 @@ class ValueWriter:
             cells[item] = value
 
 
+_DATE_TIME = re.compile(r"(?:L?DT)#(\d{4})-(\d\d)-(\d\d)-(\d\d):(\d\d):(\d\d)(?:\.([\d_]+))?Z$", re.IGNORECASE)
+
+
+def date_time(text: str) -> int | None:
+    """A LINT's date-and-time value (``DT#2022-02-22-06:00:00.000_000Z``, the
+    form exports write with the Date/Time radix) as the microseconds since
+    1970-01-01 UTC Logix holds (1756-PM020, "LINT ... Date/Time"); None if
+    the text is not one."""
+    m = _DATE_TIME.match(text.strip())
+    if not m:
+        return None
+    year, month, day, hour, minute, second, fraction = m.groups()
+    try:
+        moment = datetime(int(year), int(month), int(day), int(hour), int(minute), int(second), tzinfo=timezone.utc)
+    except ValueError:
+        return None
+    digits = (fraction or "").replace("_", "")
+    micros = int((digits + "000000")[:6]) if digits else 0
+    return int(moment.timestamp()) * 1_000_000 + micros
+
+
 def _flat(value) -> list:
     if isinstance(value, list):
         out = []
@@ -59,6 +83,12 @@ def apply_initial(d: Declared, writer: ValueWriter, problems: list[Problem]) -> 
         leaf = d.leaves.get(path)
         if leaf is None:
             return
+        if isinstance(value, str) and value.upper().startswith("DT#") and t.name == "LINT":
+            stamp = date_time(value)
+            if stamp is None:
+                bad(f"{value!r}: expected DT#YYYY-MM-DD-hh:mm:ss.ffffffZ")
+                return
+            value = stamp
         if isinstance(value, str) and t.name != "BOOL":
             bad(f"{value!r} is not a number for a {t.name}")
             return

@@ -88,8 +88,9 @@ def translate_rung(rung: model.Rung, ctx: RoutineContext) -> Rung | None:
     out = _series(elements, rung, ctx)
     if len(ctx.problems) > before:
         return None
-    if ctx.skip:  # kept in its place, running nothing (rung numbers stay the export's)
-        out = [Instruction("NOP", [], rung.pos)]
+    if ctx.skip:  # kept in its place, running nothing (rung numbers stay the export's), its label kept
+        label = out[:1] if out and isinstance(out[0], Instruction) and out[0].mnemonic == "LBL" else []
+        out = label + [Instruction("NOP", [], rung.pos)]
     elif not out:
         out = [Instruction("NOP", [], rung.pos)]  # an empty rung of the export: Logix takes it, the ladder NOP
     return Rung(out, rung.comment, rung.pos)

@@ -124,8 +124,16 @@ class TypeSystem:
     def add_data_types(self, data_types: list[DataType]) -> None:
         pending = {d.name.upper(): d for d in data_types}
         for d in data_types:
-            if d.name.upper() in PREDEFINED:
-                self.problems.append(Problem(d.pos, f"data type {d.name} has the name of a predefined type"))
+            if not d.members:
+                # No members: a type of Logix's own that the export names (Studio writes them as
+                # ProductDefined: BOOL, TIMER, UINT ...), not a definition: the predefined one stands,
+                # and one softplc_lite does not hold is not held.
+                pending.pop(d.name.upper(), None)
+                if d.name.upper() not in PREDEFINED:
+                    self.held_not[d.name.upper()] = f"data type {d.name} is not one softplc_lite holds yet"
+            elif d.name.upper() in PREDEFINED:
+                # Logix's own definition of a predefined type (Studio may write it, as ProductDefined):
+                # softplc_lite's layout of it stands (no user type may take a predefined type's name).
                 pending.pop(d.name.upper(), None)
         resolving: list[str] = []
 
