@@ -243,3 +243,20 @@ def test_lper_is_true_once_per_period_ended_and_a_false_rung_unschedules_it(exec
     assert e.table.read("N7:0") == 4 and e.table.read("L9:1") == 225
     e.run(1)
     assert e.table.read("N7:0") == 5
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_a_restored_run_keeps_the_counts_and_schedules_its_tasks_anew(tmp_path, executor):
+    path = counting_export(tmp_path, Task("Every50", ["Fast"], kind="PERIODIC", rate_ms=50))
+    state = tmp_path / "state"
+    for run in range(2):
+        app = load_app(path, state_dir=state)
+        r = Runner(app, RunOptions(executor=executor, fresh=run == 0), log=lambda m: None)
+        r.engine.table.write(obj(r, "Program", "Main", "DisableFlag"), run)  # Scans keeps the first run's 100
+        r.run(100)
+        r.close()
+        r.save()
+    # The second run's clock starts again from 0: a schedule kept from the first run's clock would
+    # catch up nothing or everything; anew, it runs 20 more times.
+    assert (tag(r, "FastRuns"), tag(r, "Scans")) == (40, 100)
+    assert r.engine.table.read(obj(r, "Task", "Every50", "OverlapCount")) == 0

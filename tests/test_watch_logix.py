@@ -147,3 +147,9 @@ def test_the_monitor_still_shows_data_files_and_says_what_it_expected(session):
     assert session.message.startswith("Tanks[7]: ") and "expected a tag (Tanks, Tanks[1]" in session.message
     session.close_panels()
     assert session.grid is None
+
+
+def test_the_view_starts_at_the_continuous_tasks_first_routine_not_a_periodic_tasks_file(tmp_path):
+    app = load_app(ROOT / "programs" / "logix" / "dosing.L5X", tmp_path)
+    first = Naming(app).first_file(sorted(app.program.files))
+    assert app.program.files[first].name == "MainProgram.MainRoutine"

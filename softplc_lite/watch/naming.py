@@ -160,12 +160,13 @@ class Naming:
     def first_file(self, files: list[int]) -> int | None:
         """The file shown at start: the main file (2); for a Logix app the
         routine the continuous task runs first, where its rungs are (a
-        choice: file 2 holds only the task's JSRs)."""
+        choice: file 2 holds only the tasks' JSRs)."""
         program = self.app.program
         if self.operands is not None and MAIN_FILE in program.files:
             for rung in program.files[MAIN_FILE].rungs:
                 for el in rung.elements:
                     target = getattr(el, "operands", [None])[0] if getattr(el, "mnemonic", None) == "JSR" else None
-                    if target is not None and getattr(target, "value", None) in files:
-                        return target.value
+                    number = getattr(target, "value", None)
+                    if number in files and self.operands.routine_of(number) is not None:  # not a periodic task's file
+                        return number
         return MAIN_FILE if MAIN_FILE in files else files[0] if files else None
