@@ -27,3 +27,34 @@ def test_files_reads_and_writes_on_a_table():
         assert "past its end" in str(e)
     else:
         raise AssertionError("a read past the end must raise")
+
+
+def test_masked_writes_keep_each_items_width_and_a_group_lands_whole():
+    """What a Logix app's bit writes and structure writes need of the
+    image's protocol (protocol.py): a masked write of an 8-, 32- or 64-bit
+    item, and several writes applied at one input point, or none."""
+    from array import array
+
+    from softplc_lite.netserver import APPLIED, REFUSED
+    from softplc_lite.tlm.enips.config import ServerConfig
+    from softplc_lite.tlm.enips.identity import Identity
+    from softplc_lite.tlm.enips.protocol import EnipProtocol, build_slots, group_payload, mask_payload, write_payload
+
+    t = DataTable()
+    for letter, number in (("SI", 10), ("L", 11), ("LI", 12), ("F", 13)):
+        t.create_file(letter, number, 4)
+    opened = {"SI10": [(0, 4)], "L11": [(0, 4)], "LI12": [(0, 2)], "F13": [(0, 4)]}
+    slots = build_slots(t, ServerConfig(), opened, {"F13": [(2, 3)]})
+    protocol = EnipProtocol(ServerConfig(), slots, Identity("X"), {})
+    assert protocol.apply(mask_payload(11, 1, ~(1 << 31), 1 << 31), t) == APPLIED and t.read("L11:1") == -2 ** 31
+    assert protocol.apply(mask_payload(10, 0, 0xFF, 0x80), t) == APPLIED and t.read("SI10:0") == -128
+    assert protocol.apply(mask_payload(12, 1, -1, 1 << 40), t) == APPLIED and t.read("LI12:1") == 2 ** 40
+    assert protocol.apply(mask_payload(12, 3, -1, 1), t) == REFUSED  # past the opened items
+    assert protocol.apply(mask_payload(13, 0, -1, 1), t) == REFUSED  # a float has no bits to mask
+    good = write_payload(11, 2, array("i", [7, 8]))
+    assert protocol.apply(group_payload([good, write_payload(13, 2, array("f", [1.0]))]), t) == REFUSED
+    assert t.read("L11:2") == 0  # F13:2 is closed: nothing of the group is applied
+    assert protocol.apply(group_payload([good, write_payload(13, 3, array("f", [1.0]))]), t) == APPLIED
+    assert (t.read("L11:2"), t.read("L11:3"), t.read("F13:3")) == (7, 8, 1.0)
+    access = TableAccessOnTable(t, writable={"L11"})
+    assert asyncio.run(access.write_masked("L11", 0, -1, 1 << 30)) and t.read("L11:0") == 1 << 30

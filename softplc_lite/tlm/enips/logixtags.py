@@ -230,7 +230,8 @@ def _walk(cat: LogixCatalogue, tag: LogixTag, rest: list):
             while rest and rest[0][0] == "index":
                 indexes.append(rest.pop(0)[1])
             if not dims or len(indexes) != len(dims):
-                raise PathError(PATH_SEGMENT_ERROR, f"{tag.name}: {len(indexes)} index(es) for {len(dims)} dimension(s)")
+                raise PathError(PATH_SEGMENT_ERROR,
+                                f"{tag.name}: {len(indexes)} index(es) for {len(dims)} dimension(s)")
             k = 0
             for i, size in zip(indexes, dims):
                 if i >= size:

@@ -76,7 +76,8 @@ class EnipServer(NetServerModule):
         if problems:
             raise ModuleErrors(problems)
         self.closed = closed_ranges(self.logix)
-        return list(self.config.warnings)
+        return list(self.config.warnings) + [f"{config_path}: tag {why}: not served to clients"
+                                             for why in self.logix.skipped]
 
     def config_references(self) -> list:
         return config_references(self.config)
