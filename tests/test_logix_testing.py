@@ -101,3 +101,15 @@ def test_mutation_judges_the_exports_rungs(tmp_path):
     assert report.count(KILLED) >= 30 and report.count(SURVIVED) == 0
     # every mutant is killed by a failed expectation, never by an error of the runner
     assert all("Error:" not in o.detail for _, o in report.with_status(KILLED))
+
+
+def test_coverage_annotates_the_export_itself(tmp_path):
+    export = _export(tmp_path, 'scenario "started":\n    set Start = 1\n    run 300 ms\n')
+    out = tmp_path / "cover"
+    r = softplc_here("test", str(export), "--coverage-annotate", str(out))
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert [p.name for p in out.iterdir()] == ["tank_line.L5X.cover"]  # not the continuous task's <generated>
+    lines = (out / "tank_line.L5X.cover").read_text(encoding="utf-8").splitlines()
+    settle = next(k for k, line in enumerate(lines) if "TON(SettleTimer,?,?)" in line)
+    assert lines[settle].startswith("! <![CDATA[XIC(Tanks[Active].Drain)")
+    assert lines[settle + 1].strip() == "^ rung never true"  # 30 scans: tank 0 is not full yet

@@ -17,6 +17,8 @@ from softplc_lite.watch.naming import Naming
 from softplc_lite.watch.session import WatchOptions, WatchSession
 from softplc_lite.watch.snapshot import render
 
+from helpers.cli import softplc_here
+
 ROOT = Path(__file__).resolve().parent.parent
 TANK_LINE = ROOT / "programs" / "logix" / "tank_line.L5X"
 GOLDENS = Path(__file__).resolve().parent / "data" / "watch"
@@ -153,3 +155,42 @@ def test_the_view_starts_at_the_continuous_tasks_first_routine_not_a_periodic_ta
     app = load_app(ROOT / "programs" / "logix" / "dosing.L5X", tmp_path)
     first = Naming(app).first_file(sorted(app.program.files))
     assert app.program.files[first].name == "MainProgram.MainRoutine"
+
+
+def test_the_doc_shows_the_golden_view():
+    """docs/logix.md shows the text of its --snapshot example: the tank line's 80x24 golden (the
+    console example beside it, run by test_docs.py, is the same view: test_watch_snapshots.py)."""
+    doc = (ROOT / "docs" / "logix.md").read_text(encoding="utf-8")
+    shown = doc.split("`/tmp/tank_line-watch.txt` then holds:", 1)[1].split("```text\n", 1)[1].split("```", 1)[0]
+    assert shown == (GOLDENS / "tank_line-80x24.txt").read_text(encoding="utf-8")
+
+
+def test_the_cli_snapshot_is_the_golden_view(tmp_path):
+    out = tmp_path / "view.txt"
+    r = softplc_here("watch", "programs/logix/tank_line.L5X", "--fresh", "--scans", "300", "--set", "Start=1",
+                     "--watch", "Tanks[0].Level", "--watch", "Tanks[1].Level", "--watch", "Batches.ACC",
+                     "--snapshot", str(out), "--width", "80", "--height", "24")
+    assert r.returncode == 0, r.stderr
+    text = "".join(line.rstrip() + "\n" for line in out.read_text(encoding="utf-8").splitlines())
+    assert text == (GOLDENS / "tank_line-80x24.txt").read_text(encoding="utf-8")
+
+
+def test_break_when_find_set_and_force_take_tag_paths(tmp_path):
+    app = load_app(TANK_LINE, tmp_path / "state")
+    s = WatchSession(app, WatchOptions(run=RunOptions(fresh=True), break_when=("Batches.ACC >= 1",),
+                                       forces=("Stop=0",), online=False))
+    try:
+        s.find("SettleTimer.DN")
+        assert s.message.startswith("SettleTimer.DN (L15:1/29) 1 of 2: file 3 rung 2")
+        s.set_value("Start = 1")
+        assert s.message == "set Start = 1"
+        hit = None
+        for _ in range(400):
+            hit = s.scan()
+            if hit is not None:
+                break
+        assert hit is not None and s.engine.scans == 281  # 80 scans filling, 200 settling, one to count
+        assert s.message == "break: Batches.ACC >= 1 became true at scan 281"
+        assert (s.file, s.selected) == (3, 2)  # the break is shown in its routine
+    finally:
+        s.quit()

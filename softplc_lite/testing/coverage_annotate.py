@@ -100,6 +100,8 @@ def annotate(cov: Coverage, directory: str | Path) -> list[Path]:
     directory.mkdir(parents=True, exist_ok=True)
     written = []
     for source in sorted({os.path.abspath(info.source) for info in cov.files.values()}):
+        if not os.path.isfile(source):  # a file the program made itself (a Logix app's continuous task)
+            continue
         path = directory / (Path(source).name + ".cover")
         path.write_text(annotate_source(cov, source), encoding="utf-8")
         written.append(path)

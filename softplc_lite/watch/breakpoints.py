@@ -79,7 +79,9 @@ class Condition:
     def __init__(self, text: str, symbols=None) -> None:
         self.text = text
         try:
-            self.node = _resolve(parse_expression(text, Pos("--break-when", 1, 1)), symbols or {})
+            # a Logix app's symbols are an empty mapping that resolves tag paths: kept, not replaced
+            node = parse_expression(text, Pos("--break-when", 1, 1))
+            self.node = _resolve(node, symbols if symbols is not None else {})
         except LadderError as e:
             raise DataTableError(f"--break-when {quoted(text)}: {e.message if hasattr(e, 'message') else e}") from None
         for ref in address_refs(self.node):
