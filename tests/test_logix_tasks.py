@@ -232,7 +232,7 @@ def test_on_the_wall_clock_the_runs_and_overlaps_count_the_periods_that_ended(tm
 def test_lper_is_true_once_per_period_ended_and_a_false_rung_unschedules_it(executor):
     from softplc_lite.ladder import run_text
 
-    rung = "DATA L9 3\nLBL 0 XIO B3/0 LPER 25 L9:0 L9:1 L9:2 ADD N7:0 1 N7:0 JMP 0"
+    rung = "DATA L9 3\nLBL 0 XIO B3/0 LPER 25 L9:0 L9:1 L9:2 500 ADD N7:0 1 N7:0 JMP 0"
     e = run_text(rung, scans=10, executor=executor, values={"B3/0": 0})
     assert (e.table.read("N7:0"), e.table.read("L9:1"), e.table.read("L9:0")) == (4, 125, 1)
     e.table.write("B3/0", 1)
@@ -260,3 +260,27 @@ def test_a_restored_run_keeps_the_counts_and_schedules_its_tasks_anew(tmp_path, 
     # catch up nothing or everything; anew, it runs 20 more times.
     assert (tag(r, "FastRuns"), tag(r, "Scans")) == (40, 100)
     assert r.engine.table.read(obj(r, "Task", "Every50", "OverlapCount")) == 0
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_a_periodic_run_longer_than_the_tasks_watchdog_is_a_major_fault(tmp_path, executor, monkeypatch):
+    from softplc_lite.ladder.instr import logix_task
+    from softplc_lite.ladder.status import FAULT_WATCHDOG
+
+    ticks = []
+
+    def two_ms_a_reading():  # every reading of the watchdog's clock is 2 ms after the one before
+        ticks.append(None)
+        return len(ticks) * 0.002
+    monkeypatch.setattr(logix_task, "clock", two_ms_a_reading)
+    within = counting_export(tmp_path, Task("Every50", ["Fast"], kind="PERIODIC", rate_ms=50, watchdog_ms=3))
+    r = start(within, executor)
+    r.run(20)
+    assert r.engine.fault is None and tag(r, "FastRuns") == 4
+    over = counting_export(tmp_path, Task("Every50", ["Fast"], kind="PERIODIC", rate_ms=50, watchdog_ms=1))
+    r = start(over, executor)
+    r.run(20)
+    fault = r.engine.fault
+    assert fault is not None and fault.code == FAULT_WATCHDOG and (fault.file, fault.rung) == (2, 1)
+    assert "task watchdog: a run of the periodic task took 2.0 ms, more than its Watchdog of 1 ms" in fault.message
+    assert tag(r, "FastRuns") == 1 and r.engine.mode is Mode.FAULTED

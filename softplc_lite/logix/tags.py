@@ -98,7 +98,8 @@ class NotRun(PathError):
 
 _STEP = re.compile(r"\s*(?:\.\s*([A-Za-z_][A-Za-z0-9_]*|[0-9]+)|\[((?:[^\[\]]|\[[^\[\]]*\])*)\]|\.\s*\[((?:[^\[\]]|\[[^\[\]]*\])*)\])")
 _PROGRAM_SCOPED = re.compile(r"\s*Program:([A-Za-z_][A-Za-z0-9_]*)\.", re.IGNORECASE)
-_OBJECT_ATTRIBUTE = re.compile(r"(Task|Program):([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)", re.IGNORECASE)
+_OBJECT_ATTRIBUTE = re.compile(r"(Task|Program):([A-Za-z_][A-Za-z0-9_]*)\.([A-Za-z_][A-Za-z0-9_]*)",
+                               re.IGNORECASE)
 _NAME = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_]*(?::[A-Za-z0-9_]+)*)")
 
 

@@ -10,12 +10,13 @@ routines. docs/logix.md ("Tasks") says it for users; the rules:
   each program's main routine, or its only routine.
 - A periodic task is a rung at the start of file 2, in priority order (1
   highest, then the export's order): ``LBL k XIO(task inhibit)
-  LPER(rate, ctl, next, overlaps) JSR(task file) JMP(k)``. LPER
+  LPER(rate, ctl, next, overlaps, watchdog) JSR(task file) JMP(k)``. LPER
   (ladder/instr/logix_task.py) is true once for each period of the engine's
   clock that has ended since the task last ran, so the task runs as many
   times as periods have passed, before the continuous task's rungs (a
   softplc choice: Logix interrupts the continuous task when the period
-  ends, PM005 "Manage tasks"; softplc_lite's scan is not interrupted).
+  ends, PM005 "Manage tasks"; softplc_lite's scan is not interrupted). A
+  run longer than the task's Watchdog is a major fault.
 - Every program has a disable bit, every task an inhibit bit, in the data
   table, set from the export (``Disabled="true"``, ``InhibitTask="true"``)
   and settable while running: PM005's "Inhibit a program" and "Inhibit a
@@ -111,7 +112,8 @@ class Schedule:
                 p.task.programs, routine_files, None), pos)
             main.append(Rung([Instruction("LBL", [Const(label, pos)], pos), _ins("XIO", pos, p.inhibit),
                               Instruction("LPER", [Const(p.rate, pos), AddressRef(p.ctl, pos),
-                                                   AddressRef(p.next, pos), AddressRef(p.overlaps, pos)], pos),
+                                                   AddressRef(p.next, pos), AddressRef(p.overlaps, pos),
+                                                   Const(max(round(p.task.watchdog_ms), 1), pos)], pos),
                               Instruction("JSR", [Const(number, pos)], pos),
                               Instruction("JMP", [Const(label, pos)], pos)],
                              f"periodic task {p.task.name}: every {p.rate} ms, priority {p.task.priority}", pos))

@@ -26,6 +26,7 @@ class Task:
     rate_ms: int | None = None
     priority: int = 10
     inhibited: bool = False
+    watchdog_ms: int = 500
 
 
 def _tag(name: str, data_type: str) -> str:
@@ -59,7 +60,7 @@ def l5x_text(tags: list[tuple[str, str]], programs: list[Prog], tasks: list[Task
     out += ["</Programs>", "<Tasks>"]
     for t in tasks:
         rate = f' Rate="{t.rate_ms}"' if t.rate_ms is not None else ""
-        out.append(f'<Task Name="{t.name}" Type="{t.kind}"{rate} Priority="{t.priority}" Watchdog="500" '
+        out.append(f'<Task Name="{t.name}" Type="{t.kind}"{rate} Priority="{t.priority}" Watchdog="{t.watchdog_ms}" '
                    f'DisableUpdateOutputs="false" InhibitTask="{str(t.inhibited).lower()}">')
         out += ["<ScheduledPrograms>"] + [f'<ScheduledProgram Name="{escape(p)}"/>' for p in t.programs]
         out += ["</ScheduledPrograms>", "</Task>"]

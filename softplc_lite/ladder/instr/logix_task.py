@@ -2,7 +2,7 @@
 both executors run the same code. The Logix loader (logix/tasks.py) makes
 each periodic task of an export a rung of program file 2:
 
-    LBL k  XIO inhibit  LPER rate ctl next overlaps  JSR task-file  JMP k
+    LBL k  XIO inhibit  LPER rate ctl next overlaps watchdog  JSR task-file  JMP k
 
 so the task's programs run once for every period of the engine's clock
 that has ended, at the start of the scan (docs/logix.md, "Tasks"). The
@@ -22,11 +22,21 @@ and the watch view keep and show it):
 
 Rung-out: true when a period has ended (``next`` then moves on by one
 period), false otherwise.
+
+The task's watchdog: each run of the task (from LPER's true rung-out to its
+next evaluation, which follows the JSR) is timed on the wall clock, as the
+engine's scan watchdog is; a run longer than ``watchdog`` ms is a major
+fault (the scan watchdog's code), as a Logix task's watchdog faults
+(1756-PM005; major fault type 6, code 1 in 1756-PM014).
 """
 
 from __future__ import annotations
 
+import time
+
+from .. import status as S
 from ..bound import BoundInstruction
+from ..semantics import MajorFault
 from ..specs import InstructionSpec, K, OperandSpec
 
 SCHEDULED = 1  # bit 0 of ctl
@@ -34,7 +44,8 @@ MAX_RUNS = 100  # runs of one periodic task in one scan; periods beyond are over
 DINT_MAX = 2 ** 31 - 1
 
 SPECS = [InstructionSpec("LPER", "Logix periodic task due", tuple(
-    OperandSpec(n, K.ANY) for n in ("rate ms", "CTL", "next", "overlaps")), False)]
+    OperandSpec(n, K.ANY) for n in ("rate ms", "CTL", "next", "overlaps", "watchdog ms")), False)]
+clock = time.perf_counter  # the watchdog's clock (seconds); tests count with their own
 
 
 def _dint(v: int) -> int:
@@ -42,8 +53,20 @@ def _dint(v: int) -> int:
     return v - (1 << 32) if v & 0x80000000 else v
 
 
-def _periodic(rate, ctl, nxt, overlaps, machine):
+def _periodic(rate, ctl, nxt, overlaps, watchdog, machine):
+    started = [None, None]  # the wall clock when the task's run began, and that scan's count
+
     def run(c: bool) -> bool:
+        s = machine.s
+        scan = (s[S.SCAN_COUNT_LOW], s[S.SCAN_COUNT_HIGH])
+        if started[0] is not None and started[1] == scan:  # the run that LPER let in has returned
+            elapsed_ms = (clock() - started[0]) * 1000
+            limit = watchdog()
+            if elapsed_ms > limit:
+                started[0] = None
+                raise MajorFault(S.FAULT_WATCHDOG, f"task watchdog: a run of the periodic task took "
+                                                   f"{elapsed_ms:.1f} ms, more than its Watchdog of {limit} ms")
+        started[0] = None
         cd, ci, _ = ctl()
         if not c:
             cd[ci] &= ~SCHEDULED
@@ -64,14 +87,15 @@ def _periodic(rate, ctl, nxt, overlaps, machine):
             od[oi] = min(od[oi] + skipped, DINT_MAX)
             nd[ni] = _dint(nd[ni] + skipped * period)
         nd[ni] = _dint(nd[ni] + period)
+        started[0], started[1] = clock(), scan
         return True
     return run
 
 
 def _bind(instr, access):
-    rate, ctl, nxt, overlaps = instr.operands
+    rate, ctl, nxt, overlaps, watchdog = instr.operands
     return _periodic(access.value(rate), access.location(ctl), access.location(nxt), access.location(overlaps),
-                     access.machine)
+                     access.value(watchdog), access.machine)
 
 
 INSTRUCTIONS = [BoundInstruction(spec, _bind) for spec in SPECS]
