@@ -181,7 +181,7 @@ def test_break_when_find_set_and_force_take_tag_paths(tmp_path):
                                        forces=("Stop=0",), online=False))
     try:
         s.find("SettleTimer.DN")
-        assert s.message.startswith("SettleTimer.DN (L15:1/29) 1 of 2: file 3 rung 2")
+        assert s.message.startswith("SettleTimer.DN (L15:1/29) 1 of 2: MainProgram.MainRoutine rung 2")
         s.set_value("Start = 1")
         assert s.message == "set Start = 1"
         hit = None
@@ -194,3 +194,17 @@ def test_break_when_find_set_and_force_take_tag_paths(tmp_path):
         assert (s.file, s.selected) == (3, 2)  # the break is shown in its routine
     finally:
         s.quit()
+
+
+def test_the_find_list_names_routines_instructions_and_tags(session):
+    session.scan()
+    session.find("Tanks[0].Level")
+    assert session.message == ("Tanks[0].Level (F12:0) 1 of 5: MainProgram.MainRoutine rung 4  instruction 3 MOV  "
+                               "operand 2 Tanks[Active].Level  indirect write")
+    text = "\n".join(_screen(session, 80, 40))
+    assert "find Tanks[0].Level (F12:0): 5 uses, 2 writing" in text
+    assert "▶ indirect write  MainProgram.MainRoutine rung 4  MOV Tanks[Active].Level" in text
+    assert "  read            MainProgram.MainRoutine rung 5  CPT Tanks[0].Level" in text
+    assert "  indirect write  MainProgram.FillTank rung 1  ADD Tanks[Active].Level" in text
+    session.find("SettleTimer.DN")
+    assert "instruction 2 TON  operand 1 SettleTimer.CTL" in session.message  # LTON shows as TON

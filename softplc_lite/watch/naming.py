@@ -138,6 +138,14 @@ class Naming:
             names = self.by_file[number] = TagPathNames(self.operands, self.operands.scope_of(number))
         return names
 
+    def where(self, number: int) -> str:
+        """A file as a list of uses names it: ``file 3``; a Logix app's by
+        its routine (``MainProgram.FillTank``) or task."""
+        pfile = self.app.program.files.get(number)
+        if self.operands is not None and pfile is not None and pfile.name:
+            return pfile.name
+        return f"file {number}"
+
     def file_label(self, pfile) -> str:
         if self.operands is not None and pfile.name:
             return pfile.name

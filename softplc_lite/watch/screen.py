@@ -236,7 +236,7 @@ class WatchScreen:
     def side(self) -> Group:
         parts = [self.session.watch, self.forces]
         if self.session.finding is not None:  # the find list first, above the watch list
-            parts.insert(0, XrefPanel(self.session.finding, height=FIND_LINES))
+            parts.insert(0, XrefPanel(self.session.finding, height=FIND_LINES, naming=self.session.naming))
         if self.ports:
             parts.append(self.ports)
         if self.servers:

@@ -286,7 +286,7 @@ class WatchSession:
             return
         self.file = where[0]
         self.goto(where[1])
-        self.message = f"{f.title} {f.current + 1} of {len(f.uses)}: {f.uses[f.current].describe()}"
+        self.message = f"{f.title} {f.current + 1} of {len(f.uses)}: {f.uses[f.current].describe(self.naming)}"
 
     def show_file(self, text: str) -> None:
         """Show a data file as a grid (``N7``, or ``N7:20`` from element 20);

@@ -110,21 +110,32 @@ class Use:
     indirect: bool = False  # may touch the file: the word is chosen at run time, or the block's length is
     span: int = 1  # elements from the address on (a block of known length)
 
-    def describe(self) -> str:
+    def describe(self, naming=None) -> str:
         """One line: where (instruction and operand numbered from 1, as the
-        rung shows them left to right), what and how."""
-        return (f"file {self.file} rung {self.rung}  instruction {self.instruction + 1} {self.mnemonic}  "
-                f"operand {self.operand + 1} {self.address}  {self.how}")
+        rung shows them left to right), what and how. ``naming``: the view's
+        (naming.py), which names a Logix app's routines, instructions and
+        operands its way."""
+        where, mnemonic, address = self._parts(naming)
+        return (f"{where} rung {self.rung}  instruction {self.instruction + 1} {mnemonic}  "
+                f"operand {self.operand + 1} {address}  {self.how}")
+
+    def _parts(self, naming) -> tuple[str, str, str]:
+        if naming is None:
+            return f"file {self.file}", self.mnemonic, str(self.address)
+        names = naming.for_file(self.file)
+        address = (names.name(self.address) if names.replaces_address else None) or str(self.address)
+        return naming.where(self.file), names.mnemonic(self.mnemonic), address
 
     @property
     def how(self) -> str:
         """``read``, ``write``, ``read/write``, or one of them ``indirect``."""
         return "indirect " + self.access.value if self.indirect else self.access.value
 
-    def brief(self) -> str:
+    def brief(self, naming=None) -> str:
         """Where, short, for a narrow list (the how goes first there):
         ``file 2 rung 3  OTL B3/0``."""
-        return f"file {self.file} rung {self.rung}  {self.mnemonic} {self.address}"
+        where, mnemonic, address = self._parts(naming)
+        return f"{where} rung {self.rung}  {mnemonic} {address}"
 
 
 class _Target:
@@ -298,9 +309,10 @@ class XrefPanel:
     then one line a use, the current one marked; as many as fit
     ``height`` lines, the current one kept in view."""
 
-    def __init__(self, finding: Finding, height: int | None = None) -> None:
+    def __init__(self, finding: Finding, height: int | None = None, naming=None) -> None:
         self.finding = finding
         self.height = height
+        self.naming = naming  # the view's names (naming.py); None: addresses and file numbers
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         f = self.finding
@@ -328,12 +340,12 @@ class XrefPanel:
         shown = uses[first:first + rows]
         # Where a whole line does not fit (the 46-column side panel), read or write goes first, in a
         # column of its own, and the line says where more briefly: what was cut is never the access.
-        brief = any(2 + len(use.describe()) > options.max_width for use in shown)
+        brief = any(2 + len(use.describe(self.naming)) > options.max_width for use in shown)
         how_w = max(len(use.how) for use in shown)
         for k, use in enumerate(shown, first):
             line = Text(no_wrap=True, overflow="ellipsis")
             mark = k == f.current
             line.append("▶ " if mark else "  ", style="bold")
-            text = f"{use.how.ljust(how_w)}  {use.brief()}" if brief else use.describe()
+            text = f"{use.how.ljust(how_w)}  {use.brief(self.naming)}" if brief else use.describe(self.naming)
             line.append(text, style="reverse" if mark else "red" if use.access is not Access.READ else None)
             yield line
