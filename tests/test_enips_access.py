@@ -58,3 +58,24 @@ def test_masked_writes_keep_each_items_width_and_a_group_lands_whole():
     assert (t.read("L11:2"), t.read("L11:3"), t.read("F13:3")) == (7, 8, 1.0)
     access = TableAccessOnTable(t, writable={"L11"})
     assert asyncio.run(access.write_masked("L11", 0, -1, 1 << 30)) and t.read("L11:0") == 1 << 30
+
+
+def test_a_b_files_bits_are_opened_one_by_one():
+    """A Logix app's BOOL tags share the words of a B file: a tag opened to
+    clients opens its bit alone (ranges of a B file count bits)."""
+    from softplc_lite.netserver import APPLIED, REFUSED
+    from softplc_lite.tlm.enips.config import ServerConfig, parse_config
+    from softplc_lite.tlm.enips.identity import Identity
+    from softplc_lite.tlm.enips.protocol import EnipProtocol, build_slots, mask_payload
+
+    t = DataTable()
+    t.create_file("B", 10, 2)
+    slots = build_slots(t, ServerConfig(), {"B10": [(3, 4)]})
+    b10 = next(s for s in slots if s.info.name == "B10")
+    assert b10.may_mask(0, ~(1 << 3), 1 << 3) and not b10.may_mask(0, ~(1 << 4), 0) and not b10.may_write(0, 1)
+    protocol = EnipProtocol(ServerConfig(), slots, Identity("X"), {})
+    assert protocol.apply(mask_payload(10, 0, 0xFFFF, 1 << 3), t) == APPLIED and t.read("B10:0/3") == 1
+    assert protocol.apply(mask_payload(10, 0, 0xFFFF, 1 << 5), t) == REFUSED and t.read("B10:0/5") == 0
+    whole = parse_config(b'<EtherNetIpServer><Writable address="B10:1"/></EtherNetIpServer>')
+    b10 = next(s for s in build_slots(t, whole) if s.info.name == "B10")
+    assert b10.may_write(1, 1) and b10.may_mask(1, 0, 0xFFFF) and not b10.may_write(0, 1)

@@ -147,3 +147,22 @@ def test_the_templates_lay_out_the_export_types():
     assert (timer.name, timer.size, timer.predefined) == ("TIMER", 12, True)
     assert timer.member("DN").bit == 29 and timer.member("ACC").offset == 8
     assert view.programs == ["MainProgram"] and [t.name for t in view.tags["MainProgram"]] == ["Settled", "Overview"]
+
+
+def test_module_tags_with_booleans_of_their_own_are_read_and_written_whole(tmp_path):
+    """programs/logix/io_rack.L5X: module-defined types whose BOOL members
+    are no host's bits (a byte each in the template) read and written whole,
+    each BOOL masked into its word so its neighbours keep their value."""
+    source = TANK_LINE.parent / "io_rack.L5X"
+    plc = Running(tank_line(tmp_path / "rack", body='  <Writable tag="Local:2:C"/>\n', source=source), module="ENIPS")
+    try:
+        with LogixDriver(f"127.0.0.1:{plc.port}") as driver:
+            config = driver.read("Local:2:C")
+            assert config.error is None and config.value["ProgToFaultEn"] is False
+            assert driver.read("Local:4:I").value["Ch0Fault"] is False
+            assert driver.write("Local:2:C", dict(config.value, ProgToFaultEn=True, FaultValue=5)).error is None
+            assert value(plc, "Local:2:C.ProgToFaultEn") == 1 and value(plc, "Local:2:C.FaultValue") == 5
+            assert driver.read("Local:2:C.ProgToFaultEn").value is True
+            assert driver.write("Local:4:I.Ch0Fault", True).error == "Permission denied"  # no <Writable>
+    finally:
+        plc.stop()

@@ -124,14 +124,14 @@ TANK_LINE_WRITABLE = """  <Writable tag="Start"/>
 """
 
 
-def tank_line(directory: Path, body: str = TANK_LINE_WRITABLE, edit=None) -> Path:
-    """programs/logix/tank_line.L5X copied into ``directory`` (``edit``
-    changes its text), with ``tank_line.ENIPS.XML`` beside it serving on a
-    free port; the export's path."""
+def tank_line(directory: Path, body: str = TANK_LINE_WRITABLE, edit=None, source: Path = TANK_LINE) -> Path:
+    """programs/logix/tank_line.L5X (or ``source``) copied into
+    ``directory`` (``edit`` changes its text), with its ``STEM.ENIPS.XML``
+    beside it serving on a free port; the export's path."""
     directory.mkdir(parents=True, exist_ok=True)
-    text = TANK_LINE.read_text(encoding="utf-8")
-    export = directory / "tank_line.L5X"
+    text = source.read_text(encoding="utf-8")
+    export = directory / source.name
     export.write_text(edit(text) if edit else text, encoding="utf-8")
     xml = f'<?xml version="1.0"?>\n<EtherNetIpServer port="{free_tcp_port()}">\n{body}</EtherNetIpServer>\n'
-    (directory / "tank_line.ENIPS.XML").write_text(xml, encoding="utf-8")
+    (directory / f"{source.stem}.ENIPS.XML").write_text(xml, encoding="utf-8")
     return export

@@ -65,6 +65,12 @@ class TableAccess(abc.ABC):
     def writable(self, name: str, first: int, count: int) -> bool:
         """Whether a client may write items first..first+count-1 of file ``name``."""
 
+    def writable_bits(self, name: str, index: int, and_mask: int, or_mask: int) -> bool:
+        """Whether a masked write of item ``index`` (``write_masked``) changes
+        only what a client may write: a B file's bits are opened one by one
+        (a Logix app's BOOL tags), other items whole."""
+        return self.writable(name, index, 1)
+
     @abc.abstractmethod
     async def read(self, spans: list[tuple[str, int, int]]) -> list[list]:
         """The items of each span (file name, first item, count), all from
@@ -83,10 +89,11 @@ class TableAccess(abc.ABC):
         width: 16 bits for a word, 8 for SI, 32 for L, 64 for LI), so the
         bits a client leaves alone keep what the scan gave them."""
 
-    async def write_group(self, writes: list[tuple[str, int, list]]) -> bool:
-        """Several writes (file name, first item, items) applied at one
-        input point, all or none; the caller checked ``writable``."""
-        return all([await self.write(name, first, items) for name, first, items in writes])
+    async def write_group(self, writes: list[tuple]) -> bool:
+        """Several writes applied at one input point, all or none: (file
+        name, first item, items), or (file name, item, and-mask, or-mask) a
+        masked write; the caller checked ``writable``."""
+        return all([await (self.write(*w) if len(w) == 3 else self.write_masked(*w)) for w in writes])
 
 
 def file_infos(table: DataTable, writable_names: frozenset[str] = frozenset()) -> list[FileInfo]:
@@ -132,7 +139,7 @@ class TableAccessOnTable(TableAccess):
         return True
 
     async def write_masked(self, name: str, index: int, and_mask: int, or_mask: int) -> bool:
-        if not self.writable(name, index, 1):
+        if not self.writable_bits(name, index, and_mask, or_mask):
             return False
         data = self.table.file(name).data
         if data.typecode not in "bhiq":

@@ -27,6 +27,10 @@ class ImageAccess(TableAccess):
         slot = self.slots.get(name)
         return slot is not None and slot.may_write(first, count)
 
+    def writable_bits(self, name: str, index: int, and_mask: int, or_mask: int) -> bool:
+        slot = self.slots.get(name)
+        return slot is not None and slot.may_mask(index, and_mask, or_mask)
+
     async def read(self, spans: list[tuple[str, int, int]]) -> list[list]:
         wanted, slots = [], []
         for name, first, count in spans:
@@ -50,15 +54,18 @@ class ImageAccess(TableAccess):
 
     async def write_masked(self, name: str, index: int, and_mask: int, or_mask: int) -> bool:
         slot = self.slots.get(name)
-        if slot is None or not slot.may_write(index, 1):
+        if slot is None or not slot.may_mask(index, and_mask, or_mask):
             return False
         return await self.server.through_scan(mask_payload(slot.info.number, index, and_mask, or_mask))
 
-    async def write_group(self, writes: list[tuple[str, int, list]]) -> bool:
+    async def write_group(self, writes: list[tuple]) -> bool:
         payloads = []
-        for name, first, items in writes:
+        for name, first, *rest in writes:
             slot = self.slots.get(name)
-            if slot is None or not slot.may_write(first, len(items)):
+            allowed = slot is not None and (slot.may_write(first, len(rest[0])) if len(rest) == 1
+                                            else slot.may_mask(first, *rest))
+            if not allowed:
                 return False
-            payloads.append(write_payload(slot.info.number, first, array(slot.typecode, items)))
+            payloads.append(write_payload(slot.info.number, first, array(slot.typecode, rest[0])) if len(rest) == 1
+                            else mask_payload(slot.info.number, first, *rest))
         return await self.server.through_scan(group_payload(payloads))

@@ -63,10 +63,15 @@ def _spans(cat: LogixCatalogue, target, one: bool):
             n = count * f.per
             if f.kind == "string":
                 yield leaf.file, first * ST_ITEMS, (first + n) * ST_ITEMS
+            elif f.kind == "bool":  # a B file's ranges count bits
+                yield leaf.file, first, first + n
             else:
                 yield leaf.file, first, first + n
         return
     t = target.target
+    if t.kind == "B":  # a BOOL tag, or an element of a BOOL array: its bit alone (a B file's ranges count bits)
+        yield t.file, t.item * 16 + t.bit, t.item * 16 + t.bit + 1
+        return
     units = 1 if one or t.bit is not None else t.units
     yield t.file, t.item, t.item + units * t.items_per_unit
 
@@ -104,8 +109,5 @@ def _closed_of(cat: LogixCatalogue, tag: LogixTag):
 def _leaf_items(leaf, kind: str):
     if kind == "string":
         yield leaf.file, leaf.first * ST_ITEMS, (leaf.first + leaf.count) * ST_ITEMS
-    elif leaf.letter == "B":
-        # a word of shared BOOLs stays open for the others: the tag's own path refuses the write
-        return
-    else:
+    else:  # items; bits in a B file, whose ranges count bits as the leaf's first and count do
         yield leaf.file, leaf.first, leaf.first + leaf.count

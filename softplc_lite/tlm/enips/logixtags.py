@@ -41,10 +41,11 @@ def _weaker(a: str, b: str) -> str:
 @dataclass(frozen=True)
 class Field:
     """An atomic or string leaf under a structure: ``per`` leaf items (or
-    string elements) a structure element, byte ``offsets`` of each in it."""
+    string elements, or bits of a B file) a structure element, byte
+    ``offsets`` of each in it."""
 
     path: tuple[str, ...]
-    kind: str  # "atomic" or "string"
+    kind: str  # "atomic", "bool" (a bit of a B file, a byte in the structure) or "string"
     code: int
     per: int
     offsets: tuple[int, ...]
@@ -72,8 +73,8 @@ def fields(view: LogixView, template: Template) -> list[Field]:
     out: list[Field] = []
     for m in template.members:
         n = max(m.dim, 1)
-        if m.kind == "atomic":
-            out.append(Field((m.key,), "atomic", m.code, n, tuple(m.offset + j * m.size for j in range(n)), m.access))
+        if m.kind in ("atomic", "bool"):
+            out.append(Field((m.key,), m.kind, m.code, n, tuple(m.offset + j * m.size for j in range(n)), m.access))
         elif m.kind == "string":
             out.append(Field((m.key,), "string", m.code, n, tuple(m.offset + j * STRING_SIZE for j in range(n)),
                              m.access))
@@ -144,10 +145,16 @@ class LogixCatalogue:
                 return False
             if isinstance(target, StructTarget):
                 return target.access == "rw"
-            return target.access == "rw" and self.access.writable(target.target.file, target.target.item, 1)
+            t = target.target
+            if t.bit is not None:
+                return target.access == "rw" and self.access.writable_bits(t.file, t.item, ~(1 << t.bit), 1 << t.bit)
+            return target.access == "rw" and self.access.writable(t.file, t.item, 1)
         for leaf in tag.leaves.values():
-            first = leaf.first // 16 if leaf.letter == "B" else leaf.first * (ST_ITEMS if leaf.letter == "ST" else 1)
-            if self.access.writable(leaf.file, first, 1):
+            if leaf.letter == "B":
+                word, bit = divmod(leaf.first, 16)
+                if self.access.writable_bits(leaf.file, word, ~(1 << bit), 1 << bit):
+                    return True
+            elif self.access.writable(leaf.file, leaf.first * (ST_ITEMS if leaf.letter == "ST" else 1), 1):
                 return True
         return False
 
@@ -331,6 +338,8 @@ async def read_struct(request: CipRequest, access: TableAccess, target: StructTa
 
 
 def _spans(target: StructTarget, cat: LogixCatalogue, count: int):
+    """Each field's storage: (field, file, first item, items); a "bool"
+    field's first item is a bit number, and its items bits."""
     for f in cat.fields_of(target.template):
         leaf = target.tag.leaves[target.path + f.path]
         first = leaf.first + target.flat * f.per
@@ -340,16 +349,25 @@ def _spans(target: StructTarget, cat: LogixCatalogue, count: int):
             yield f, leaf.file, first, count * f.per
 
 
+def _words(first_bit: int, bits: int) -> tuple[int, int]:
+    """The B file words holding bits first_bit..first_bit+bits-1."""
+    return first_bit // 16, (first_bit + bits - 1) // 16 - first_bit // 16 + 1
+
+
 async def _struct_bytes(access: TableAccess, target: StructTarget, cat: LogixCatalogue, count: int) -> bytes:
     spans = list(_spans(target, cat, count))
-    values = await access.read([(file, first, n) for _, file, first, n in spans])
+    values = await access.read([(file, *_words(first, n)) if f.kind == "bool" else (file, first, n)
+                                for f, file, first, n in spans])
     size = target.template.size
     out = bytearray(size * count)
-    for (f, _, _, _), items in zip(spans, values):
+    for (f, _, first, _), items in zip(spans, values):
         for r in range(count * f.per):
             e, q = divmod(r, f.per)
             at = e * size + f.offsets[q]
-            if f.kind == "string":
+            if f.kind == "bool":
+                bit = first % 16 + r
+                out[at] = 1 if items[bit // 16] & (1 << bit % 16) else 0
+            elif f.kind == "string":
                 element = items[r * ST_ITEMS:(r + 1) * ST_ITEMS]
                 chars = bytes(c if 0 <= c < 256 else 0x3F for c in element[1:])
                 out[at:at + STRING_SIZE] = struct.pack("<i", element[0]) + chars + b"\x00\x00"
@@ -380,8 +398,18 @@ async def write_struct(request: CipRequest, access: TableAccess, target: StructT
         return CipReply.error(request, st.NOT_ENOUGH_DATA)
     if target.access != "rw" or any(f.access != "rw" for f in cat.fields_of(target.template)):
         return CipReply.error(request, st.PRIVILEGE_VIOLATION)
-    writes = []
+    writes: list[tuple] = []
     for f, file, first, n in _spans(target, cat, count):
+        if f.kind == "bool":  # each bit masked into its word, the other BOOLs of the word left as they are
+            for r in range(n):
+                e, q = divmod(r, f.per)
+                word, bit = divmod(first + r, 16)
+                on = payload[e * size + f.offsets[q]] & 1
+                masks = (0xFFFF & ~(1 << bit), (1 << bit) if on else 0)
+                if not access.writable_bits(file, word, *masks):
+                    return CipReply.error(request, st.PRIVILEGE_VIOLATION)
+                writes.append((file, word, *masks))
+            continue
         items: list = []
         for r in range(n if f.kind != "string" else n // ST_ITEMS):
             e, q = divmod(r, f.per)

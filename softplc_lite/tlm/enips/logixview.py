@@ -42,7 +42,8 @@ def access_of(text: str | None) -> str:
 @dataclass(frozen=True)
 class Member:
     """One member of a template. ``kind``: "atomic", "bit" (a BOOL kept in
-    a bit of its ``host``), "struct" (``template``), "string"."""
+    a bit of its ``host``), "bool" (a BOOL of its own: a byte, bit 0;
+    module-defined types have them), "struct" (``template``), "string"."""
 
     name: str
     kind: str
@@ -96,6 +97,8 @@ class Template:
             if m.kind == "bit":
                 # pycomm3 takes a bit member as a bit of the byte at its offset
                 offset, info = m.offset + m.bit // 8, m.bit % 8
+            elif m.kind == "bool":
+                info = 0  # bit 0 of its own byte
             out += struct.pack("<HHI", info, m.code, offset)
         name = self.name.encode("ascii", "replace")
         if not self.predefined:
@@ -190,10 +193,12 @@ class _Builder:
         for m in t.members:
             if m.host is not None:
                 continue
-            if m.type.kind == "atomic" and m.type.name == "BOOL":
-                raise ValueError(f"{t.name}.{m.name}: a BOOL member that is not a bit of a host is not served yet")
             kind, code, sub = self.type_code(m.type)
-            if kind == "atomic":
+            if kind == "atomic" and m.type.name == "BOOL":
+                if m.dim:
+                    raise ValueError(f"{t.name}.{m.name}: a BOOL array member is not served yet")
+                kind = "bool"
+            if kind in ("atomic", "bool"):
                 size = ATOMIC_SIZES[code]
                 align = size
             elif kind == "string":

@@ -37,10 +37,22 @@ class FileSlot:
     typecode: str  # the file's array typecode: "h", "f", or the 4-byte integer code
     itemsize: int
     offset: int  # in the image, bytes
-    writable: tuple[tuple[int, int], ...]  # item ranges [first, end) clients may write
+    writable: tuple[tuple[int, int], ...]  # item ranges [first, end) clients may write; bit ranges in a B file
 
     def may_write(self, first: int, count: int) -> bool:
+        if self.info.kind == "B":  # every bit of the words
+            first, count = first * 16, count * 16
         return count > 0 and any(lo <= first and first + count <= hi for lo, hi in self.writable)
+
+    def may_mask(self, index: int, and_mask: int, or_mask: int) -> bool:
+        """Whether a masked write of item ``index`` changes only bits clients
+        may write: in a B file, a Logix app's BOOL tags share words, and
+        each is opened alone."""
+        if self.info.kind != "B":
+            return self.may_write(index, 1)
+        touched = (~and_mask | or_mask) & 0xFFFF
+        bits = [index * 16 + b for b in range(16) if touched >> b & 1]
+        return all(any(lo <= bit < hi for lo, hi in self.writable) for bit in bits)
 
 
 def build_slots(table, config: ServerConfig, extra: dict | None = None,
@@ -54,6 +66,8 @@ def build_slots(table, config: ServerConfig, extra: dict | None = None,
         if w.address is None:
             continue
         per = table.file(w.file).ftype.words_per_element
+        if w.address.type_letter == "B":  # a B file's ranges count bits
+            per = 16
         ranges.setdefault(w.file, []).append((w.address.element * per, (w.last + 1) * per))
     slots, offset = [], 0
     for f in table.files():
@@ -104,8 +118,8 @@ def mask_payload(number: int, index: int, and_mask: int, or_mask: int) -> bytes:
 
 
 def group_payload(writes: list[bytes]) -> bytes:
-    """Several WRITE payloads applied together at one input point, or none
-    of them (a structure a client writes whole)."""
+    """Several WRITE or MASK payloads applied together at one input point,
+    or none of them (a structure a client writes whole)."""
     return GROUP + b"".join(_PART.pack(len(w)) + w for w in writes)
 
 
@@ -144,34 +158,45 @@ class EnipProtocol(Protocol):
         string's LEN kept within 82."""
         tag, rest = payload[:1], payload[1:]
         if tag == GROUP:
-            parts, at = [], 0
-            while at < len(rest):
-                (size,) = _PART.unpack_from(rest, at)
-                part = self._checked_write(rest[at + _PART.size + 1:at + _PART.size + size])
-                if part is None:
-                    return REFUSED
-                parts.append(part)
-                at += _PART.size + size
-            for slot, first, items in parts:
-                table.file(slot.info.name).data[first:first + len(items)] = items
-            return APPLIED
-        if tag == WRITE:
-            part = self._checked_write(rest)
-            if part is None:
+            parts = self._group_parts(rest)
+            if parts is None:
                 return REFUSED
+            for part in parts:
+                self._apply_part(part, table)
+            return APPLIED
+        part = self._checked_write(rest) if tag == WRITE else self._checked_mask(rest)
+        if part is None:
+            return REFUSED
+        if len(part) == 4:  # a masked word of an ST element may be its LEN
+            slot, index, and_mask, or_mask = part
+            new = masked(table.file(slot.info.name).data[index], and_mask, or_mask, slot.itemsize * 8)
+            if not _string_lengths_fit(slot, index, array(slot.typecode, [new])):
+                return REFUSED
+        self._apply_part(part, table)
+        return APPLIED
+
+    def _group_parts(self, rest: bytes) -> list | None:
+        """A GROUP's parts, each checked; None if any may not be applied."""
+        parts, at = [], 0
+        while at < len(rest):
+            (size,) = _PART.unpack_from(rest, at)
+            body = rest[at + _PART.size:at + _PART.size + size]
+            part = self._checked_write(body[1:]) if body[:1] == WRITE else self._checked_mask(body[1:])
+            if part is None or (len(part) == 4 and part[0].info.kind == "ST"):
+                return None
+            parts.append(part)
+            at += _PART.size + size
+        return parts
+
+    @staticmethod
+    def _apply_part(part: tuple, table) -> None:
+        if len(part) == 3:
             slot, first, items = part
             table.file(slot.info.name).data[first:first + len(items)] = items
-            return APPLIED
-        number, index, and_mask, or_mask = _MASK.unpack(rest)
-        slot = self._by_number.get(number)
-        if slot is None or slot.typecode not in MASKABLE or not slot.may_write(index, 1):
-            return REFUSED
-        data = table.file(slot.info.name).data
-        new = masked(data[index], and_mask, or_mask, slot.itemsize * 8)  # TableAccess.write_masked's rule
-        if not _string_lengths_fit(slot, index, array(slot.typecode, [new])):
-            return REFUSED
-        data[index] = new
-        return APPLIED
+        else:
+            slot, index, and_mask, or_mask = part
+            data = table.file(slot.info.name).data
+            data[index] = masked(data[index], and_mask, or_mask, slot.itemsize * 8)  # TableAccess.write_masked's rule
 
     def _checked_write(self, rest: bytes):
         """A WRITE payload's (slot, first item, items), or None if it may not be applied."""
@@ -184,6 +209,14 @@ class EnipProtocol(Protocol):
         if len(items) != count or not _string_lengths_fit(slot, first, items):
             return None
         return slot, first, items
+
+    def _checked_mask(self, rest: bytes):
+        """A MASK payload's (slot, item, and-mask, or-mask), or None if it may not be applied."""
+        number, index, and_mask, or_mask = _MASK.unpack(rest)
+        slot = self._by_number.get(number)
+        if slot is None or slot.typecode not in MASKABLE or not slot.may_mask(index, and_mask, or_mask):
+            return None
+        return slot, index, and_mask, or_mask
 
     # -- the server process's side -------------------------------------------------------------------
     def handler(self, server):

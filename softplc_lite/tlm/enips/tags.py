@@ -22,7 +22,7 @@ from .access import TableAccess
 from .logixtags import LogixCatalogue, StructTarget, read_struct, write_struct
 from .logixview import LogixView
 from .objects import REPLY, CipObject, CipReply, CipRequest
-from .tagnames import (BOOL, DINT, INT, LINT, SINT, ST_ITEMS, STRING_BYTES, STRING_CHARS, STRUCT, UNIT_BYTES,
+from .tagnames import (DINT, INT, LINT, SINT, ST_ITEMS, STRING_BYTES, STRING_CHARS, STRUCT, UNIT_BYTES,
                        UNIT_FORMATS, Catalogue, PathError, Target, parse_path)
 
 READ_TAG, WRITE_TAG, RMW_TAG = 0x4C, 0x4D, 0x4E
@@ -154,10 +154,11 @@ class TagServices(CipObject):
         units = len(payload) // unit
         if target.bit is not None:
             mask = 1 << target.bit
-            if not access.writable(target.file, target.item, 1):
-                return CipReply.error(request, st.PRIVILEGE_VIOLATION)
             full = (1 << ITEM_BITS.get(target.kind, 16)) - 1
-            ok = await access.write_masked(target.file, target.item, full & ~mask, mask if payload[0] else 0)
+            and_mask, or_mask = full & ~mask, mask if payload[0] else 0
+            if not access.writable_bits(target.file, target.item, and_mask, or_mask):
+                return CipReply.error(request, st.PRIVILEGE_VIOLATION)
+            ok = await access.write_masked(target.file, target.item, and_mask, or_mask)
             return _done(request, ok)
         try:
             items = _decode_units(target, payload, units)
@@ -178,7 +179,7 @@ class TagServices(CipObject):
             # masks of the target's own integer width: the table's masked write is one item's
             return CipReply.error(request, st.GENERAL_ERROR, EXT_TYPE_MISMATCH)
         or_mask, and_mask = struct.unpack_from(f"<{width[1]}{width[1]}", data, 2)
-        if not access.writable(target.file, target.item, 1):
+        if not access.writable_bits(target.file, target.item, and_mask, or_mask):
             return CipReply.error(request, st.PRIVILEGE_VIOLATION)
         return _done(request, await access.write_masked(target.file, target.item, and_mask, or_mask))
 
