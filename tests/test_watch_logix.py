@@ -6,6 +6,7 @@ are checked by test_watch_snapshots.py; here each rule on its own."""
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -208,3 +209,37 @@ def test_the_find_list_names_routines_instructions_and_tags(session):
     assert "  indirect write  MainProgram.FillTank rung 1  ADD Tanks[Active].Level" in text
     session.find("SettleTimer.DN")
     assert "instruction 2 TON  operand 1 SettleTimer.CTL" in session.message  # LTON shows as TON
+
+
+def test_a_re_exported_file_is_put_in_place_and_named_anew(tmp_path):
+    """Online program edit: the export saved again (a rung changed, a tag added before the others, so
+    every tag moves in the data table) is loaded as any app's edit, and the view names the new layout."""
+    import os
+    import time
+
+    export = tmp_path / "tank_line.L5X"
+    shutil.copy(TANK_LINE, export)
+    s = WatchSession(load_app(export, tmp_path / "state"), WatchOptions(run=RunOptions(fresh=True)))
+    try:
+        s.scan()
+        text = export.read_text(encoding="utf-8")
+        text = text.replace("XIC(Running)JSR(FillTank,0);", "XIC(Running)XIO(Hold)JSR(FillTank,0);")
+        text = text.replace("<Tags>\n<Tag Name=\"Start\"", "<Tags>\n<Tag Name=\"Hold\" TagType=\"Base\" "
+                            "DataType=\"BOOL\" Radix=\"Decimal\" Constant=\"false\" ExternalAccess=\"Read/Write\"/>\n"
+                            "<Tag Name=\"Start\"", 1)
+        before = export.stat().st_mtime_ns
+        export.write_text(text, encoding="utf-8")
+        os.utime(export, ns=(before, before + 10_000_000))
+        deadline = time.monotonic() + 10
+        while s.last_edit is None and time.monotonic() < deadline:
+            s.poll_online()
+            time.sleep(0.05)
+        assert s.last_edit is not None and s.last_edit.applied, s.message
+        s.goto(1)
+        lines = _screen(s)
+        rung = next(k for k, line in enumerate(lines) if line.startswith(">  Rung 1"))
+        assert lines[rung + 1].split()[:4] == ["|", "Running", "Hold", "+-JSR----+"]
+        s.show_file("tags")
+        assert "Hold " in "\n".join(_screen(s))
+    finally:
+        s.quit()

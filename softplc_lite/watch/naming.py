@@ -118,20 +118,27 @@ class Naming:
 
     def __init__(self, app) -> None:
         self.app = app
-        self.symbols = app.program.symbols
+        self._learn()
+
+    def _learn(self) -> None:
+        """The names of the app's program as it is now."""
+        program = self.app.program
+        self.symbols = program.symbols
         self.plain = SymbolNames(self.symbols)
         self.by_file: dict[int | None, TagPathNames] = {}
-        self.operands = OperandNames.of(app.program)
+        self.operands = OperandNames.of(program)
+
+    def _current(self) -> None:
+        if self.app.program.symbols is not self.symbols:  # an online edit put a new program (and tags) in place
+            self._learn()
 
     @property
     def is_logix(self) -> bool:
         return self.operands is not None
 
     def for_file(self, number: int | None):
+        self._current()
         if self.operands is None:
-            if self.app.program.symbols is not self.symbols:  # an online edit put a new program in place
-                self.symbols = self.app.program.symbols
-                self.plain = SymbolNames(self.symbols)
             return self.plain
         names = self.by_file.get(number)
         if names is None:
@@ -141,6 +148,7 @@ class Naming:
     def where(self, number: int) -> str:
         """A file as a list of uses names it: ``file 3``; a Logix app's by
         its routine (``MainProgram.FillTank``) or task."""
+        self._current()
         pfile = self.app.program.files.get(number)
         if self.operands is not None and pfile is not None and pfile.name:
             return pfile.name
@@ -154,6 +162,7 @@ class Naming:
     def tag_grid(self, table, text: str):
         """The tag monitor ``d TEXT`` shows in a Logix app (tagbrowser.py);
         None when TEXT names no tag (or the app is not a Logix app)."""
+        self._current()
         if self.operands is None:
             return None
         from .tagbrowser import tag_grid_for
