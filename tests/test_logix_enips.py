@@ -166,3 +166,32 @@ def test_module_tags_with_booleans_of_their_own_are_read_and_written_whole(tmp_p
             assert driver.write("Local:4:I.Ch0Fault", True).error == "Permission denied"  # no <Writable>
     finally:
         plc.stop()
+
+
+ARRAYS = """<Tag Name="Counts" TagType="Base" DataType="DINT" Dimensions="5" Radix="Decimal" ExternalAccess="Read/Write"/>
+<Tag Name="Grid" TagType="Base" DataType="INT" Dimensions="2 3" Radix="Decimal" ExternalAccess="Read/Write"/>
+<Tag Name="Lamps" TagType="Base" DataType="BOOL" Dimensions="32" Radix="Decimal" ExternalAccess="Read/Write"/>
+</Tags>
+<Programs>"""
+
+
+def test_atomic_arrays_are_read_and_written_by_element_and_by_count(tmp_path):
+    body = '  <Writable tag="Counts"/>\n  <Writable tag="Grid"/>\n  <Writable tag="Lamps[3]"/>\n'
+    export = tank_line(tmp_path / "arrays", body=body, edit=lambda t: t.replace("</Tags>\n<Programs>", ARRAYS, 1))
+    plc = Running(export, module="ENIPS")
+    try:
+        with LogixDriver(f"127.0.0.1:{plc.port}") as driver:
+            assert driver.write("Counts{5}", [1, 2, 3, 4, 5]).error is None and value(plc, "Counts[4]") == 5
+            assert driver.read("Counts[2]{3}").value == [3, 4, 5]  # from an element to the array's end
+            assert driver.write("Grid[1,2]", 7).error is None and driver.read("Grid{6}").value == [0] * 5 + [7]
+            assert driver.write("Lamps[3]", True).error is None and value(plc, "Lamps[3]") == 1
+            assert driver.write("Lamps[4]", True).error == "Permission denied"  # its word's other bits stay closed
+            listed = {t["tag_name"]: (t["data_type"], t["dimensions"]) for t in driver.get_tag_list()}
+            assert listed["Grid"] == ("INT", [2, 3, 0]) and listed["Lamps"] == ("BOOL", [32, 0, 0])
+        with PLC("127.0.0.1") as c:
+            c.Port = plc.port
+            assert c.Read("Counts[1]", 4).Value == [2, 3, 4, 5] and c.Read("Grid[1,2]").Value == 7
+            assert c.Read("Lamps[3]").Value is True
+    finally:
+        plc.stop()
+    assert value(plc, "Lamps[4]") == 0
