@@ -168,7 +168,7 @@ def test_module_tags_with_booleans_of_their_own_are_read_and_written_whole(tmp_p
         plc.stop()
 
 
-ARRAYS = """<Tag Name="Counts" TagType="Base" DataType="DINT" Dimensions="5" Radix="Decimal" ExternalAccess="Read/Write"/>
+ARRAYS = """<Tag Name="Counts" TagType="Base" DataType="DINT" Dimensions="5" ExternalAccess="Read/Write"/>
 <Tag Name="Grid" TagType="Base" DataType="INT" Dimensions="2 3" Radix="Decimal" ExternalAccess="Read/Write"/>
 <Tag Name="Lamps" TagType="Base" DataType="BOOL" Dimensions="32" Radix="Decimal" ExternalAccess="Read/Write"/>
 </Tags>
