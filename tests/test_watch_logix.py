@@ -243,3 +243,21 @@ def test_a_re_exported_file_is_put_in_place_and_named_anew(tmp_path):
         assert "Hold " in "\n".join(_screen(s))
     finally:
         s.quit()
+
+
+def test_the_d_key_asks_for_a_tag_and_enter_alone_lists_them_all(session):
+    from softplc_lite.watch.terminal import PROMPTS, Controller
+
+    c = Controller(session)
+    c.key("d")
+    assert c.prompt == PROMPTS["tags"] and c.prompt.startswith("tag (Tanks, Tanks[1]; Enter: every tag)")
+    c.key("\r")
+    assert session.grid is not None and session.grid.name == "tags"
+    c.key("esc")
+    assert session.grid is None
+    c.key("d")
+    for ch in "Tanks[1]":
+        c.key(ch)
+    c.key("\r")
+    assert session.grid.name == "Tanks[1]"
+    assert "Tanks[1].Setpoint  REAL  80.0" in "\n".join(_screen(session))

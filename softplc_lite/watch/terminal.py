@@ -87,6 +87,7 @@ _ACTIONS = {k: b.action for b in BINDINGS for k in b.keys}
 PROMPTS = {"g": "go to rung: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: ",
            "M": "mode (program, run, test): ", "=": "set ADDR = VALUE: ", "t": "toggle bit: ",
            "/": "find address or symbol: ", "d": "data file (N7, T4, ST9; N7:20): ",
+           "tags": "tag (Tanks, Tanks[1]; Enter: every tag) or data file (F12): ",  # d in a Logix app
            "T": "trend: ADDR (add/remove), range LO HI | range auto: ", "W": "write trend to FILE.csv|.vcd: "}
 
 
@@ -224,7 +225,7 @@ class Controller:
         self.session.next_use() if k == "x" else self.session.prev_use()
 
     def _do_data_file(self, k: str) -> None:
-        self._ask("d")
+        self._ask("tags" if self.session.naming.is_logix else "d")
 
     def _do_radix(self, k: str) -> None:
         self.session.cycle_radix()
@@ -258,7 +259,7 @@ class Controller:
         if k in ("\r", "\n"):
             kind, text = self.prompt_kind, self.buffer.strip()
             self.prompt_kind, self.prompt = "", None
-            if text:
+            if text or kind == "tags":  # a Logix app's d: Enter alone lists every tag
                 self._submit(kind, text)
             return
         if k in ("\x7f", "\x08"):
@@ -284,7 +285,7 @@ class Controller:
                 s.toggle(text)
             elif kind == "/":
                 s.find(text)
-            elif kind == "d":
+            elif kind in ("d", "tags"):
                 s.show_file(text)
             elif kind == "T":
                 s.trend_command(text)
