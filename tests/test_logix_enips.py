@@ -195,3 +195,37 @@ def test_atomic_arrays_are_read_and_written_by_element_and_by_count(tmp_path):
     finally:
         plc.stop()
     assert value(plc, "Lamps[4]") == 0
+
+
+RECIPE = """<DataType Name="Recipe" Family="NoFamily" Class="User">
+<Members>
+<Member Name="Name" DataType="STRING" Dimension="0" Hidden="false" ExternalAccess="Read/Write"/>
+<Member Name="Steps" DataType="INT" Dimension="3" Radix="Decimal" Hidden="false" ExternalAccess="Read/Write"/>
+<Member Name="Big" DataType="LINT" Dimension="0" Radix="Decimal" Hidden="false" ExternalAccess="Read/Write"/>
+<Member Name="T" DataType="TIMER" Dimension="0" Hidden="false" ExternalAccess="Read/Write"/>
+</Members>
+</DataType>
+</DataTypes>"""
+
+
+def _with_recipes(text: str) -> str:
+    text = text.replace("</DataTypes>", RECIPE, 1)
+    return text.replace("</Tags>\n<Programs>", '<Tag Name="Rec" TagType="Base" DataType="Recipe" Dimensions="2" '
+                                                'ExternalAccess="Read/Write"/>\n</Tags>\n<Programs>', 1)
+
+
+def test_nested_structures_strings_and_member_arrays_round_trip(tmp_path):
+    plc = Running(tank_line(tmp_path / "recipes", body='  <Writable tag="Rec"/>\n', edit=_with_recipes),
+                  module="ENIPS")
+    try:
+        with LogixDriver(f"127.0.0.1:{plc.port}") as driver:
+            recipe = driver.read("Rec[1]").value
+            recipe.update(Name="cola", Steps=[1, 2, 3], Big=2 ** 40)
+            recipe["T"]["PRE"] = 77
+            assert driver.write("Rec[1]", recipe).error is None  # one structure: applied at one input point
+            assert (value(plc, "Rec[1].T.PRE"), value(plc, "Rec[1].Steps[2]"), value(plc, "Rec[1].Big")) == (
+                77, 3, 2 ** 40)
+            assert driver.read("Rec[1].Name").value == "cola" and driver.read("Rec[1].Steps{3}").value == [1, 2, 3]
+            assert driver.read("Rec[0]").value["Name"] == ""
+    finally:
+        plc.stop()
