@@ -35,7 +35,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
         description="The online view of a running PLC in the terminal (docs/watch.md), or with --snapshot "
                     "one rendering of it to a file.")
     _keys_in_the_epilog(w)
-    w.add_argument("app", metavar="APP", help="app directory or .lad file")
+    w.add_argument("app", metavar="APP", help="app directory, .lad file or Studio 5000 export (.L5X, .L5K)")
     w.add_argument("--watch", action="append", default=[], metavar="ADDR",
                    help="add ADDR (address or symbol) to the watch list (repeatable; checked before scan 0)")
     w.add_argument("--watch-file", metavar="FILE", help="a watch file: one address or symbol a line")
