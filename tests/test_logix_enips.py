@@ -209,7 +209,12 @@ RECIPE = """<DataType Name="Recipe" Family="NoFamily" Class="User">
 
 
 def _with_recipes(text: str) -> str:
+    """Recipe structures, and in MainProgram an alias of a controller tag."""
     text = text.replace("</DataTypes>", RECIPE, 1)
+    text = text.replace('<Program Name="MainProgram" TestEdits="false" MainRoutineName="MainRoutine" Disabled="false" '
+                        'UseAsFolder="false">\n<Tags>', '<Program Name="MainProgram" TestEdits="false" MainRoutineName='
+                        '"MainRoutine" Disabled="false" UseAsFolder="false">\n<Tags>\n<Tag Name="Fill1" TagType='
+                        '"Alias" AliasFor="Tanks[1].Fill" ExternalAccess="Read/Write"/>', 1)
     return text.replace("</Tags>\n<Programs>", '<Tag Name="Rec" TagType="Base" DataType="Recipe" Dimensions="2" '
                                                 'ExternalAccess="Read/Write"/>\n</Tags>\n<Programs>', 1)
 
@@ -227,5 +232,6 @@ def test_nested_structures_strings_and_member_arrays_round_trip(tmp_path):
                 77, 3, 2 ** 40)
             assert driver.read("Rec[1].Name").value == "cola" and driver.read("Rec[1].Steps{3}").value == [1, 2, 3]
             assert driver.read("Rec[0]").value["Name"] == ""
+            assert driver.read("Program:MainProgram.Fill1").value is False  # a program's alias of a controller tag
     finally:
         plc.stop()

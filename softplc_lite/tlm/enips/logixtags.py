@@ -193,8 +193,10 @@ class LogixCatalogue:
             tag = self.by_instance(scope, first)
         elif kind == "name":
             tag = self.view.find(str(first), scope)
-            if tag is None and scope is not None:
-                tag = None  # a program's request path names its own tags only (Program:Name.Tag)
+            if tag is None and scope is not None and for_alias:
+                # an alias in a program sees the controller's tags too, as the program's rungs do;
+                # a request's Program:Name.Tag names the program's own tags only
+                tag = self.view.find(str(first), None)
             if tag is None:
                 raise PathError(PATH_DESTINATION_UNKNOWN, f"no tag named {first!r}")
         else:
