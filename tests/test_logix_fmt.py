@@ -64,3 +64,14 @@ def test_comments_are_escaped_as_l5k_strings(tmp_path):
     r = softplc_here("fmt", str(export))
     assert r.returncode == 0, r.stderr
     assert '        RC: "Start and stop the line: a $"seal-in$"$Ncosts $$0";' in r.stdout.splitlines()
+
+
+def test_an_l5k_export_prints_the_same_form():
+    r = softplc_here("fmt", "tests/fixtures/logix/whole_controller.L5K")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[:4] == ["PROGRAM MainProgram", "    ROUTINE MainRoutine",
+                         '        RC: "Fill for five seconds while the tank runs";',
+                         "        N: XIC(Tank1.Running)TON(T1,?,?);"]
+    assert "    ROUTINE Calc" in lines and "        // Structured Text: fmt prints RLL routines" in lines
+    assert lines.count("END_PROGRAM") == 2

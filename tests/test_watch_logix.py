@@ -208,7 +208,7 @@ def test_the_find_list_names_routines_instructions_and_tags(session):
     assert "  read            MainProgram.MainRoutine rung 5  CPT Tanks[0].Level" in text
     assert "  indirect write  MainProgram.FillTank rung 1  ADD Tanks[Active].Level" in text
     session.find("SettleTimer.DN")
-    assert "instruction 2 TON  operand 1 SettleTimer.CTL" in session.message  # LTON shows as TON
+    assert "instruction 2 TON  operand 1 SettleTimer  read/write" in session.message  # LTON as TON, its timer
 
 
 def test_a_re_exported_file_is_put_in_place_and_named_anew(tmp_path):

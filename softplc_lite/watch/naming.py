@@ -73,7 +73,10 @@ class TagPathNames:
         try:
             return self.cache[address]
         except KeyError:
-            found = self.cache[address] = self.operands.name_of(address, self.scope)
+            found = self.operands.name_of(address, self.scope)
+            if found and found.upper().endswith(".CTL"):  # a TIMER's, COUNTER's or CONTROL's hidden word: the tag
+                found = found[:-4]
+            self.cache[address] = found
             return found
 
     def mnemonic(self, mnemonic: str) -> str:
