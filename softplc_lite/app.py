@@ -474,7 +474,9 @@ def _export_modules(path: Path, made) -> tuple[list[TLM], list[str]]:
         return [], []
     try:
         module = load_module("ENIPS")
-        warnings = module.configure_export(config, shown_path(path.stem), made.directory)
+        # each program's name as spelled: its routines' files are named PROGRAM.ROUTINE
+        programs = list(dict.fromkeys(made.program.files[n].name.split(".")[0] for n in made.routine_files.values()))
+        warnings = module.configure_export(config, shown_path(path.stem), made.directory, programs)
     except ModuleErrors as e:
         raise AppError(list(e.problems)) from None
     except ModuleError as e:

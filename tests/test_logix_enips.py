@@ -10,7 +10,7 @@ from __future__ import annotations
 import struct
 
 import pytest
-from pycomm3 import LogixDriver
+from pycomm3 import LogixDriver, SLCDriver
 from pylogix import PLC
 
 from softplc_lite.app import AppError, load_app
@@ -43,7 +43,7 @@ def value(plc: Running, path: str):
 
 def test_pycomm3_reads_tags_structures_and_arrays_by_path(line):
     with LogixDriver(f"127.0.0.1:{line.port}") as plc:
-        assert plc.read("Tanks[1].Setpoint").value == 80.0
+        assert plc.read("Tanks[1].Setpoint").value == 80.0 and plc.read("Tanks[1].Level").value == 0.0
         assert plc.read("SettleTimer.PRE").value == 2000
         assert plc.read("Banner").value == "idle" and plc.read("Banner").type == "STRING"
         assert plc.read("Flags.8").value is False
@@ -120,6 +120,8 @@ def test_without_writable_tags_every_tag_is_read_only(tmp_path):
         with PLC("127.0.0.1") as c:  # the data table files are not tags of a Logix app
             c.Port = plc.port
             assert c.Read("N7[0]").Status == "Path destination unknown"
+        with SLCDriver(f"127.0.0.1:{plc.port}") as panel:  # nor reached by PCCC: no file is mapped
+            assert panel.read("F12:0").error is not None
     finally:
         plc.stop()
     assert value(plc, "Tanks[1].Setpoint") == 80.0
@@ -233,5 +235,19 @@ def test_nested_structures_strings_and_member_arrays_round_trip(tmp_path):
             assert driver.read("Rec[1].Name").value == "cola" and driver.read("Rec[1].Steps{3}").value == [1, 2, 3]
             assert driver.read("Rec[0]").value["Name"] == ""
             assert driver.read("Program:MainProgram.Fill1").value is False  # a program's alias of a controller tag
+    finally:
+        plc.stop()
+
+
+def test_every_program_is_listed_with_or_without_tags(tmp_path):
+    source = TANK_LINE.parent / "dosing.L5X"
+    plc = Running(tank_line(tmp_path / "dosing", body="", source=source), module="ENIPS")
+    try:
+        with LogixDriver(f"127.0.0.1:{plc.port}") as driver:
+            assert set(driver.info["programs"]) == {"MainProgram", "Sampler", "Service"}
+        with PLC("127.0.0.1") as c:
+            c.Port = plc.port
+            names = [t.TagName for t in c.GetTagList(allTags=True).Value]
+        assert {"Program:Sampler", "Program:Service"} <= set(names)
     finally:
         plc.stop()

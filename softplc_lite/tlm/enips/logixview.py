@@ -245,10 +245,11 @@ def _handle(name: str, members: list[Member], size: int) -> int:
     return value if value not in (STRING_HANDLE, *PREDEFINED_INSTANCES.values()) else value ^ 0x5555
 
 
-def build_view(directory) -> LogixView:
+def build_view(directory, programs: list[str] | tuple = ()) -> LogixView:
     """The view of a ``logix.tags.TagDirectory``: every tag it lays out
     (controller tags, then each program's), aliases as the paths they
-    stand for; a tag of a type not held, or not served yet, in ``skipped``."""
+    stand for; a tag of a type not held, or not served yet, in ``skipped``.
+    ``programs``: every program's name, those without tags too."""
     b = _Builder()
     view = b.view
     for scope, names in directory.scopes.items():
@@ -273,6 +274,10 @@ def build_view(directory) -> LogixView:
             leaves = {path: LeafAt(f"{leaf.letter}{leaf.file}", leaf.letter, leaf.first, leaf.count)
                       for path, leaf in declared.leaves.items()}
             out.append(LogixTag(tag.name, label, code, kind, tuple(declared.dims), access, leaves, template))
+    for name in programs:
+        if view.program(name) is None:
+            view.programs.append(name)
+            view.tags.setdefault(name, [])
     return view
 
 

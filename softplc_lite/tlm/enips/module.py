@@ -61,17 +61,18 @@ class EnipServer(NetServerModule):
                 raise ModuleErrors(tagged)
         return list(self.config.warnings)
 
-    def configure_export(self, config_path: Path, app_name: str, directory) -> list[str]:
+    def configure_export(self, config_path: Path, app_name: str, directory, programs=()) -> list[str]:
         """A Studio 5000 export's server: ``config_path`` its ENIPS.XML
         (``<export stem>.ENIPS.XML``), ``directory`` its tag directory
-        (logix/tags.py). ModuleErrors lists every problem of the file."""
+        (logix/tags.py), ``programs`` its programs' names. ModuleErrors
+        lists every problem of the file."""
         try:
             data = read_bytes(config_path)
         except OSError as e:
             raise ModuleError(f"{config_path}: cannot read it: {e.strerror or e}") from None
         self.config = parse_config(data, str(config_path))
         self.app_name = app_name
-        self.logix = build_view(directory)
+        self.logix = build_view(directory, programs)
         self.open_ranges, problems = tag_ranges(self.logix, self.config)
         if problems:
             raise ModuleErrors(problems)
