@@ -29,6 +29,10 @@ class NBranch:
     column: int = 0
 
 
+# Instructions without operands, taken without their "()" too (Studio writes NOP(); some exports NOP;).
+BARE = frozenset({"NOP", "AFI", "TND", "MCR", "RET", "SBR", "EOT", "UID", "UIE"})
+
+
 class NeutralError(Exception):
     def __init__(self, message: str, column: int) -> None:
         super().__init__(message)
@@ -120,6 +124,10 @@ def parse_rung(text: str) -> list:
                 raise NeutralError(f"expected an instruction, found {ch!r}", i)
             mnemonic = text[i:j]
             k = skip(j)
+            if (k >= n or text[k] != "(") and mnemonic.upper() in BARE:
+                elements.append(NInstruction(mnemonic.upper(), [], i))  # NOP; as some exports write it
+                i = k
+                continue
             if k >= n or text[k] != "(":
                 raise NeutralError(f"expected ( after {mnemonic}", k)
             operands, end = split_operands(text, k + 1)
