@@ -16,7 +16,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
     c = sub.add_parser(NAME, help="parse and validate an app; list every problem",
                        description="Parse and validate an app; list every problem (exit 1), then RSLogix-style "
                                    "verify warnings (exit 0 with warnings only). See docs/language.md.")
-    c.add_argument("app", metavar="APP", help="app directory or .lad file")
+    c.add_argument("app", metavar="APP", help="app directory, .lad file, or Studio 5000 export (.L5X, .L5K)")
     c.set_defaults(func=run)
     return c
 

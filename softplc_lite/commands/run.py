@@ -31,7 +31,7 @@ def add_parser(sub) -> argparse.ArgumentParser:
         epilog=f"Time: an unbounded run (no --scans, no --replay) follows the wall clock; a bounded one is on "
                f"simulated time; --realtime or --simulated says which. Exit codes: 0 ok, 1 error, 2 usage, "
                f"3 PLC fault, 4 internal error, 5 --replay output differed. See {DOCS} and docs/engine.md.")
-    r.add_argument("app", metavar="APP", help="app directory or .lad file")
+    r.add_argument("app", metavar="APP", help="app directory, .lad file, or Studio 5000 export (.L5X, .L5K)")
     r.add_argument("--scans", type=int_in(SCANS_RANGE, "--scans"), metavar="N",
                    help="stop after N scans (0 or more; default: until Ctrl-C or SIGTERM, or the end of the "
                    "--replay trace)")
