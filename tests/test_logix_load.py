@@ -186,3 +186,22 @@ def test_logix_own_types_in_an_export_and_a_date_time_lint(tmp_path):
     r = Runner(app, RunOptions(fresh=True, save_state=False))
     assert r.table.read(app.program.symbols.resolve_path("Stamp")) == 1_645_509_600_000_250
     r.close()
+
+
+def test_a_message_tag_is_held_and_its_msg_not_run(tmp_path):
+    """A MSG is not sent (no network: a warning, its rung a NOP), but its
+    MESSAGE tag is laid out, so the rungs that read its status bits run."""
+    from helpers.logix_l5x import Prog, Task, write_l5x
+
+    path = write_l5x(tmp_path / "msg.L5X", [("Msg", "MESSAGE"), ("Go", "BOOL"), ("Done", "BOOL"), ("Err", "DINT")],
+                     [Prog("P", {"Main": ["XIC(Go)MSG(Msg);", "XIC(Msg.DN)OTE(Done);", "MOV(Msg.ERR,Err);"]})],
+                     [Task("T", ["P"])])
+    app = load_app(path)
+    assert any("MSG: a message to another device" in w and "rung 0" in w for w in app.warnings)
+    r = Runner(app, RunOptions(fresh=True, save_state=False))
+    names = app.program.symbols
+    r.table.write(names.resolve_path("Msg.DN"), 1)
+    r.table.write(names.resolve_path("Msg.ERR"), 7)
+    r.run(1)
+    assert r.table.read(names.resolve_path("Done")) == 1 and r.table.read(names.resolve_path("Err")) == 7
+    r.close()

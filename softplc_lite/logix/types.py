@@ -100,6 +100,21 @@ PREDEFINED: dict[str, LogixType] = {
                                    *_status("CTL", ("EN", 31), ("EU", 30), ("DN", 29), ("EM", 28), ("ER", 27),
                                             ("UL", 26), ("IN", 25), ("FD", 24))]),
     "STRING": LogixType("STRING", "string", chars=STRING_CHARS, builtin=True),
+    # MESSAGE: the members a rung reads of a MSG's tag; softplc_lite sends no message (MSG is not
+    # run), so its status bits stay as the export or the program leaves them (docs/logix.md).
+    "MESSAGE": _struct("MESSAGE", [MemberType("FLAGS", _ATOMIC_TYPES["INT"]),
+                                   *_status("FLAGS", ("EW", 2), ("ER", 4), ("DN", 5), ("ST", 6), ("EN", 7),
+                                            ("TO", 8), ("EN_CC", 9)),
+                                   MemberType("ERR", _ATOMIC_TYPES["INT"]), _dint("EXERR"),
+                                   MemberType("ERR_SRC", _ATOMIC_TYPES["SINT"]),
+                                   MemberType("DN_LEN", _ATOMIC_TYPES["INT"]),
+                                   MemberType("REQ_LEN", _ATOMIC_TYPES["INT"]),
+                                   _dint("DestinationLink"), _dint("DestinationNode"), _dint("SourceLink"),
+                                   _dint("Class"), _dint("Attribute"), _dint("Instance"),
+                                   _dint("LocalIndex"), _dint("Channel"), _dint("Rack"), _dint("Group"),
+                                   _dint("Slot"), _dint("RemoteIndex"), _dint("RemoteElement"),
+                                   _dint("UnconnectedTimeout"), _dint("ConnectionRate"),
+                                   MemberType("TimeoutMultiplier", _ATOMIC_TYPES["SINT"])]),
 }
 
 
