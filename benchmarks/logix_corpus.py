@@ -154,6 +154,12 @@ def main() -> int:
           f"with errors {rungs['errors']} ({100 * rungs['errors'] / max(total, 1):.1f}%)")
     print(f"  ran {SCANS} scans without a major fault: {stages['ran']} ({100 * stages['ran'] / max(n, 1):.1f}% of all, "
           f"{100 * stages['ran'] / max(loaded, 1):.1f}% of those loaded); faulted: {stages['faulted']}")
+    ran = [r for r in results if r["stage"] in ("ran", "faulted") and r["rungs"]["total"]]
+    if ran:
+        big = max(ran, key=lambda r: r["rungs"]["total"])
+        print(f"  the largest export that loads: {Path(big['file']).name}, {big['rungs']['total']} rungs "
+              f"({big['rungs']['run']} run): load {big['load_s']:.2f} s, {big.get('scan_us', 0):.0f} us a scan "
+              f"(benchmarks/bench_logix.py --export compares it with its rungs as PLC-5 text)")
     for title, key, stage_set in (("why files do not load (files with the cause)", "causes", ("load", "read", "crashed", "timed out")),
                                   ("why loaded files fault", "causes", ("faulted",)),
                                   ("what is not run (files with the warning)", "warnings", ("ran", "faulted", "load"))):
