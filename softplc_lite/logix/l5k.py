@@ -40,7 +40,7 @@ from .exportfile import read_export
 from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
                     ModuleTag, Program, Project, Routine, Rung, Tag, Task)
 from .l5k_scan import IDENT, Scanner, split_attrs, split_commas
-from .values import ValueSyntax, parse_l5k_value, parse_number, unescape
+from .values import ValueSyntax, flag, parse_l5k_value, parse_number, unescape
 
 _TYPE = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_:]*)\s*(?:\[([^\]]*)\])?")
 _VERSION = re.compile(r"Version\s*:=\s*RSLogix 5000 v([\d.]+)")
@@ -61,11 +61,6 @@ def read_l5k(path_or_text, source_name: str | None = None) -> Project:
         raise ExportError(reader.problems)
     return project
 
-
-def _bool(value: str | None, default: bool = False) -> bool:
-    if value is None:
-        return default
-    return value.strip().lower() in ("yes", "1", "true")
 
 
 class _Reader(Scanner):
@@ -177,7 +172,7 @@ class _Reader(Scanner):
         if m is None:
             self.problem(start, f"expected a member (TYPE Name[dim] (attributes); or BIT Name Host : bit;), found {text.strip()[:40]!r}")
             return None
-        common = dict(hidden=_bool(attrs.get("hidden")), external_access=attrs.get("externalaccess", "Read/Write"),
+        common = dict(hidden=flag(attrs.get("hidden")), external_access=attrs.get("externalaccess", "Read/Write"),
                       description=attrs.get("description"), radix=attrs.get("radix"), pos=self.pos(start))
         if head.strip().startswith("BIT") and m.re.pattern.startswith(r"\s*BIT"):
             return Member(m.group(1), "BIT", target=m.group(2), bit_number=int(m.group(3)), **common)
@@ -237,9 +232,9 @@ class _Reader(Scanner):
     def tag(self, name, data_type, dims, attrs, value, start, alias_for=None) -> Tag:
         return Tag(name, data_type, dims, tag_type=_tag_type(attrs, alias_for),
                    alias_for=alias_for, external_access=attrs.get("externalaccess", "Read/Write"),
-                   constant=_bool(attrs.get("constant")), description=attrs.get("description"),
+                   constant=flag(attrs.get("constant")), description=attrs.get("description"),
                    radix=attrs.get("radix"), value=value, usage=attrs.get("usage") or _usage(attrs.get("type")),
-                   required=_bool(attrs.get("required")), visible=_bool(attrs.get("visible"), True), pos=self.pos(start))
+                   required=flag(attrs.get("required")), visible=flag(attrs.get("visible"), True), pos=self.pos(start))
 
     # -- modules --------------------------------------------------------------------------
 
@@ -301,7 +296,7 @@ class _Reader(Scanner):
 
     def program(self, at: int) -> Program:
         name, _, attrs = self.block_header("PROGRAM")
-        p = Program(name, attrs.get("main"), attrs.get("fault"), _bool(attrs.get("disableflag")),
+        p = Program(name, attrs.get("main"), attrs.get("fault"), flag(attrs.get("disableflag")),
                     description=attrs.get("description"), pos=self.pos(at))
         while not self.end_of("PROGRAM", name, at):
             w = self.word()
@@ -397,7 +392,7 @@ class _Reader(Scanner):
 
     def task(self, at: int) -> Task:
         name, _, attrs = self.block_header("TASK")
-        t = Task(name, attrs.get("type", "CONTINUOUS"), inhibited=_bool(attrs.get("inhibittask")), pos=self.pos(at))
+        t = Task(name, attrs.get("type", "CONTINUOUS"), inhibited=flag(attrs.get("inhibittask")), pos=self.pos(at))
         try:
             t.priority = int(parse_number(attrs.get("priority", "10")))
             t.watchdog_ms = float(parse_number(attrs.get("watchdog", "500")))

@@ -43,7 +43,7 @@ from .exportfile import read_export
 from .modules import describe_structure
 from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
                     ModuleTag, Problem, Program, Project, Routine, Rung, Tag, Task)
-from .values import MAX_DEPTH, ValueSyntax, parse_l5k_value, parse_quoted, typed_scalar
+from .values import MAX_DEPTH, ValueSyntax, flag, parse_l5k_value, parse_quoted, typed_scalar
 
 TARGET_TYPES = ("Controller", "Program", "Routine", "Rung", "AddOnInstructionDefinition", "DataType", "Module")
 
@@ -152,11 +152,6 @@ def read_l5x(path_or_text, source_name: str | None = None, prefer: str = "decora
     return project
 
 
-def _bool(value: str | None, default: bool = False) -> bool:
-    if value is None:
-        return default
-    return value.strip().lower() in ("true", "1", "yes")
-
 
 def _dims(text: str | None) -> tuple[int, ...]:
     if not text:
@@ -255,7 +250,7 @@ class _Reader:
                 continue
             dt.members.append(Member(
                 mname, m.attrs.get("DataType", ""), dimension=self.int_attr(m, "Dimension", 0),
-                hidden=_bool(m.attrs.get("Hidden")), target=m.attrs.get("Target"),
+                hidden=flag(m.attrs.get("Hidden")), target=m.attrs.get("Target"),
                 bit_number=self.int_attr(m, "BitNumber"),
                 external_access=m.attrs.get("ExternalAccess", "Read/Write"),
                 description=self.description(m), radix=m.attrs.get("Radix"), pos=m.pos))
@@ -274,8 +269,8 @@ class _Reader:
         tag_type = a.get("TagType", "Base")
         t = Tag(name, a.get("DataType"), dims=_dims(a.get("Dimensions")), tag_type=tag_type,
                 alias_for=a.get("AliasFor"), external_access=a.get("ExternalAccess", "Read/Write"),
-                constant=_bool(a.get("Constant")), description=self.description(node), radix=a.get("Radix"),
-                usage=a.get("Usage"), required=_bool(a.get("Required")), visible=_bool(a.get("Visible"), True),
+                constant=flag(a.get("Constant")), description=self.description(node), radix=a.get("Radix"),
+                usage=a.get("Usage"), required=flag(a.get("Required")), visible=flag(a.get("Visible"), True),
                 pos=node.pos)
         if tag_type == "Alias" and not t.alias_for:
             self.problem(node.pos, f"expected an AliasFor attribute on alias tag {name}")
@@ -369,11 +364,11 @@ class _Reader:
     def module(self, node: _Node) -> Module | None:
         name = node.attrs.get("Name", "")  # a drive's peripheral modules have no name
         a = node.attrs
-        m = Module(name, a.get("CatalogNumber"), parent=a.get("ParentModule"), inhibited=_bool(a.get("Inhibited")), pos=node.pos)
+        m = Module(name, a.get("CatalogNumber"), parent=a.get("ParentModule"), inhibited=flag(a.get("Inhibited")), pos=node.pos)
         ports = node.child("Ports")
         for p in ports.all("Port") if ports is not None else []:
             address = p.attrs.get("Address", "")
-            if _bool(p.attrs.get("Upstream")) and p.attrs.get("Type") != "Ethernet" and address.isdigit():
+            if flag(p.attrs.get("Upstream")) and p.attrs.get("Type") != "Ethernet" and address.isdigit():
                 m.slot = int(address)
         prefix = f"{m.parent}:{m.slot}" if m.slot is not None and m.parent and m.parent != name else name
         comms = node.child("Communications")
@@ -420,7 +415,7 @@ class _Reader:
         if name is None:
             return None
         a = node.attrs
-        p = Program(name, a.get("MainRoutineName"), a.get("FaultRoutineName"), _bool(a.get("Disabled")),
+        p = Program(name, a.get("MainRoutineName"), a.get("FaultRoutineName"), flag(a.get("Disabled")),
                     description=self.description(node), pos=node.pos)
         tags = node.child("Tags")
         if tags is not None:
@@ -492,7 +487,7 @@ class _Reader:
         a = node.attrs
         t = Task(name, a.get("Type", "CONTINUOUS"), priority=self.int_attr(node, "Priority", 10),
                  watchdog_ms=float(self.int_attr(node, "Watchdog", 500.0)),
-                 inhibited=_bool(a.get("InhibitTask")), pos=node.pos)
+                 inhibited=flag(a.get("InhibitTask")), pos=node.pos)
         if t.kind != "CONTINUOUS" and "Rate" in a:
             t.rate_ms = float(self.int_attr(node, "Rate", 0))
         scheduled = node.child("ScheduledPrograms")

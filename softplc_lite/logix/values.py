@@ -221,3 +221,10 @@ def typed_scalar(text: str, data_type: str | None, radix: str | None, offset: in
     if isinstance(number, float) and dt:
         raise ValueSyntax(offset, f"expected an integer for a {data_type}, found {t!r}")
     return number
+
+
+def flag(value: str | None, default: bool = False) -> bool:
+    """An export's yes/no attribute (``Disabled="true"``, ``Hidden := 1``)."""
+    if value is None:
+        return default
+    return value.strip().lower() in ("true", "1", "yes")
