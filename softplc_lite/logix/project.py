@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from ..datatable import DataTable
 from ..ladder.ast import MAIN_FILE, DataDecl, Instruction, Program, ProgramFile, Rung, walk
 from . import model
+from .aoi import AoiCalls, add_instance_types
 from .initial import ValueWriter, apply_initial, data_files
 from .modules import declare_module_tags
 from .rungs import RoutineContext, translate_rung
@@ -52,13 +53,12 @@ class LogixProgram:
 def build_program(project: model.Project) -> LogixProgram:
     types = TypeSystem()
     types.add_data_types(project.data_types)
+    add_instance_types(types, project.add_on_instructions)
     table = DataTable()
     directory = TagDirectory(table, types)
     result = LogixProgram(Program(symbols=TagSymbols(directory)), directory)
     problems, warnings = result.problems, result.warnings
     problems += types.problems
-    for aoi in project.add_on_instructions:
-        warnings.append(model.Problem(aoi.pos, f"Add-On Instruction {aoi.name}: not yet run by softplc_lite"))
     for tag in project.tags:
         directory.declare(tag)
     declare_module_tags(project, directory, problems, warnings)
@@ -69,8 +69,10 @@ def build_program(project: model.Project) -> LogixProgram:
     warnings += directory.warnings
 
     writer = ValueWriter()
+    aois = AoiCalls(project, directory, types)
     for scope in directory.scopes.values():
         for declared in scope.values():
+            aois.defaults(declared, writer, problems)
             apply_initial(declared, writer, problems)
     schedule = Schedule(project, directory, writer, warnings)
 
@@ -85,10 +87,13 @@ def build_program(project: model.Project) -> LogixProgram:
         for routine in prog.routines:
             file_number = routines[routine.name.upper()]
             rungs = _routine_rungs(routine, prog, directory, routines, project.source, problems, warnings,
-                                   result.rungs, not_passed, file_number)
+                                   result.rungs, not_passed, file_number, aois)
             result.program.files[file_number] = ProgramFile(file_number, f"{prog.name}.{routine.name}", rungs,
                                                             routine.pos)
         _calls_not_run(prog, routines, result.program.files, not_passed, warnings, result.rungs)
+    made = aois.files(number)
+    result.program.files.update(made)
+    number += len(made)
     result.program.files.update(schedule.files(result.routine_files, number))
     for letter, file, values in data_files(writer, table):
         result.program.data.append(DataDecl(f"{letter}{file}", len(values), values))
@@ -100,13 +105,14 @@ def build_program(project: model.Project) -> LogixProgram:
 
 
 def _routine_rungs(routine, prog, directory, routines, source, problems, warnings, counts, not_passed,
-                   file_number) -> list[Rung]:
+                   file_number, aois=None) -> list[Rung]:
     if routine.kind != "RLL":
         kind = NOT_RUN_KINDS.get(routine.kind, routine.kind)
         warnings.append(model.Problem(routine.pos, f"routine {prog.name}.{routine.name} is {kind}: not yet run "
                                                    f"by softplc_lite"))
         return []
     ctx = RoutineContext(directory, prog.name, routines, source, f"{prog.name}.{routine.name}")
+    ctx.aoi = aois
     rungs = []
     for rung in routine.rungs:
         translated = translate_rung(rung, ctx)

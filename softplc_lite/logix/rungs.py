@@ -64,6 +64,7 @@ class RoutineContext:
         self.skip = False  # the rung being translated holds an instruction not run
         self.before: list[Instruction] = []  # LIDXs the instruction being translated needs before it
         self.parameters_not_run = False  # a JSR, SBR or RET of this routine has a parameter not passed
+        self.aoi = None  # the project's Add-On Instructions (logix/aoi.py AoiCalls): calls to them
 
     def warn(self, pos: Pos, message: str) -> None:
         self.warnings.append(model.Problem(pos, f"routine {self.routine}: {message}"))
@@ -127,6 +128,8 @@ def _instruction(el, rung, ctx) -> Instruction | None:
     pos = _at(rung.pos, rung.text, el.column)
     plan = PLAN.get(el.mnemonic)
     if plan is None:
+        if ctx.aoi is not None and ctx.aoi.defines(el.mnemonic):
+            return ctx.aoi.call(el, pos, rung, ctx)
         reason = NOT_RUN_REASON.get(el.mnemonic, "not an instruction softplc_lite runs yet")
         ctx.warn(pos, f"rung {rung.number}: {el.mnemonic}: {reason}; the rung is not run")
         ctx.skip = True

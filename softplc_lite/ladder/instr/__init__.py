@@ -14,7 +14,7 @@ from importlib import import_module
 from ..bound import BoundInstruction
 
 # Group modules, in the order docs/instructions.md lists them.
-_GROUPS = ("misc", "mathfn", "convert", "pid", "shift", "sequencer", "filemath", "logix", "logix_task")
+_GROUPS = ("misc", "mathfn", "convert", "pid", "shift", "sequencer", "filemath", "logix", "logix_task", "logix_aoi")
 
 
 def _collect() -> dict[str, BoundInstruction]:

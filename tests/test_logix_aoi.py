@@ -1,0 +1,221 @@
+"""Add-On Instructions run (logix/aoi.py, ladder/instr/logix_aoi.py;
+docs/logix.md "Add-On Instructions"), on both executors: an AOI with Input,
+Output and InOut parameters and a local TIMER called with two instances,
+EnableIn false, an EnableInFalse routine, nested calls, a variable index in an
+InOut argument; errors at the call located and said at once; a
+source-protected AOI a warning; the fixtures that hold AOIs load."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from softplc_lite.app import AppError, load_app
+from softplc_lite.runner import RunOptions, Runner
+
+from helpers.cli import softplc_here
+from helpers.logix_aoi import Aoi, Param, write_aoi_l5x
+from helpers.logix_l5x import Prog, Task
+
+FIXTURES = Path(__file__).resolve().parent / "fixtures" / "logix"
+EXECUTORS = pytest.mark.parametrize("executor", ["compiled", "reference"])
+TIMER_30 = ('<Structure DataType="TIMER">\n<DataValueMember Name="PRE" DataType="DINT" Radix="Decimal" Value="30"/>\n'
+            "</Structure>")
+
+# Out = In * Gain; the caller's Count (InOut) counts the runs; Done is the local TIMER's DN (30 ms).
+SCALE = Aoi("Scale", [Param("In", "REAL", "Input"), Param("Gain", "REAL", "Input", required=False, default="2.0"),
+                      Param("Out", "REAL", "Output"), Param("Count", "DINT", "InOut"),
+                      Param("Done", "BOOL", "Output")],
+            {"Logic": ["MUL(In,Gain,Out);", "ADD(Count,1,Count);", "TON(Delay,?,?);", "XIC(Delay.DN)OTE(Done);",
+                       "ADD(Runs,1,Runs);"]},
+            [("Delay", "TIMER", TIMER_30), ("Runs", "DINT", None)])
+SCALE_TAGS = [("S1", "Scale"), ("S2", "Scale"), ("Go1", "BOOL"), ("Go2", "BOOL"), ("In1", "REAL"), ("Out1", "REAL"),
+              ("Out2", "REAL"), ("Cnt1", "DINT"), ("Cnt2", "DINT"), ("Done1", "BOOL"), ("Done2", "BOOL"),
+              ("Eo1", "BOOL"), ("Eo2", "BOOL")]
+SCALE_RUNGS = ["XIC(Go1)Scale(S1,In1,Out1,Cnt1,Done1)OTE(Eo1);", "XIC(Go2)Scale(S2,5.0,Out2,Cnt2,Done2)OTE(Eo2);"]
+
+
+def runner(tmp_path, aois, tags, rungs, executor) -> Runner:
+    path = write_aoi_l5x(tmp_path / "aoi.L5X", aois, tags, [Prog("P", {"Main": rungs})], [Task("T", ["P"])])
+    return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+
+
+def read(r, tag):
+    return r.table.read(r.app.program.symbols.resolve_path(tag))
+
+
+def write(r, tag, value):
+    r.table.write(r.app.program.symbols.resolve_path(tag), value)
+
+
+@EXECUTORS
+def test_two_instances_run_the_logic_each_with_its_own_data(tmp_path, executor):
+    r = runner(tmp_path, [SCALE], SCALE_TAGS, SCALE_RUNGS, executor)
+    assert read(r, "S1.Gain") == 2.0 and read(r, "S2.Delay.PRE") == 30  # the AOI's defaults
+    write(r, "In1", 1.5)
+    write(r, "Go1", 1)
+    write(r, "Go2", 1)
+    r.run(1)
+    assert read(r, "Out1") == 3.0 and read(r, "Out2") == 10.0  # In * Gain, the constant 5.0 for S2
+    assert read(r, "S1.In") == 1.5 and read(r, "S1.Out") == 3.0
+    assert read(r, "Cnt1") == 1 and read(r, "Cnt2") == 1 and read(r, "Eo1") == 1 and read(r, "S1.EnableOut") == 1
+    write(r, "S2.Gain", 3.0)  # an instance's member, set from outside: S2 alone changes
+    write(r, "Go1", 0)
+    r.run(5)
+    assert read(r, "Out2") == 15.0 and read(r, "Out1") == 3.0
+    assert read(r, "Cnt1") == 1 and read(r, "Cnt2") == 6 and read(r, "S1.Runs") == 1 and read(r, "S2.Runs") == 6
+    assert read(r, "Done2") == 1 and read(r, "S2.Delay.DN") == 1 and read(r, "Done1") == 0  # 30 ms of 10 ms scans
+    r.close()
+
+
+@EXECUTORS
+def test_enablein_false_skips_the_logic_clears_enableout_and_copies_nothing(tmp_path, executor):
+    r = runner(tmp_path, [SCALE], SCALE_TAGS, SCALE_RUNGS, executor)
+    write(r, "Go1", 1)
+    write(r, "In1", 2.0)
+    r.run(4)
+    assert read(r, "Done1") == 1 and read(r, "S1.Delay.ACC") == 30
+    write(r, "Go1", 0)
+    write(r, "In1", 7.0)
+    r.run(2)
+    assert read(r, "S1.EnableIn") == 0 and read(r, "S1.EnableOut") == 0 and read(r, "Eo1") == 0
+    assert read(r, "Cnt1") == 4 and read(r, "S1.In") == 2.0 and read(r, "Out1") == 4.0
+    assert read(r, "Done1") == 1 and read(r, "S1.Delay.ACC") == 30  # the TON inside is not scanned false
+    r.close()
+
+
+@EXECUTORS
+def test_an_enableinfalse_routine_runs_when_the_rung_is_false(tmp_path, executor):
+    hold = Aoi("Hold", [Param("In", "DINT", "Input"), Param("Out", "DINT", "Output")],
+               {"Logic": ["ADD(In,100,Out);"], "EnableInFalse": ["MOV(In,Out)ADD(Falses,1,Falses);"]},
+               [("Falses", "DINT", None)])
+    r = runner(tmp_path, [hold], [("H", "Hold"), ("Go", "BOOL"), ("X", "DINT"), ("Y", "DINT"), ("Eo", "BOOL")],
+               ["XIC(Go)Hold(H,X,Y)OTE(Eo);"], executor)
+    write(r, "X", 5)
+    r.run(2)
+    assert read(r, "Y") == 5 and read(r, "H.Falses") == 2 and read(r, "Eo") == 0
+    write(r, "Go", 1)
+    r.run(1)
+    assert read(r, "Y") == 105 and read(r, "H.Falses") == 2 and read(r, "Eo") == 1
+    r.close()
+
+
+TWICE = Aoi("Twice", [Param("X", "DINT", "Input"), Param("Y", "DINT", "Output")], {"Logic": ["MUL(X,2,Y);"]})
+BUMP = Aoi("Bump", [Param("V", "DINT", "InOut")], {"Logic": ["ADD(V,1,V);"]})
+# B = 4 * A through two calls of an inner instance; Acc (InOut) gets B added, and is passed on to Bump's InOut.
+QUAD = Aoi("Quad", [Param("A", "DINT", "Input"), Param("B", "DINT", "Output"), Param("Acc", "DINT", "InOut")],
+           {"Logic": ["Twice(T,A,Mid)Twice(T,Mid,B);", "ADD(Acc,B,Acc)Bump(Bp,Acc);"]},
+           [("T", "Twice", None), ("Mid", "DINT", None), ("Bp", "Bump", None)])
+
+
+@EXECUTORS
+def test_nested_calls_and_a_variable_index_bound_at_the_call(tmp_path, executor):
+    r = runner(tmp_path, [QUAD, TWICE, BUMP],  # QUAD first: its local types are made after it
+               [("Q", "Quad"), ("Res", "DINT"), ("Accs", "DINT[3]"), ("I", "DINT")],
+               ["Quad(Q,3,Res,Accs[I]);"], executor)
+    write(r, "I", 1)
+    r.run(2)
+    assert read(r, "Res") == 12 and read(r, "Q.Mid") == 6 and read(r, "Q.T.Y") == 12
+    assert [read(r, f"Accs[{k}]") for k in range(3)] == [0, 26, 0]  # (12 + 1) twice
+    write(r, "I", 2)
+    r.run(1)
+    assert [read(r, f"Accs[{k}]") for k in range(3)] == [0, 26, 13]
+    write(r, "I", 3)  # past the array: Logix faults an out-of-range subscript (major fault type 4, code 20)
+    r.run(1)
+    assert r.engine.mode.name == "FAULTED"
+    r.close()
+
+
+def test_errors_at_the_call_are_located_and_said_at_once(tmp_path):
+    rungs = ["Scale(S1,In1,Out1,Cnt1);", "Scale(S1,In1,Out1,5,Done1);", "Scale(In1,In1,Out1,Out1,Done1);",
+             "Scale(S1,In1,3,Cnt1,Done1);", "Scaler(S1);"]
+    path = write_aoi_l5x(tmp_path / "bad.L5X", [SCALE], SCALE_TAGS, [Prog("P", {"Main": rungs})], [Task("T", ["P"])])
+    with pytest.raises(AppError) as info:
+        load_app(path)
+    reports = [str(e) for e in info.value.errors]
+    lines = path.read_text().splitlines()
+
+    def at(text: str, column_of: str) -> str:
+        line = next(k for k, ln in enumerate(lines, 1) if text in ln)
+        return f"{path}:{line}:{lines[line - 1].index(column_of) + 1}"
+
+    assert len(reports) == 5, reports
+    assert reports[0].startswith(at(rungs[0], "Scale")) and "routine P.Main: rung 0: Scale takes 5 operands" in \
+        reports[0] and "found 4" in reports[0]
+    assert reports[1].startswith(at(rungs[1], "5,")) and "Count: an InOut parameter is passed by reference" in reports[1]
+    assert reports[2].startswith(at(rungs[2], "In1")) and "instance 'In1': expected a tag of type Scale" in reports[2]
+    assert reports[3].startswith(at(rungs[2], "Out1,Done1")) and "Count: expected a DINT tag" in reports[3]
+    assert reports[4].startswith(at(rungs[3], "3,")) and "expected a tag to receive" in reports[4]
+    p = softplc_here("check", str(path))
+    assert p.returncode == 1 and "Traceback" not in p.stderr
+
+
+def test_an_aoi_that_calls_itself_is_an_error(tmp_path):
+    loop = Aoi("Loop", [Param("V", "DINT", "InOut")], {"Logic": ["Loop(Me,V);"]}, [("Me", "DINT", None)])
+    path = write_aoi_l5x(tmp_path / "loop.L5X", [loop], [("L1", "Loop"), ("V", "DINT")],
+                         [Prog("P", {"Main": ["Loop(L1,V);"]})], [Task("T", ["P"])])
+    with pytest.raises(AppError) as info:
+        load_app(path)
+    assert "loop.L5X:20:10: routine Loop.Logic: rung 0: Loop: an Add-On Instruction may not call itself (Loop -> " \
+           "Loop)" in str(info.value)
+
+
+def test_a_source_protected_aoi_is_a_warning_and_its_calls_are_not_run(tmp_path):
+    secret = Aoi("Secret", [Param("In", "DINT", "Input")], {}, encoded=True)
+    path = write_aoi_l5x(tmp_path / "secret.L5X", [secret], [("K", "Secret"), ("Ran", "BOOL")],
+                         [Prog("P", {"Main": ["Secret(K,5)OTE(Ran);", "OTE(Ran);", "Secrets(K,5);"]})], [Task("T", ["P"])])
+    app = load_app(path)
+    warnings = "\n".join(app.warnings)
+    assert "rung 0: Secret: source protected: its logic cannot be read; the rung is not run" in warnings
+    assert "rung 2: SECRETS: not an instruction softplc_lite runs yet" in warnings  # neither instruction nor AOI
+    r = Runner(app, RunOptions(fresh=True, save_state=False))
+    r.run(1)
+    assert read(r, "Ran") == 1 and read(r, "K.In") == 0  # the instance is laid out; rung 1 ran
+    r.close()
+
+
+@pytest.mark.parametrize("name", ["whole_controller.L5X", "whole_controller.L5K"])
+def test_the_fixture_limiter_runs(tmp_path, name):
+    shutil.copy(FIXTURES / name, tmp_path / name)
+    p = softplc_here("run", str(tmp_path / name), "--scans", "2", "--executor", "reference", "--print", "Levels[0]",
+                     "--print", "Lim1.Out", "--print", "Lim1.EnableOut")
+    assert p.returncode == 0, p.stderr
+    assert "Limiter" not in p.stderr  # no warning about the AOI, its tag or its call
+    assert p.stdout.splitlines()[0].endswith("= 25") and p.stdout.splitlines()[2].endswith("= 1")
+
+
+def test_the_public_duty_cycle_aois_load_and_their_types_are_held(tmp_path):
+    src = FIXTURES / "public" / "Alex-OPTIM__rslogix5000-aois" / "DUTY_CYCLE.L5X"
+    app = load_app(shutil.copy(src, tmp_path / "DUTY_CYCLE.L5X"))
+    assert not [w for w in app.warnings if "Add-On Instruction" in w]
+    types = app.program.symbols.directory.types
+    assert [m.name for m in types.get("BOOLS_2_DINT").visible_members()] == ["EnableIn", "EnableOut", "DINT_OUT"]
+
+
+# -- LAIN and LAOUT on the ladder (ladder/instr/logix_aoi.py), each executor (the engine fixture) ------------
+# L9:0/0 is EnableIn, L9:0/1 EnableOut; file 3 the Logic (doubles L9:1 into L9:2), file 4 an EnableInFalse routine.
+CALL = ("DATA L9 4\nXIC B3/0 LAIN L9:0/0 L9:0/1 {flags} N7:0 L9:1 BST XIC L9:0/0 JSR 3 NXB XIO L9:0/0 JSR 4 BND "
+        "LAOUT L9:0/0 L9:0/1 {flags} L9:2 N7:1 OTE B3/1\nFILE 3\nMUL L9:1 2 L9:2\nXIC B3/2 OTU L9:0/1\n"
+        "FILE 4\nADD L9:3 1 L9:3\n")
+
+
+def test_lain_laout_copy_in_run_the_logic_copy_out_and_pass_enableout(engine):
+    e = engine(CALL.format(flags=0), {"N7:0": 21, "B3/0": 1})
+    e.scan()
+    assert e.table.read("L9:0") == 3 and e.table.read("N7:1") == 42 and e.table.read("B3/1") == 1
+    assert e.table.read("L9:3") == 0  # the second leg's routine runs only with EnableIn false
+    e.table.write("B3/2", 1)  # the Logic clears EnableOut: the rung-out follows it
+    e.scan()
+    assert e.table.read("L9:0") == 1 and e.table.read("B3/1") == 0 and e.table.read("N7:1") == 42
+
+
+def test_lain_laout_with_enablein_false_clear_enableout_and_copy_only_for_an_enableinfalse_routine(engine):
+    e = engine(CALL.format(flags=0), {"N7:0": 21, "L9:0": 3, "N7:1": 5})
+    e.scan()
+    assert e.table.read("L9:0") == 0 and e.table.read("L9:1") == 0 and e.table.read("N7:1") == 5
+    assert e.table.read("B3/1") == 0 and e.table.read("L9:3") == 1  # the XIO leg ran file 4
+    e = engine(CALL.format(flags=1), {"N7:0": 21, "L9:2": 8})
+    e.scan()
+    assert e.table.read("L9:1") == 21 and e.table.read("N7:1") == 8 and e.table.read("B3/1") == 0
