@@ -393,7 +393,9 @@ class AoiCalls:
                     self.said.add((p.pos, p.message))
                     into.append(p)
         jsr = Instruction("JSR", [Const(0, pos)], pos)
-        self.made.append((ProgramFile(0, f"{aoi.name}.{routine.name}({inst})", rungs, routine.pos), jsr))
+        # Named as the caller's program's (its scope: logix/names.py), the watch view shows Ramp.Logic(Ramp1).
+        name = f"{ctx.scope + '.' if ctx.scope else ''}{aoi.name}.{routine.name}({inst})"
+        self.made.append((ProgramFile(0, name, rungs, routine.pos), jsr))
         return jsr
 
     def files(self, first: int) -> dict[int, ProgramFile]:
