@@ -453,7 +453,9 @@ def _load_export_app(path: Path, state_dir: str | Path | None, program: Program 
         _, layout = layout_problems(resolved, [])
         errors += layout
     if errors:
-        raise AppError(errors)
+        # an Add-On Instruction's logic is a file for each call (logix/aoi.py): a problem in it is said once
+        said: set[str] = set()
+        raise AppError([e for e in errors if not (e.report() in said or said.add(e.report()))])
     # a mutant is checked over the export's tags, and serves no client
     modules, warnings = _export_modules(path, made) if program is None else ([], [])
     app = App(path, False, [path], resolved, Settings(overflow="wrap"), made.program,

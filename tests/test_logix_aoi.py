@@ -219,3 +219,23 @@ def test_lain_laout_with_enablein_false_clear_enableout_and_copy_only_for_an_ena
     e = engine(CALL.format(flags=1), {"N7:0": 21, "L9:2": 8})
     e.scan()
     assert e.table.read("L9:1") == 21 and e.table.read("N7:1") == 8 and e.table.read("B3/1") == 0
+
+
+def test_an_instance_in_l5k_data_packs_its_bools_first_and_nests_its_timer_array(tmp_path):
+    seq = Aoi("Seq", [Param("In", "DINT", "Input")], {"Logic": ["MOV(In,Last);"]},
+              [("Tmrs", "TIMER[2]", None), ("Flag", "BOOL", None), ("Last", "DINT", None)])
+    path = write_aoi_l5x(tmp_path / "seq.L5X", [seq], [("Q", "Seq")], [Prog("P", {"Main": ["Seq(Q,3);"]})],
+                         [Task("T", ["P"])])
+    # as Studio writes an instance's L5K data: the BOOLs' DINT (EnableIn bit 0, Flag bit 2), In, Tmrs, Last
+    text = path.read_text().replace('<Tag Name="Q" TagType="Base" DataType="Seq" Constant="false" '
+                                    'ExternalAccess="Read/Write"/>',
+                                    '<Tag Name="Q" TagType="Base" DataType="Seq" Constant="false" ExternalAccess='
+                                    '"Read/Write">\n<Data Format="L5K">\n<![CDATA[[5,7,[[0,100,0],[0,200,0]],9]]]>\n'
+                                    '</Data>\n</Tag>')
+    path.write_text(text)
+    r = Runner(load_app(path), RunOptions(fresh=True, save_state=False))
+    assert [read(r, p) for p in ("Q.EnableIn", "Q.EnableOut", "Q.Flag", "Q.In", "Q.Tmrs[1].PRE", "Q.Last")] == \
+        [1, 0, 1, 7, 200, 9]
+    r.run(1)
+    assert read(r, "Q.Last") == 3 and read(r, "Q.EnableOut") == 1
+    r.close()

@@ -69,6 +69,22 @@ def _flat(value) -> list:
     return [value]
 
 
+def _elements(value, t: LogixType, count: int) -> list:
+    """An array's ``count`` element values, written flat or nested by
+    dimension. An element of a structure is a list (positional) or a dict of
+    its own, so only the dimensions' nesting is undone: one level at a time
+    while there are fewer values than elements."""
+    if t.kind != "struct":
+        return _flat(value)
+    out = value if isinstance(value, list) else [value]
+    while len(out) < count and out and all(isinstance(v, list) for v in out):
+        deeper = [e for row in out for e in row]
+        if len(deeper) > count:
+            break
+        out = deeper
+    return out
+
+
 def apply_initial(d: Declared, writer: ValueWriter, problems: list[Problem]) -> None:
     """Write tag ``d``'s initial value, if it has one."""
     iv: InitialValue | None = d.tag.value
@@ -156,7 +172,7 @@ def apply_initial(d: Declared, writer: ValueWriter, problems: list[Problem]) -> 
                 continue
             sub = path + (m.name.upper(),)
             if m.dim:
-                elems = _flat(v)
+                elems = _elements(v, m.type, m.dim)
                 for j, e in enumerate(elems[:m.dim]):
                     one(m.type, sub, k * m.dim + j, e)
             else:
@@ -170,10 +186,10 @@ def apply_initial(d: Declared, writer: ValueWriter, problems: list[Problem]) -> 
                     atomic(t, path + (m.host.upper(),), k, v, bit=m.bit)
 
     if d.dims:
-        elems = _flat(iv.data)
         count = 1
         for n in d.dims:
             count *= n
+        elems = _elements(iv.data, d.type, count)
         if len(elems) > count:
             bad(f"{len(elems)} values for {count} elements")
         for k, e in enumerate(elems[:count]):
