@@ -100,12 +100,13 @@ def test_every_problem_of_an_export_is_located_and_said_at_once(tmp_path):
 def test_what_is_not_run_is_a_warning_by_name_and_place_and_the_rest_runs(tmp_path):
     def add_unrun(text: str) -> str:
         text = text.replace('<![CDATA[XIC(Running)JSR(FillTank,0);]]>',
-                            '<![CDATA[XIC(Running)JSR(FillTank,0)GSV(WallClockTime,,CurrentValue,Now);]]>')
+                            '<![CDATA[XIC(Running)JSR(FillTank,0)GSV(Module,Rack,EntryStatus,Now);]]>')
         return text.replace("</Tasks>", '<Task Name="Slow" Type="EVENT" Priority="5" Watchdog="500">'
                                          '<ScheduledPrograms/></Task>\n</Tasks>')
     app = load_app(tank_line(tmp_path, add_unrun))
     warnings = "\n".join(app.warnings)
-    assert "GSV: not yet run by softplc_lite; the rung is not run" in warnings
+    assert "GSV: Module.EntryStatus is not an attribute softplc_lite holds" in warnings
+    assert "the rung is not run" in warnings
     assert "routine MainProgram.MainRoutine: rung 1" in warnings
     assert "event task Slow: not run: softplc_lite raises no event to trigger it" in warnings
     p = softplc_here("run", str(tmp_path / "tank_line.L5X"), "--scans", "3", "--set", "Start=1", "--print", "Running")

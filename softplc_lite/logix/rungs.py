@@ -17,7 +17,7 @@ in the structure (``TON(T1,?,?)``: written as ``?`` or a value, not used).
 from __future__ import annotations
 
 from ..ladder.ast import AddressRef, Branch, Const, Instruction, Pos, Rung
-from . import model
+from . import copy, model, strings, system
 from .expr import ExprError, number, parse_expression
 from .neutral import NBranch, NeutralError, parse_rung
 from .tags import NotRun, PathError, TagDirectory
@@ -43,8 +43,12 @@ PLAN: dict[str, tuple[str, str]] = {
 }
 # Instructions Logix has and softplc_lite does not run yet, or cannot (MSG: a message to
 # another device): said by name where they are used.
-NOT_RUN_REASON = {"MSG": "a message to another device; softplc_lite has no network to send it on",
-                  "GSV": "not yet run by softplc_lite", "SSV": "not yet run by softplc_lite"}
+NOT_RUN_REASON = {"MSG": "a message to another device; softplc_lite has no network to send it on"}
+# Instructions translated by a module of their own (operands of several kinds, or one ladder
+# instruction per member): the handler returns the instruction, or NotImplemented for PLAN's.
+HANDLERS = {**{m: copy.translate for m in ("COP", "CPS", "FLL")},
+            **{m: strings.translate for m in (*strings.PLAN, "SIZE", *strings.COMPARES, "MOV", "MOVE")},
+            "GSV": system.translate, "SSV": system.translate}
 
 
 class RoutineContext:
@@ -126,6 +130,11 @@ def _series(elements, rung, ctx) -> list:
 
 def _instruction(el, rung, ctx) -> Instruction | None:
     pos = _at(rung.pos, rung.text, el.column)
+    handler = HANDLERS.get(el.mnemonic)
+    if handler is not None:
+        out = handler(el, pos, rung, ctx)
+        if out is not NotImplemented:
+            return out
     plan = PLAN.get(el.mnemonic)
     if plan is None:
         if ctx.aoi is not None and ctx.aoi.defines(el.mnemonic):

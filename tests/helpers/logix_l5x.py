@@ -38,12 +38,14 @@ def _tag(name: str, data_type: str) -> str:
             f'ExternalAccess="Read/Write"/>')
 
 
-def l5x_text(tags: list[tuple[str, str]], programs: list[Prog], tasks: list[Task], name: str = "Test") -> str:
+def l5x_text(tags: list[tuple[str, str]], programs: list[Prog], tasks: list[Task], name: str = "Test",
+             data_types: str = "") -> str:
+    """``data_types``: the export's <DataType> elements, as XML text."""
     out = ['<?xml version="1.0" encoding="UTF-8" standalone="yes"?>',
            f'<RSLogix5000Content SchemaRevision="1.0" SoftwareRevision="33.01" TargetName="{name}" '
            'TargetType="Controller" ContainsContext="false">',
            f'<Controller Use="Target" Name="{name}" ProcessorType="1756-L83E" MajorRev="33" MinorRev="11">',
-           "<DataTypes/>", "<AddOnInstructionDefinitions/>", "<Tags>"]
+           f"<DataTypes>{data_types}</DataTypes>", "<AddOnInstructionDefinitions/>", "<Tags>"]
     out += [_tag(n, t) for n, t in tags]
     out += ["</Tags>", "<Programs>"]
     for p in programs:
@@ -68,6 +70,6 @@ def l5x_text(tags: list[tuple[str, str]], programs: list[Prog], tasks: list[Task
     return "\n".join(out)
 
 
-def write_l5x(path: Path, tags, programs, tasks, name: str = "Test") -> Path:
-    path.write_text(l5x_text(tags, programs, tasks, name), encoding="utf-8")
+def write_l5x(path: Path, tags, programs, tasks, name: str = "Test", data_types: str = "") -> Path:
+    path.write_text(l5x_text(tags, programs, tasks, name, data_types), encoding="utf-8")
     return path

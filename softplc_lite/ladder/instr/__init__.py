@@ -14,7 +14,8 @@ from importlib import import_module
 from ..bound import BoundInstruction
 
 # Group modules, in the order docs/instructions.md lists them.
-_GROUPS = ("misc", "mathfn", "convert", "pid", "shift", "sequencer", "filemath", "logix", "logix_task", "logix_aoi")
+_GROUPS = ("misc", "mathfn", "convert", "pid", "shift", "sequencer", "filemath", "logix", "logix_task", "logix_aoi",
+           "logix_data", "logix_string", "logix_system")
 
 
 def _collect() -> dict[str, BoundInstruction]:

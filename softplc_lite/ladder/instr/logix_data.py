@@ -1,0 +1,94 @@
+"""Logix's file instructions on tags (COP, CPS, FLL), bound objects run by
+both executors. The Logix translator (logix/copy.py) writes one per atomic
+leaf of what is copied: an array of one atomic type is one leaf, an array of
+a user-defined type one leaf per member (tags.py lays each member of an
+array of structures out as a file of its own).
+
+Rules (1756-RM003, Logix 5000 Controllers General Instructions, "Copy File
+(COP), Synchronous Copy File (CPS)" and "File Fill (FLL)"):
+
+- The length counts elements of the destination; the bytes copied are the
+  length times the destination element's size ("Byte Count = Length *
+  number of bytes in the Destination data type").
+- A length past the end of the destination array stops at the array's end;
+  no fault ("If the Length is too big, the instruction stops at the end of
+  the array. No major fault is generated").
+- COP and CPS copy bytes: between two atomic types the destination gets the
+  source's bytes, not converted values (Logix's byte layout: little-endian
+  SINT, INT, DINT, LINT, IEEE REAL).
+- FLL converts the source into the destination's type (RM003, "Data
+  conversions": a REAL into an integer rounds, half to even).
+- A source that ends before the length does: Logix copies "unpredictable
+  data" for the rest; softplc_lite copies what the source holds and leaves
+  the rest of the destination as it is (a softplc choice).
+- A length of zero or less copies nothing (a softplc choice).
+- CPS differs from COP in that nothing may change the data while it copies;
+  nothing does during a softplc_lite scan, so CPS is COP.
+"""
+
+from __future__ import annotations
+
+from array import array
+
+from ..bound import BoundInstruction
+from ..specs import InstructionSpec, K, OperandSpec
+
+
+def _spec(mnemonic: str, title: str, *names: str) -> InstructionSpec:
+    return InstructionSpec(mnemonic, title, tuple(OperandSpec(n, K.ANY) for n in names), True)
+
+
+SPECS = [
+    _spec("LCOP", "Logix copy file", "source", "dest", "length", "items per element", "dest end", "source end"),
+    _spec("LFLL", "Logix file fill", "source", "dest", "length", "items per element", "dest end"),
+]
+LOGIX_NAMES = {"LCOP": "COP", "LFLL": "FLL"}
+
+
+def _copy(instr, access):
+    src, dest, length, per, dest_end, src_end = instr.operands
+    get_src, get_dest, get_length = access.location(src), access.location(dest), access.value(length)
+    per, dest_end, src_end = per.value, dest_end.value, src_end.value
+    wpe_d = dest.address.ftype.words_per_element
+    wpe_s = src.address.ftype.words_per_element
+
+    def run(c: bool) -> bool:
+        if c:
+            n = int(get_length()) * per
+            if n <= 0:
+                return c
+            dd, di, _ = get_dest()
+            sd, si, _ = get_src()
+            n = min(n, dest_end - di // wpe_d)
+            have = src_end - si // wpe_s
+            if n <= 0 or have <= 0:
+                return c
+            if sd.typecode == dd.typecode:
+                n = min(n, have) * wpe_d
+                dd[di:di + n] = sd[si:si + n]
+                return c
+            raw = sd[si:si + have * wpe_s].tobytes()[:n * wpe_d * dd.itemsize]
+            n = len(raw) // dd.itemsize
+            dd[di:di + n] = array(dd.typecode, raw[:n * dd.itemsize])
+        return c
+    return run
+
+
+def _fill(instr, access):
+    source, dest, length, per, dest_end = instr.operands
+    value, get_dest, get_length = access.value(source), access.location(dest), access.value(length)
+    per, dest_end = per.value, dest_end.value
+    machine = access.machine
+    wpe = dest.address.ftype.words_per_element  # an ST element's words, cleared by a FLL of 0
+
+    def run(c: bool) -> bool:
+        if c:
+            dd, di, _ = get_dest()
+            n = min(int(get_length()) * per, dest_end - di // wpe)
+            if n > 0:
+                machine.fll(value(), dd, di, n * wpe)
+        return c
+    return run
+
+
+INSTRUCTIONS = [BoundInstruction(SPECS[0], _copy), BoundInstruction(SPECS[1], _fill)]

@@ -1,0 +1,54 @@
+"""GSV(Class, Instance, Attribute, Dest) and SSV(Class, Instance,
+Attribute, Source): the class and attribute are names in the rung, known
+when the export is loaded (1756-RM003, "Get System Value (GSV) and Set
+System Value (SSV)").
+
+- An attribute the data table holds (the tag directory's ``objects``: a
+  task's InhibitTask and OverlapCount, a program's DisableFlag; tasks.py) is
+  read from it (GSV) or written into it (SSV): LGSV/LSSV code 0. The instance ``THIS`` of a Program
+  is the program the rung is in.
+- An attribute read from the engine (the wall clock, the scan times, the
+  fault bits: ladder/instr/logix_system.py) is an LGSV or LSSV.
+- Any other (Module.EntryStatus, Controller, Axis ...): the rung is not run,
+  with a warning naming the class and attribute.
+"""
+
+from __future__ import annotations
+
+from ..ladder.ast import AddressRef, Const, Instruction
+from ..ladder.instr.logix_system import ATTRIBUTES, HELD, WALL_CURRENT, WORDS
+from . import operands
+from .copy import element_run
+from .operands import Operands, Skip
+from .tags import PathError
+
+
+def translate(el, pos, rung, ctx):
+    return operands.translate(el, pos, rung, ctx, _build)
+
+
+def _build(ops: Operands) -> list[Instruction]:
+    ops.count(4)
+    get = ops.el.mnemonic == "GSV"
+    cls, instance, attribute = (ops.text(k).upper() for k in range(3))
+    if cls == "PROGRAM" and instance == "THIS" and ops.ctx.scope:
+        instance = ops.ctx.scope.upper()
+    held = ops.ctx.directory.objects.get((cls, instance, attribute))
+    code = HELD if held is not None else ATTRIBUTES.get((cls, attribute))
+    if code is None:
+        raise Skip(f"{ops.text(0)}.{ops.text(2)} is not an attribute softplc_lite holds (it has WallClockTime "
+                   f"CurrentValue, DateTime, LocalDateTime; Task and Program LastScanTime, MaxScanTime; Task "
+                   f"Watchdog, InhibitTask, OverlapCount; Program DisableFlag; FaultLog MinorFaultBits, "
+                   f"MajorFaultBits)")
+    r = ops.resolve(3)
+    where = ops.where(3)
+    if r.type.kind != "atomic" or r.type.name in ("BOOL", "REAL"):
+        raise PathError(f"expected a DINT{' or LINT' if code == WALL_CURRENT else ''}, found {r.type.name}")
+    run = element_run(r, where, ops.ctx)
+    address, _, end = run.leaves[()]
+    need = WORDS.get(code, 2 if code == WALL_CURRENT and address.type_letter == "L" else 1)
+    if isinstance(address.element, int) and end - address.element < need:
+        raise PathError(f"{ops.el.mnemonic} of {ops.text(0)}.{ops.text(2)} takes {need} DINTs: expected an "
+                        f"array with {need} elements from here")
+    extra = [AddressRef(held, ops.pos)] if held is not None else []
+    return [Instruction("LGSV" if get else "LSSV", [Const(code, ops.pos), AddressRef(address, where)] + extra, ops.pos)]

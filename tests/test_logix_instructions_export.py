@@ -1,0 +1,277 @@
+"""COP, CPS, FLL, the string instructions, SIZE, string compares and moves,
+and GSV/SSV through an export's rungs (logix/copy.py, strings.py,
+system.py), on both executors: what each rung becomes, the cases 1756-RM003
+gives, and what is not run said as a warning."""
+
+from __future__ import annotations
+
+import pytest
+
+from softplc_lite.app import AppError, load_app
+from softplc_lite.runner import RunOptions, Runner
+
+from helpers.logix_l5x import Prog, Task, write_l5x
+
+EXECUTORS = pytest.mark.parametrize("executor", ["compiled", "reference"])
+TYPES = """<DataType Name="Pt" Family="NoFamily" Class="User"><Members>
+<Member Name="ZZZZZZZZZZPt0" DataType="SINT" Dimension="0" Radix="Decimal" Hidden="true" ExternalAccess="Read/Write"/>
+<Member Name="On" DataType="BIT" Dimension="0" Radix="Decimal" Hidden="false" Target="ZZZZZZZZZZPt0" BitNumber="0"
+ ExternalAccess="Read/Write"/>
+<Member Name="X" DataType="REAL" Dimension="0" Radix="Float" Hidden="false" ExternalAccess="Read/Write"/>
+<Member Name="H" DataType="DINT" Dimension="3" Radix="Decimal" Hidden="false" ExternalAccess="Read/Write"/>
+<Member Name="Name" DataType="STRING" Dimension="0" Radix="NullType" Hidden="false" ExternalAccess="Read/Write"/>
+</Members></DataType>
+<DataType Name="STRING8" Family="StringFamily" Class="User"><Members>
+<Member Name="LEN" DataType="DINT" Dimension="0" Radix="Decimal" Hidden="false" ExternalAccess="Read/Write"/>
+<Member Name="DATA" DataType="SINT" Dimension="8" Radix="ASCII" Hidden="false" ExternalAccess="Read/Write"/>
+</Members></DataType>"""
+TAGS = [("A", "DINT[5]"), ("B", "DINT[5]"), ("I", "INT[4]"), ("R", "REAL[3]"), ("P", "Pt[3]"), ("Q", "Pt[3]"),
+        ("One", "Pt"), ("S1", "STRING"), ("S2", "STRING"), ("S3", "STRING"), ("Short", "STRING8"),
+        ("Names", "STRING[3]"), ("N", "DINT"), ("N2", "DINT"), ("F", "REAL"), ("DT", "DINT[7]"), ("Us", "LINT"),
+        ("Flag", "BOOL"), ("Flag3", "BOOL"), ("k", "DINT"), ("Grid", "INT[2,3]"), ("T1", "TIMER"),
+        ("T2", "TIMER"), ("Zero", "DINT"), ("Flag2", "DINT")]
+
+
+def runner(tmp_path, rungs, executor="compiled") -> Runner:
+    path = write_l5x(tmp_path / "x.L5X", TAGS, [Prog("P", {"Main": rungs})], [Task("T", ["P"])], data_types=TYPES)
+    return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+
+
+def read(r, tag):
+    return r.table.read(r.app.program.symbols.resolve_path(tag))
+
+
+def write(r, tag, value):
+    r.table.write(r.app.program.symbols.resolve_path(tag), value)
+
+
+def warnings_of(tmp_path, rungs) -> str:
+    path = write_l5x(tmp_path / "w.L5X", TAGS, [Prog("P", {"Main": rungs})], [Task("T", ["P"])], data_types=TYPES)
+    return "\n".join(load_app(path).warnings)
+
+
+def errors_of(tmp_path, rungs) -> list[str]:
+    path = write_l5x(tmp_path / "e.L5X", TAGS, [Prog("P", {"Main": rungs})], [Task("T", ["P"])], data_types=TYPES)
+    with pytest.raises(AppError) as info:
+        load_app(path)
+    return [str(e) for e in info.value.errors]
+
+
+# -- COP, CPS, FLL ---------------------------------------------------------------------------
+
+@EXECUTORS
+@pytest.mark.parametrize("mnemonic", ["COP", "CPS"])
+def test_cop_and_cps_of_whole_arrays_stop_at_the_destination_end(tmp_path, executor, mnemonic):
+    r = runner(tmp_path, [f"{mnemonic}(A,B,10);", f"{mnemonic}(A[1],A[0],4);"], executor)
+    for k in range(5):
+        write(r, f"A[{k}]", k + 1)
+    r.run(1)
+    assert [read(r, f"B[{k}]") for k in range(5)] == [1, 2, 3, 4, 5] and r.engine.fault is None
+    assert [read(r, f"A[{k}]") for k in range(5)] == [2, 3, 4, 5, 5]  # overlapping: as a move
+    r.close()
+
+
+@EXECUTORS
+def test_cop_between_types_copies_logix_bytes(tmp_path, executor):
+    r = runner(tmp_path, ["COP(R[0],A[3],2);", "COP(A[0],I[0],2);"], executor)
+    write(r, "R[0]", 1.5)
+    write(r, "A[0]", 0x00020001)
+    r.run(1)
+    assert read(r, "A[3]") == 0x3FC00000 and read(r, "A[4]") == 0  # R[1] is 0.0
+    assert [read(r, "I[0]"), read(r, "I[1]")] == [1, 2]  # a DINT's low INT first
+    r.close()
+
+
+@EXECUTORS
+def test_cop_of_structures_copies_every_member_bools_arrays_and_strings(tmp_path, executor):
+    r = runner(tmp_path, ["COP(P[0],Q[1],5);", "COP(P[1],One,1);", "COP(T1,T2,1);"], executor)
+    write(r, "P[0].X", 3.25)
+    write(r, "P[0].H[2]", 9)
+    write(r, "P[0].On", 1)
+    write(r, "P[0].Name", "feed")
+    write(r, "P[1].H[0]", 5)
+    write(r, "Q[2].X", 7.0)
+    write(r, "T1.PRE", 1500)
+    r.run(1)
+    assert (read(r, "Q[1].X"), read(r, "Q[1].H[2]"), read(r, "Q[1].On"), read(r, "Q[1].Name")) == (3.25, 9, 1, "feed")
+    assert read(r, "Q[2].H[0]") == 5 and read(r, "Q[2].X") == 0.0  # P[1] into Q[2]; then the end of Q
+    assert read(r, "Q[0].X") == 0.0 and read(r, "One.H[0]") == 5 and read(r, "T2.PRE") == 1500
+    r.close()
+
+
+@EXECUTORS
+def test_cop_with_an_index_tag_and_a_length_tag(tmp_path, executor):
+    r = runner(tmp_path, ["COP(A[k],B[N],N2);", "COP(P[k],Q[0],1);"], executor)
+    for k in range(5):
+        write(r, f"A[{k}]", 10 + k)
+    write(r, "k", 2)
+    write(r, "N", 1)
+    write(r, "N2", 2)
+    write(r, "P[2].H[1]", 8)
+    r.run(1)
+    assert [read(r, f"B[{k}]") for k in range(5)] == [0, 12, 13, 0, 0] and read(r, "Q[0].H[1]") == 8
+    write(r, "k", 3)
+    write(r, "N", 7)  # the destination index past the array: major fault 20 as for any subscript
+    r.run(1)
+    assert r.engine.fault is not None and r.engine.fault.code == 20
+    r.close()
+
+
+@EXECUTORS
+def test_fll_converts_with_logix_rules_and_clears_structures(tmp_path, executor):
+    r = runner(tmp_path, ["FLL(70000,I[1],10);", "FLL(2.5,A[0],2);", "FLL(0,P[1],2);", "FLL(F,R,3);"], executor)
+    write(r, "P[1].X", 1.0)
+    write(r, "P[2].Name", "x")
+    write(r, "P[0].H[0]", 4)
+    write(r, "F", -1.25)
+    r.run(1)
+    assert [read(r, f"I[{k}]") for k in range(4)] == [0, 4464, 4464, 4464]  # low 16 bits of 70000, to the end
+    assert [read(r, "A[0]"), read(r, "A[1]")] == [2, 2]  # half to even
+    assert read(r, "P[1].X") == 0.0 and read(r, "P[2].Name") == "" and read(r, "P[0].H[0]") == 4
+    assert [read(r, f"R[{k}]") for k in range(3)] == [-1.25] * 3
+    r.close()
+
+
+def test_cop_and_fll_that_softplc_lite_does_not_run_are_warnings(tmp_path):
+    warnings = warnings_of(tmp_path, ["COP(P[0],A[0],1);", "FLL(5,P[0],1);", "COP(S1,A[0],1);", "COP(Flag,N,1);"])
+    assert "rung 0: COP: a copy from a Pt into a DINT copies Logix's byte layout" in warnings
+    assert "rung 1: FLL: a FLL of a number into Pt structures" in warnings
+    assert "rung 2: COP: a copy from a STRING into a DINT" in warnings
+    assert "rung 3: COP: Flag is a BOOL" in warnings
+    assert warnings.count("the rung is not run") == 4
+
+
+def test_cop_with_a_wrong_operand_is_a_located_error(tmp_path):
+    errors = errors_of(tmp_path, ["COP(A,Nope,2);", "FLL(1,A[0]);"])
+    assert "rung 0: COP operand 'Nope': unknown tag 'Nope'" in errors[0]
+    assert "rung 1: FLL takes 3 operands, found 2" in errors[1]
+
+
+# -- strings ---------------------------------------------------------------------------------
+
+@EXECUTORS
+def test_concat_mid_find_insert_delete_upper_lower_on_tags(tmp_path, executor):
+    r = runner(tmp_path, ["CONCAT(S1,S2,S3);", "MID(S3,3,2,Names[0]);", "FIND(S3,S2,1,N);",
+                          "INSERT(S1,S2,2,Names[1]);", "DELETE(S3,2,1,Names[2]);", "UPPER(S3,S1);",
+                          "LOWER(S1,S2);", "CONCAT(S3,S3,Short);"], executor)
+    write(r, "S1", "Ab")
+    write(r, "S2", "Cd")
+    r.run(1)
+    assert read(r, "S3") == "AbCd" and read(r, "Names[0]") == "bCd" and read(r, "N") == 3
+    assert read(r, "Names[1]") == "ACdb" and read(r, "Names[2]") == "Cd"
+    assert read(r, "S1") == "ABCD" and read(r, "S2") == "abcd"
+    assert read(r, "Short") == "AbCdAbCd"  # 8 characters: a STRING8 holds them
+    r.close()
+
+
+@EXECUTORS
+def test_concat_past_a_string_types_size_truncates_with_the_minor_fault(tmp_path, executor):
+    r = runner(tmp_path, ["CONCAT(S1,S1,Short);"], executor)
+    write(r, "S1", "12345")
+    r.run(1)
+    assert read(r, "Short") == "12345123" and read(r, "S:MINOR") == 0  # S:MINOR is S:10/14, the overflow bit
+    assert r.table.read("S:17/2") == 1
+    r.close()
+
+
+@EXECUTORS
+def test_dtos_stod_rtos_stor(tmp_path, executor):
+    r = runner(tmp_path, ["DTOS(N,S1);", "STOD(S1,N2);", "RTOS(F,S2);", "STOR(S2,R[0]);", "STOD(S3,k);"], executor)
+    write(r, "N", -1234567)
+    write(r, "F", 0.1)
+    write(r, "S3", "Tank 12")
+    r.run(1)
+    assert read(r, "S1") == "-1234567" and read(r, "N2") == -1234567
+    assert read(r, "S2") == "0.1" and abs(read(r, "R[0]") - 0.1) < 1e-7 and read(r, "k") == 12
+    r.close()
+
+
+@EXECUTORS
+def test_size_of_arrays_by_dimension(tmp_path, executor):
+    r = runner(tmp_path, ["SIZE(A,0,N);", "SIZE(Grid,1,N2);", "SIZE(P[0].H,0,k);"], executor)
+    r.run(1)
+    assert (read(r, "N"), read(r, "N2"), read(r, "k")) == (5, 3, 3)
+    r.close()
+
+
+def test_size_of_a_dimension_the_array_does_not_have_is_a_located_error(tmp_path):
+    errors = errors_of(tmp_path, ["SIZE(A,1,N);", "SIZE(N,0,k);"])
+    assert "SIZE operand '1': expected the dimension to vary as a number from 0 to 0" in errors[0]
+    assert "SIZE operand 'N': expected an array, found DINT" in errors[1]
+
+
+@EXECUTORS
+@pytest.mark.parametrize("mnemonic, out", [("EQU", 0), ("NEQ", 1), ("LES", 1), ("GRT", 0), ("LEQ", 1), ("GEQ", 0),
+                                           ("EQ", 0), ("LT", 1)])
+def test_equ_neq_les_grt_leq_geq_compare_strings(tmp_path, executor, mnemonic, out):
+    r = runner(tmp_path, [f"{mnemonic}(S1,S2)OTE(Flag);", "EQU(S1,S1)EQU(N,0)OTE(Flag3);"], executor)
+    write(r, "S1", "AB")
+    write(r, "S2", "AC")
+    r.run(1)
+    assert read(r, "Flag") == out and read(r, "Flag3") == 1
+    r.close()
+
+
+@EXECUTORS
+def test_mov_and_move_of_a_string(tmp_path, executor):
+    r = runner(tmp_path, ["MOV(S1,S2);", "MOVE(S1,Names[2]);", "MOV(5,N);"], executor)
+    write(r, "S1", "hello")
+    r.run(1)
+    assert read(r, "S2") == "hello" and read(r, "Names[2]") == "hello" and read(r, "N") == 5
+    r.close()
+
+
+def test_a_string_instruction_on_a_number_is_a_located_error(tmp_path):
+    errors = errors_of(tmp_path, ["CONCAT(S1,N,S2);", "EQU(S1,N)OTE(Flag);"])
+    assert "CONCAT operand 'N': expected a string, found DINT" in errors[0]
+    assert "EQU operand 'N': expected a string, found DINT" in errors[1]
+
+
+# -- GSV, SSV --------------------------------------------------------------------------------
+
+@EXECUTORS
+def test_gsv_and_ssv_of_the_wall_clock(tmp_path, executor):
+    r = runner(tmp_path, ["XIC(Flag)SSV(WallClockTime,,DateTime,DT);", "GSV(WallClockTime,,CurrentValue,Us);",
+                          "GSV(WALLCLOCKTIME,,DATETIME,DT[0]);"], executor)
+    for k, v in enumerate((2030, 1, 2, 3, 4, 5, 0)):
+        write(r, f"DT[{k}]", v)
+    write(r, "Flag", 1)
+    r.run(1)
+    assert read(r, "Us") == 1893553445_000_000  # 2030-01-02 03:04:05 UTC
+    write(r, "Flag", 0)
+    r.run(10)
+    assert [read(r, f"DT[{k}]") for k in range(7)] == [2030, 1, 2, 3, 4, 5, 100_000]
+    r.close()
+
+
+@EXECUTORS
+def test_gsv_of_task_program_and_fault_log_and_ssv_of_a_programs_disable_flag(tmp_path, executor):
+    r = runner(tmp_path, ["GSV(Task,T,LastScanTime,N);", "GSV(Program,THIS,MaxScanTime,N2);",
+                          "GSV(Program,P,DisableFlag,k);", "CONCAT(S1,S1,Short);",
+                          "GSV(FaultLog,,MinorFaultBits,A[0]);", "SSV(FaultLog,,MinorFaultBits,Zero);",
+                          "GSV(FaultLog,,MinorFaultBits,A[1]);", "XIC(Flag)SSV(Program,THIS,DisableFlag,Flag2);"],
+               executor)
+    write(r, "S1", "123456")
+    r.run(2)
+    assert (read(r, "N"), read(r, "N2"), read(r, "k")) == (10_000, 10_000, 0)  # 10 ms simulated scans, in µs
+    assert [read(r, "A[0]"), read(r, "A[1]")] == [16, 0]
+    write(r, "Flag", 1)
+    write(r, "Flag2", 1)
+    r.run(1)
+    assert read(r, "Program:P.DisableFlag") == 1
+    write(r, "N", 0)
+    r.run(1)
+    assert read(r, "N") == 0  # the program is disabled
+    r.close()
+
+
+def test_gsv_of_what_softplc_lite_does_not_hold_is_a_warning(tmp_path):
+    warnings = warnings_of(tmp_path, ["GSV(Module,Rack,EntryStatus,N);", "SSV(Axis,Servo,HomeSpeed,F);"])
+    assert "rung 0: GSV: Module.EntryStatus is not an attribute softplc_lite holds" in warnings
+    assert "rung 1: SSV: Axis.HomeSpeed is not an attribute softplc_lite holds" in warnings
+
+
+def test_gsv_into_a_too_small_destination_is_a_located_error(tmp_path):
+    errors = errors_of(tmp_path, ["GSV(WallClockTime,,DateTime,DT[3]);", "GSV(Task,T,LastScanTime,F);"])
+    assert "takes 7 DINTs: expected an array with 7 elements from here" in errors[0]
+    assert "expected a DINT, found REAL" in errors[1]
