@@ -109,6 +109,15 @@ def _tod(v) -> int | float:
     return out - 0x10000 if out & 0x8000 else out
 
 
+def _trn(v) -> int | float:
+    """TRN: the fraction cut off, toward zero, a REAL staying a REAL (Logix,
+    1756-RM003 "Truncate (TRN)"; PLC-5 text has no TRN: parse_actions._CALLS
+    leaves it out). An infinite or NaN REAL is as it is."""
+    if isinstance(v, float) and math.isfinite(v):
+        return float(math.trunc(v))
+    return v
+
+
 FUNCTIONS: dict[str, Callable] = {
     "SQR": _safe(lambda v: math.sqrt(abs(v))),
     "ABS": abs,
@@ -125,6 +134,7 @@ FUNCTIONS: dict[str, Callable] = {
     "ATN": _safe(math.atan),
     "DEG": _safe(math.degrees),
     "RAD": _safe(math.radians),
+    "TRN": _trn,
 }
 
 PY_COMPARE = {"=": "==", "<>": "!=", "<": "<", "<=": "<=", ">": ">", ">=": ">="}

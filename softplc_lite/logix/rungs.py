@@ -17,7 +17,7 @@ in the structure (``TON(T1,?,?)``: written as ``?`` or a value, not used).
 from __future__ import annotations
 
 from ..ladder.ast import AddressRef, Branch, Const, Instruction, Pos, Rung
-from . import copy, model, strings, system
+from . import bits, copy, model, strings, system
 from .expr import ExprError, number, parse_expression
 from .neutral import NBranch, NeutralError, parse_rung
 from .tags import NotRun, PathError, TagDirectory
@@ -33,9 +33,9 @@ PLAN: dict[str, tuple[str, str]] = {
     "EQU": ("EQU", "vv"), "NEQ": ("NEQ", "vv"), "GRT": ("GRT", "vv"), "LES": ("LES", "vv"),
     "GEQ": ("GEQ", "vv"), "LEQ": ("LEQ", "vv"), "EQ": ("EQU", "vv"), "NE": ("NEQ", "vv"),
     "GT": ("GRT", "vv"), "LT": ("LES", "vv"), "GE": ("GEQ", "vv"), "LE": ("LEQ", "vv"),
-    "LIM": ("LIM", "vvv"), "MEQ": ("MEQ", "vvv"),
-    "AND": ("AND", "vvd"), "OR": ("OR", "vvd"), "XOR": ("XOR", "vvd"), "NOT": ("NOT", "vd"),
-    "BAND": ("AND", "vvd"), "BOR": ("OR", "vvd"), "BXOR": ("XOR", "vvd"), "BNOT": ("NOT", "vd"),
+    "LIM": ("LIM", "vvv"), "MEQ": ("LMEQ", "vvv"), "MVM": ("LMVM", "vvd"),
+    "AND": ("LAND", "vvd"), "OR": ("LOR", "vvd"), "XOR": ("LXOR", "vvd"), "NOT": ("LNOT", "vd"),
+    "BAND": ("LAND", "vvd"), "BOR": ("LOR", "vvd"), "BXOR": ("LXOR", "vvd"), "BNOT": ("LNOT", "vd"),
     "CPT": ("CPT", "de"), "CMP": ("CMP", "e"),
     "JMP": ("JMP", "l"), "LBL": ("LBL", "l"), "JSR": ("JSR", "r"), "RET": ("RET", "p"), "SBR": ("SBR", "p"),
     "TON": ("LTON", "T??"), "TOF": ("LTOF", "T??"), "RTO": ("LRTO", "T??"),
@@ -48,7 +48,8 @@ NOT_RUN_REASON = {"MSG": "a message to another device; softplc_lite has no netwo
 # instruction per member): the handler returns the instruction, or NotImplemented for PLAN's.
 HANDLERS = {**{m: copy.translate for m in ("COP", "CPS", "FLL")},
             **{m: strings.translate for m in (*strings.PLAN, "SIZE", *strings.COMPARES, "MOV", "MOVE")},
-            "GSV": system.translate, "SSV": system.translate}
+            "GSV": system.translate, "SSV": system.translate,
+            **{m: bits.translate for m in ("BTD", "SWPB", "TRN")}}
 
 
 class RoutineContext:

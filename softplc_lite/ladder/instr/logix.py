@@ -41,6 +41,7 @@ from __future__ import annotations
 from ..bound import BoundInstruction
 from ..semantics import MajorFault
 from ..specs import InstructionSpec, K, OperandSpec
+from .logix_bits import LOGIX_NAMES as _BITS_NAMES
 from .logix_data import LOGIX_NAMES as _DATA_NAMES
 from .logix_string import LOGIX_NAMES as _STRING_NAMES
 from .logix_system import LOGIX_NAMES as _SYSTEM_NAMES
@@ -73,7 +74,7 @@ SPECS = [
 # The Logix name each shows as (the watch view, fmt, messages); LIDX is no Logix instruction: it
 # computes an index Logix computes inside the instruction that uses it.
 LOGIX_NAMES = {s.mnemonic: s.mnemonic[1:] for s in SPECS if s.mnemonic != "LIDX"}
-LOGIX_NAMES.update(_DATA_NAMES, **_STRING_NAMES, **_SYSTEM_NAMES)
+LOGIX_NAMES.update(_DATA_NAMES, **_STRING_NAMES, **_SYSTEM_NAMES, **_BITS_NAMES)
 FAULT_SUBSCRIPT = 20  # major fault type 4 code 20: an array subscript out of range (1756-PM014)
 
 
