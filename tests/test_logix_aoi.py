@@ -239,3 +239,20 @@ def test_an_instance_in_l5k_data_packs_its_bools_first_and_nests_its_timer_array
     r.run(1)
     assert read(r, "Q.Last") == 3 and read(r, "Q.EnableOut") == 1
     r.close()
+
+
+@EXECUTORS
+def test_a_user_defined_type_may_hold_an_aoi_instance_and_an_aoi_a_local_of_such_a_type(tmp_path, executor):
+    cell = ('<DataTypes>\n<DataType Name="Cell" Family="NoFamily" Class="User">\n<Members>\n'
+            '<Member Name="Doubler" DataType="Twice" Dimension="0" Radix="NullType" Hidden="false" '
+            'ExternalAccess="Read/Write"/>\n<Member Name="Count" DataType="DINT" Dimension="0" Radix="Decimal" '
+            'Hidden="false" ExternalAccess="Read/Write"/>\n</Members>\n</DataType>\n</DataTypes>')
+    keeper = Aoi("Keeper", [Param("X", "DINT", "Input")], {"Logic": ["Twice(Inner.Doubler,X,Inner.Count);"]},
+                 [("Inner", "Cell", None)])
+    path = write_aoi_l5x(tmp_path / "cell.L5X", [keeper, TWICE], [("C", "Cell"), ("K", "Keeper")],
+                         [Prog("P", {"Main": ["Twice(C.Doubler,21,C.Count);", "Keeper(K,4);"]})], [Task("T", ["P"])])
+    path.write_text(path.read_text().replace("<DataTypes/>", cell, 1))
+    r = Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+    r.run(1)
+    assert read(r, "C.Count") == 42 and read(r, "C.Doubler.Y") == 42 and read(r, "K.Inner.Count") == 8
+    r.close()

@@ -59,6 +59,28 @@ def _is_bool(tag: model.Tag) -> bool:
     return (tag.data_type or "").upper() == "BOOL" and not tag.dims
 
 
+def add_types(types: TypeSystem, data_types: list[model.DataType], aois: list[model.AddOnInstruction]) -> None:
+    """The export's user-defined types and AOI instance types into
+    ``types``: each may use the other (a UDT member of an AOI's type, an AOI
+    local tag of a UDT), so a type not held for a type made after it is made
+    again, until no more is."""
+    types.add_data_types(data_types)
+    add_instance_types(types, aois)
+    while True:
+        retry = [d for d in data_types if d.members and d.name.upper() not in types.types
+                 and d.name.upper() in types.held_not]
+        again = [a for a in aois if a.name.upper() not in types.types]
+        if not retry and not again:
+            return
+        held = len(types.types)
+        for name in [d.name for d in retry] + [a.name for a in again]:
+            types.held_not.pop(name.upper(), None)
+        types.add_data_types(retry)
+        add_instance_types(types, again)
+        if len(types.types) == held:
+            return
+
+
 def add_instance_types(types: TypeSystem, aois: list[model.AddOnInstruction]) -> None:
     """Each AOI's instance type into ``types`` (an AOI's local tag may be of
     another AOI's type: resolved in the order they depend on each other)."""
@@ -256,6 +278,10 @@ class AoiCalls:
         for p, (text, _), w in zip(required, el.operands[1:], where[1:]):
             if (p.usage or "").upper() == "INOUT":
                 inouts.append((p, text.strip(), w))
+                why = self.types.not_held.get(p.data_type or "")
+                if why is not None:  # a MODULE (an I/O module object), a type of Logix's softplc_lite does not hold
+                    not_run(f"its InOut parameter {p.name}: {why}")
+                    continue
                 if number(text) is not None:
                     ctx.problem(w, f"{label} {p.name}: an InOut parameter is passed by reference: expected a tag, "
                                    f"found {text.strip()!r}")
@@ -264,7 +290,8 @@ class AoiCalls:
                 if arg is not None and not _fits(arg, p):
                     found = f"{arg.type.name}{list(arg.dims) if arg.dims else ''}"
                     wanted = f"{p.data_type}{list(p.dims) if p.dims else ''}"
-                    ctx.problem(w, f"{label} {p.name}: expected a {wanted} tag (the InOut parameter's type), "
+                    size = "; an array of any size" if p.dims else ""
+                    ctx.problem(w, f"{label} {p.name}: expected a {wanted} tag (the InOut parameter's type{size}), "
                                    f"found {found}")
         if len(ctx.problems) > before or ctx.skip:
             return None
@@ -409,6 +436,9 @@ class AoiCalls:
 
 
 def _fits(arg: Resolved, p: model.Tag) -> bool:
+    """An InOut argument of the parameter's data type, with as many
+    dimensions: an array parameter takes an array of another size (the
+    logic reaches the argument's own elements, its SIZE)."""
     if (arg.type.name or "").upper() != (p.data_type or "").upper():
         return False
-    return tuple(arg.dims) == tuple(p.dims)
+    return len(arg.dims) == len(p.dims)

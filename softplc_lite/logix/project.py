@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from ..datatable import DataTable
 from ..ladder.ast import MAIN_FILE, DataDecl, Instruction, Program, ProgramFile, Rung, walk
 from . import model
-from .aoi import AoiCalls, add_instance_types
+from .aoi import AoiCalls, add_types
 from .initial import ValueWriter, apply_initial, data_files
 from .modules import declare_module_tags
 from .rungs import RoutineContext, translate_rung
@@ -52,8 +52,7 @@ class LogixProgram:
 
 def build_program(project: model.Project) -> LogixProgram:
     types = TypeSystem()
-    types.add_data_types(project.data_types)
-    add_instance_types(types, project.add_on_instructions)
+    add_types(types, project.data_types, project.add_on_instructions)
     table = DataTable()
     directory = TagDirectory(table, types)
     result = LogixProgram(Program(symbols=TagSymbols(directory)), directory)
