@@ -7,6 +7,7 @@ source-protected AOI a warning; the fixtures that hold AOIs load."""
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -251,7 +252,7 @@ def test_a_user_defined_type_may_hold_an_aoi_instance_and_an_aoi_a_local_of_such
                  [("Inner", "Cell", None)])
     path = write_aoi_l5x(tmp_path / "cell.L5X", [keeper, TWICE], [("C", "Cell"), ("K", "Keeper")],
                          [Prog("P", {"Main": ["Twice(C.Doubler,21,C.Count);", "Keeper(K,4);"]})], [Task("T", ["P"])])
-    path.write_text(path.read_text().replace("<DataTypes/>", cell, 1))
+    path.write_text(re.sub(r"<DataTypes(/>|>\s*</DataTypes>)", cell, path.read_text(), count=1))
     r = Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
     r.run(1)
     assert read(r, "C.Count") == 42 and read(r, "C.Doubler.Y") == 42 and read(r, "K.Inner.Count") == 8
