@@ -169,8 +169,7 @@ def main() -> int:
             for cause, count in counted.most_common(25):
                 print(f"    {count:4}  {cause}")
     figures = {"files": n, "stages": dict(stages), "rungs": dict(rungs), "results": results}
-    if not args.no_save:
-        C.save_figures("logix_corpus", figures, False, args.json)
+    C.save_figures("logix_corpus", figures, args.no_save, args.json)
     return 0
 
 

@@ -206,3 +206,17 @@ def test_a_message_tag_is_held_and_its_msg_not_run(tmp_path):
     r.run(1)
     assert r.table.read(names.resolve_path("Done")) == 1 and r.table.read(names.resolve_path("Err")) == 7
     r.close()
+
+
+def test_an_array_larger_than_a_data_table_file_is_a_warning_not_an_error(tmp_path):
+    from helpers.logix_l5x import Prog, Task, write_l5x
+
+    path = write_l5x(tmp_path / "big.L5X", [("Regs", "INT[65536]"), ("i", "DINT"), ("x", "INT"), ("y", "INT")],
+                     [Prog("P", {"Main": ["MOV(Regs[i],x);", "ADD(y,1,y);"]})], [Task("T", ["P"])])
+    app = load_app(path)
+    assert any("tag Regs: 65536 elements" in w and "not run" in w for w in app.warnings), app.warnings
+    assert any("rung 0: MOV operand 'Regs[i]'" in w for w in app.warnings)
+    r = Runner(app, RunOptions(fresh=True, save_state=False))
+    r.run(3)
+    assert r.table.read(app.program.symbols.resolve_path("y")) == 3  # the rest runs
+    r.close()

@@ -30,7 +30,7 @@ class NBranch:
 
 
 # Instructions without operands, taken without their "()" too (Studio writes NOP(); some exports NOP;).
-BARE = frozenset({"NOP", "AFI", "TND", "MCR", "RET", "SBR", "EOT", "UID", "UIE"})
+BARE = frozenset({"NOP", "AFI", "TND", "MCR", "RET", "SBR", "EOT", "UID", "UIE", "NXT", "BRK"})
 
 
 class NeutralError(Exception):

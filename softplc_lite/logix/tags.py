@@ -190,9 +190,11 @@ class TagDirectory:
         d = Declared(tag, t, tuple(tag.dims), scope)
         try:
             self._lay_out(d, t, (), _count(d.dims))
-        except PathError as e:
-            self.problems.append(Problem(tag.pos, f"tag {tag.name}: {e}"))
-            return None
+        except PathError as e:  # larger than the table holds: a limit of softplc_lite's, not a mistake
+            reason = str(e)
+            self.warnings.append(Problem(tag.pos, f"tag {tag.name}: {reason}; rungs that use it are not run"))
+            d = names[key] = Declared(tag, None, (), scope, opaque=reason)
+            return d
         names[key] = d
         return d
 

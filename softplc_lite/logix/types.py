@@ -112,7 +112,11 @@ PREDEFINED: dict[str, LogixType] = {
                                    _dint("DestinationLink"), _dint("DestinationNode"), _dint("SourceLink"),
                                    _dint("Class"), _dint("Attribute"), _dint("Instance"),
                                    _dint("LocalIndex"), _dint("Channel"), _dint("Rack"), _dint("Group"),
-                                   _dint("Slot"), _dint("RemoteIndex"), _dint("RemoteElement"),
+                                   _dint("Slot"), _dint("RemoteIndex"),
+                                   MemberType("RemoteElement", LogixType("STRING", "string", chars=STRING_CHARS,
+                                                                         builtin=True)),
+                                   MemberType("Path", LogixType("STRING", "string", chars=STRING_CHARS,
+                                                                builtin=True)),
                                    _dint("UnconnectedTimeout"), _dint("ConnectionRate"),
                                    MemberType("TimeoutMultiplier", _ATOMIC_TYPES["SINT"])]),
 }
