@@ -5,6 +5,8 @@ gives, and what is not run said as a warning."""
 
 from __future__ import annotations
 
+import struct
+
 import pytest
 
 from softplc_lite.app import AppError, load_app
@@ -21,15 +23,22 @@ TYPES = """<DataType Name="Pt" Family="NoFamily" Class="User"><Members>
 <Member Name="H" DataType="DINT" Dimension="3" Radix="Decimal" Hidden="false" ExternalAccess="Read/Write"/>
 <Member Name="Name" DataType="STRING" Dimension="0" Radix="NullType" Hidden="false" ExternalAccess="Read/Write"/>
 </Members></DataType>
+<DataType Name="Stamp" Family="NoFamily" Class="User"><Members>
+{STAMP}
+</Members></DataType>
 <DataType Name="STRING8" Family="StringFamily" Class="User"><Members>
 <Member Name="LEN" DataType="DINT" Dimension="0" Radix="Decimal" Hidden="false" ExternalAccess="Read/Write"/>
 <Member Name="DATA" DataType="SINT" Dimension="8" Radix="ASCII" Hidden="false" ExternalAccess="Read/Write"/>
 </Members></DataType>"""
+TYPES = TYPES.replace("{STAMP}", "\n".join(
+    f'<Member Name="{m}" DataType="DINT" Dimension="0" Radix="Decimal" Hidden="false" ExternalAccess="Read/Write"/>'
+    for m in ("Note", "Yr", "Mo", "Da", "Hr", "Min", "Sec", "uSec")))
 TAGS = [("A", "DINT[5]"), ("B", "DINT[5]"), ("I", "INT[4]"), ("R", "REAL[3]"), ("P", "Pt[3]"), ("Q", "Pt[3]"),
         ("One", "Pt"), ("S1", "STRING"), ("S2", "STRING"), ("S3", "STRING"), ("Short", "STRING8"),
         ("Names", "STRING[3]"), ("N", "DINT"), ("N2", "DINT"), ("F", "REAL"), ("DT", "DINT[7]"), ("Us", "LINT"),
         ("Flag", "BOOL"), ("Flag3", "BOOL"), ("k", "DINT"), ("Grid", "INT[2,3]"), ("T1", "TIMER"),
-        ("T2", "TIMER"), ("Zero", "DINT"), ("Flag2", "DINT")]
+        ("T2", "TIMER"), ("Zero", "DINT"), ("Flag2", "DINT"), ("When", "Stamp"),
+        ("Msg", "MESSAGE")]
 
 
 def runner(tmp_path, rungs, executor="compiled") -> Runner:
@@ -141,6 +150,13 @@ def test_cop_and_fll_that_softplc_lite_does_not_run_are_warnings(tmp_path):
     assert warnings.count("the rung is not run") == 4
 
 
+def test_question_marks_string_literals_and_message_members_are_warnings(tmp_path):
+    warnings = warnings_of(tmp_path, ["COP(?,?,1);", "MOVE('hello',S1);", "CONCAT(Msg.Path,S1,S2);"])
+    assert "rung 0: COP operand '?': an operand left as ?" in warnings
+    assert "rung 1: MOVE operand \"'hello'\": a string literal is not yet taken by softplc_lite" in warnings
+    assert "rung 2: CONCAT operand 'Msg.Path': Path of a MESSAGE is not held by softplc_lite" in warnings
+
+
 def test_cop_with_a_wrong_operand_is_a_located_error(tmp_path):
     errors = errors_of(tmp_path, ["COP(A,Nope,2);", "FLL(1,A[0]);"])
     assert "rung 0: COP operand 'Nope': unknown tag 'Nope'" in errors[0]
@@ -189,6 +205,14 @@ def test_dtos_stod_rtos_stor(tmp_path, executor):
 @EXECUTORS
 def test_size_of_arrays_by_dimension(tmp_path, executor):
     r = runner(tmp_path, ["SIZE(A,0,N);", "SIZE(Grid,1,N2);", "SIZE(P[0].H,0,k);"], executor)
+    r.run(1)
+    assert (read(r, "N"), read(r, "N2"), read(r, "k")) == (5, 3, 3)
+    r.close()
+
+
+@EXECUTORS
+def test_size_of_an_arrays_first_element_as_exports_write_it(tmp_path, executor):
+    r = runner(tmp_path, ["SIZE(A[0],0,N);", "SIZE(Grid[0,0],1,N2);", "SIZE(P[k].H[0],0,k);"], executor)
     r.run(1)
     assert (read(r, "N"), read(r, "N2"), read(r, "k")) == (5, 3, 3)
     r.close()
@@ -265,6 +289,24 @@ def test_gsv_of_task_program_and_fault_log_and_ssv_of_a_programs_disable_flag(tm
     r.close()
 
 
+@EXECUTORS
+def test_gsv_and_ssv_of_a_date_time_into_a_structures_dints_and_a_real_gets_the_bytes(tmp_path, executor):
+    r = runner(tmp_path, ["XIC(Flag)SSV(WallClockTime,,DateTime,When.Yr);", "GSV(WallClockTime,,DateTime,When.Yr);",
+                          "GSV(Task,T,LastScanTime,F);"], executor)
+    for member, v in zip(("Yr", "Mo", "Da", "Hr", "Min", "Sec", "uSec"), (2031, 12, 31, 23, 59, 59, 990_000)):
+        write(r, f"When.{member}", v)
+    write(r, "When.Note", 77)
+    write(r, "Flag", 1)
+    r.run(1)
+    write(r, "Flag", 0)
+    r.run(1)
+    assert [read(r, f"When.{m}") for m in ("Yr", "Mo", "Da", "Hr", "Min", "Sec", "uSec")] == [2032, 1, 1, 0, 0, 0,
+                                                                                              0]
+    assert read(r, "When.Note") == 77
+    assert read(r, "F") == struct.unpack("f", struct.pack("i", 10_000))[0]  # the DINT's bytes, not 10000.0
+    r.close()
+
+
 def test_gsv_of_what_softplc_lite_does_not_hold_is_a_warning(tmp_path):
     warnings = warnings_of(tmp_path, ["GSV(Module,Rack,EntryStatus,N);", "SSV(Axis,Servo,HomeSpeed,F);"])
     assert "rung 0: GSV: Module.EntryStatus is not an attribute softplc_lite holds" in warnings
@@ -272,6 +314,6 @@ def test_gsv_of_what_softplc_lite_does_not_hold_is_a_warning(tmp_path):
 
 
 def test_gsv_into_a_too_small_destination_is_a_located_error(tmp_path):
-    errors = errors_of(tmp_path, ["GSV(WallClockTime,,DateTime,DT[3]);", "GSV(Task,T,LastScanTime,F);"])
+    errors = errors_of(tmp_path, ["GSV(WallClockTime,,DateTime,DT[3]);", "GSV(Task,T,LastScanTime,Flag);"])
     assert "takes 7 DINTs: expected an array with 7 elements from here" in errors[0]
-    assert "expected a DINT, found REAL" in errors[1]
+    assert "expected a DINT, found BOOL" in errors[1]

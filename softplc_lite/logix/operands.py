@@ -42,25 +42,55 @@ class Operands:
         from . import rungs
 
         where = self.where(k)
-        return rungs._resolve(self.text(k), where, self.ctx)
+        text = self.text(k)
+        if text == "?":
+            raise NotRun("an operand left as ? (a rung not finished in the export)")
+        if text[:1] in ("'", '"'):
+            raise NotRun("a string literal is not yet taken by softplc_lite (a string tag is)")
+        try:
+            return rungs._resolve(text, where, self.ctx)
+        except NotRun:
+            raise
+        except PathError as e:
+            message = self._message_member(text)
+            if message is not None:
+                raise NotRun(message, e.offset) from None
+            raise
+
+    def _ref(self, k: int) -> AddressRef:
+        """Operand k as one value's address (rungs.py's ``_resolve_ref``)."""
+        r = self.resolve(k)
+        if r.address is None:
+            raise PathError(f"{self.text(k)} is a {r.type.name}{' array' if r.dims else ''}: expected a single "
+                            f"value here")
+        return AddressRef(r.address, self.where(k))
+
+    def _message_member(self, text: str) -> str | None:
+        """Why a path into a MESSAGE tag that does not resolve is not the
+        export's mistake (its Path and the other members softplc_lite does
+        not hold), or None."""
+        name = text.split(".", 1)[0].split("[", 1)[0].strip()
+        try:
+            r = self.ctx.directory.resolve(name, self.ctx.scope, _no_index)
+        except PathError:
+            return None
+        if r.type.name != "MESSAGE" or "." not in text:
+            return None
+        return f"{text.split('.', 1)[1]} of a MESSAGE is not held by softplc_lite"
 
     def value(self, k: int):
         """A number or a tag's value (Logix: immediate or tag)."""
-        from . import rungs
-
         where = self.where(k)
         v = number(self.text(k))
         if v is not None:
             return Const(v, where)
-        return rungs._resolve_ref(self.text(k), where, self.ctx)
+        return self._ref(k)
 
     def dest(self, k: int) -> AddressRef:
-        from . import rungs
-
-        where = self.where(k)
+        self.where(k)
         if number(self.text(k)) is not None:
             raise PathError("expected a tag to write, found a number")
-        ref = rungs._resolve_ref(self.text(k), where, self.ctx)
+        ref = self._ref(k)
         if ref.address.bit is not None:
             raise PathError("expected a number tag, found a BOOL")
         return ref

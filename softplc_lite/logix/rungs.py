@@ -12,6 +12,11 @@ expression where Logix allows one), ``d`` a destination, ``e`` an
 expression, ``l`` a label, ``r`` a routine, ``p`` parameters (SBR, RET),
 ``T``/``C``/``R`` a TIMER, COUNTER or CONTROL (its CTL, and PRE and ACC), ``?`` an operand Logix keeps
 in the structure (``TON(T1,?,?)``: written as ``?`` or a value, not used).
+
+Instructions whose operands need more than a letter (``HANDLERS``: COP, CPS and
+FLL by member, the string instructions, SIZE, compares and moves of strings,
+BTD, SWPB, TRN, GSV and SSV) are translated by copy.py, strings.py, bits.py and
+system.py.
 """
 
 from __future__ import annotations

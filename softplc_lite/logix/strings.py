@@ -81,9 +81,18 @@ def _move(ops: Operands):
 def _size(ops: Operands) -> list[Instruction]:
     """SIZE(Source, Dim, Size): the number of elements of dimension ``Dim``
     (0 the first) of the array Source (RM003, "Size In Elements (SIZE)"),
-    known when the export is loaded: a MOV of that number."""
+    known when the export is loaded: a MOV of that number. Source is the
+    array or, as exports write it, its element (``Arr[0]``, ``Grid[0,0]``)."""
     ops.count(3)
     r = ops.resolve(0)
+    if not r.dims and ops.text(0).endswith("]"):  # Arr[0], as Studio 5000 writes it: the array
+        text = ops.text(0)
+        depth = 0
+        for k in range(len(text) - 1, -1, -1):
+            depth += {"]": 1, "[": -1}.get(text[k], 0)
+            if depth == 0:
+                break
+        r = ops.ctx.directory.resolve(text[:k], ops.ctx.scope, operands._no_index)
     dims = r.dims
     if not dims:
         raise PathError(f"expected an array, found {r.type.name}")

@@ -42,13 +42,43 @@ def _build(ops: Operands) -> list[Instruction]:
                    f"MajorFaultBits)")
     r = ops.resolve(3)
     where = ops.where(3)
-    if r.type.kind != "atomic" or r.type.name in ("BOOL", "REAL"):
+    if r.type.kind != "atomic" or r.type.name == "BOOL":
         raise PathError(f"expected a DINT{' or LINT' if code == WALL_CURRENT else ''}, found {r.type.name}")
+    need = WORDS.get(code, 1)
+    name = "LGSV" if get else "LSSV"
+    if need > 1 and r.address is not None and r.path and not r.dims:  # DateTime.Year: a structure's DINTs
+        members = _members_from(r, need)
+        if members is not None:
+            head = ops.text(3)[:ops.text(3).rfind(".") + 1]
+            refs = [AddressRef(rungs_resolve(ops, head + m, where).address, where) for m in members]
+            return [Instruction(name, [Const(code, ops.pos)] + refs, ops.pos)]
     run = element_run(r, where, ops.ctx)
     address, _, end = run.leaves[()]
-    need = WORDS.get(code, 2 if code == WALL_CURRENT and address.type_letter == "L" else 1)
+    if code == WALL_CURRENT and address.type_letter == "L":
+        need = 2
     if isinstance(address.element, int) and end - address.element < need:
         raise PathError(f"{ops.el.mnemonic} of {ops.text(0)}.{ops.text(2)} takes {need} DINTs: expected an "
-                        f"array with {need} elements from here")
+                        f"array with {need} elements from here, or a structure with {need} DINT members from here")
     extra = [AddressRef(held, ops.pos)] if held is not None else []
-    return [Instruction("LGSV" if get else "LSSV", [Const(code, ops.pos), AddressRef(address, where)] + extra, ops.pos)]
+    return [Instruction(name, [Const(code, ops.pos), AddressRef(address, where)] + extra, ops.pos)]
+
+
+def _members_from(r, need: int) -> list[str] | None:
+    """The names of ``need`` DINT members of the structure holding the
+    member ``r`` names, from that member on (Logix copies a DateTime's seven
+    DINTs into them, in order), or None."""
+    t = r.declared.type
+    for key in r.path[:-1]:
+        t = t.member(key).type
+    names = [m for m in t.members if not m.hidden and m.host is None]
+    at = next((k for k, m in enumerate(names) if m.name.upper() == r.path[-1]), None)
+    run = names[at:at + need] if at is not None else []
+    if len(run) < need or any(m.type.name != "DINT" or m.dim for m in run):
+        return None
+    return [m.name for m in run]
+
+
+def rungs_resolve(ops: Operands, text: str, where):
+    from . import rungs
+
+    return rungs._resolve(text, where, ops.ctx)

@@ -24,11 +24,15 @@ its appendix "GSV/SSV objects"; the choices are softplc_lite's):
   minor fault words (S:10/14, S:17) hold one; MajorFaultBits: bit 4 while
   S:11 holds a major fault. An SSV with bit 4 clear clears them (the idiom
   ``SSV(FaultLog,,MinorFaultBits,Zero)``); other bits are ignored.
+- GSV and SSV copy bytes: a REAL tag gets (gives) the attribute's 32 bits as
+  they are, not a converted value (RM003: "the GSV ... copies the data").
 """
 
 from __future__ import annotations
 
+import struct
 import time
+from array import array
 from datetime import datetime, timedelta, timezone
 
 from .. import status as S
@@ -46,11 +50,11 @@ ATTRIBUTES = {
     ("FAULTLOG", "MINORFAULTBITS"): MINOR_BITS, ("FAULTLOG", "MAJORFAULTBITS"): MAJOR_BITS,
 }
 WORDS = {WALL_DATETIME: 7, WALL_LOCAL: 7}  # DINTs an attribute takes (the rest: one value)
-SPECS = [
-    InstructionSpec("LGSV", "Logix get system value", (OperandSpec("attribute", K.ANY), OperandSpec("dest", K.ANY),
-                                                       OperandSpec("held", K.ANY)), True, optional=1),
-    InstructionSpec("LSSV", "Logix set system value", (OperandSpec("attribute", K.ANY), OperandSpec("source", K.ANY),
-                                                       OperandSpec("held", K.ANY)), True, optional=1),
+SPECS = [  # a dest (source) of one item, or of several in a row, or (DateTime) one operand per DINT
+    InstructionSpec("LGSV", "Logix get system value", (OperandSpec("attribute", K.ANY), OperandSpec("dest", K.ANY)),
+                    True, repeat=7),
+    InstructionSpec("LSSV", "Logix set system value", (OperandSpec("attribute", K.ANY),
+                                                       OperandSpec("source", K.ANY)), True, repeat=7),
 ]
 LOGIX_NAMES = {"LGSV": "GSV", "LSSV": "SSV"}
 INSTRUCTION_FAULT = 1 << 4  # FaultLog's bit of an instruction (program) fault
@@ -124,6 +128,17 @@ def _bind_get(instr, access):
     code = instr.operands[0].value
     if code == HELD:
         return _held(instr, access, True)
+    if len(instr.operands) > 2:  # one operand per value (a structure's DINT members)
+        dests = [access.location(op) for op in instr.operands[1:]]
+        machine = access.machine
+
+        def each(c: bool) -> bool:
+            if c:
+                for get, v in zip(dests, _get(code, machine)):
+                    d, i, _ = get()
+                    d[i] = v
+            return c
+        return each
     dest = access.location(instr.operands[1])
     machine = access.machine
 
@@ -134,6 +149,9 @@ def _bind_get(instr, access):
             if code == WALL_CURRENT and d.itemsize == 4:  # a DINT[2]: low, high
                 v = values[0]
                 values = [(v & 0xFFFFFFFF) - ((v & 0x80000000) << 1), v >> 32]
+            if d.typecode == "f":  # a REAL destination gets the DINT's bytes, as GSV copies them
+                values = list(struct.unpack(f"{len(values)}f", struct.pack(f"{len(values)}i", *(
+                    (v & 0xFFFFFFFF) - ((v & 0x80000000) << 1) for v in values))))
             if i + len(values) > len(d):
                 values = values[:len(d) - i]
             d[i:i + len(values)] = type(d)(d.typecode, values)
@@ -145,12 +163,20 @@ def _bind_set(instr, access):
     code = instr.operands[0].value
     if code == HELD:
         return _held(instr, access, False)
-    source = access.location(instr.operands[1])
+    sources = [access.location(op) for op in instr.operands[1:]]
     machine = access.machine
 
     def run(c: bool) -> bool:
         if c:
-            d, i, _ = source()
+            d, i, _ = sources[0]()
+            if d.typecode == "f":  # a REAL source gives its bytes
+                d, i = array("i", struct.pack("f", d[i])), 0
+            if len(sources) > 1:  # one operand per value: gathered in a row
+                values = []
+                for get in sources:
+                    sd, si, _ = get()
+                    values.append(sd[si])
+                d, i = array("q", values), 0
             s = machine.s
             if code == WALL_CURRENT:
                 _set_us(machine, d[i] if d.itemsize == 8 else (d[i] & 0xFFFFFFFF) | (d[i + 1] << 32))
