@@ -193,6 +193,9 @@ def test_the_public_duty_cycle_aois_load_and_their_types_are_held(tmp_path):
     assert not [w for w in app.warnings if "Add-On Instruction" in w]
     types = app.program.symbols.directory.types
     assert [m.name for m in types.get("BOOLS_2_DINT").visible_members()] == ["EnableIn", "EnableOut", "DINT_OUT"]
+    # no rung calls them: their logic is checked in files of their own, DUTY_CYCLE's calls to the other two too
+    names = sorted(f.name for f in app.program.files.values() if "(" in (f.name or ""))
+    assert "DUTY_CYCLE.Logic(not called)" in names and len(names) >= 3
 
 
 # -- LAIN and LAOUT on the ladder (ladder/instr/logix_aoi.py), each executor (the engine fixture) ------------
@@ -257,3 +260,16 @@ def test_a_user_defined_type_may_hold_an_aoi_instance_and_an_aoi_a_local_of_such
     r.run(1)
     assert read(r, "C.Count") == 42 and read(r, "C.Doubler.Y") == 42 and read(r, "K.Inner.Count") == 8
     r.close()
+
+
+def test_an_aoi_no_rung_calls_has_its_logic_checked(tmp_path):
+    lone = Aoi("Lone", [Param("In", "DINT", "Input"), Param("Buf", "DINT[4]", "InOut")],
+               {"Logic": ["MOV(In,Buf[2]);", "MOV(In,Nowhere);", "MOV(Buf[In],Last);"]}, [("Last", "DINT", None)])
+    path = write_aoi_l5x(tmp_path / "lone.L5X", [lone], [], [Prog("P", {"Main": ["NOP();"]})], [Task("T", ["P"])])
+    with pytest.raises(AppError) as info:
+        load_app(path)
+    line = next(k for k, ln in enumerate(path.read_text().splitlines(), 1) if "MOV(In,Nowhere)" in ln)
+    assert str(info.value).startswith(f"{path}:{line}:") and "routine Lone.Logic: rung 1: MOV operand 'Nowhere': " \
+        "unknown tag 'Nowhere': the logic of Add-On Instruction Lone names only its parameters and local tags" \
+        in str(info.value)
+    assert len(info.value.errors) == 1  # its other rungs are right: the InOut array, an index by a parameter

@@ -160,6 +160,8 @@ class _Names:
         if m is None:
             raise PathError("expected a tag name", 0)
         key = m.group(1).upper()
+        if key in self.hidden and isinstance(self.hidden[key], Declared):
+            return self._resolve_top(text, scope, index_of)
         if key in self.hidden and not text[m.end():].strip():
             return Resolved(text, PREDEFINED["DINT"], (), self.hidden[key])
         target = self.mapping.get(key)
@@ -167,10 +169,20 @@ class _Names:
             raise PathError(f"unknown tag {m.group(1)!r}: the logic of Add-On Instruction {self.aoi} names only its "
                             f"parameters and local tags", m.start(1))
         try:
-            return self.directory.resolve(target + text[m.end():], scope, index_of)
+            return self._resolve_top(target + text[m.end():], scope, index_of)
         except PathError as e:
             at = e.offset - len(target) + m.end()
             raise type(e)(str(e), at if at >= m.end() else m.start(1)) from None
+
+    def _resolve_top(self, text: str, scope, index_of) -> Resolved:
+        """A path of the outermost caller: a tag's, or one of a hidden tag
+        that stands for an instance or argument when an AOI no rung calls is
+        checked (``AoiCalls.check_uncalled``)."""
+        m = _NAME.match(text)
+        h = self.hidden.get(m.group(1).upper()) if m else None
+        if isinstance(h, Declared):
+            return self.directory._walk(text, m.end(), h, h.type, h.dims, (), 0, index_of, None, var=None)
+        return self.directory.resolve(text, scope, index_of)
 
     def head(self, text: str) -> str:
         m = _NAME.match(text)
@@ -192,7 +204,8 @@ class AoiCalls:
         self.directory = directory
         self.types = types
         self.made: list[tuple[ProgramFile, Instruction]] = []  # a file and the JSR to it
-        self.hidden: dict = {}
+        self.hidden: dict = {}  # name -> an index's Address (see _bind), or a Declared (check_uncalled)
+        self.called: set[str] = set()
         self.stack: list[str] = []
         self.said: set = set()  # problems of an AOI's logic said once, not at every call
         self._index = None  # an index item for _shape, which makes no code
@@ -332,6 +345,7 @@ class AoiCalls:
         eif = routines.get("ENABLEINFALSE")
         eif = eif if eif is not None and eif.kind == "RLL" and not eif.encoded else None
         flags = Const(HAS_EIF if eif else 0, pos)
+        self.called.add(aoi.name.upper())
         legs = [[Instruction("XIC", [ein], pos), self._routine(aoi, logic, mapping, inst, ctx, pos)]]
         if eif is not None:
             legs.append([Instruction("XIO", [ein], pos), self._routine(aoi, eif, mapping, inst, ctx, pos)])
@@ -421,9 +435,51 @@ class AoiCalls:
                     into.append(p)
         jsr = Instruction("JSR", [Const(0, pos)], pos)
         # Named as the caller's program's (its scope: logix/names.py), the watch view shows Ramp.Logic(Ramp1).
-        name = f"{ctx.scope + '.' if ctx.scope else ''}{aoi.name}.{routine.name}({inst})"
+        shown = re.sub(r"__AOI[0-9]+", lambda m: self.hidden[m.group(0)].tag.name
+                       if isinstance(self.hidden.get(m.group(0)), Declared) else "?", inst)
+        name = f"{ctx.scope + '.' if ctx.scope else ''}{aoi.name}.{routine.name}({shown})"
         self.made.append((ProgramFile(0, name, rungs, routine.pos), jsr))
         return jsr
+
+    def check_uncalled(self, source: str, problems: list, warnings: list) -> None:
+        """The logic of each AOI no rung calls (an AOI's own export), made
+        once over hidden storage for an instance and its InOut arguments, in a
+        file no rung calls: its problems are said as a call's would be."""
+        for key, aoi in self.defs.items():
+            t = self.types.get(aoi.name)
+            routines = {r.name.upper(): r for r in aoi.routines}
+            logic = routines.get("LOGIC")
+            if key in self.called or aoi.encoded or t is None or t.kind != "struct" or logic is None \
+                    or logic.kind != "RLL" or logic.encoded:
+                continue
+            inst = self._hidden_tag(aoi.name, t, ())
+            mapping = {m.name.upper(): f"{inst}.{m.name}" for m in _members(aoi)}
+            for p in aoi.parameters:
+                if (p.usage or "").upper() == "INOUT":
+                    pt = self.types.get(p.data_type)
+                    mapping[p.name.upper()] = pt and self._hidden_tag(p.name, pt, tuple(p.dims))
+            if inst is None or not all(mapping.values()):
+                continue  # an argument softplc_lite cannot stand in for: checked when a rung calls it
+            ctx = RoutineContext(self.directory, None, {}, source, aoi.name)
+            for name in ("LOGIC", "ENABLEINFALSE"):
+                r = routines.get(name)
+                if r is not None and r.kind == "RLL" and not r.encoded:
+                    self._routine(aoi, r, mapping, "not called", ctx, r.pos)
+            problems += ctx.problems
+            warnings += ctx.warnings
+
+    def _hidden_tag(self, name: str, t: LogixType, dims: tuple[int, ...]) -> str | None:
+        d = Declared(model.Tag(name, t.name, dims), t, dims, None)
+        count = 1
+        for size in dims:
+            count *= size
+        try:
+            self.directory._lay_out(d, t, (), count)
+        except PathError:
+            return None
+        key = HIDDEN.format(len(self.hidden))
+        self.hidden[key.upper()] = d
+        return key
 
     def files(self, first: int) -> dict[int, ProgramFile]:
         """The calls' program files, numbered from ``first``."""

@@ -90,6 +90,7 @@ def build_program(project: model.Project) -> LogixProgram:
             result.program.files[file_number] = ProgramFile(file_number, f"{prog.name}.{routine.name}", rungs,
                                                             routine.pos)
         _calls_not_run(prog, routines, result.program.files, not_passed, warnings, result.rungs)
+    aois.check_uncalled(project.source, problems, warnings)
     made = aois.files(number)
     result.program.files.update(made)
     number += len(made)
