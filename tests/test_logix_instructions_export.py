@@ -151,10 +151,13 @@ def test_cop_and_fll_that_softplc_lite_does_not_run_are_warnings(tmp_path):
 
 
 def test_question_marks_string_literals_and_message_members_are_warnings(tmp_path):
-    warnings = warnings_of(tmp_path, ["COP(?,?,1);", "MOVE('hello',S1);", "CONCAT(Msg.Path,S1,S2);"])
+    warnings = warnings_of(tmp_path, ["COP(?,?,1);", "MOVE('hello',S1);", "CONCAT(Msg.LocalElement,S1,S2);",
+                                      "CONCAT(Msg.Path,S1,S2);"])
     assert "rung 0: COP operand '?': an operand left as ?" in warnings
     assert "rung 1: MOVE operand \"'hello'\": a string literal is not yet taken by softplc_lite" in warnings
-    assert "rung 2: CONCAT operand 'Msg.Path': Path of a MESSAGE is not held by softplc_lite" in warnings
+    assert "rung 2: CONCAT operand 'Msg.LocalElement': LocalElement of a MESSAGE is not held by softplc_lite" \
+        in warnings
+    assert "rung 3" not in warnings  # a MESSAGE's Path is a STRING softplc_lite holds
 
 
 def test_cop_with_a_wrong_operand_is_a_located_error(tmp_path):
