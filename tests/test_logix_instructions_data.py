@@ -92,6 +92,12 @@ def test_lfll_of_zero_clears_strings(engine):
     assert e.table.read("ST10:0") == "" and e.table.read("ST10:1") == ""
 
 
+def test_lfll_of_a_string_fills_each_string(engine):
+    e = engine("DATA ST10 3\nLFLL ST9:0 ST10:1 5 1 3", {"ST9:0": "ok"})
+    e.scan()
+    assert [e.table.read(f"ST10:{k}") for k in range(3)] == ["", "ok", "ok"]
+
+
 # -- strings ---------------------------------------------------------------------------------
 
 def test_lconcat_joins_and_truncates_to_the_capacity_with_the_string_error(engine):

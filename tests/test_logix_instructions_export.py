@@ -142,12 +142,25 @@ def test_fll_converts_with_logix_rules_and_clears_structures(tmp_path, executor)
 
 
 def test_cop_and_fll_that_softplc_lite_does_not_run_are_warnings(tmp_path):
-    warnings = warnings_of(tmp_path, ["COP(P[0],A[0],1);", "FLL(5,P[0],1);", "COP(S1,A[0],1);", "COP(Flag,N,1);"])
+    warnings = warnings_of(tmp_path, ["COP(P[0],A[0],1);", "FLL(5,P[0],1);", "COP(S1,A[0],1);", "COP(Flag,N,1);",
+                                      "FLL(S1,A[0],2);", "FLL(5,Names[0],2);"])
     assert "rung 0: COP: a copy from a Pt into a DINT copies Logix's byte layout" in warnings
     assert "rung 1: FLL: a FLL of a number into Pt structures" in warnings
     assert "rung 2: COP: a copy from a STRING into a DINT" in warnings
     assert "rung 3: COP: Flag is a BOOL" in warnings
-    assert warnings.count("the rung is not run") == 4
+    assert "rung 4: FLL: a FLL of a string into DINT" in warnings and "rung 5: FLL: a FLL of a number into STRING" \
+        in warnings
+    assert warnings.count("the rung is not run") == 6
+
+
+@EXECUTORS
+def test_fll_of_a_string_or_of_0_into_strings(tmp_path, executor):
+    r = runner(tmp_path, ["FLL(S1,Names[1],5);", "FLL(0,S2,1);"], executor)
+    write(r, "S1", "idle")
+    write(r, "S2", "x")
+    r.run(1)
+    assert [read(r, f"Names[{k}]") for k in range(3)] == ["", "idle", "idle"] and read(r, "S2") == ""
+    r.close()
 
 
 def test_question_marks_string_literals_and_message_members_are_warnings(tmp_path):

@@ -113,17 +113,21 @@ def copy_run(source: Run, where, dest: Run, length, pos) -> list[Instruction]:
 
 def _fill(ops: Operands, dest: Run, length) -> list[Instruction]:
     pos = ops.pos
+    string_source = False
     if number(ops.text(0)) is None:
         r = ops.resolve(0)
-        if r.address is None or r.type.kind != "atomic" or r.address.bit is not None:
+        string_source = r.type.kind == "string" and not r.dims
+        if r.address is None or r.type.kind not in ("atomic", "string") or r.address.bit is not None:
             raise Skip(f"a FLL source of type {r.type.name}{' array' if r.dims else ''} is not filled by "
-                       f"softplc_lite (an atomic value is)")
+                       f"softplc_lite (an atomic value or a string is)")
         source = AddressRef(r.address, ops.where(0))
     else:
         source = ops.value(0)
-    if dest.type.kind == "string":
-        raise Skip("a FLL into strings is not run by softplc_lite")
-    if dest.type.kind != "atomic" and not (isinstance(source, Const) and source.value == 0):
+    zero = isinstance(source, Const) and source.value == 0
+    if string_source != (dest.type.kind == "string") and not zero:
+        raise Skip(f"a FLL of a {'string' if string_source else 'number'} into {dest.type.name} fills Logix's "
+                   f"bytes, which softplc_lite's tag layout does not keep")
+    if dest.type.kind not in ("atomic", "string") and not zero:
         raise Skip(f"a FLL of a number into {dest.type.name} structures fills Logix's bytes, which softplc_lite's "
                    f"tag layout does not keep (a FLL of 0 clears them)")
     return [Instruction("LFLL", [source, AddressRef(d_address, pos), length, Const(per, pos), Const(d_end, pos)], pos)

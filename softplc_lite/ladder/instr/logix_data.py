@@ -17,7 +17,8 @@ Rules (1756-RM003, Logix 5000 Controllers General Instructions, "Copy File
   source's bytes, not converted values (Logix's byte layout: little-endian
   SINT, INT, DINT, LINT, IEEE REAL).
 - FLL converts the source into the destination's type (RM003, "Data
-  conversions": a REAL into an integer rounds, half to even).
+  conversions": a REAL into an integer rounds, half to even); a string
+  source fills strings with itself, 0 clears them (and structures).
 - A source that ends before the length does: Logix copies "unpredictable
   data" for the rest; softplc_lite copies what the source holds and leaves
   the rest of the destination as it is (a softplc choice).
@@ -30,6 +31,7 @@ from __future__ import annotations
 
 from array import array
 
+from ..ast import AddressRef
 from ..bound import BoundInstruction
 from ..specs import InstructionSpec, K, OperandSpec
 
@@ -76,6 +78,8 @@ def _copy(instr, access):
 
 def _fill(instr, access):
     source, dest, length, per, dest_end = instr.operands
+    if isinstance(source, AddressRef) and source.address.ftype.is_string:
+        return _fill_strings(instr, access)
     value, get_dest, get_length = access.value(source), access.location(dest), access.value(length)
     per, dest_end = per.value, dest_end.value
     machine = access.machine
@@ -87,6 +91,23 @@ def _fill(instr, access):
             n = min(int(get_length()) * per, dest_end - di // wpe)
             if n > 0:
                 machine.fll(value(), dd, di, n * wpe)
+        return c
+    return run
+
+
+def _fill_strings(instr, access):
+    """A string source: each destination string gets it whole."""
+    source, dest, length, per, dest_end = instr.operands
+    get_src, get_dest, get_length = access.location(source), access.location(dest), access.value(length)
+    wpe, per, dest_end = dest.address.ftype.words_per_element, per.value, dest_end.value
+
+    def run(c: bool) -> bool:
+        if c:
+            dd, di, _ = get_dest()
+            n = min(int(get_length()) * per, dest_end - di // wpe)
+            if n > 0:
+                sd, si, _ = get_src()
+                dd[di:di + n * wpe] = sd[si:si + wpe] * n
         return c
     return run
 
