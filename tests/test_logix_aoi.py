@@ -273,3 +273,17 @@ def test_an_aoi_no_rung_calls_has_its_logic_checked(tmp_path):
         "unknown tag 'Nowhere': the logic of Add-On Instruction Lone names only its parameters and local tags" \
         in str(info.value)
     assert len(info.value.errors) == 1  # its other rungs are right: the InOut array, an index by a parameter
+
+
+@EXECUTORS
+@pytest.mark.parametrize("modes,first", [(None, 101), ([], 1)])
+def test_a_prescan_routine_runs_in_the_first_scan_when_the_export_says_so(tmp_path, executor, modes, first):
+    prime = Aoi("Prime", [Param("Out", "DINT", "Output")],
+                {"Logic": ["ADD(Count,1,Count)MOV(Count,Out);"], "Prescan": ["MOV(100,Count);"]},
+                [("Count", "DINT", None)], scan_modes=modes)
+    r = runner(tmp_path, [prime], [("P1", "Prime"), ("Out", "DINT")], ["Prime(P1,Out);"], executor)
+    r.run(1)
+    assert read(r, "Out") == first
+    r.run(2)
+    assert read(r, "Out") == first + 2  # once, in the first scan only
+    r.close()

@@ -53,7 +53,7 @@ def _expected_l5x() -> Project:
             ],
             local_tags=[Tag("Tmp", "REAL", external_access="None", radix="Float", value=_dec(0.0))],
             routines=[Routine("Logic", "RLL", rungs=[Rung(0, "MUL(Raw,Gain,Tmp)MOV(Tmp,Out);")])],
-            revision="1.2", description="Scale a raw count")],
+            revision="1.2", description="Scale a raw count", scan_modes=set())],
         modules=[
             Module("Local", "1769-L33ER", parent="Local"),
             Module("DIO", "1769-IQ6XOW4/B", parent="Local", slot=1, tags=[

@@ -342,16 +342,33 @@ class AoiCalls:
         copy_in = [op for name, arg in inputs for op in (arg, member(name))]
         copy_out = [op for name, arg in outputs for op in (member(name), arg)]
         ctx.before += member_ctx.before
-        eif = routines.get("ENABLEINFALSE")
-        eif = eif if eif is not None and eif.kind == "RLL" and not eif.encoded else None
+        eif = self._scan_mode(aoi, "ENABLEINFALSE", pos, label, ctx)
+        prescan = self._scan_mode(aoi, "PRESCAN", pos, label, ctx)
         flags = Const(HAS_EIF if eif else 0, pos)
         self.called.add(aoi.name.upper())
         legs = [[Instruction("XIC", [ein], pos), self._routine(aoi, logic, mapping, inst, ctx, pos)]]
         if eif is not None:
             legs.append([Instruction("XIO", [ein], pos), self._routine(aoi, eif, mapping, inst, ctx, pos)])
+        if prescan is not None:  # the first scan, before the Logic (docs/logix.md: Logix's prescan, as near as it goes)
+            legs.insert(0, [Instruction("XIC", [AddressRef(STATUS_FLAGS["S:FS"], pos)], pos),
+                            self._routine(aoi, prescan, mapping, inst, ctx, pos)])
         ctx.before.append(Instruction("LAIN", [ein, eout, flags] + copy_in, pos))
         ctx.before += legs[0] if len(legs) == 1 else [Branch(legs, pos)]
         return Instruction("LAOUT", [ein, eout, flags] + copy_out, pos)
+
+    def _scan_mode(self, aoi, name: str, pos, label: str, ctx) -> model.Routine | None:
+        """The AOI's EnableInFalse or Prescan routine when the export says
+        to run it (``ExecuteEnableInFalse``, ``ExecutePrescan``; an export
+        that says neither: when it has the routine); one not in ladder is a
+        warning, and not run."""
+        routine = next((r for r in aoi.routines if r.name.upper() == name), None)
+        if routine is None or (aoi.scan_modes is not None and name not in aoi.scan_modes):
+            return None
+        if routine.kind != "RLL" or routine.encoded:
+            kind = "source protected" if routine.encoded else routine.kind
+            ctx.warn(pos, f"{label}: its {routine.name} routine is {kind}: not run by softplc_lite")
+            return None
+        return routine
 
     def _shape(self, text, pos, ctx, label, what) -> Resolved | None:
         """What ``text`` names (its type and dimensions), without making its
@@ -461,7 +478,7 @@ class AoiCalls:
             if inst is None or not all(mapping.values()):
                 continue  # an argument softplc_lite cannot stand in for: checked when a rung calls it
             ctx = RoutineContext(self.directory, None, {}, source, aoi.name)
-            for name in ("LOGIC", "ENABLEINFALSE"):
+            for name in ("LOGIC", "ENABLEINFALSE", "PRESCAN"):
                 r = routines.get(name)
                 if r is not None and r.kind == "RLL" and not r.encoded:
                     self._routine(aoi, r, mapping, "not called", ctx, r.pos)

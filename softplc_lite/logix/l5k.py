@@ -40,7 +40,7 @@ from .exportfile import read_export
 from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
                     ModuleTag, Program, Project, Routine, Rung, Tag, Task)
 from .l5k_scan import IDENT, Scanner, split_attrs, split_commas
-from .values import ValueSyntax, flag, parse_l5k_value, parse_number, unescape
+from .values import ValueSyntax, flag, parse_l5k_value, parse_number, scan_modes, unescape
 
 _TYPE = re.compile(r"\s*([A-Za-z_][A-Za-z0-9_:]*)\s*(?:\[([^\]]*)\])?")
 _VERSION = re.compile(r"Version\s*:=\s*RSLogix 5000 v([\d.]+)")
@@ -292,6 +292,7 @@ class _Reader(Scanner):
                 aoi.local_tags += self.decls("LOCAL_TAGS", wat)
             elif not self.routine(word, wat, aoi.routines):
                 self.skip_block(word, "", wat)
+        aoi.scan_modes = scan_modes(attrs)
         return aoi
 
     def program(self, at: int) -> Program:

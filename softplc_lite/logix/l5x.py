@@ -43,7 +43,7 @@ from .exportfile import read_export
 from .modules import describe_structure
 from .model import (AddOnInstruction, DataType, ExportError, InitialValue, Line, Member, Module,
                     ModuleTag, Problem, Program, Project, Routine, Rung, Tag, Task)
-from .values import MAX_DEPTH, ValueSyntax, flag, parse_l5k_value, parse_quoted, typed_scalar
+from .values import MAX_DEPTH, ValueSyntax, flag, parse_l5k_value, parse_quoted, scan_modes, typed_scalar
 
 TARGET_TYPES = ("Controller", "Program", "Routine", "Rung", "AddOnInstructionDefinition", "DataType", "Module")
 
@@ -408,6 +408,7 @@ class _Reader:
         if local is not None:
             aoi.local_tags = self.tags(local, "LocalTag")
         aoi.routines = self.routines(node)
+        aoi.scan_modes = scan_modes(node.attrs)
         return aoi
 
     def program(self, node: _Node) -> Program | None:

@@ -144,6 +144,9 @@ class AddOnInstruction:
     revision: str | None = None
     description: str | None = None
     encoded: bool = False  # source-protected (L5X EncodedData): parameters only, no routines
+    # the scan modes the export says to run (ExecutePrescan, ExecutePostscan, ExecuteEnableInFalse),
+    # as routine names upper-cased: PRESCAN, POSTSCAN, ENABLEINFALSE; None when the export does not say
+    scan_modes: set[str] | None = None
     pos: Pos = NOWHERE
 
 

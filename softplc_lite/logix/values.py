@@ -228,3 +228,16 @@ def flag(value: str | None, default: bool = False) -> bool:
     if value is None:
         return default
     return value.strip().lower() in ("true", "1", "yes")
+
+
+SCAN_MODES = {"EXECUTEPRESCAN": "PRESCAN", "EXECUTEPOSTSCAN": "POSTSCAN", "EXECUTEENABLEINFALSE": "ENABLEINFALSE"}
+
+
+def scan_modes(attrs: dict) -> set[str] | None:
+    """The scan-mode routines an AOI's header says to run
+    (``ExecutePrescan="true"``, ``ExecuteEnableInFalse := Yes``), as routine
+    names upper-cased; None when it names none of them."""
+    said = {key.upper(): value for key, value in attrs.items() if key.upper() in SCAN_MODES}
+    if not said:
+        return None
+    return {SCAN_MODES[key] for key, value in said.items() if flag(value)}

@@ -26,6 +26,7 @@ class Aoi:
     routines: dict[str, list[str]]  # Logic, EnableInFalse ... -> rung texts
     local_tags: list[tuple[str, str, str | None]] = field(default_factory=list)  # (name, type, decorated data XML)
     encoded: bool = False
+    scan_modes: list[str] | None = None  # the routines the header says to run (None: the Prescan, EnableInFalse given)
 
 
 def _dims(data_type: str) -> tuple[str, str]:
@@ -38,8 +39,9 @@ def _dims(data_type: str) -> tuple[str, str]:
 def aoi_xml(a: Aoi) -> str:
     out = []
     params = [Param("EnableIn", "BOOL", "Input", False), Param("EnableOut", "BOOL", "Output", False)] + a.params
-    head = (f'Name="{a.name}" Revision="1.0" ExecutePrescan="false" ExecutePostscan="false" '
-            f'ExecuteEnableInFalse="{str("EnableInFalse" in a.routines).lower()}"')
+    modes = a.scan_modes if a.scan_modes is not None else [r for r in a.routines if r in ("Prescan", "EnableInFalse")]
+    head = (f'Name="{a.name}" Revision="1.0" ExecutePrescan="{str("Prescan" in modes).lower()}" '
+            f'ExecutePostscan="false" ExecuteEnableInFalse="{str("EnableInFalse" in modes).lower()}"')
     out.append(f'<EncodedData EncodedType="AddOnInstructionDefinition" {head}>' if a.encoded
                else f"<AddOnInstructionDefinition {head}>")
     out.append("<Parameters>")
