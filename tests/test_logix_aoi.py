@@ -145,7 +145,8 @@ def test_errors_at_the_call_are_located_and_said_at_once(tmp_path):
     assert len(reports) == 5, reports
     assert reports[0].startswith(at(rungs[0], "Scale")) and "routine P.Main: rung 0: Scale takes 5 operands" in \
         reports[0] and "found 4" in reports[0]
-    assert reports[1].startswith(at(rungs[1], "5,")) and "Count: an InOut parameter is passed by reference" in reports[1]
+    assert reports[1].startswith(at(rungs[1], "5,"))
+    assert "Count: an InOut parameter is passed by reference" in reports[1]
     assert reports[2].startswith(at(rungs[2], "In1")) and "instance 'In1': expected a tag of type Scale" in reports[2]
     assert reports[3].startswith(at(rungs[2], "Out1,Done1")) and "Count: expected a DINT tag" in reports[3]
     assert reports[4].startswith(at(rungs[3], "3,")) and "expected a tag to receive" in reports[4]
@@ -166,7 +167,8 @@ def test_an_aoi_that_calls_itself_is_an_error(tmp_path):
 def test_a_source_protected_aoi_is_a_warning_and_its_calls_are_not_run(tmp_path):
     secret = Aoi("Secret", [Param("In", "DINT", "Input")], {}, encoded=True)
     path = write_aoi_l5x(tmp_path / "secret.L5X", [secret], [("K", "Secret"), ("Ran", "BOOL")],
-                         [Prog("P", {"Main": ["Secret(K,5)OTE(Ran);", "OTE(Ran);", "Secrets(K,5);"]})], [Task("T", ["P"])])
+                         [Prog("P", {"Main": ["Secret(K,5)OTE(Ran);", "OTE(Ran);", "Secrets(K,5);"]})],
+                         [Task("T", ["P"])])
     app = load_app(path)
     warnings = "\n".join(app.warnings)
     assert "rung 0: Secret: source protected: its logic cannot be read; the rung is not run" in warnings

@@ -23,12 +23,17 @@ docs/logix.md, "Add-On Instructions", says it for users; the rules:
   stands, ``LAIN ... XIC EnableIn JSR logic LAOUT ...``
   (ladder/instr/logix_aoi.py): EnableIn is the rung-in, the inputs are copied
   in, the Logic runs if EnableIn is true (the EnableInFalse routine if not,
-  when the AOI defines one), the outputs are copied out and EnableOut is the
-  rung-out. A call inside an AOI's logic (nesting) is made the same way.
+  when the export says to run one), the outputs are copied out and EnableOut
+  is the rung-out. A Prescan routine the export says to run runs at the call
+  in the first scan (S:FS), before the Logic: the engine has no prescan. A
+  call inside an AOI's logic (nesting) is made the same way.
 - **Not run**: a source-protected AOI (its logic cannot be read), one whose
-  Logic is not RLL, one whose instance type is not held: each call is a
-  warning and its rung is not run. A call's wrong operand count or argument
-  kind, or an AOI that calls itself, is an error at the call.
+  Logic is not RLL, one whose instance type is not held, one with an InOut
+  parameter of a type not held (MODULE): each call is a warning and its rung
+  is not run. A call's wrong operand count or argument kind, or an AOI that
+  calls itself, is an error at the call.
+- **An AOI no rung calls** has its logic made once over hidden storage, in a
+  file no rung calls, so its problems are said (``check_uncalled``).
 """
 
 from __future__ import annotations
@@ -327,6 +332,11 @@ class AoiCalls:
         for p, (text, _), w in zip(required, el.operands[1:], where[1:]):
             usage = (p.usage or "").upper()
             if usage == "INOUT":
+                continue
+            pt = self.types.get(p.data_type)
+            if pt is None or not pt.is_atomic or p.dims:  # a copy is of one number (Logix's are atomic too)
+                not_run(f"its {p.usage} parameter {p.name} is a {p.data_type}{list(p.dims) if p.dims else ''}: "
+                        f"not yet passed by softplc_lite")
                 continue
             try:
                 arg = self._argument(text.strip(), w, ctx, usage == "INPUT", _is_bool(p))
