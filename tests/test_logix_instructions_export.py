@@ -323,8 +323,18 @@ def test_gsv_and_ssv_of_a_date_time_into_a_structures_dints_and_a_real_gets_the_
     r.close()
 
 
+@EXECUTORS
+def test_gsv_of_a_tasks_priority_rate_and_watchdog_gives_the_exports(tmp_path, executor):
+    r = runner(tmp_path, ["GSV(Task,T,Priority,N);", "GSV(TASK,T,WATCHDOG,N2);", "GSV(Task,T,Rate,k);"], executor)
+    r.run(1)
+    assert (read(r, "N"), read(r, "N2"), read(r, "k")) == (10, 500_000, 0)  # a continuous task has no Rate
+    r.close()
+
+
 def test_gsv_of_what_softplc_lite_does_not_hold_is_a_warning(tmp_path):
-    warnings = warnings_of(tmp_path, ["GSV(Module,Rack,EntryStatus,N);", "SSV(Axis,Servo,HomeSpeed,F);"])
+    warnings = warnings_of(tmp_path, ["GSV(Module,Rack,EntryStatus,N);", "SSV(Axis,Servo,HomeSpeed,F);",
+                                      "SSV(Task,T,Priority,N);"])
+    assert "rung 2: SSV: SSV of Task.Priority is not applied by softplc_lite" in warnings
     assert "rung 0: GSV: Module.EntryStatus is not an attribute softplc_lite holds" in warnings
     assert "rung 1: SSV: Axis.HomeSpeed is not an attribute softplc_lite holds" in warnings
 

@@ -6,7 +6,8 @@ System Value (SSV)").
 - An attribute the data table holds (the tag directory's ``objects``: a
   task's InhibitTask and OverlapCount, a program's DisableFlag; tasks.py) is
   read from it (GSV) or written into it (SSV): LGSV/LSSV code 0. The instance ``THIS`` of a Program
-  is the program the rung is in.
+  is the program the rung is in. A task's Priority, Rate and Watchdog (µs) are the export's; an SSV
+  of one is a rung not run (a softplc choice: the schedule is made at load).
 - An attribute read from the engine (the wall clock, the scan times, the
   fault bits: ladder/instr/logix_system.py) is an LGSV or LSSV.
 - Any other (Module.EntryStatus, Controller, Axis ...): the rung is not run,
@@ -22,6 +23,8 @@ from .copy import element_run
 from .operands import Operands, Skip
 from .tags import PathError
 
+FIXED = ("PRIORITY", "RATE", "WATCHDOG")  # a task's schedule: read, not changed
+
 
 def translate(el, pos, rung, ctx):
     return operands.translate(el, pos, rung, ctx, _build)
@@ -34,11 +37,15 @@ def _build(ops: Operands) -> list[Instruction]:
     if cls == "PROGRAM" and instance == "THIS" and ops.ctx.scope:
         instance = ops.ctx.scope.upper()
     held = ops.ctx.directory.objects.get((cls, instance, attribute))
+    if not get and cls == "TASK" and attribute in FIXED:
+        raise Skip(f"SSV of Task.{ops.text(2)} is not applied by softplc_lite: a task's schedule is the export's "
+                   f"(GSV reads it)")
     code = HELD if held is not None else ATTRIBUTES.get((cls, attribute))
     if code is None:
         raise Skip(f"{ops.text(0)}.{ops.text(2)} is not an attribute softplc_lite holds (it has WallClockTime "
                    f"CurrentValue, DateTime, LocalDateTime; Task and Program LastScanTime, MaxScanTime; Task "
-                   f"Watchdog, InhibitTask, OverlapCount; Program DisableFlag; FaultLog MinorFaultBits, "
+                   f"Priority, Rate, Watchdog, InhibitTask, OverlapCount; Program DisableFlag; FaultLog "
+                   f"MinorFaultBits, "
                    f"MajorFaultBits)")
     r = ops.resolve(3)
     where = ops.where(3)

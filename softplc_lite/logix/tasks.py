@@ -92,6 +92,16 @@ class Schedule:
                 objects[("TASK", task.name.upper(), "OVERLAPCOUNT")] = overlaps
                 self.periodic.append(Periodic(task, max(round(rate), 1), bit, ctl, nxt, overlaps))
         self.periodic.sort(key=lambda p: p.task.priority)  # stable: equal priorities keep the export's order
+        # what GSV reads of each task's schedule (1756-RM003, GSV/SSV objects, TASK: Rate and Watchdog
+        # in microseconds); logix/system.py does not let SSV change them
+        for task in project.tasks:
+            if ("TASK", task.name.upper(), "INHIBITTASK") not in objects:
+                continue
+            for attribute, value in (("PRIORITY", task.priority), ("WATCHDOG", round(task.watchdog_ms * 1000)),
+                                     ("RATE", round((task.rate_ms or 0) * 1000))):
+                leaf = directory.alloc.one("L")
+                writer.put(leaf, 0, value)
+                objects[("TASK", task.name.upper(), attribute)] = Address("L", leaf.file, leaf.first, None, None)
 
     def files(self, routine_files: dict[tuple[str, str], int], first_file: int) -> dict[int, ProgramFile]:
         """Program file 2 and a file for each periodic task (numbered from

@@ -43,8 +43,9 @@ COMMENT_INDENT = 4
 
 _GLYPHS = {"XIC": "] [", "XIO": "]/[", "OTE": "( )", "OTL": "(L)", "OTU": "(U)", "ONS": "[ONS]"}
 _COMPARE = {"EQU": "==", "NEQ": "<>", "LES": "<", "LEQ": "<=", "GRT": ">", "GEQ": ">="}
-_INFIX = {"ADD": "+", "SUB": "-", "MUL": "*", "DIV": "/", "MOD": "MOD", "AND": "AND", "OR": "OR", "XOR": "XOR"}
-_MOVES = {"MOV", "NEG", "ABS", "SQR", "NOT", "ACI", "AIC"}  # source -> dest
+_INFIX = {"ADD": "+", "SUB": "-", "MUL": "*", "DIV": "/", "MOD": "MOD", "AND": "AND", "OR": "OR", "XOR": "XOR",
+          "LAND": "AND", "LOR": "OR", "LXOR": "XOR"}  # L...: a Logix export's 32-bit forms (ladder/instr/logix_bits.py)
+_MOVES = {"MOV", "NEG", "ABS", "SQR", "NOT", "ACI", "AIC", "LNOT"}  # source -> dest
 _LIVE_PRESETS = {"TON": (2, 3), "TOF": (2, 3), "RTO": (2, 3), "CTU": (1, 2), "CTD": (1, 2)}  # shown from the table
 _STATUS_BITS = {"T": ("EN", "TT", "DN"), "C": ("CU", "CD", "DN", "OV", "UN"), "R": ("EN", "DN", "ER", "EM")}
 _STRUCTS = (ValueKind.TIMER, ValueKind.COUNTER, ValueKind.CONTROL)

@@ -18,8 +18,10 @@ its appendix "GSV/SSV objects"; the choices are softplc_lite's):
 - Task.LastScanTime, MaxScanTime and Program.LastScanTime, MaxScanTime, in
   microseconds: the whole scan's (S:8 and S:9, ms) for every task and
   program (a softplc choice: softplc_lite times the scan, not each
-  program). Task.Watchdog, in ms: the scan watchdog, S:28. An SSV of one
-  sets it (``SSV(Task,MainTask,MaxScanTime,Zero)`` restarts the maximum).
+  program). An SSV of one sets it (``SSV(Task,MainTask,MaxScanTime,Zero)``
+  restarts the maximum). Code 6 (WATCHDOG) is the scan watchdog, S:28 in ms,
+  for PLC-5 text; a Logix task's Priority, Rate and Watchdog are the
+  export's, held in the data table (logix/tasks.py), read as code 0.
 - FaultLog.MinorFaultBits: bit 4 (an instruction's minor fault) while the
   minor fault words (S:10/14, S:17) hold one; MajorFaultBits: bit 4 while
   S:11 holds a major fault. An SSV with bit 4 clear clears them (the idiom
@@ -45,7 +47,7 @@ WALL_CURRENT, WALL_DATETIME, WALL_LOCAL, LAST_SCAN, MAX_SCAN, WATCHDOG, MINOR_BI
 ATTRIBUTES = {
     ("WALLCLOCKTIME", "CURRENTVALUE"): WALL_CURRENT, ("WALLCLOCKTIME", "DATETIME"): WALL_DATETIME,
     ("WALLCLOCKTIME", "LOCALDATETIME"): WALL_LOCAL,
-    ("TASK", "LASTSCANTIME"): LAST_SCAN, ("TASK", "MAXSCANTIME"): MAX_SCAN, ("TASK", "WATCHDOG"): WATCHDOG,
+    ("TASK", "LASTSCANTIME"): LAST_SCAN, ("TASK", "MAXSCANTIME"): MAX_SCAN,
     ("PROGRAM", "LASTSCANTIME"): LAST_SCAN, ("PROGRAM", "MAXSCANTIME"): MAX_SCAN,
     ("FAULTLOG", "MINORFAULTBITS"): MINOR_BITS, ("FAULTLOG", "MAJORFAULTBITS"): MAJOR_BITS,
 }
