@@ -289,3 +289,15 @@ def test_a_prescan_routine_runs_in_the_first_scan_when_the_export_says_so(tmp_pa
     r.run(2)
     assert read(r, "Out") == first + 2  # once, in the first scan only
     r.close()
+
+
+def test_an_export_without_enablein_and_enableout_parameters_still_has_them(tmp_path):
+    bare = Aoi("Bare", [Param("X", "DINT", "Input")], {"Logic": ["MOV(X,Y);"]}, [("Y", "DINT", None)])
+    path = write_aoi_l5x(tmp_path / "bare.L5X", [bare], [("B", "Bare"), ("Go", "BOOL")],
+                         [Prog("P", {"Main": ["Bare(B,6)OTE(Go);"]})], [Task("T", ["P"])])
+    text = path.read_text()
+    path.write_text("\n".join(ln for ln in text.splitlines() if 'Name="Enable' not in ln))
+    r = Runner(load_app(path), RunOptions(fresh=True, save_state=False))
+    r.run(1)
+    assert read(r, "B.Y") == 6 and read(r, "B.EnableOut") == 1 and read(r, "Go") == 1
+    r.close()

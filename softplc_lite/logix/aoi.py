@@ -57,7 +57,13 @@ HAS_EIF = 1
 
 
 def _members(aoi: model.AddOnInstruction) -> list[model.Tag]:
-    return [p for p in aoi.parameters if (p.usage or "").upper() != "INOUT"] + list(aoi.local_tags)
+    """The instance's members: EnableIn and EnableOut (Logix's own, kept
+    even where a hand-made export leaves them out), the Input and Output
+    parameters, the local tags."""
+    named = {p.name.upper() for p in aoi.parameters}
+    enable = [model.Tag(n, "BOOL", usage=u, pos=aoi.pos) for n, u in (("EnableIn", "Input"), ("EnableOut", "Output"))
+              if n.upper() not in named]
+    return enable + [p for p in aoi.parameters if (p.usage or "").upper() != "INOUT"] + list(aoi.local_tags)
 
 
 def _is_bool(tag: model.Tag) -> bool:
@@ -327,7 +333,14 @@ class AoiCalls:
         def member(name: str) -> AddressRef:
             return _resolve_ref(name, pos, member_ctx)
 
-        ein, eout = member("EnableIn"), member("EnableOut")
+        try:
+            ein, eout = member("EnableIn"), member("EnableOut")
+        except (PathError, ExprError) as e:
+            ctx.problem(pos, f"{label}: EnableIn, EnableOut: {e}")
+            return None
+        if ein.address.bit is None or eout.address.bit is None:
+            ctx.problem(pos, f"{label}: EnableIn and EnableOut: expected BOOL parameters")
+            return None
         inputs, outputs = [], []
         for p, (text, _), w in zip(required, el.operands[1:], where[1:]):
             usage = (p.usage or "").upper()
@@ -349,8 +362,12 @@ class AoiCalls:
             (inputs if usage == "INPUT" else outputs).append((p.name, arg))
         if len(ctx.problems) > before or ctx.skip:
             return None
-        copy_in = [op for name, arg in inputs for op in (arg, member(name))]
-        copy_out = [op for name, arg in outputs for op in (member(name), arg)]
+        try:
+            copy_in = [op for name, arg in inputs for op in (arg, member(name))]
+            copy_out = [op for name, arg in outputs for op in (member(name), arg)]
+        except (PathError, ExprError) as e:  # an instance member softplc_lite cannot reach (a bug if ever)
+            ctx.problem(pos, f"{label}: {e}")
+            return None
         ctx.before += member_ctx.before
         eif = self._scan_mode(aoi, "ENABLEINFALSE", pos, label, ctx)
         prescan = self._scan_mode(aoi, "PRESCAN", pos, label, ctx)
