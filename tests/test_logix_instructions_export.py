@@ -343,3 +343,21 @@ def test_gsv_into_a_too_small_destination_is_a_located_error(tmp_path):
     errors = errors_of(tmp_path, ["GSV(WallClockTime,,DateTime,DT[3]);", "GSV(Task,T,LastScanTime,Flag);"])
     assert "takes 7 DINTs: expected an array with 7 elements from here" in errors[0]
     assert "expected a DINT, found BOOL" in errors[1]
+
+
+def test_the_watch_view_shows_string_compares_and_copies_by_logix_name(tmp_path):
+    from softplc_lite.watch.session import WatchOptions, WatchSession
+    from softplc_lite.watch.snapshot import render
+
+    path = write_l5x(tmp_path / "v.L5X", TAGS, [Prog("P", {"Main": ["NEQ(S1,S2)CONCAT(S1,S2,S3);",
+                                                                    "COP(A,B,5)BXOR(N,16#FF,N);"]})],
+                     [Task("T", ["P"])], data_types=TYPES)
+    s = WatchSession(load_app(path, tmp_path / "state"), WatchOptions(run=RunOptions(fresh=True), online=False))
+    try:
+        s.engine.table.write(s.app.program.symbols.resolve_path("S1"), "ab")
+        s.scan()
+        text = render(s, 140, 30).export_text()
+    finally:
+        s.quit()
+    assert "+-NEQ" in text and "S1=\"ab\" <> S2" in text and "+-CONCAT" in text and "+-COP" in text
+    assert "N=255 XOR 255 -> N=255" in text and "LSCMP" not in text and "LCOP" not in text

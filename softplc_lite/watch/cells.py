@@ -25,6 +25,7 @@ from ..ladder.ast import (
 from ..ladder.ast import Text as TextOperand
 from ..ladder.instructions import InstructionSet, K
 from ..ladder.instr.logix import CD, CU, DN, EN, OV, TT, UN
+from ..ladder.instr.logix_string import COMPARISONS
 from .naming import SymbolNames
 from .power import READ_FAILURES, Power
 
@@ -258,7 +259,10 @@ def _box_cell(ins: Instruction, budget: int, ctx: _Context) -> _Block:
     state = ctx.state(ins)
     p_in, p_out = (state.power_in, state.power_out) if state else (False, False)
     title_style = FAULT if state is not None and state.fault else _power_style(state is not None and state.is_true)
-    return _box(ctx.names.mnemonic(ins.mnemonic), title_style, _box_items(ins, ctx), budget, p_in, p_out)
+    title = ctx.names.mnemonic(ins.mnemonic)
+    if ins.mnemonic == "LSCMP":  # a compare of two strings: shown by the compare it is
+        title = COMPARISONS[ins.operands[2].value]
+    return _box(title, title_style, _box_items(ins, ctx), budget, p_in, p_out)
 
 
 def _box(title: str, title_style: Style | None, groups: list[list[Line]], budget: int, p_in: bool,
@@ -291,6 +295,8 @@ def _box_items(ins: Instruction, ctx: _Context) -> list[list[Line]]:
 
     if m in _COMPARE and len(ops) == 2:
         main = [item(0, False), _prefixed(_COMPARE[m], item(1, False))]
+    elif m == "LSCMP" and len(ops) == 3:
+        main = [item(0, False), _prefixed(_COMPARE[COMPARISONS[ops[2].value]], item(1, False))]
     elif m == "LIM" and len(ops) == 3:
         main = [item(0, False), _prefixed("<=", item(1, False)), _prefixed("<=", item(2, False))]
     elif m in _INFIX and len(ops) == 3:
