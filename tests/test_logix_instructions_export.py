@@ -360,4 +360,5 @@ def test_the_watch_view_shows_string_compares_and_copies_by_logix_name(tmp_path)
     finally:
         s.quit()
     assert "+-NEQ" in text and "S1=\"ab\" <> S2" in text and "+-CONCAT" in text and "+-COP" in text
+    assert "|A[0]=0 -> B[0]=0 length 5|" in text and "dest end" not in text
     assert "N=255 XOR 255 -> N=255" in text and "LSCMP" not in text and "LCOP" not in text

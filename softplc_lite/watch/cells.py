@@ -313,6 +313,8 @@ def _box_items(ins: Instruction, ctx: _Context) -> list[list[Line]]:
         return [[_structure_item(ops[0], ctx)], [_logix_status(m, ops, ctx)]]
     elif m == "LRES" and len(ops) == 1:
         return [[_structure_item(ops[0], ctx)]]
+    elif m in ("LCOP", "LFLL") and len(ops) >= 3:  # COP and FLL: their three Logix operands, not the layout's
+        main = [item(0, False), _prefixed("->", item(1, False)), _prefixed("length", item(2, False))]
     elif m == "JSR" and ops and isinstance(ops[0], Const) and ctx.names.file_name(ops[0].value):
         main = [[(ctx.names.file_name(ops[0].value), None)], *(item(i) for i in range(1, len(ops)))]
     else:
