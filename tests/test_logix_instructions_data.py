@@ -71,6 +71,13 @@ def test_lcop_of_strings_copies_whole_elements(engine):
     assert e.table.read("ST10:1") == "pump 3"
 
 
+def test_lcop_of_strings_into_a_smaller_string_type_cuts_them(engine):
+    e = engine("DATA ST10 2\nLCOP ST9:0 ST10:0 5 1 2 2 3", {"ST9:0": "abcdef", "ST9:1": "xy"})
+    e.scan()
+    assert [e.table.read("ST10:0"), e.table.read("ST10:1")] == ["abc", "xy"]
+    assert e.table.read("ST10:0.LEN") == 3
+
+
 def test_lcop_does_nothing_on_a_false_rung_or_a_zero_length(engine):
     e = engine("DATA L10 2\nDATA L11 2\nXIC B3/0 LCOP L10:0 L11:0 2 1 2 2\nLCOP L10:0 L11:1 0 1 2 2")
     e.table.write("L10:0", 4)

@@ -261,6 +261,16 @@ def test_mov_and_move_of_a_string(tmp_path, executor):
     r.close()
 
 
+@EXECUTORS
+def test_cop_and_mov_of_a_string_into_a_smaller_string_type_cut_it_to_fit(tmp_path, executor):
+    r = runner(tmp_path, ["COP(S1,Short,1);", "MOV(S1,S3);", "MOV(Short,S2);"], executor)
+    write(r, "S1", "0123456789")
+    r.run(1)
+    assert read(r, "Short") == "01234567" and read(r, "S3") == "0123456789" and read(r, "S2") == "01234567"
+    assert read(r, "Short.LEN") == 8
+    r.close()
+
+
 def test_a_string_instruction_on_a_number_is_a_located_error(tmp_path):
     errors = errors_of(tmp_path, ["CONCAT(S1,N,S2);", "EQU(S1,N)OTE(Flag);"])
     assert "CONCAT operand 'N': expected a string, found DINT" in errors[0]

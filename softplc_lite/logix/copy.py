@@ -106,9 +106,24 @@ def copy_run(source: Run, where, dest: Run, length, pos) -> list[Instruction]:
     out = []
     for path, (d_address, per, d_end) in dest.leaves.items():
         s_address, s_per, s_end = source.leaves[path]
-        out.append(Instruction("LCOP", [AddressRef(s_address, where), AddressRef(d_address, pos), length,
-                                        Const(per, pos), Const(d_end, pos), Const(s_end, pos)], pos))
+        operands = [AddressRef(s_address, where), AddressRef(d_address, pos), length, Const(per, pos),
+                    Const(d_end, pos), Const(s_end, pos)]
+        chars = _chars(dest.type, path), _chars(source.type, path)
+        if chars[0] is not None and chars[1] is not None and chars[0] < chars[1]:
+            operands.append(Const(chars[0], pos))  # a string into a smaller string type: cut to fit
+        out.append(Instruction("LCOP", operands, pos))
     return out
+
+
+def _chars(t, path: tuple[str, ...]) -> int | None:
+    """The characters of the string type at ``path`` below type ``t``, or
+    None (not a string)."""
+    for key in path:
+        m = t.member(key)
+        if m is None:
+            return None
+        t = m.type
+    return t.chars if t.kind == "string" else None
 
 
 def _fill(ops: Operands, dest: Run, length) -> list[Instruction]:

@@ -23,6 +23,9 @@ Rules (1756-RM003, Logix 5000 Controllers General Instructions, "Copy File
   data" for the rest; softplc_lite copies what the source holds and leaves
   the rest of the destination as it is (a softplc choice).
 - A length of zero or less copies nothing (a softplc choice).
+- A string copied into a string type of fewer characters is cut to fit,
+  LEN with it (a softplc choice: Logix copies the destination's bytes and
+  leaves the source's LEN, larger than the destination's DATA).
 - CPS differs from COP in that nothing may change the data while it copies;
   nothing does during a softplc_lite scan, so CPS is COP.
 """
@@ -31,6 +34,7 @@ from __future__ import annotations
 
 from array import array
 
+from ...datatable.table import read_string, store_text
 from ..ast import AddressRef
 from ..bound import BoundInstruction
 from ..specs import InstructionSpec, K, OperandSpec
@@ -41,13 +45,16 @@ def _spec(mnemonic: str, title: str, *names: str) -> InstructionSpec:
 
 
 SPECS = [
-    _spec("LCOP", "Logix copy file", "source", "dest", "length", "items per element", "dest end", "source end"),
+    InstructionSpec("LCOP", "Logix copy file", tuple(OperandSpec(n, K.ANY) for n in (
+        "source", "dest", "length", "items per element", "dest end", "source end", "capacity")), True, optional=1),
     _spec("LFLL", "Logix file fill", "source", "dest", "length", "items per element", "dest end"),
 ]
 LOGIX_NAMES = {"LCOP": "COP", "LFLL": "FLL"}
 
 
 def _copy(instr, access):
+    if len(instr.operands) == 7:
+        return _copy_strings(instr, access)
     src, dest, length, per, dest_end, src_end = instr.operands
     get_src, get_dest, get_length = access.location(src), access.location(dest), access.value(length)
     per, dest_end, src_end = per.value, dest_end.value, src_end.value
@@ -72,6 +79,28 @@ def _copy(instr, access):
             raw = sd[si:si + have * wpe_s].tobytes()[:n * wpe_d * dd.itemsize]
             n = len(raw) // dd.itemsize
             dd[di:di + n] = array(dd.typecode, raw[:n * dd.itemsize])
+        return c
+    return run
+
+
+def _copy_strings(instr, access):
+    """Strings into strings of a smaller type (the 7th operand, its
+    characters): each cut to fit, LEN with it (a softplc choice: Logix
+    copies the destination's bytes, leaving a LEN larger than its DATA)."""
+    src, dest, length, per, dest_end, src_end, capacity = instr.operands
+    get_src, get_dest, get_length = access.location(src), access.location(dest), access.value(length)
+    per, dest_end, src_end, cap = per.value, dest_end.value, src_end.value, capacity.value
+    wpe = dest.address.ftype.words_per_element
+
+    def run(c: bool) -> bool:
+        if c:
+            dd, di, _ = get_dest()
+            sd, si, _ = get_src()
+            n = min(int(get_length()) * per, dest_end - di // wpe, src_end - si // wpe)
+            texts = [read_string(sd, si + k * wpe) for k in range(max(n, 0))]
+            for k, text in enumerate(texts):
+                store_text(dd, di + k * wpe, text[:cap])
+                dd[di + k * wpe] = min(len(text), cap)
         return c
     return run
 
