@@ -100,7 +100,7 @@ def test_refusals_carry_the_status_clients_report(plc, logix):
         assert comm.Read("NOSUCHTAG").Status == "Path destination unknown"
     assert plc.read("N11:0") == plc.read("N7:1")  # the ladder's value, not the client's
     plc.wait_for(lambda: plc.status(S.W_READ_ONLY) == 2, "both read-only refusals in the status words")
-    assert plc.status(S.W_CIP_ERRORS) >= 2
+    plc.wait_for(lambda: plc.status(S.W_CIP_ERRORS) >= 2, "both unknown-destination refusals in the status words")
     assert plc.status(S.W_REFUSALS) == sum(plc.status(w) for w in range(S.W_REFUSED_NETWORK, S.W_REFUSALS))
     status = plc.module.server_status()
     assert status.refused["read-only"] == 2 and status.refused["CIP status"] >= 2
