@@ -18,7 +18,7 @@ from softplc_lite.runner import RunOptions, Runner
 
 from helpers.cli import softplc_here
 from helpers.logix_aoi import Aoi, Param, write_aoi_l5x
-from helpers.logix_l5x import Prog, Task
+from helpers.logix_l5x import Prog, Task, read_tag, write_tag
 
 FIXTURES = Path(__file__).resolve().parent / "fixtures" / "logix"
 EXECUTORS = pytest.mark.parametrize("executor", ["compiled", "reference"])
@@ -43,47 +43,41 @@ def runner(tmp_path, aois, tags, rungs, executor) -> Runner:
     return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
 
 
-def read(r, tag):
-    return r.table.read(r.app.program.symbols.resolve_path(tag))
-
-
-def write(r, tag, value):
-    r.table.write(r.app.program.symbols.resolve_path(tag), value)
 
 
 @EXECUTORS
 def test_two_instances_run_the_logic_each_with_its_own_data(tmp_path, executor):
     r = runner(tmp_path, [SCALE], SCALE_TAGS, SCALE_RUNGS, executor)
-    assert read(r, "S1.Gain") == 2.0 and read(r, "S2.Delay.PRE") == 30  # the AOI's defaults
-    write(r, "In1", 1.5)
-    write(r, "Go1", 1)
-    write(r, "Go2", 1)
+    assert read_tag(r, "S1.Gain") == 2.0 and read_tag(r, "S2.Delay.PRE") == 30  # the AOI's defaults
+    write_tag(r, "In1", 1.5)
+    write_tag(r, "Go1", 1)
+    write_tag(r, "Go2", 1)
     r.run(1)
-    assert read(r, "Out1") == 3.0 and read(r, "Out2") == 10.0  # In * Gain, the constant 5.0 for S2
-    assert read(r, "S1.In") == 1.5 and read(r, "S1.Out") == 3.0
-    assert read(r, "Cnt1") == 1 and read(r, "Cnt2") == 1 and read(r, "Eo1") == 1 and read(r, "S1.EnableOut") == 1
-    write(r, "S2.Gain", 3.0)  # an instance's member, set from outside: S2 alone changes
-    write(r, "Go1", 0)
+    assert read_tag(r, "Out1") == 3.0 and read_tag(r, "Out2") == 10.0  # In * Gain, the constant 5.0 for S2
+    assert read_tag(r, "S1.In") == 1.5 and read_tag(r, "S1.Out") == 3.0
+    assert read_tag(r, "Cnt1") == 1 and read_tag(r, "Cnt2") == 1 and read_tag(r, "Eo1") == 1 and read_tag(r, "S1.EnableOut") == 1
+    write_tag(r, "S2.Gain", 3.0)  # an instance's member, set from outside: S2 alone changes
+    write_tag(r, "Go1", 0)
     r.run(5)
-    assert read(r, "Out2") == 15.0 and read(r, "Out1") == 3.0
-    assert read(r, "Cnt1") == 1 and read(r, "Cnt2") == 6 and read(r, "S1.Runs") == 1 and read(r, "S2.Runs") == 6
-    assert read(r, "Done2") == 1 and read(r, "S2.Delay.DN") == 1 and read(r, "Done1") == 0  # 30 ms of 10 ms scans
+    assert read_tag(r, "Out2") == 15.0 and read_tag(r, "Out1") == 3.0
+    assert read_tag(r, "Cnt1") == 1 and read_tag(r, "Cnt2") == 6 and read_tag(r, "S1.Runs") == 1 and read_tag(r, "S2.Runs") == 6
+    assert read_tag(r, "Done2") == 1 and read_tag(r, "S2.Delay.DN") == 1 and read_tag(r, "Done1") == 0  # 30 ms of 10 ms scans
     r.close()
 
 
 @EXECUTORS
 def test_enablein_false_skips_the_logic_clears_enableout_and_copies_nothing(tmp_path, executor):
     r = runner(tmp_path, [SCALE], SCALE_TAGS, SCALE_RUNGS, executor)
-    write(r, "Go1", 1)
-    write(r, "In1", 2.0)
+    write_tag(r, "Go1", 1)
+    write_tag(r, "In1", 2.0)
     r.run(4)
-    assert read(r, "Done1") == 1 and read(r, "S1.Delay.ACC") == 30
-    write(r, "Go1", 0)
-    write(r, "In1", 7.0)
+    assert read_tag(r, "Done1") == 1 and read_tag(r, "S1.Delay.ACC") == 30
+    write_tag(r, "Go1", 0)
+    write_tag(r, "In1", 7.0)
     r.run(2)
-    assert read(r, "S1.EnableIn") == 0 and read(r, "S1.EnableOut") == 0 and read(r, "Eo1") == 0
-    assert read(r, "Cnt1") == 4 and read(r, "S1.In") == 2.0 and read(r, "Out1") == 4.0
-    assert read(r, "Done1") == 1 and read(r, "S1.Delay.ACC") == 30  # the TON inside is not scanned false
+    assert read_tag(r, "S1.EnableIn") == 0 and read_tag(r, "S1.EnableOut") == 0 and read_tag(r, "Eo1") == 0
+    assert read_tag(r, "Cnt1") == 4 and read_tag(r, "S1.In") == 2.0 and read_tag(r, "Out1") == 4.0
+    assert read_tag(r, "Done1") == 1 and read_tag(r, "S1.Delay.ACC") == 30  # the TON inside is not scanned false
     r.close()
 
 
@@ -94,12 +88,12 @@ def test_an_enableinfalse_routine_runs_when_the_rung_is_false(tmp_path, executor
                [("Falses", "DINT", None)])
     r = runner(tmp_path, [hold], [("H", "Hold"), ("Go", "BOOL"), ("X", "DINT"), ("Y", "DINT"), ("Eo", "BOOL")],
                ["XIC(Go)Hold(H,X,Y)OTE(Eo);"], executor)
-    write(r, "X", 5)
+    write_tag(r, "X", 5)
     r.run(2)
-    assert read(r, "Y") == 5 and read(r, "H.Falses") == 2 and read(r, "Eo") == 0
-    write(r, "Go", 1)
+    assert read_tag(r, "Y") == 5 and read_tag(r, "H.Falses") == 2 and read_tag(r, "Eo") == 0
+    write_tag(r, "Go", 1)
     r.run(1)
-    assert read(r, "Y") == 105 and read(r, "H.Falses") == 2 and read(r, "Eo") == 1
+    assert read_tag(r, "Y") == 105 and read_tag(r, "H.Falses") == 2 and read_tag(r, "Eo") == 1
     r.close()
 
 
@@ -116,14 +110,14 @@ def test_nested_calls_and_a_variable_index_bound_at_the_call(tmp_path, executor)
     r = runner(tmp_path, [QUAD, TWICE, BUMP],  # QUAD first: its local types are made after it
                [("Q", "Quad"), ("Res", "DINT"), ("Accs", "DINT[3]"), ("I", "DINT")],
                ["Quad(Q,3,Res,Accs[I]);"], executor)
-    write(r, "I", 1)
+    write_tag(r, "I", 1)
     r.run(2)
-    assert read(r, "Res") == 12 and read(r, "Q.Mid") == 6 and read(r, "Q.T.Y") == 12
-    assert [read(r, f"Accs[{k}]") for k in range(3)] == [0, 26, 0]  # (12 + 1) twice
-    write(r, "I", 2)
+    assert read_tag(r, "Res") == 12 and read_tag(r, "Q.Mid") == 6 and read_tag(r, "Q.T.Y") == 12
+    assert [read_tag(r, f"Accs[{k}]") for k in range(3)] == [0, 26, 0]  # (12 + 1) twice
+    write_tag(r, "I", 2)
     r.run(1)
-    assert [read(r, f"Accs[{k}]") for k in range(3)] == [0, 26, 13]
-    write(r, "I", 3)  # past the array: Logix faults an out-of-range subscript (major fault type 4, code 20)
+    assert [read_tag(r, f"Accs[{k}]") for k in range(3)] == [0, 26, 13]
+    write_tag(r, "I", 3)  # past the array: Logix faults an out-of-range subscript (major fault type 4, code 20)
     r.run(1)
     assert r.engine.mode.name == "FAULTED"
     r.close()
@@ -175,7 +169,7 @@ def test_a_source_protected_aoi_is_a_warning_and_its_calls_are_not_run(tmp_path)
     assert "rung 2: SECRETS: not an instruction softplc_lite runs yet" in warnings  # neither instruction nor AOI
     r = Runner(app, RunOptions(fresh=True, save_state=False))
     r.run(1)
-    assert read(r, "Ran") == 1 and read(r, "K.In") == 0  # the instance is laid out; rung 1 ran
+    assert read_tag(r, "Ran") == 1 and read_tag(r, "K.In") == 0  # the instance is laid out; rung 1 ran
     r.close()
 
 
@@ -240,10 +234,10 @@ def test_an_instance_in_l5k_data_packs_its_bools_first_and_nests_its_timer_array
                                     '</Data>\n</Tag>')
     path.write_text(text)
     r = Runner(load_app(path), RunOptions(fresh=True, save_state=False))
-    assert [read(r, p) for p in ("Q.EnableIn", "Q.EnableOut", "Q.Flag", "Q.In", "Q.Tmrs[1].PRE", "Q.Last")] == \
+    assert [read_tag(r, p) for p in ("Q.EnableIn", "Q.EnableOut", "Q.Flag", "Q.In", "Q.Tmrs[1].PRE", "Q.Last")] == \
         [1, 0, 1, 7, 200, 9]
     r.run(1)
-    assert read(r, "Q.Last") == 3 and read(r, "Q.EnableOut") == 1
+    assert read_tag(r, "Q.Last") == 3 and read_tag(r, "Q.EnableOut") == 1
     r.close()
 
 
@@ -260,7 +254,7 @@ def test_a_user_defined_type_may_hold_an_aoi_instance_and_an_aoi_a_local_of_such
     path.write_text(re.sub(r"<DataTypes(/>|>\s*</DataTypes>)", cell, path.read_text(), count=1))
     r = Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
     r.run(1)
-    assert read(r, "C.Count") == 42 and read(r, "C.Doubler.Y") == 42 and read(r, "K.Inner.Count") == 8
+    assert read_tag(r, "C.Count") == 42 and read_tag(r, "C.Doubler.Y") == 42 and read_tag(r, "K.Inner.Count") == 8
     r.close()
 
 
@@ -285,9 +279,9 @@ def test_a_prescan_routine_runs_in_the_first_scan_when_the_export_says_so(tmp_pa
                 [("Count", "DINT", None)], scan_modes=modes)
     r = runner(tmp_path, [prime], [("P1", "Prime"), ("Out", "DINT")], ["Prime(P1,Out);"], executor)
     r.run(1)
-    assert read(r, "Out") == first
+    assert read_tag(r, "Out") == first
     r.run(2)
-    assert read(r, "Out") == first + 2  # once, in the first scan only
+    assert read_tag(r, "Out") == first + 2  # once, in the first scan only
     r.close()
 
 
@@ -299,5 +293,5 @@ def test_an_export_without_enablein_and_enableout_parameters_still_has_them(tmp_
     path.write_text("\n".join(ln for ln in text.splitlines() if 'Name="Enable' not in ln))
     r = Runner(load_app(path), RunOptions(fresh=True, save_state=False))
     r.run(1)
-    assert read(r, "B.Y") == 6 and read(r, "B.EnableOut") == 1 and read(r, "Go") == 1
+    assert read_tag(r, "B.Y") == 6 and read_tag(r, "B.EnableOut") == 1 and read_tag(r, "Go") == 1
     r.close()

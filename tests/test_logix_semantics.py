@@ -12,7 +12,7 @@ from softplc_lite.app import load_app
 from softplc_lite.ladder import status as S
 from softplc_lite.runner import RunOptions, Runner
 
-from helpers.logix_l5x import Prog, Task, write_l5x
+from helpers.logix_l5x import Prog, Task, write_l5x, read_tag, write_tag
 
 TAGS = [("D", "DINT"), ("D2", "DINT"), ("I", "INT"), ("Si", "SINT"), ("R", "REAL"), ("Big", "DINT"),
         ("Trig", "BOOL"), ("Store", "BOOL"), ("Pulse", "BOOL"), ("Once", "BOOL"), ("Scans", "DINT"),
@@ -25,20 +25,14 @@ def runner(tmp_path, rungs, executor) -> Runner:
     return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
 
 
-def read(r, tag):
-    return r.table.read(r.app.program.symbols.resolve_path(tag))
-
-
-def write(r, tag, value):
-    r.table.write(r.app.program.symbols.resolve_path(tag), value)
 
 
 @EXECUTORS
 def test_dint_overflow_wraps_sets_s_v_and_the_minor_fault(tmp_path, executor):
     r = runner(tmp_path, ["ADD(Big,1,D)XIC(S:V)OTE(Over);"], executor)
-    write(r, "Big", 2_147_483_647)
+    write_tag(r, "Big", 2_147_483_647)
     r.run(1)
-    assert read(r, "D") == -2_147_483_648 and read(r, "Over") == 1
+    assert read_tag(r, "D") == -2_147_483_648 and read_tag(r, "Over") == 1
     assert r.table.read(f"S:{S.PLC5_MINOR_FAULT_BITS}") >> S.MINOR_OVERFLOW_BIT & 1
     r.close()
 
@@ -47,7 +41,7 @@ def test_dint_overflow_wraps_sets_s_v_and_the_minor_fault(tmp_path, executor):
 def test_a_smaller_destination_keeps_the_low_bits_with_s_v(tmp_path, executor):
     r = runner(tmp_path, ["ADD(30000,30000,I)ADD(100,100,Si)MUL(65536,65536,D);"], executor)
     r.run(1)
-    assert read(r, "I") == -5536 and read(r, "Si") == -56 and read(r, "D") == 0
+    assert read_tag(r, "I") == -5536 and read_tag(r, "Si") == -56 and read_tag(r, "D") == 0
     r.close()
 
 
@@ -55,9 +49,9 @@ def test_a_smaller_destination_keeps_the_low_bits_with_s_v(tmp_path, executor):
 @pytest.mark.parametrize("real, dint", [(2.5, 2), (3.5, 4), (-2.5, -2), (2.4999, 2), (-3.5, -4)])
 def test_a_real_into_a_dint_rounds_half_to_even(tmp_path, executor, real, dint):
     r = runner(tmp_path, ["MOV(R,D);"], executor)
-    write(r, "R", real)
+    write_tag(r, "R", real)
     r.run(1)
-    assert read(r, "D") == dint
+    assert read_tag(r, "D") == dint
     r.close()
 
 
@@ -66,11 +60,11 @@ def test_s_fs_is_the_first_scan_only_and_ons_osr_fire_once(tmp_path, executor):
     r = runner(tmp_path, ["XIC(S:FS)ADD(Firsts,1,Firsts);", "ADD(Scans,1,Scans);",
                           "XIC(Trig)ONS(Store)ADD(Out,1,Out);", "XIC(Trig)OSR(Once,Pulse);"], executor)
     r.run(3)
-    write(r, "Trig", 1)
+    write_tag(r, "Trig", 1)
     r.run(1)
-    assert read(r, "Pulse") == 1
+    assert read_tag(r, "Pulse") == 1
     r.run(4)
-    assert read(r, "Firsts") == 1 and read(r, "Scans") == 8 and read(r, "Out") == 1 and read(r, "Pulse") == 0
+    assert read_tag(r, "Firsts") == 1 and read_tag(r, "Scans") == 8 and read_tag(r, "Out") == 1 and read_tag(r, "Pulse") == 0
     r.close()
 
 
@@ -79,5 +73,5 @@ def test_cpt_with_logix_operators_and_functions(tmp_path, executor):
     r = runner(tmp_path, ["CPT(D,(7 MOD 3) + 2 ** 3 + (12 AND 10) + ABS(-4));", "CPT(R,SQR(16.0) / 8);",
                           "CPT(D2,16#10 + 2#101 + 8#7);"], executor)
     r.run(1)
-    assert read(r, "D") == 1 + 8 + 8 + 4 and read(r, "R") == 0.5 and read(r, "D2") == 16 + 5 + 7
+    assert read_tag(r, "D") == 1 + 8 + 8 + 4 and read_tag(r, "R") == 0.5 and read_tag(r, "D2") == 16 + 5 + 7
     r.close()

@@ -73,3 +73,21 @@ def l5x_text(tags: list[tuple[str, str]], programs: list[Prog], tasks: list[Task
 def write_l5x(path: Path, tags, programs, tasks, name: str = "Test", data_types: str = "") -> Path:
     path.write_text(l5x_text(tags, programs, tasks, name, data_types), encoding="utf-8")
     return path
+
+
+def export_runner(path: Path, executor: str = "compiled"):
+    """A Runner of the export at ``path`` on ``executor``, from the export's
+    own values, saving nothing."""
+    from softplc_lite.app import load_app
+    from softplc_lite.runner import RunOptions, Runner
+
+    return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+
+
+def read_tag(runner, path: str):
+    """The value of tag ``path`` (``Tanks[1].Level``) in ``runner``'s table."""
+    return runner.table.read(runner.app.program.symbols.resolve_path(path))
+
+
+def write_tag(runner, path: str, value) -> None:
+    runner.table.write(runner.app.program.symbols.resolve_path(path), value)
