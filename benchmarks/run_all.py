@@ -27,6 +27,11 @@ BENCHMARKS = (
 )
 
 
+def med(xs: list) -> float:
+    """The middle of a round's figures (the upper one of an even count), as the summary lines show them."""
+    return sorted(xs)[len(xs) // 2]
+
+
 def main() -> int:
     t_start = time.perf_counter()
     failed: list[str] = []
@@ -169,7 +174,6 @@ def main() -> int:
     mts = load("bench_modbus_server")
     if mts:
         row = next(r for r in mts["rows"] if r["kind"] == "read" and r["clients"] == 16 and r["processes"] == 1)
-        med = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731
         lines.append(f"modbtcps  reads of 100 by 16 clients: {med(row['modbtcps_rates']):,.0f}/s vs pymodbus's server "
                      f"{med(row['pymodbus_rates']):,.0f}/s = {row['ratio']:.2f}x; under 50 busy clients "
                      f"{mts['busy']['scans'].get('late_scans', 0)} late scans, the ladder's longest "
@@ -178,7 +182,6 @@ def main() -> int:
     enips = load("bench_enips_server")
     if enips:
         table = enips["table"]
-        med = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731
         lines.append(f"enips     reads of 100 (K=4): CIP tag {med(table['cip K=4']['rates']):,.0f}/s = "
                      f"{med(table['cip K=4']['ratio_to_modbtcps']):.2f}x MODBTCPS, PCCC "
                      f"{med(table['pccc K=4']['rates']):,.0f}/s = {med(table['pccc K=4']['ratio_to_modbtcps']):.2f}x; "
@@ -186,13 +189,11 @@ def main() -> int:
 
     logix = load("bench_logix")
     if logix:
-        med = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731
         lines.append(f"logix     {logix['export']} ({logix['rungs']} rungs): scan / its rungs as PLC-5 text "
                      f"{med(logix['ratio']):.2f} [{'PASS' if logix['verdict'] else 'MISS'} <= {logix['target']}]")
 
     trends = load("bench_trends")
     if trends:
-        med = lambda xs: sorted(xs)[len(xs) // 2]  # noqa: E731
         every = [x for r in trends["ratios"].values() for x in r]
         lines.append(f"trends    recording 20 addresses / none: {med(every):.3f} (+{max(trends['added_us'].values()):.2f} "
                      f"us a scan) [{'PASS' if trends['verdict']['both'] else 'MISS'} >= {trends['target']}]")
