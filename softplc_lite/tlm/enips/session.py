@@ -61,16 +61,13 @@ class EncapSession:
         service = (data.data[2 if message.command == encap.SEND_UNIT_DATA else 0:][:1] or b"\x00")[0]
         response = MessageRouterResponse(service | 0x80, general_status).encode()
         if message.command == encap.SEND_RR_DATA:
-            return message.reply(message.data[:6] + cpf.encode([cpf.Item(cpf.NULL_ADDRESS),
-                                                                cpf.Item(cpf.UNCONNECTED_DATA, response)]))
+            return _unconnected_reply(message, response)
         manager = self.router.objects.get(CONNECTION_MANAGER)
         o_t_id = struct.unpack("<I", address.data)[0] if len(address.data) == 4 else 0
         connection = manager.connections.get(o_t_id) if manager is not None else None
         if connection is None or manager.owners.get(o_t_id) is not self:
             return message.reply(status=encap.INCORRECT_DATA)
-        return message.reply(message.data[:6] + cpf.encode([
-            cpf.Item(cpf.CONNECTED_ADDRESS, struct.pack("<I", connection[0])),
-            cpf.Item(cpf.CONNECTED_DATA, data.data[:2] + response)]))
+        return _connected_reply(message, connection[0], data.data[:2], response)
 
     async def _reply(self, message: EncapMessage) -> EncapMessage | None:
         command = message.command
@@ -122,10 +119,7 @@ class EncapSession:
         if connection is None:
             return message.reply(status=encap.INCORRECT_DATA)
         response = await self.router.handle(items[1].data[2:], self.access)
-        body = message.data[:6] + cpf.encode([
-            cpf.Item(cpf.CONNECTED_ADDRESS, struct.pack("<I", connection[0])),
-            cpf.Item(cpf.CONNECTED_DATA, items[1].data[:2] + response)])
-        return message.reply(body)
+        return _connected_reply(message, connection[0], items[1].data[:2], response)
 
     async def send_rr_data(self, message: EncapMessage) -> EncapMessage:
         """Interface handle (4), timeout (2), then the items: a null address
@@ -137,9 +131,22 @@ class EncapSession:
         if len(items) != 2 or items[0].type_id != cpf.NULL_ADDRESS or len(data) != 1:
             return message.reply(status=encap.INCORRECT_DATA)
         response = await self.router.handle(data[0].data, self.access)
-        body = message.data[:6] + cpf.encode([cpf.Item(cpf.NULL_ADDRESS),
-                                              cpf.Item(cpf.UNCONNECTED_DATA, response)])
-        return message.reply(body)
+        return _unconnected_reply(message, response)
+
+
+def _unconnected_reply(message: EncapMessage, response: bytes) -> EncapMessage:
+    """SendRRData's reply: the request's interface handle and timeout, a
+    null address item and the Message Router response."""
+    return message.reply(message.data[:6] + cpf.encode([cpf.Item(cpf.NULL_ADDRESS),
+                                                        cpf.Item(cpf.UNCONNECTED_DATA, response)]))
+
+
+def _connected_reply(message: EncapMessage, t_o_id: int, sequence: bytes, response: bytes) -> EncapMessage:
+    """SendUnitData's reply: the client's T->O connection id, and the
+    request's sequence count before the Message Router response."""
+    return message.reply(message.data[:6] + cpf.encode([
+        cpf.Item(cpf.CONNECTED_ADDRESS, struct.pack("<I", t_o_id)),
+        cpf.Item(cpf.CONNECTED_DATA, sequence + response)]))
 
 
 def _items(message: EncapMessage) -> list | None:
