@@ -13,9 +13,8 @@ read-only (status.py).
 from __future__ import annotations
 
 import asyncio
-import struct
 
-from ...cip import cpf, encap
+from ...cip import encap
 from ...cip import status as st
 from ...cip.encap import EncapMessage
 from ...netserver import Handler, Malformed
@@ -23,7 +22,7 @@ from ...netserver import counters as C
 from ...netserver.connection import PEER, admitted
 from ...netserver.tcp import TcpListener
 from .connmgr import ConnectionManager
-from .identity import Identity
+from .identity import Identity, list_identity_reply
 from .imageaccess import ImageAccess
 from .protocol import EnipProtocol
 from .router import OBJECTS, MessageRouter
@@ -147,14 +146,9 @@ class _ListIdentityOverUdp(asyncio.DatagramProtocol):
             self.server.count(C.REFUSED_NETWORK, f"{addr[0]}:{addr[1]}: UDP ListIdentity refused, not in the "
                                                  "allow-list")
             return
-        if len(data) < encap.HEADER_SIZE or struct.unpack_from("<H", data)[0] != encap.LIST_IDENTITY:
-            return
-        if not self.server.rate_ok(str(addr[0])):
-            return
-        message = EncapMessage.decode(data[:encap.HEADER_SIZE])
-        host = self.server.settings.host
-        item = self.identity.list_identity_item(host, self.port)
-        self.transport.sendto(message.reply(cpf.encode([item])).encode(), addr)
+        reply = list_identity_reply(self.identity, data, self.server.settings.host, self.port)
+        if reply is not None and self.server.rate_ok(str(addr[0])):
+            self.transport.sendto(reply, addr)
 
 
 class EnipListener(TcpListener):

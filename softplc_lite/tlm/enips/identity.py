@@ -12,7 +12,8 @@ import hashlib
 import struct
 from dataclasses import dataclass
 
-from ...cip import cpf, status
+from ...cip import cpf, encap, status
+from ...cip.encap import EncapMessage
 from .objects import CipObject, CipReply
 
 CLASS_ID = 0x01
@@ -74,3 +75,13 @@ class IdentityObject(CipObject):
                 return CipReply.error(request, status.ATTRIBUTE_NOT_SUPPORTED)
             return CipReply.ok(request, attrs[attribute])
         return CipReply.error(request, status.SERVICE_NOT_SUPPORTED)
+
+
+def list_identity_reply(identity: Identity, data: bytes, host: str, tcp_port: int) -> bytes | None:
+    """The reply to a ListIdentity datagram (CIP Volume 2, 2-4.2.1): the
+    identity item naming the TCP listener; None for any other datagram,
+    which is dropped unanswered (a choice: UDP carries no session to refuse)."""
+    if len(data) < encap.HEADER_SIZE or struct.unpack_from("<H", data)[0] != encap.LIST_IDENTITY:
+        return None
+    message = EncapMessage.decode(data[:encap.HEADER_SIZE])
+    return message.reply(cpf.encode([identity.list_identity_item(host, tcp_port)])).encode()

@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import asyncio
 
-from ...cip import cpf, encap
+from ...cip import encap
 from ...cip.encap import EncapHeader, EncapMessage
 from .access import TableAccess
-from .identity import Identity
+from .identity import Identity, list_identity_reply
 from .router import MessageRouter
 from .session import EncapSession
 
@@ -55,13 +55,9 @@ class _ListIdentityProtocol(asyncio.DatagramProtocol):
         self.transport = transport
 
     def datagram_received(self, data, addr):
-        try:
-            message = EncapMessage.decode(data)
-        except encap.EncapError:
-            return
-        if message.command == encap.LIST_IDENTITY:
-            item = self.identity.list_identity_item(self.host, self.tcp_port)
-            self.transport.sendto(message.reply(cpf.encode([item])).encode(), addr)
+        reply = list_identity_reply(self.identity, data, self.host, self.tcp_port)
+        if reply is not None:
+            self.transport.sendto(reply, addr)
 
 
 async def serve_udp(identity: Identity, host: str = "127.0.0.1", port: int = 0,
