@@ -21,7 +21,6 @@ benchmarks/results/logix_corpus.json unless --no-save.
 from __future__ import annotations
 
 import argparse
-import json
 import multiprocessing
 import re
 import sys

@@ -19,7 +19,7 @@ import threading
 
 from ..datatable import DataTable, DataTableError
 from ..datatable.display import format_read
-from ..ladder.symbols import SymbolIndex, is_name, is_symbol_text, resolve_name
+from ..ladder.symbols import SymbolIndex, is_name, resolve_name
 
 EXIT_OK, EXIT_ERROR, EXIT_USAGE, EXIT_FAULT, EXIT_INTERNAL = 0, 1, 2, 3, 4
 EXIT_REPLAY = 5  # --replay: the program wrote bytes other than the recording's

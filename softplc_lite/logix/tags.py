@@ -29,7 +29,6 @@ from dataclasses import dataclass, field
 
 from ..datatable import Address, DataTable
 from ..datatable.filetypes import MAX_ELEMENTS
-from ..ladder.ast import Pos
 from .model import Problem, Tag
 from .types import LogixType, TypeSystem
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from ..datatable import DataTableError
 from ..datatable.address import Address, ValueKind
-from ..ladder.symbols import SymbolIndex, is_name, is_symbol_text, resolve_name
+from ..ladder.symbols import SymbolIndex, is_name, resolve_name
 
 BIT, WORD, LONG, FLOAT = "bit", "word", "long", "float"
 KIND_OF = {ValueKind.BIT: BIT, ValueKind.WORD: WORD, ValueKind.LONG: LONG, ValueKind.FLOAT: FLOAT}
