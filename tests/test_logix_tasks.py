@@ -190,15 +190,14 @@ def test_both_executors_leave_the_same_table(tmp_path):
     assert tables[0] == tables[1]
 
 
-def test_a_bool_parameter_is_a_warning_and_neither_the_call_nor_the_subroutine_runs(tmp_path):
+def test_a_dint_passed_to_a_bool_parameter_is_a_warning_and_the_call_is_not_run(tmp_path):
     path = write_l5x(tmp_path / "bool.L5X", [("Flag", "BOOL"), ("Count", "DINT"), ("N", "DINT")],
                      [Prog("P", {"Main": ["JSR(Take,1,N);", "ADD(Count,1,Count);"],
                                  "Take": ["SBR(B);", "ADD(Count,100,Count);"]}, main="Main",
                            tags=[("B", "BOOL")])], [Task("T", ["P"])])
     r = start(path, "compiled")
     warnings = "\n".join(r.app.warnings)
-    assert "SBR parameter 'B': a BOOL parameter is not yet passed by softplc_lite" in warnings
-    assert "routine P.Main: JSR to Take: its SBR or RET has a parameter not passed; the rung is not run" in warnings
+    assert "routine P.Main: rung 0: JSR parameter 'N': a DINT passed to a BOOL parameter" in warnings
     r.run(2)
     assert tag(r, "Count") == 2  # the rest runs
 

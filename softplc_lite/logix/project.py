@@ -27,6 +27,7 @@ from .aoi import AoiCalls, add_types
 from .initial import ValueWriter, apply_initial, data_files
 from .modules import declare_module_tags
 from .rungs import RoutineContext, translate_rung
+from .subroutines import Subroutines
 from .tags import TagDirectory, TagSymbols
 from .tasks import Schedule
 from .types import TypeSystem
@@ -83,10 +84,11 @@ def build_program(project: model.Project) -> LogixProgram:
             result.routine_files[(prog.name.upper(), routine.name.upper())] = number
             number += 1
         not_passed: set[int] = set()  # routines whose SBR or RET has a parameter not passed
+        calls = Subroutines(prog, directory)
         for routine in prog.routines:
             file_number = routines[routine.name.upper()]
             rungs = _routine_rungs(routine, prog, directory, routines, project.source, problems, warnings,
-                                   result.rungs, not_passed, file_number, aois)
+                                   result.rungs, not_passed, file_number, aois, calls)
             result.program.files[file_number] = ProgramFile(file_number, f"{prog.name}.{routine.name}", rungs,
                                                             routine.pos)
         _calls_not_run(prog, routines, result.program.files, not_passed, warnings, result.rungs)
@@ -105,7 +107,7 @@ def build_program(project: model.Project) -> LogixProgram:
 
 
 def _routine_rungs(routine, prog, directory, routines, source, problems, warnings, counts, not_passed,
-                   file_number, aois=None) -> list[Rung]:
+                   file_number, aois=None, calls=None) -> list[Rung]:
     if routine.kind != "RLL":
         kind = NOT_RUN_KINDS.get(routine.kind, routine.kind)
         warnings.append(model.Problem(routine.pos, f"routine {prog.name}.{routine.name} is {kind}: not yet run "
@@ -113,6 +115,7 @@ def _routine_rungs(routine, prog, directory, routines, source, problems, warning
         return []
     ctx = RoutineContext(directory, prog.name, routines, source, f"{prog.name}.{routine.name}")
     ctx.aoi = aois
+    ctx.calls, ctx.name = calls, routine.name
     rungs = []
     for rung in routine.rungs:
         translated = translate_rung(rung, ctx)

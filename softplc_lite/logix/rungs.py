@@ -22,7 +22,7 @@ system.py.
 from __future__ import annotations
 
 from ..ladder.ast import AddressRef, Branch, Const, Instruction, Pos, Rung
-from . import bits, copy, model, strings, system
+from . import bits, copy, model, strings, subroutines, system
 from .expr import ExprError, number, parse_expression
 from .neutral import NBranch, NeutralError, parse_rung
 from .tags import NotRun, PathError, TagDirectory
@@ -75,6 +75,8 @@ class RoutineContext:
         self.before: list[Instruction] = []  # LIDXs the instruction being translated needs before it
         self.parameters_not_run = False  # a JSR, SBR or RET of this routine has a parameter not passed
         self.aoi = None  # the project's Add-On Instructions (logix/aoi.py AoiCalls): calls to them
+        self.calls = None  # the program's routines' parameter plans (logix/subroutines.py Subroutines)
+        self.name = routine  # the routine's own name in its program
 
     def warn(self, pos: Pos, message: str) -> None:
         self.warnings.append(model.Problem(pos, f"routine {self.routine}: {message}"))
@@ -130,7 +132,7 @@ def _series(elements, rung, ctx) -> list:
             ins = _instruction(el, rung, ctx)
             if ins is not None:
                 out += ctx.before
-                out.append(ins)
+                out += ins if isinstance(ins, list) else [ins]  # several: JSR, SBR, RET with copied parameters
     return out
 
 
@@ -154,6 +156,9 @@ def _instruction(el, rung, ctx) -> Instruction | None:
     if letters == "r":  # JSR(routine, count, parameters...)
         return _jsr(el, pos, rung, ctx)
     if letters == "p":  # SBR(parameters...) receives, RET(values...) returns
+        plan = ctx.calls.plan(ctx.name) if ctx.calls is not None else None
+        if plan is not None and plan.copies:
+            return subroutines.sbr_ret(el, pos, rung, ctx, plan)
         params = _parameters(el, rung, ctx, 0, len(el.operands) if mnemonic == "RET" else 0)
         return None if params is None else Instruction(mnemonic, params, pos)
     if len(ops) != len(letters):
@@ -174,7 +179,7 @@ def _instruction(el, rung, ctx) -> Instruction | None:
     return Instruction(mnemonic, operands, pos)
 
 
-def _jsr(el, pos, rung, ctx) -> Instruction | None:
+def _jsr(el, pos, rung, ctx) -> Instruction | list | None:
     """JSR(routine, input count, inputs..., returns...): the ladder's JSR with
     the routine's file number, its operands in Logix's order (1756-RM003,
     JSR; docs/logix.md, "Subroutines with parameters")."""
@@ -198,6 +203,9 @@ def _jsr(el, pos, rung, ctx) -> Instruction | None:
         return None
     if len(el.operands) == 2:
         return Instruction("JSR", [Const(number_of, pos)], pos)
+    plan = ctx.calls.plan(name) if ctx.calls is not None else None
+    if plan is not None and plan.copies:
+        return subroutines.jsr(el, pos, rung, ctx, plan, number_of, count)
     params = _parameters(el, rung, ctx, 2, count)
     return None if params is None else Instruction("JSR", [Const(number_of, pos), Const(count, pos)] + params, pos)
 
@@ -206,7 +214,8 @@ def _parameters(el, rung, ctx, first: int, inputs: int) -> list | None:
     """The operands of JSR, SBR or RET from ``first``: the first ``inputs``
     of them values (a number or a tag), the rest tags that receive. An
     atomic number tag (SINT, INT, DINT, LINT, REAL) is passed; a BOOL, a
-    string, a structure or an array is not yet (the rung is not run)."""
+    string, a structure or an array is copied around them (subroutines.py),
+    so one here is not passed (the rung is not run)."""
     out = []
     for k, (text, column) in enumerate(el.operands[first:]):
         where = _at(rung.pos, rung.text, column)
@@ -225,7 +234,7 @@ def _parameters(el, rung, ctx, first: int, inputs: int) -> list | None:
         except NotRun as e:
             ctx.warn(where, f"rung {rung.number}: {el.mnemonic} parameter {text!r}: {e}; the rung is not run")
             ctx.skip = True
-            ctx.parameters_not_run = True
+            ctx.parameters_not_run = ctx.parameters_not_run or el.mnemonic != "JSR"
         except (PathError, ExprError) as e:
             ctx.problem(_at(rung.pos, rung.text, column + e.offset), f"rung {rung.number}: {el.mnemonic} "
                                                                      f"parameter {text!r}: {e}")
