@@ -134,12 +134,30 @@ def test_recursion_returns_each_call_its_callees_value(tmp_path, executor):
 
 @EXECUTORS
 def test_a_parameter_of_another_kind_is_a_warning_and_the_call_is_not_run(tmp_path, executor):
-    path = export(tmp_path, ["JSR(Take,1,N);", "ADD(Count,1,Count);", "JSR(Pt1,1,N);"],
-                  {"Take": ["SBR(B);", "ADD(Count,100,Count);"], "Pt1": ["SBR(Pin);", "ADD(Count,100,Count);"]},
-                  [("Count", "DINT"), ("N", "DINT")], [("B", "BOOL"), ("Pin", "Pt")])
+    path = export(tmp_path, ["JSR(Take,1,N);", "ADD(Count,1,Count);", "JSR(Pt1,1,N);", "JSR(Num,1,F);"],
+                  {"Take": ["SBR(B);", "ADD(Count,100,Count);"], "Pt1": ["SBR(Pin);", "ADD(Count,100,Count);"],
+                   "Num": ["SBR(D);", "ADD(Count,100,Count);"]},
+                  [("Count", "DINT"), ("N", "DINT"), ("F", "BOOL")], [("B", "BOOL"), ("Pin", "Pt"), ("D", "DINT")])
     r = start(path, executor)
     warnings = "\n".join(r.app.warnings)
     assert "rung 0: JSR parameter 'N': a DINT passed to a BOOL parameter" in warnings
     assert "rung 2: JSR parameter 'N': a DINT passed to a Pt parameter: the types must match" in warnings
+    assert "rung 3: JSR parameter 'F': a BOOL where the routine's SBR or RET has a number" in warnings
     r.run(2)
     assert tag(r, "Count") == 2  # the rest runs
+
+
+def test_an_aoi_input_that_is_a_string_is_said_as_logix_allows_only_atomic_ones(tmp_path):
+    # Studio 5000 makes no such AOI (1756-PM010): the call is a warning, not run; the rest runs.
+    from helpers.logix_aoi import Aoi, Param, write_aoi_l5x
+
+    named = Aoi("Named", [Param("Who", "STRING", "Input"), Param("N", "DINT", "Output")], {"Logic": ["MOV(1,N);"]})
+    path = write_aoi_l5x(tmp_path / "aoi.L5X", [named], [("K", "Named"), ("S", "STRING"), ("Out", "DINT"),
+                                                         ("Ran", "DINT")],
+                         [Prog("P", {"Main": ["Named(K,S,Out);", "ADD(Ran,1,Ran);"]})], [Task("T", ["P"])])
+    r = start(path, "compiled")
+    warnings = "\n".join(r.app.warnings)
+    assert "Named: its Input parameter Who is a STRING: Logix passes Input and Output parameters of atomic " \
+           "types only (1756-PM010" in warnings
+    r.run(1)
+    assert tag(r, "Ran") == 1 and tag(r, "Out") == 0

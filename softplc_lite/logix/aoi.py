@@ -347,9 +347,11 @@ class AoiCalls:
             if usage == "INOUT":
                 continue
             pt = self.types.get(p.data_type)
-            if pt is None or not pt.is_atomic or p.dims:  # a copy is of one number (Logix's are atomic too)
+            if pt is None or not pt.is_atomic or p.dims:  # a copy is of one number, as Logix's are
                 not_run(f"its {p.usage} parameter {p.name} is a {p.data_type}{list(p.dims) if p.dims else ''}: "
-                        f"not yet passed by softplc_lite")
+                        f"Logix passes Input and Output parameters of atomic types only (1756-PM010, \"Passing "
+                        f"arguments to parameters by reference or by value\"; a structure, string or array is an "
+                        f"InOut)")
                 continue
             try:
                 arg = self._argument(text.strip(), w, ctx, usage == "INPUT", _is_bool(p))

@@ -229,7 +229,8 @@ def _parameters(el, rung, ctx, first: int, inputs: int) -> list | None:
             r = _resolve(text, where, ctx)
             if r.address is None or r.address.bit is not None or r.type.name == "BOOL":
                 kind = "BOOL" if r.address is not None else (f"{r.type.name} array" if r.dims else r.type.name)
-                raise NotRun(f"a {kind} parameter is not yet passed by softplc_lite (numbers are)")
+                raise NotRun(f"a {kind} where the routine's SBR or RET has a number: softplc_lite passes a "
+                             f"BOOL, string, structure or array to a parameter of its own kind")
             out.append(AddressRef(r.address, where))
         except NotRun as e:
             ctx.warn(where, f"rung {rung.number}: {el.mnemonic} parameter {text!r}: {e}; the rung is not run")
