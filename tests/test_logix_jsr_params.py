@@ -161,3 +161,23 @@ def test_an_aoi_input_that_is_a_string_is_said_as_logix_allows_only_atomic_ones(
            "types only (1756-PM010" in warnings
     r.run(1)
     assert tag(r, "Ran") == 1 and tag(r, "Out") == 0
+
+
+@EXECUTORS
+def test_an_argument_indexed_at_run_time_is_the_element_of_the_call_and_past_the_end_faults(tmp_path, executor):
+    path = export(tmp_path, ["JSR(Twice,1,Pts[I],Qs[I]);"],
+                  {"Twice": ["SBR(Pin);", "COP(Pin,Pout,1);", "MUL(Pin.X,2.0,Pout.X);", "RET(Pout);"]},
+                  [("Pts", "Pt[3]"), ("Qs", "Pt[3]"), ("I", "DINT")], [("Pin", "Pt"), ("Pout", "Pt")])
+    r = start(path, executor)
+    assert r.app.warnings == []
+    set_tag(r, "Pts[1].X", 2.5)
+    set_tag(r, "Pts[2].X", 7.0)
+    set_tag(r, "I", 1)
+    r.run(1)
+    set_tag(r, "I", 2)
+    r.run(1)
+    assert r.engine.fault is None
+    assert [tag(r, f"Qs[{k}].X") for k in range(3)] == [0.0, 5.0, 14.0]
+    set_tag(r, "I", 3)  # past Pt[3]: Logix's major fault type 4, code 20; the ladder's file end
+    r.run(1)
+    assert r.engine.fault is not None and r.engine.fault.code == 20
