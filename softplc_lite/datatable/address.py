@@ -426,11 +426,14 @@ def _member(sc: _Scanner, ftype: FileType) -> tuple[str | None, Part | None]:
         raise sc.error(f"{ftype.title} ({ftype.letter}) elements have no members", pos - 1)
     if not name:
         raise sc.error(f"expected a member name ({ftype.member_names()}) after '.'")
+    if ftype.is_string and name == "DATA":  # ST9:0.DATA3: code unit 3
+        name += sc.digits()
     member = ftype.members_by_name.get(name)
     if member is None:
+        chars = f" DATA0..DATA{ftype.chars - 1}" if ftype.is_string else ""
         raise sc.error(
             f"'{name}' is not a member of a {ftype.title} ({ftype.letter}) element; "
-            f"members are {ftype.member_names()}", pos,
+            f"members are {ftype.member_names()}{chars}", pos,
         )
     if hasattr(member, "bit"):
         return None, member.bit  # T4:0.DN is T4:0/DN

@@ -16,6 +16,9 @@ MAX_ELEMENTS = 10_000
 MAX_FILE_NUMBER = 9999
 #: Characters in one ST element (SoftPLC: UCS-2, any 16-bit code unit).
 STRING_CHARS = 82
+#: Characters in one SL element: a softplc choice, the longest string type
+#: real Logix exports declare (STRING_100 .. a DATA of 4,950 SINTs), rounded up.
+LONG_STRING_CHARS = 5000
 #: Bits in a data table word.
 WORD_BITS = 16
 #: An L element's range (1747-RM001 / 1763-RM001: -2,147,483,648..2,147,483,647).
@@ -80,6 +83,7 @@ class FileType:
     # How text forms (DATA values, --print, the watch view) show a word:
     # "decimal", "bcd" (D: four BCD digits) or "ascii" (A: two characters).
     radix: str = "decimal"
+    chars: int = 0  # a string file: the code units an element holds after its LEN word
     members_by_name: dict[str, WordMember | BitMember] = field(
         init=False, repr=False, compare=False
     )
@@ -88,6 +92,8 @@ class FileType:
         table: dict[str, WordMember | BitMember] = {}
         for m in self.word_members + self.bit_members:
             table[m.name] = m
+        for k in range(self.chars):  # ST9:0.DATA3: one code unit as a word
+            table[f"DATA{k}"] = WordMember(f"DATA{k}", 1 + k)
         object.__setattr__(self, "members_by_name", table)
 
     @property
@@ -106,7 +112,7 @@ class FileType:
 
     @property
     def is_string(self) -> bool:
-        return self.letter == "ST"
+        return self.chars > 0
 
     def bit_name(self, bit: int) -> str | None:
         """The mnemonic of a status bit in word 0, if it has one."""
@@ -155,7 +161,14 @@ FLOAT = FileType("F", "float", Storage.FLOAT, 1, has_bits=False, default_number=
 STRING = FileType(
     "ST", "string", Storage.WORD, 1 + STRING_CHARS,
     word_members=(WordMember("LEN", 0),),
-    has_bits=False,
+    has_bits=False, chars=STRING_CHARS,
+)
+# A long string element (softplc choice: no PLC-5 file type holds one): LEN,
+# then LONG_STRING_CHARS code units. SL clashes with no PLC-5/SLC letter.
+LONG_STRING = FileType(
+    "SL", "long string", Storage.WORD, 1 + LONG_STRING_CHARS,
+    word_members=(WordMember("LEN", 0),),
+    has_bits=False, chars=LONG_STRING_CHARS,
 )
 
 # PLC-5 BCD and ASCII files (1785-6.1 data table: D and A file types): 16-bit
@@ -175,7 +188,7 @@ LINT = FileType("LI", "long long integer", Storage.LONG64, 1)
 FILE_TYPES: dict[str, FileType] = {
     t.letter: t
     for t in (OUTPUT, INPUT, STATUS, BINARY, TIMER, COUNTER, CONTROL, INTEGER, FLOAT, STRING,
-              BCD, ASCII, LONG, SINT, LINT)
+              BCD, ASCII, LONG, SINT, LINT, LONG_STRING)
 }
 
 

@@ -67,15 +67,15 @@ def _export_file(f: DataFile) -> list[Any]:
         return data.tolist()
     wpe = ftype.words_per_element
     if ftype.is_string:
-        return [_export_string(data, e * wpe) for e in range(f.size)]
+        return [_export_string(data, e * wpe, ftype.chars) for e in range(f.size)]
     return [_export_struct(data, e * wpe, ftype) for e in range(f.size)]
 
 
-def _export_string(data: array, start: int) -> str | dict[str, Any]:
+def _export_string(data: array, start: int, size: int) -> str | dict[str, Any]:
     length = data[start] & RAW_MAX
-    units = array("H", data[start + 1:start + 1 + STRING_CHARS].tobytes())
-    if length <= STRING_CHARS and not any(units[length:]):
-        return read_string(data, start)
+    units = array("H", data[start + 1:start + 1 + size].tobytes())
+    if length <= size and not any(units[length:]):
+        return read_string(data, start, size)
     # Raw writes left characters past LEN, or a LEN above 82: keep them all.
     chars = "".join(map(chr, units)).rstrip("\0")
     return {"LEN": length, "CHARS": chars}
@@ -285,7 +285,7 @@ def _load_element(f: DataFile, element: int, value: Any) -> None:
         else:
             data[start] = check_float32(value, name)
     elif ftype.is_string:
-        _load_string(data, start, value, name)
+        _load_string(data, start, value, name, ftype.chars)
     elif ftype.is_structure:
         _load_struct(data, start, ftype, value, name)
     elif ftype.storage in OTHER_INTEGERS:
@@ -296,11 +296,11 @@ def _load_element(f: DataFile, element: int, value: Any) -> None:
         data[start] = _check_int(value, -32768, 32767, name, "a 16-bit signed integer")
 
 
-def _load_string(data: array, start: int, value: Any, name: str) -> None:
+def _load_string(data: array, start: int, value: Any, name: str, size: int) -> None:
     from .table import write_string
 
     if isinstance(value, str):
-        write_string(data, start, _utf16_units(value), name)
+        write_string(data, start, _utf16_units(value), name, size)
         return
     if not isinstance(value, dict):
         raise DataTableError(f"{name} is a string element; give a string or {{\"LEN\":..,\"CHARS\":..}}")
@@ -313,7 +313,7 @@ def _load_string(data: array, start: int, value: Any, name: str) -> None:
         keep = data[start]
         if isinstance(chars, str):
             chars = _utf16_units(chars)
-        write_string(data, start, chars, name)  # checks width and 16-bit range
+        write_string(data, start, chars, name, size)  # checks width and 16-bit range
         data[start] = keep
     if length is not None:
         data[start] = to_signed(_check_int(length, 0, RAW_MAX, f"{name}.LEN", "a raw word"))

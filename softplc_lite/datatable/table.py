@@ -352,7 +352,7 @@ class DataTable:
         if kind is ValueKind.WORD or kind is ValueKind.FLOAT or kind is ValueKind.LONG:
             return data[i]
         if kind is ValueKind.STRING:
-            return read_string(data, i)
+            return read_string(data, i, f.ftype.chars)
         return {m: self._member(data, i, f.ftype, m) for m in member_order(f.ftype)}
 
     @staticmethod
@@ -374,8 +374,8 @@ class DataTable:
             mask = data_bit_mask(data, bit)
             data[i] = (data[i] | mask) if on else (data[i] & ~mask)
         elif kind is ValueKind.WORD:
-            if f.ftype.is_string:  # ST LEN
-                data[i] = _check_int(value, 0, STRING_CHARS, str(a), "a string length")
+            if f.ftype.is_string and a.member == "LEN":
+                data[i] = _check_int(value, 0, f.ftype.chars, str(a), "a string length")
             elif isinstance(value, str) and f.ftype.radix != "decimal" and a.member is None:
                 data[i] = word_from_text(value, f.ftype, str(a))
             else:
@@ -385,7 +385,7 @@ class DataTable:
         elif kind is ValueKind.LONG:
             data[i] = check_item(value, f.ftype.storage, a)
         elif kind is ValueKind.STRING:
-            write_string(data, i, value, str(a))
+            write_string(data, i, value, str(a), f.ftype.chars)
         else:
             self._write_members(f, i, value, a)
 
@@ -558,20 +558,21 @@ def member_order(ftype: FileType) -> list[str]:
     return [m.name for m in ftype.bit_members] + [m.name for m in ftype.word_members]
 
 
-def read_string(data: array, start: int) -> str:
-    """The characters of the ST element whose LEN word is ``data[start]``.
-    Each 16-bit code unit is one character (UCS-2), surrogates included."""
-    length = min(data[start] & RAW_MAX, STRING_CHARS)
+def read_string(data: array, start: int, chars: int = STRING_CHARS) -> str:
+    """The characters of the string element (``chars`` code units: ST 82,
+    SL more) whose LEN word is ``data[start]``. Each 16-bit code unit is one
+    character (UCS-2), surrogates included."""
+    length = min(data[start] & RAW_MAX, chars)
     units = array("H", data[start + 1:start + 1 + length].tobytes())
     return "".join(map(chr, units))
 
 
-def write_string(data: array, start: int, text: Any, where: str) -> None:
+def write_string(data: array, start: int, text: Any, where: str, chars: int = STRING_CHARS) -> None:
     if not isinstance(text, str):
         raise ValueRangeError(f"{where} holds a string (text), got {shown(text)}")
-    if len(text) > STRING_CHARS:
+    if len(text) > chars:
         raise ValueRangeError(
-            f"a {len(text)}-character string does not fit {where}: at most {STRING_CHARS} characters"
+            f"a {len(text)}-character string does not fit {where}: at most {chars} characters"
         )
     units = [ord(c) for c in text]
     wide = next((c for c in units if c > RAW_MAX), None)
@@ -579,20 +580,19 @@ def write_string(data: array, start: int, text: Any, where: str) -> None:
         raise ValueRangeError(
             f"U+{wide:X} does not fit {where}: ST characters are UCS-2 (16-bit code units)"
         )
-    store_text(data, start, text)
+    store_text(data, start, text, chars)
 
 
 _NATIVE_UTF16 = "utf-16-le" if sys.byteorder == "little" else "utf-16-be"
-_ZERO_UNITS = bytes(2 * STRING_CHARS)
 
 
-def store_text(data: array, start: int, text: str) -> None:
-    """Store the first STRING_CHARS characters of ``text`` into the ST element
-    whose LEN word is ``data[start]`` and zero the rest, in one slice write.
-    A character above U+FFFF keeps its low 16 bits (ST is UCS-2)."""
-    text = text[:STRING_CHARS]
+def store_text(data: array, start: int, text: str, chars: int = STRING_CHARS) -> None:
+    """Store the first ``chars`` characters of ``text`` into the string
+    element whose LEN word is ``data[start]`` and zero the rest, in one slice
+    write. A character above U+FFFF keeps its low 16 bits (UCS-2)."""
+    text = text[:chars]
     raw = text.encode(_NATIVE_UTF16, "surrogatepass")
     if len(raw) != 2 * len(text):  # a character above U+FFFF took two units
         raw = array("H", [ord(c) & RAW_MAX for c in text]).tobytes()
     data[start] = len(text)
-    data[start + 1:start + 1 + STRING_CHARS] = array("h", raw + _ZERO_UNITS[len(raw):])
+    data[start + 1:start + 1 + chars] = array("h", raw + bytes(2 * chars - len(raw)))

@@ -14,7 +14,7 @@ import operator
 from dataclasses import replace
 
 from ..gcpause import gc_paused
-from ..datatable import FILE_TYPES, MAX_ELEMENTS, STRING_CHARS, Address, AddressError, ValueKind, parse_address
+from ..datatable import FILE_TYPES, MAX_ELEMENTS, Address, AddressError, ValueKind, parse_address
 from ..datatable.errors import DataTableError
 from ..datatable.filetypes import OTHER_INTEGERS, int_range, split_file_name
 from ..datatable.table import word_from_text
@@ -247,6 +247,9 @@ class _Checker(SubroutineChecks):
         if a.kind not in want:
             bad(kind.value)
             return None
+        if kind is K.STRING and a.ftype.letter != "ST":  # ACN, AEX ...: 82 characters (PLC-5, SLC)
+            bad("an ST string (an SL file's long strings go to the Logix string instructions)")
+            return None
         if kind in _FILE_KINDS and a.indexed:
             # '#' marks a file operand here (PLC-5 file instructions), not indexing.
             return AddressRef(replace(a, indexed=False), resolved.pos)  # keeps an SLC address's form
@@ -328,7 +331,8 @@ class _Checker(SubroutineChecks):
             if op.__class__ is AddressRef:
                 # The common case, answered here: an address of a kind the operand takes.
                 want, address = wants[j], op.address
-                if want is not None and address.kind in want and not (address.indexed and unindexed[j]):
+                if (want is not None and address.kind in want and not (address.indexed and unindexed[j])
+                        and (kinds[j] is not K.STRING or address.type_letter == "ST")):
                     checked_operands.append(op)
                     continue
             elif _refused(op):
@@ -455,8 +459,8 @@ class _Checker(SubroutineChecks):
             self.error(decl.pos, f"DATA {text}: {len(decl.values)} values for {decl.size} elements")
         for v in decl.values:
             if ftype.is_string:
-                if not isinstance(v, str) or len(v) > STRING_CHARS:
-                    self.error(decl.pos, f"DATA {text}: string files take quoted strings of at most {STRING_CHARS} characters")
+                if not isinstance(v, str) or len(v) > ftype.chars:
+                    self.error(decl.pos, f"DATA {text}: string files take quoted strings of at most {ftype.chars} characters")
                     return
             elif ftype.letter == "F":
                 if isinstance(v, str):

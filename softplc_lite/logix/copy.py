@@ -54,6 +54,8 @@ def element_run(r: Resolved, pos, ctx) -> Run:
         m = t.member(key)
         count *= max(m.dim, 1)
         t = m.type
+    if r.address is not None and is_characters(r.address):  # Str.DATA[k]: the characters k.. of its type
+        return Run(r.type, {(): (r.address, 1, t.chars - int(r.address.member[4:]))})
     if r.address is not None:  # one atomic value or string: its address has its index (tags.py)
         leaf = d.leaves[r.path]
         return Run(r.type, {(): (r.address, 1, leaf.first + leaf.count)})
@@ -93,12 +95,29 @@ def _build(ops: Operands) -> list[Instruction]:
     return copy_run(element_run(ops.resolve(0), ops.where(0), ops.ctx), ops.where(0), dest, length, ops.pos)
 
 
+def is_characters(address: Address) -> bool:
+    """``Str.DATA[k]`` (the word member DATAk of a string element)."""
+    return address.member is not None and address.member.startswith("DATA")
+
+
+def _characters(source: Run, dest: Run) -> None:
+    """A copy or fill with a string's DATA: its characters as Logix's SINTs,
+    with a SINT array or another string's DATA; anything else is a byte copy
+    this layout does not keep (a softplc choice)."""
+    for run, other in ((source, dest), (dest, source)):
+        address = next(iter(run.leaves.values()))[0] if run.leaves else None
+        if address is not None and is_characters(address) and other.type.name != "SINT":
+            raise Skip(f"a copy between a string's DATA and {other.type.name} copies Logix's bytes, which "
+                       f"softplc_lite's tag layout does not keep (a SINT array's are)")
+
+
 def _kind(t) -> str:
     return "string" if t.kind == "string" else ("atomic" if t.kind == "atomic" else t.name)
 
 
 def copy_run(source: Run, where, dest: Run, length, pos) -> list[Instruction]:
     """An LCOP per leaf of ``dest`` from the same leaf of ``source``."""
+    _characters(source, dest)
     sk, dk = _kind(source.type), _kind(dest.type)
     if sk != dk:
         raise Skip(f"a copy from a {source.type.name} into a {dest.type.name} copies Logix's byte layout, which "
@@ -109,8 +128,10 @@ def copy_run(source: Run, where, dest: Run, length, pos) -> list[Instruction]:
         operands = [AddressRef(s_address, where), AddressRef(d_address, pos), length, Const(per, pos),
                     Const(d_end, pos), Const(s_end, pos)]
         chars = _chars(dest.type, path), _chars(source.type, path)
-        if chars[0] is not None and chars[1] is not None and chars[0] < chars[1]:
-            operands.append(Const(chars[0], pos))  # a string into a smaller string type: cut to fit
+        if chars[0] is not None and chars[1] is not None and (
+                chars[0] < chars[1] or s_address.type_letter != d_address.type_letter):
+            # a string into a smaller string type, or between ST and SL elements: one by one, cut to fit
+            operands.append(Const(chars[0], pos))
         out.append(Instruction("LCOP", operands, pos))
     return out
 

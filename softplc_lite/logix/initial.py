@@ -218,7 +218,7 @@ def data_files(writer: ValueWriter, table) -> list[tuple[str, int, list]]:
                     v = v - (1 << bits) if v >> (bits - 1) else v
                 values.append(v)
             else:
-                values.append("" if letter == "ST" else (0.0 if letter == "F" else 0))
+                values.append("" if letter in ("ST", "SL") else (0.0 if letter == "F" else 0))
         out.append((letter, file, values))
     return out
 

@@ -202,7 +202,8 @@ class TagDirectory:
             d.leaves[path] = self.alloc.one(t.letter) if count == 1 else self.alloc.many(t.letter, count)
             return
         if t.kind == "string":
-            d.leaves[path] = self.alloc.one("ST") if count == 1 else self.alloc.many("ST", count)
+            letter = t.letter or "ST"  # SL: a string type longer than an ST element holds
+            d.leaves[path] = self.alloc.one(letter) if count == 1 else self.alloc.many(letter, count)
             return
         for m in t.members:
             if m.host is not None:
@@ -320,10 +321,11 @@ class TagDirectory:
                 r.address = Address(r.address.type_letter, r.address.file, r.address.element, "LEN")
                 r.type = self.types.get("DINT")
                 return r
+            if t.kind == "string" and member.upper() == "DATA":
+                return self._character(text, m, d, t, path, flat, terms, index_of)
             if t.kind != "struct":
-                raise (NotRun if t.kind == "string" else PathError)(
-                    f"{t.name} has no member {member}" + (" (a string's DATA is not yet reached character by "
-                                                          "character)" if t.kind == "string" else ""), m.start() + 1)
+                raise PathError(f"{t.name} has no member {member}" + (" (a string has LEN and DATA)" if t.kind ==
+                                                                      "string" else ""), m.start() + 1)
             mt = t.member(member)
             if mt is None:
                 names = ", ".join(x.name for x in t.visible_members())
@@ -345,6 +347,29 @@ class TagDirectory:
             return r
         # an atomic value, or a string's ST element
         return self._finish(text, d, path, flat, bit, terms, bit_term, t=t, index_of=index_of)
+
+    def _character(self, text, m, d, t, path, flat, terms, index_of) -> Resolved:
+        """``Str.DATA[k]``: code unit k of the string element, the data table
+        word member DATAk, typed SINT (docs/logix.md). Only a constant k:
+        the member of an element is not computed at run time."""
+        step = _STEP.match(text, m.end())
+        if step is None or step.group(2) is None:
+            raise PathError(f"{t.name}.DATA is SINT[{t.chars}]: expected [index] after DATA", m.end())
+        k_text = step.group(2).strip()
+        if not re.fullmatch(r"[0-9]+", k_text):
+            raise NotRun("a string's DATA indexed at run time is not reached (a constant index is)",
+                         step.start() + 1)
+        k = int(k_text)
+        if k >= t.chars:
+            raise PathError(f"index {k} is past the end of {t.name}.DATA (SINT[{t.chars}])", step.start() + 1)
+        if text[step.end():].strip():
+            raise NotRun("a bit of a string's character is not reached", step.end())
+        if terms:
+            raise NotRun("a string's DATA in an array indexed at run time is not reached", m.start())
+        r = self._finish(text, d, path, flat, None, terms, None, t=t, index_of=index_of)
+        r.address = Address(r.address.type_letter, r.address.file, r.address.element, f"DATA{k}")
+        r.type = self.types.get("SINT")
+        return r
 
     def _finish(self, text, d, path, flat, bit, terms, bit_term, t=None, boolean=False, index_of=None) -> Resolved:
         leaf = d.leaves.get(path)

@@ -29,6 +29,9 @@ ATOMIC: dict[str, tuple[str, int]] = {
     "REAL": ("F", 32),
 }
 STRING_CHARS = 82  # DATA of the predefined STRING (1756-PM020, "STRING data type")
+#: A string type longer than STRING_CHARS lives in an SL file of this many
+#: code units an element (datatable/filetypes.py LONG_STRING_CHARS).
+LONG_STRING_CHARS = 5000
 
 
 @dataclass
@@ -99,7 +102,7 @@ PREDEFINED: dict[str, LogixType] = {
     "CONTROL": _struct("CONTROL", [_dint("CTL", True), _dint("LEN"), _dint("POS"),
                                    *_status("CTL", ("EN", 31), ("EU", 30), ("DN", 29), ("EM", 28), ("ER", 27),
                                             ("UL", 26), ("IN", 25), ("FD", 24))]),
-    "STRING": LogixType("STRING", "string", chars=STRING_CHARS, builtin=True),
+    "STRING": LogixType("STRING", "string", letter="ST", chars=STRING_CHARS, builtin=True),
     # MESSAGE: the members a rung reads of a MSG's tag; softplc_lite sends no message (MSG is not
     # run), so its status bits stay as the export or the program leaves them (docs/logix.md).
     "MESSAGE": _struct("MESSAGE", [MemberType("FLAGS", _ATOMIC_TYPES["INT"]),
@@ -113,9 +116,9 @@ PREDEFINED: dict[str, LogixType] = {
                                    _dint("Class"), _dint("Attribute"), _dint("Instance"),
                                    _dint("LocalIndex"), _dint("Channel"), _dint("Rack"), _dint("Group"),
                                    _dint("Slot"), _dint("RemoteIndex"),
-                                   MemberType("RemoteElement", LogixType("STRING", "string", chars=STRING_CHARS,
+                                   MemberType("RemoteElement", LogixType("STRING", "string", letter="ST", chars=STRING_CHARS,
                                                                          builtin=True)),
-                                   MemberType("Path", LogixType("STRING", "string", chars=STRING_CHARS,
+                                   MemberType("Path", LogixType("STRING", "string", letter="ST", chars=STRING_CHARS,
                                                                 builtin=True)),
                                    _dint("UnconnectedTimeout"), _dint("ConnectionRate"),
                                    MemberType("TimeoutMultiplier", _ATOMIC_TYPES["SINT"])]),
@@ -181,11 +184,11 @@ class TypeSystem:
         if d.family.lower().startswith("string"):
             data = next((m for m in d.members if m.name.upper() == "DATA"), None)
             chars = data.dimension if data is not None else 0
-            if not 0 < chars <= STRING_CHARS:
+            if not 0 < chars <= LONG_STRING_CHARS:
                 self.held_not[d.name.upper()] = (f"string type {d.name} holds {chars} characters; softplc_lite "
-                                                 f"holds strings of 1 to {STRING_CHARS}")
+                                                 f"holds strings of 1 to {LONG_STRING_CHARS}")
                 return None
-            return LogixType(d.name, "string", chars=chars)
+            return LogixType(d.name, "string", letter="ST" if chars <= STRING_CHARS else "SL", chars=chars)
         members: list[MemberType] = []
         ok = True
         for m in d.members:

@@ -188,7 +188,7 @@ class DataGrid:
         for e in range(self.first, f.size):
             if len(lines) == rows:
                 break
-            text = read_string(f.data, e * per)
+            text = read_string(f.data, e * per, f.ftype.chars)
             line = Text(self._label(e).ljust(label), style="bold")
             line.append(f" LEN {len(text):2d} ", style="dim")
             line.append(json.dumps(text))

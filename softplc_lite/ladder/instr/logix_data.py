@@ -52,7 +52,55 @@ SPECS = [
 LOGIX_NAMES = {"LCOP": "COP", "LFLL": "FLL"}
 
 
+def _is_characters(operand) -> bool:
+    """A string's DATA[k] (the member DATAk): its end operand counts the
+    characters left from k, not an item (logix/copy.py)."""
+    member = operand.address.member
+    return member is not None and member.startswith("DATA")
+
+
+def _byte_unit(value: int) -> int:
+    """A SINT stored as a string's character: its byte as the code unit
+    (0..255), as Logix's DATA holds bytes."""
+    return value & 0xFF
+
+
+def _signed_byte(unit: int) -> int:
+    """A string's character read as a SINT: the low byte, signed."""
+    unit &= 0xFF
+    return unit - 256 if unit > 127 else unit
+
+
+def _copy_characters(instr, access):
+    """COP/CPS with a string's DATA and a SINT array (or another DATA): one
+    byte each, a character's low byte (signed) into a SINT, a SINT's byte
+    into a character (a softplc choice: an ST element holds 16-bit units)."""
+    src, dest, length, per, dest_end, src_end = instr.operands[:6]
+    get_src, get_dest, get_length = access.location(src), access.location(dest), access.value(length)
+    src_chars, dest_chars = _is_characters(src), _is_characters(dest)
+    dest_end, src_end = dest_end.value, src_end.value
+
+    def run(c: bool) -> bool:
+        if c:
+            dd, di, _ = get_dest()
+            sd, si, _ = get_src()
+            n = min(int(get_length()), dest_end if dest_chars else dest_end - di,
+                    src_end if src_chars else src_end - si)
+            if n <= 0:
+                return c
+            values = sd[si:si + n].tolist()
+            if src_chars and not dest_chars:
+                values = [_signed_byte(u) for u in values]
+            elif dest_chars:
+                values = [_byte_unit(v) for v in values]
+            dd[di:di + n] = array(dd.typecode, values)
+        return c
+    return run
+
+
 def _copy(instr, access):
+    if _is_characters(instr.operands[0]) or _is_characters(instr.operands[1]):
+        return _copy_characters(instr, access)
     if len(instr.operands) == 7:
         return _copy_strings(instr, access)
     src, dest, length, per, dest_end, src_end = instr.operands
@@ -91,15 +139,17 @@ def _copy_strings(instr, access):
     get_src, get_dest, get_length = access.location(src), access.location(dest), access.value(length)
     per, dest_end, src_end, cap = per.value, dest_end.value, src_end.value, capacity.value
     wpe = dest.address.ftype.words_per_element
+    src_size, dest_size = src.address.ftype.chars, dest.address.ftype.chars
 
     def run(c: bool) -> bool:
         if c:
             dd, di, _ = get_dest()
             sd, si, _ = get_src()
-            n = min(int(get_length()) * per, dest_end - di // wpe, src_end - si // wpe)
-            texts = [read_string(sd, si + k * wpe) for k in range(max(n, 0))]
+            swpe = src_size + 1
+            n = min(int(get_length()) * per, dest_end - di // wpe, src_end - si // swpe)
+            texts = [read_string(sd, si + k * swpe, src_size) for k in range(max(n, 0))]
             for k, text in enumerate(texts):
-                store_text(dd, di + k * wpe, text[:cap])
+                store_text(dd, di + k * wpe, text[:cap], dest_size)
                 dd[di + k * wpe] = min(len(text), cap)
         return c
     return run
@@ -107,6 +157,8 @@ def _copy_strings(instr, access):
 
 def _fill(instr, access):
     source, dest, length, per, dest_end = instr.operands
+    if _is_characters(dest):
+        return _fill_characters(instr, access)
     if isinstance(source, AddressRef) and source.address.ftype.is_string:
         return _fill_strings(instr, access)
     value, get_dest, get_length = access.value(source), access.location(dest), access.value(length)
@@ -124,11 +176,29 @@ def _fill(instr, access):
     return run
 
 
+def _fill_characters(instr, access):
+    """FLL into a string's DATA: the value as a SINT's byte into each character."""
+    source, dest, length, _, dest_end = instr.operands
+    value, get_dest, get_length = access.value(source), access.location(dest), access.value(length)
+    left = dest_end.value
+
+    def run(c: bool) -> bool:
+        if c:
+            dd, di, _ = get_dest()
+            n = min(int(get_length()), left)
+            if n > 0:
+                dd[di:di + n] = array("h", [_byte_unit(int(value()))]) * n
+        return c
+    return run
+
+
 def _fill_strings(instr, access):
     """A string source: each destination string gets it whole."""
     source, dest, length, per, dest_end = instr.operands
     get_src, get_dest, get_length = access.location(source), access.location(dest), access.value(length)
     wpe, per, dest_end = dest.address.ftype.words_per_element, per.value, dest_end.value
+    src_size, dest_size = source.address.ftype.chars, dest.address.ftype.chars
+    same, cap = src_size == dest_size, dest_size
 
     def run(c: bool) -> bool:
         if c:
@@ -136,7 +206,12 @@ def _fill_strings(instr, access):
             n = min(int(get_length()) * per, dest_end - di // wpe)
             if n > 0:
                 sd, si, _ = get_src()
-                dd[di:di + n * wpe] = sd[si:si + wpe] * n
+                if same:
+                    dd[di:di + n * wpe] = sd[si:si + wpe] * n
+                else:  # between ST and SL: the text, cut to the destination's type
+                    text = read_string(sd, si, src_size)[:cap]
+                    for k in range(n):
+                        store_text(dd, di + k * wpe, text, dest_size)
         return c
     return run
 

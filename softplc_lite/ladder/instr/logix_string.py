@@ -78,10 +78,11 @@ _REAL = re.compile(r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 
 def _text(access, operand):
     get = access.location(operand)
+    size = operand.address.ftype.chars  # ST 82, SL more
 
     def read() -> str:
         d, i, _ = get()
-        return read_string(d, i)
+        return read_string(d, i, size)
     return read
 
 
@@ -89,13 +90,14 @@ def _writer(access, operand, capacity):
     get = access.location(operand)
     machine = access.machine
     cap = capacity.value
+    size = operand.address.ftype.chars
 
     def write(text: str) -> None:
         if len(text) > cap:
             machine._string_error()
             text = text[:cap]
         d, i, _ = get()
-        store_text(d, i, text)
+        store_text(d, i, text, size)
         d[i] = len(text)
     return write
 

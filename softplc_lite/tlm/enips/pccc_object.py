@@ -56,6 +56,9 @@ def _file(access: TableAccess, kind: str | None, number: int) -> FileInfo:
     if info is None:
         named = f"{kind or ''} file {number}"
         raise Refused(P.STS_EXTENDED, P.EXT_NOT_USABLE, f"there is no {named.strip()} in the table")
+    if info.kind == "SL":
+        raise Refused(P.STS_EXTENDED, P.EXT_NOT_USABLE,
+                      f"{info.name} is a long string file: PCCC has no type for it (softplc_lite does not serve it)")
     if info.kind in NO_PCCC_TYPE:
         raise Refused(P.STS_EXTENDED, P.EXT_NOT_USABLE,
                       f"{info.name} is a Logix {NO_PCCC_TYPE[info.kind]} file: PCCC has no type for it "

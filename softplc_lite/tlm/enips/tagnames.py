@@ -105,6 +105,8 @@ class Tag:
 def file_tags(files: list[FileInfo]) -> list[Tag]:
     out = []
     for info in files:
+        if info.kind not in FILE_TYPES:  # SL (long strings): no CIP type serves 5,000 characters (softplc choice)
+            continue
         rows = _ROWS.get(info.kind)
         dims = (info.elements, rows) if rows else (info.elements,)
         out.append(Tag(info.name, info, 0, FILE_TYPES[info.kind], dims))
@@ -130,7 +132,7 @@ def symbol_tags(symbols: dict[str, str], access: TableAccess) -> tuple[list[Tag]
             skipped.append(f"{name}: {e}")
             continue
         info = access.file_named(a.file_name()) if a.is_direct else None
-        if info is None or a.element is None and a.bit is None:
+        if info is None or a.element is None and a.bit is None or info.kind not in FILE_TYPES:
             skipped.append(f"{name}: {text} is not a direct address of a served file")
             continue
         per = info.items_per_element
@@ -145,8 +147,8 @@ def symbol_tags(symbols: dict[str, str], access: TableAccess) -> tuple[list[Tag]
             continue
         if a.member is not None:
             offset = info_member_offset(info.kind, a.member)
-            if info.kind == "ST":
-                out.append(Tag(name, info, item, DINT, ()))
+            if info.kind == "ST":  # LEN a DINT (as a Logix STRING's), a character DATAk a word
+                out.append(Tag(name, info, item + offset, DINT if a.member == "LEN" else INT, ()))
                 continue
             item += offset
             per = 1
