@@ -132,3 +132,12 @@ def test_lidx_sums_the_strided_terms_and_faults_outside_a_dimension(engine):
     e.table.write("L9:2", 4)
     e.scan()
     assert e.fault is not None and e.fault.code == 20
+
+
+def test_lflt_faults_on_a_true_rung_only(engine):
+    e = engine("XIC B3/0 LFLT 31\n", {"B3/0": 0})
+    e.scan()
+    assert e.fault is None
+    e.table.write("B3/0", 1)
+    e.scan()
+    assert e.fault is not None and e.fault.code == 31

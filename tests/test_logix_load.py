@@ -220,3 +220,24 @@ def test_an_array_larger_than_a_data_table_file_is_a_warning_not_an_error(tmp_pa
     r.run(3)
     assert r.table.read(app.program.symbols.resolve_path("y")) == 3  # the rest runs
     r.close()
+
+
+@pytest.mark.parametrize("executor", ["compiled", "reference"])
+def test_a_jsr_whose_parameters_do_not_match_faults_when_it_runs_as_logix_does(tmp_path, executor):
+    """1756-PM014: major fault type 4, code 31 (invalid JSR parameter) comes
+    when the JSR runs, not at download: the export loads, warns, and runs
+    until the rung goes true."""
+    from helpers.logix_l5x import Prog, Task, export_runner, write_l5x, write_tag
+
+    path = write_l5x(tmp_path / "jsr.L5X", [("Go", "BOOL"), ("x", "DINT"), ("n", "DINT")],
+                     [Prog("P", {"Main": ["ADD(n,1,n);", "XIC(Go)JSR(Sub,1,x);"], "Sub": ["NOP();"]})],
+                     [Task("T", ["P"])])
+    app = load_app(path)
+    assert any("JSR to P.Sub: its parameters do not match" in w and "code 31" in w for w in app.warnings)
+    r = export_runner(path, executor)
+    r.run(3)
+    assert r.engine.fault is None
+    write_tag(r, "Go", 1)
+    r.run(1)
+    assert r.engine.fault is not None and r.engine.fault.code == 31 and "invalid JSR parameter" in r.engine.fault.message
+    r.close()

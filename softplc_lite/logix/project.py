@@ -21,7 +21,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..datatable import DataTable
-from ..ladder.ast import MAIN_FILE, DataDecl, Instruction, Program, ProgramFile, Rung, walk
+from ..ladder.ast import MAIN_FILE, Const, DataDecl, Instruction, Program, ProgramFile, Rung, instructions_of, walk
+from ..ladder.instr.logix import FAULT_JSR_PARAMETERS
 from . import model
 from .aoi import AoiCalls, add_types
 from .initial import ValueWriter, apply_initial, data_files
@@ -97,6 +98,7 @@ def build_program(project: model.Project) -> LogixProgram:
     result.program.files.update(made)
     number += len(made)
     result.program.files.update(schedule.files(result.routine_files, number))
+    _mismatched_calls(result.program, warnings)
     for letter, file, values in data_files(writer, table):
         result.program.data.append(DataDecl(f"{letter}{file}", len(values), values))
     written = {d.file for d in result.program.data}
@@ -152,3 +154,39 @@ def _calls_not_run(prog, routines, files, not_passed, warnings, counts) -> None:
                     counts["run"] -= 1
                     counts["not run"] += 1
                     break
+
+
+def _mismatched_calls(program: Program, warnings: list) -> None:
+    """A JSR whose parameters do not match its routine's SBR or RETs loads
+    in Logix and faults when it runs (major fault type 4, code 31: 1756-
+    PM014): such a JSR becomes LFLT 31, said as a warning, instead of the
+    load-time error the ladder gives a PLC-5 program."""
+    shapes: dict[int, tuple] = {}
+
+    def shape(number: int):
+        if number not in shapes:
+            rungs = program.files[number].rungs if number in program.files else []
+            first = rungs[0].elements[0] if rungs and rungs[0].elements else None
+            sbr = first if isinstance(first, Instruction) and first.mnemonic == "SBR" else None
+            rets = [ins for rung in rungs for ins in instructions_of(rung.elements)
+                    if ins.mnemonic == "RET" and ins.operands]
+            shapes[number] = (len(sbr.operands) if sbr is not None else 0, [len(r.operands) for r in rets])
+        return shapes[number]
+
+    for pfile in program.files.values():
+        for rung in pfile.rungs:
+            for ins in instructions_of(rung.elements):
+                if ins.mnemonic != "JSR" or not ins.operands or not isinstance(ins.operands[0], Const):
+                    continue
+                ops = ins.operands
+                count = ops[1].value if len(ops) > 1 and isinstance(ops[1], Const) else 0
+                returns = len(ops) - 2 - count if len(ops) > 1 else 0
+                received, rets = shape(ops[0].value)
+                if received == count and (not returns or (rets and all(n == returns for n in rets))):
+                    continue
+                target = program.files.get(ops[0].value)
+                ins.mnemonic, ins.operands = "LFLT", [Const(FAULT_JSR_PARAMETERS, ins.pos)]
+                warnings.append(model.Problem(ins.pos, f"JSR to {target.name if target else ops[0].value}: its "
+                                                       f"parameters do not match the routine's SBR or RET; the rung "
+                                                       f"faults when it runs (major fault type 4, code 31), as Logix "
+                                                       f"does"))

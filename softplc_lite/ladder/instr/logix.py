@@ -68,12 +68,17 @@ SPECS = [
     _spec("LCTD", "Logix count down", "CTL", "PRE", "ACC"),
     _spec("LRES", "Logix reset", "CTL", "ACC or POS"),
     _spec("LDIV", "Logix divide", "source A", "source B", "dest"),
+    _spec("LFLT", "Logix run-time fault", "code"),
     InstructionSpec("LIDX", "Logix array index", (OperandSpec("dest", K.ANY), OperandSpec("offset", K.ANY),
                                                   OperandSpec("term", K.ANY)), False, repeat=3 * 8),
 ]
 # The Logix name each shows as (the watch view, fmt, messages); LIDX is no Logix instruction: it
 # computes an index Logix computes inside the instruction that uses it.
-LOGIX_NAMES = {s.mnemonic: s.mnemonic[1:] for s in SPECS if s.mnemonic != "LIDX"}
+LOGIX_NAMES = {s.mnemonic: s.mnemonic[1:] for s in SPECS if s.mnemonic not in ("LIDX", "LFLT")}
+FAULT_JSR_PARAMETERS = 31  # major fault type 4 code 31, invalid JSR parameter (1756-PM014)
+# What LFLT says, by code: a rung Logix lets load but faults on when it runs.
+RUN_TIME_FAULTS = {FAULT_JSR_PARAMETERS: "JSR parameters that do not match the routine's SBR or RET: major fault "
+                                         "type 4, code 31 (invalid JSR parameter)"}
 LOGIX_NAMES.update(_DATA_NAMES, **_STRING_NAMES, **_SYSTEM_NAMES, **_BITS_NAMES)
 FAULT_SUBSCRIPT = 20  # major fault type 4 code 20: an array subscript out of range (1756-PM014)
 
@@ -262,9 +267,24 @@ def _index(instr, access):
     return run
 
 
+def _fault(instr, access):
+    """LFLT code: a true rung is the major fault ``code`` (RUN_TIME_FAULTS
+    says it); a false rung passes."""
+    code = instr.operands[0].value
+    message = RUN_TIME_FAULTS.get(code, f"major fault {code}")
+
+    def run(c: bool) -> bool:
+        if c:
+            raise MajorFault(code, message)
+        return c
+    return run
+
+
 def _bind(instr, access):
     m = instr.mnemonic
     machine = access.machine
+    if m == "LFLT":
+        return _fault(instr, access)
     if m == "LIDX":
         return _index(instr, access)
     if m == "LDIV":
