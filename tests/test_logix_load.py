@@ -241,3 +241,12 @@ def test_a_jsr_whose_parameters_do_not_match_faults_when_it_runs_as_logix_does(t
     r.run(1)
     assert r.engine.fault is not None and r.engine.fault.code == 31 and "invalid JSR parameter" in r.engine.fault.message
     r.close()
+
+
+def test_date_time_values_of_lints_in_microseconds_and_nanoseconds():
+    from softplc_lite.logix.initial import date_time
+
+    assert date_time("DT#1970-01-01-00:00:00.000_000Z") == 0
+    assert date_time("DT#2022-01-01-06:00:00.100_100_100Z") == 1_641_016_800_100_100
+    assert date_time("LDT#2022-01-01-06:00:00.100_100_100Z") == 1_641_016_800_100_100_100
+    assert date_time("DT#2022-13-01-06:00:00Z") is None and date_time("12") is None

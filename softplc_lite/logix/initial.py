@@ -45,8 +45,9 @@ _DATE_TIME = re.compile(r"(?:L?DT)#(\d{4})-(\d\d)-(\d\d)-(\d\d):(\d\d):(\d\d)(?:
 def date_time(text: str) -> int | None:
     """A LINT's date-and-time value (``DT#2022-02-22-06:00:00.000_000Z``, the
     form exports write with the Date/Time radix) as the microseconds since
-    1970-01-01 UTC Logix holds (1756-PM020, "LINT ... Date/Time"); None if
-    the text is not one."""
+    1970-01-01 UTC Logix holds (1756-PM020, "LINT ... Date/Time"), or with
+    ``LDT#`` (the Date/Time (ns) radix) the nanoseconds; None if the text
+    is not one."""
     m = _DATE_TIME.match(text.strip())
     if not m:
         return None
@@ -56,6 +57,8 @@ def date_time(text: str) -> int | None:
     except ValueError:
         return None
     digits = (fraction or "").replace("_", "")
+    if text.strip().upper().startswith("LDT#"):  # the nanosecond form (the Date/Time (ns) radix)
+        return int(moment.timestamp()) * 1_000_000_000 + (int((digits + "0" * 9)[:9]) if digits else 0)
     micros = int((digits + "000000")[:6]) if digits else 0
     return int(moment.timestamp()) * 1_000_000 + micros
 
@@ -99,7 +102,7 @@ def apply_initial(d: Declared, writer: ValueWriter, problems: list[Problem]) -> 
         leaf = d.leaves.get(path)
         if leaf is None:
             return
-        if isinstance(value, str) and value.upper().startswith("DT#") and t.name == "LINT":
+        if isinstance(value, str) and value.upper().startswith(("DT#", "LDT#")) and t.name == "LINT":
             stamp = date_time(value)
             if stamp is None:
                 bad(f"{value!r}: expected DT#YYYY-MM-DD-hh:mm:ss.ffffffZ")
