@@ -80,3 +80,21 @@ def test_datatable_print_shows_a_long_string_and_one_character(tmp_path, capsys)
     assert main(["datatable", str(path), "--print", "SL11:0", "--print", "SL11:0.DATA99"]) == 0
     out = capsys.readouterr().out
     assert "w" * 99 + "!" in out and "SL11:0.DATA99 = 33" in out
+
+
+def test_the_enips_server_leaves_an_sl_file_out_and_serves_a_character_as_an_int():
+    from softplc_lite.tlm.enips import pccc_object
+    from softplc_lite.tlm.enips.access import TableAccessOnTable
+    from softplc_lite.tlm.enips.tagnames import DINT, INT, Catalogue
+
+    t = DataTable()
+    t.create_file("SL", 11, 2)
+    t.create_file("ST", 9, 1)
+    access = TableAccessOnTable(t)
+    catalogue = Catalogue(access, {"Msg": "SL11:0", "Second": "ST9:0.DATA1", "Size": "ST9:0.LEN"})
+    tags = {tag.name: tag for tag in catalogue.tags}
+    assert "SL11" not in tags and "Msg" not in tags and "ST9" in tags
+    assert catalogue.skipped == ["Msg: SL11:0 is not a direct address of a served file"]
+    assert (tags["Second"].ctype, tags["Second"].item) == (INT, 2) and (tags["Size"].ctype, tags["Size"].item) == (DINT, 0)
+    with pytest.raises(pccc_object.Refused, match="SL11 is a long string file: PCCC has no type for it"):
+        pccc_object._file(access, None, 11)

@@ -132,3 +132,24 @@ def test_a_cop_between_a_strings_data_and_a_dint_is_not_run(tmp_path):
     path = write_l5x(tmp_path / "x.L5X", TAGS, [Prog("P", {"Main": ["COP(L1.DATA[0],N,3);"]})],
                      [Task("T", ["P"])], data_types=TYPES)
     assert "a copy between a string's DATA and DINT copies Logix's bytes" in "\n".join(load_app(path).warnings)
+
+
+def test_a_string_type_the_export_leaves_out_is_taken_from_its_name(tmp_path):
+    udt = """<DataType Name="Valve" Family="NoFamily" Class="User"><Members>
+<Member Name="Name" DataType="STRING_16" Dimension="0" Radix="NullType" Hidden="false" ExternalAccess="Read/Write"/>
+<Member Name="Pos" DataType="DINT" Dimension="0" Radix="Decimal" Hidden="false" ExternalAccess="Read/Write"/>
+</Members></DataType>"""
+    rungs = ["CONCAT(V.Name,V.Name,V.Name);", "MOV(V.Name.LEN,V.Pos);", "CONCAT(Note,Note,Note);"]
+    path = write_l5x(tmp_path / "x.L5X", [("V", "Valve"), ("Note", "STRING120")], [Prog("P", {"Main": rungs})],
+                     [Task("T", ["P"])], data_types=udt)
+    app = load_app(path)
+    warnings = "\n".join(app.warnings)
+    assert "data type STRING_16 is not in the export: taken as a string type of 16 characters" in warnings
+    assert "data type STRING120 is not in the export: taken as a string type of 120 characters" in warnings
+    r = Runner(app, RunOptions(fresh=True, save_state=False))
+    write(r, "V.Name", "abcdefghij")
+    write(r, "Note", "n" * 70)
+    r.run(1)
+    assert read(r, "V.Name") == "abcdefghijabcdef" and read(r, "V.Pos") == 16  # cut to the type's 16
+    assert read(r, "Note") == "n" * 120
+    r.close()

@@ -68,6 +68,7 @@ def build_program(project: model.Project) -> LogixProgram:
             directory.declare(tag, prog.name)
     problems += directory.problems
     warnings += directory.warnings
+    warnings += types.warnings
 
     writer = ValueWriter()
     aois = AoiCalls(project, directory, types)

@@ -173,7 +173,7 @@ class TagDirectory:
         if tag.tag_type == "Alias" or tag.alias_for:
             d = names[key] = Declared(tag, None, (), scope)
             return d
-        t = self.types.get(tag.data_type)
+        t = self.types.get(tag.data_type) or self.types.implied(tag.data_type, tag.pos)
         if t is None:
             reason = self.types.not_held.get(tag.data_type or "")
             if reason is None:

@@ -14,6 +14,7 @@ softplc_lite keeps a string whole in an ST element (docs/logix.md).
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 from .model import DataType, Problem
@@ -135,6 +136,22 @@ class TypeSystem:
         self.types: dict[str, LogixType] = {k.upper(): v for k, v in PREDEFINED.items()}
         self.problems: list[Problem] = []
         self.held_not: dict[str, str] = {}  # a user type softplc_lite does not lay out -> why
+        self.warnings: list[Problem] = []  # string types taken from their names (implied)
+
+    def implied(self, name: str | None, pos) -> LogixType | None:
+        """A string type the export uses but does not define (a program
+        export leaves its types out), named as Studio 5000 names string types
+        of N characters (``STRING_16``, ``STRING20``): taken as one of N, with
+        a warning (a softplc choice)."""
+        m = re.fullmatch(r"STRING_?([0-9]+)", (name or "").upper())
+        if m is None or not 0 < int(m.group(1)) <= LONG_STRING_CHARS or name.upper() in self.held_not:
+            return None
+        chars = int(m.group(1))
+        t = self.types[name.upper()] = LogixType(name, "string", letter="ST" if chars <= STRING_CHARS else "SL",
+                                                 chars=chars)
+        self.warnings.append(Problem(pos, f"data type {name} is not in the export: taken as a string type of "
+                                          f"{chars} characters, as its name says"))
+        return t
 
     def get(self, name: str | None) -> LogixType | None:
         return self.types.get((name or "").upper())
@@ -205,6 +222,8 @@ class TypeSystem:
             t = self.types.get(m.data_type.upper())
             if t is None and m.data_type.upper() in pending:
                 t = resolve(pending[m.data_type.upper()])
+            elif t is None:
+                t = self.implied(m.data_type, m.pos)
             if t is None:
                 if d.name.upper() not in self.held_not:
                     self.held_not[d.name.upper()] = (f"data type {d.name}: its member {m.name} is a "
