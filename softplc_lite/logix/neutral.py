@@ -142,3 +142,14 @@ def parse_rung(text: str) -> list:
     if pos < n:
         raise NeutralError(f"unexpected text after the rung's end: {text[pos:pos + 20]!r}", pos)
     return elements
+
+
+def instructions_in(elements):
+    """Every instruction of a rung's parts (NInstruction), branches opened,
+    in scan order (ladder/ast.py's ``walk`` for the ladder's tree)."""
+    for el in elements:
+        if isinstance(el, NBranch):
+            for leg in el.legs:
+                yield from instructions_in(leg)
+        else:
+            yield el

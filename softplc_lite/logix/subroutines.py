@@ -37,7 +37,7 @@ from ..datatable import Address
 from ..ladder.ast import AddressRef, Branch, Const, Instruction
 from . import copy
 from .expr import ExprError, number
-from .neutral import NBranch, NeutralError, parse_rung
+from .neutral import NBranch, NeutralError, instructions_in, parse_rung
 from .operands import Skip
 from .tags import WORD_BITS, Declared, NotRun, PathError, Resolved
 
@@ -100,13 +100,13 @@ class Subroutines:
         for k, elements in enumerate(self._rungs(routine)):
             if k == 0 and elements and not isinstance(elements[0], NBranch) and elements[0].mnemonic == "SBR":
                 plan.inputs = [self._classify(text) for text, _ in elements[0].operands]
-            for ins in _walk(elements):
+            for ins in instructions_in(elements):
                 if ins.mnemonic == "RET" and ins.operands:
                     _merge(values, [self._classify(text) for text, _ in ins.operands])
         targets: list = []
         for caller in self.routines.values():
             for elements in self._rungs(caller):
-                for ins in _walk(elements):
+                for ins in instructions_in(elements):
                     if ins.mnemonic == "JSR" and len(ins.operands) > 2 and \
                             ins.operands[0][0].strip().upper() == routine.name.upper():
                         count = number(ins.operands[1][0])
@@ -158,15 +158,6 @@ def _merge(into: list, kinds: list) -> None:
 
 def _at(items: list, p: int):
     return items[p] if p < len(items) else None
-
-
-def _walk(elements):
-    for el in elements:
-        if isinstance(el, NBranch):
-            for leg in el.legs:
-                yield from _walk(leg)
-        else:
-            yield el
 
 
 def copy_value(source: Resolved | int, dest: Resolved, where, pos, ctx) -> list:
