@@ -206,6 +206,19 @@ def test_unclosed_blocks_and_comments():
         [(2, 3, "comment '(*' is never closed")]
 
 
+@pytest.mark.parametrize("text, where", [
+    ("IF a = THEN\n  y := 2;\n  z := 3 +;\nEND_IF;\nq := 1;", [(1, 8), (3, 11)]),
+    ("WHILE DO\n  y := ;\nEND_WHILE;", [(1, 7), (2, 8)]),
+    ("FOR i = 1 TO 5 DO\n  y := 2;\nEND_FOR;", [(1, 7)]),
+    ("CASE x y OF 1: y := 1; END_CASE;", [(1, 8)]),
+    ("IF a THEN x := 1; ELSIF b c THEN y := 1; ELSE z := 1; END_IF;", [(1, 27)]),
+])
+def test_an_error_in_a_block_head_leaves_its_body_and_end_alone(text, where):
+    errors: list[StError] = []
+    parse_routine(text, "r.st", errors=errors)
+    assert [(e.pos.line, e.pos.column) for e in errors] == where
+
+
 def test_errors_list_keeps_what_parsed():
     errors: list[StError] = []
     statements = parse_routine("a := 1;\nb := ;\nc := 3;", "r.st", errors=errors)

@@ -13,7 +13,11 @@ interactive LALR parser, which is copied at each point a statement may
 start (after ";", THEN, ELSE, DO, REPEAT, a CASE label's ":"). At an error
 the parser goes back to the last copy and skips to the next ";". An error
 on the first token after such a skip is the first error's echo (an END_IF
-whose IF was skipped) and is not reported again.
+whose IF was skipped) and is not reported again. An error in a block's head
+(``IF a = THEN``) is passed over to the head's THEN, DO or OF with a
+stand-in head, so the block's body and its END_IF still parse as such. The
+statements returned beside errors are for a look only (a stand-in head's
+tag is named "_"): a routine with errors does not go on to be compiled.
 """
 
 from __future__ import annotations
@@ -77,6 +81,8 @@ _RESUME_AFTER = {"SEMICOLON", "THEN", "ELSE", "DO", "REPEAT", "COLON"}
 
 def _expected(names) -> str:
     names = set(names)
+    if "DOT" in names:  # ".5" after a tag is a "." then a bit number
+        names.discard("DOTNUM")
     if len(names & _OPERATORS) > 3:  # "an operator" rather than fifteen of them
         names = (names - _OPERATORS) | {"OPERATOR"}
     shown = sorted({_FRIENDLY.get(n, "an operator" if n == "OPERATOR" else n) for n in names})
@@ -184,6 +190,11 @@ def _parse_tree(where: _Lines, found: list[StError]):
                 found.append(_token_error(where, e, tokens, _accepted(checkpoint, tokens[since:i])))
             if i >= len(tokens):
                 return None
+            header = _header_recovery(checkpoint, tokens, since, i)
+            if header is not None:  # a bad IF/ELSIF/WHILE/FOR/CASE head: go on in its body
+                ip, i = header
+                checkpoint, since, resumed = ip.copy(), i, False
+                continue
             ip, resumed = checkpoint.copy(), True
             while i < len(tokens) and tokens[i].type != "SEMICOLON":
                 i += 1
@@ -195,6 +206,40 @@ def _parse_tree(where: _Lines, found: list[StError]):
             checkpoint, since = ip.copy(), i + 1
         i += 1
     return None
+
+
+# A block's head, as a stand-in for one that did not parse: its opening
+# keyword, the tokens of a valid head, and the keyword that ends the head.
+_HEADS = {
+    "IF": (("IF", "IF"), ("NAME", "_"), ("THEN", "THEN")),
+    "ELSIF": (("ELSIF", "ELSIF"), ("NAME", "_"), ("THEN", "THEN")),
+    "WHILE": (("WHILE", "WHILE"), ("NAME", "_"), ("DO", "DO")),
+    "FOR": (("FOR", "FOR"), ("NAME", "_"), ("ASSIGN", ":="), ("INT", "0"), ("TO", "TO"), ("INT", "0"), ("DO", "DO")),
+    "CASE": (("CASE", "CASE"), ("NAME", "_"), ("OF", "OF")),
+}
+
+
+def _header_recovery(checkpoint, tokens: list[Token], since: int, i: int):
+    """When the error is in a block's head (IF a = THEN), the parser as if
+    the head had parsed and the index of the token after it, so the body is
+    still read as the body and its END_IF is not a second error; None
+    otherwise."""
+    if since >= len(tokens) or tokens[since].type not in _HEADS:
+        return None
+    head = _HEADS[tokens[since].type]
+    end = head[-1][0]
+    j = i
+    while j < len(tokens) and tokens[j].type not in (end, "SEMICOLON"):
+        j += 1
+    if j >= len(tokens) or tokens[j].type != end:
+        return None
+    ip = checkpoint.copy()
+    try:
+        for kind, value in head:
+            ip.feed_token(Token.new_borrow_pos(kind, value, tokens[since]))
+    except UnexpectedToken:  # ELSIF outside an IF: no stand-in fits
+        return None
+    return ip, j + 1
 
 
 def _after_blank(text: str, blanked: list[int], tok: Token) -> bool:
