@@ -226,6 +226,14 @@ def test_errors_list_keeps_what_parsed():
     assert [e.pos.line for e in errors] == [2]
 
 
+def test_long_routines_and_deep_nesting_give_no_traceback():
+    assert len(parse_routine("x := 1;\n" * 3000, "r.st")) == 3000
+    for text in ("x := " + " + ".join(["a"] * 3000) + ";", "IF a THEN " * 600 + "x := 1;" + " END_IF;" * 600):
+        with pytest.raises(StErrors) as caught:
+            parse_routine(text, "r.st")
+        assert [str(e) for e in caught.value.errors] == ["r.st:1:1: an expression or block nested too deeply to read"]
+
+
 def test_empty_routine():
     assert parse_routine("", "r.st") == [] and parse_routine("// only a comment\n;", "r.st") == []
 

@@ -9,7 +9,8 @@ errors in that list and the statements that did parse instead.
 
 How it goes on after an error (a choice of ours): the routine is lexed
 first, a bad character reported and skipped; the tokens are fed to lark's
-interactive LALR parser, which is copied at each point a statement may
+interactive LALR parser, which is copied (its stacks, not the subtrees on
+them, which no later step changes) at each point a statement may
 start (after ";", THEN, ELSE, DO, REPEAT, a CASE label's ":"). At an error
 the parser goes back to the last copy and skips to the next ";". An error
 on the first token after such a skip is the first error's echo (an END_IF
@@ -28,7 +29,7 @@ from pathlib import Path
 from typing import Sequence
 
 from lark import Lark, Token, Transformer, v_args
-from lark.exceptions import UnexpectedCharacters, UnexpectedToken
+from lark.exceptions import UnexpectedCharacters, UnexpectedToken, VisitError
 
 from ..errors import LocatedError
 from . import ast as A
@@ -137,7 +138,15 @@ def parse_routine(lines: Sequence | str, source: str = "<st>", first_line: int =
     where = _Lines(lines, source, first_line)
     found: list[StError] = []
     tree = _parse_tree(where, found)
-    statements = _Build(where).transform(tree) if tree is not None else []
+    try:
+        statements = _Build(where).transform(tree) if tree is not None else []
+    except (RecursionError, VisitError) as e:
+        if not isinstance(e, RecursionError) and not isinstance(e.orig_exc, RecursionError):
+            raise
+        # Thousands of terms in one expression, or blocks hundreds deep: a
+        # generated file, not a person's, and past Python's recursion.
+        found.append(_error(where, 1, 1, "an expression or block nested too deeply to read"))
+        statements = []
     if errors is not None:
         found.sort(key=lambda e: (e.pos.line, e.pos.column))
         errors.extend(found)
@@ -176,7 +185,7 @@ def _parse_tree(where: _Lines, found: list[StError]):
     blanked: list[int] = []
     tokens = _tokens(where, where.text, found, blanked)
     ip = _parser().parse_interactive("")
-    checkpoint, since = ip.copy(), 0
+    checkpoint, since = ip.copy(deepcopy_values=False), 0
     i, resumed = 0, False
     while i <= len(tokens) and len(found) < MAX_ERRORS:
         try:
@@ -193,9 +202,9 @@ def _parse_tree(where: _Lines, found: list[StError]):
             header = _header_recovery(checkpoint, tokens, since, i)
             if header is not None:  # a bad IF/ELSIF/WHILE/FOR/CASE head: go on in its body
                 ip, i = header
-                checkpoint, since, resumed = ip.copy(), i, False
+                checkpoint, since, resumed = ip.copy(deepcopy_values=False), i, False
                 continue
-            ip, resumed = checkpoint.copy(), True
+            ip, resumed = checkpoint.copy(deepcopy_values=False), True
             while i < len(tokens) and tokens[i].type != "SEMICOLON":
                 i += 1
             i += 1
@@ -203,7 +212,7 @@ def _parse_tree(where: _Lines, found: list[StError]):
             continue
         resumed = False
         if tok.type in _RESUME_AFTER:
-            checkpoint, since = ip.copy(), i + 1
+            checkpoint, since = ip.copy(deepcopy_values=False), i + 1
         i += 1
     return None
 
@@ -233,7 +242,7 @@ def _header_recovery(checkpoint, tokens: list[Token], since: int, i: int):
         j += 1
     if j >= len(tokens) or tokens[j].type != end:
         return None
-    ip = checkpoint.copy()
+    ip = checkpoint.copy(deepcopy_values=False)
     try:
         for kind, value in head:
             ip.feed_token(Token.new_borrow_pos(kind, value, tokens[since]))
@@ -254,7 +263,7 @@ def _after_blank(text: str, blanked: list[int], tok: Token) -> bool:
 def _accepted(checkpoint, fed: list[Token]) -> set[str]:
     """The tokens the parser takes after ``fed``: lark's error lists every
     token of the LALR state, some of which another context would take."""
-    ip = checkpoint.copy()
+    ip = checkpoint.copy(deepcopy_values=False)
     for tok in fed:
         ip.feed_token(tok)
     return ip.accepts()
@@ -291,10 +300,7 @@ class _Build(Transformer):
         return list(children[0]) if children and children[0] is not None else []
 
     def stmts(self, meta, children):
-        head, stmt = (children[0] or []) if len(children) == 2 else [], children[-1]
-        if stmt is not None:
-            head.append(stmt)
-        return head
+        return [c for c in children if c is not None]
 
     def _body(self, stmts) -> tuple:
         return tuple(stmts) if stmts else ()
