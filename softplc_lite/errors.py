@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import errno
 import os
+from typing import NamedTuple
 
 
 def shown_path(path: str | bytes | os.PathLike) -> str:
@@ -33,6 +34,22 @@ def shown_path(path: str | bytes | os.PathLike) -> str:
         return name.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
     except UnicodeEncodeError:  # a surrogate that is no escaped byte
         return name.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
+class Pos(NamedTuple):
+    """A place in a source (a program file, an export): source, line,
+    column, 1-based. A tuple: made for every token while parsing, so it is
+    cheap to build. The ladder's and Structured Text's trees both carry it."""
+
+    source: str
+    line: int
+    column: int
+
+    def __str__(self) -> str:
+        return f"{self.source}:{self.line}:{self.column}"
+
+
+NOWHERE = Pos("<generated>", 0, 0)
 
 
 class LocatedError(Exception):

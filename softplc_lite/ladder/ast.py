@@ -21,24 +21,12 @@ from __future__ import annotations
 
 import threading
 from dataclasses import FrozenInstanceError, dataclass, field
-from typing import NamedTuple, Union
+from typing import Union
 
 from ..datatable import Address
+from ..errors import NOWHERE, Pos  # noqa: F401 (names of this module's too)
 
 
-class Pos(NamedTuple):
-    """A source position. A tuple: made for every token while parsing, so
-    it is cheap to build."""
-
-    source: str
-    line: int
-    column: int
-
-    def __str__(self) -> str:
-        return f"{self.source}:{self.line}:{self.column}"
-
-
-NOWHERE = Pos("<generated>", 0, 0)
 
 
 def _pos() -> Pos:

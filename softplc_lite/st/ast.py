@@ -10,23 +10,11 @@ ladder's compact slot classes would buy nothing here. Sequences are tuples.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import NamedTuple, Union
+from typing import Union
+
+from ..errors import NOWHERE, Pos  # noqa: F401 (names of this module's too)
 
 
-class Pos(NamedTuple):
-    """A place in the export: the ladder's Pos in shape (a tuple of source,
-    line, column, equal to one with the same values), kept here because
-    this unit and the ladder's sit in one layer and import neither."""
-
-    source: str
-    line: int
-    column: int
-
-    def __str__(self) -> str:
-        return f"{self.source}:{self.line}:{self.column}"
-
-
-NOWHERE = Pos("<generated>", 0, 0)
 
 
 def _pos() -> Pos:
