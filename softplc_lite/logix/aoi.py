@@ -44,8 +44,9 @@ from ..ladder.ast import AddressRef, Branch, Const, Instruction, Pos, ProgramFil
 from . import model
 from .expr import ExprError, number, parse_expression
 from .initial import apply_initial
+from .l5k_scan import split_commas
 from .rungs import RoutineContext, _at, _resolve_ref, translate_rung
-from .tags import _NAME, STATUS_FLAGS, Declared, Leaf, NotRun, PathError, Resolved, TagDirectory, _split_indexes
+from .tags import _NAME, STATUS_FLAGS, Declared, Leaf, NotRun, PathError, Resolved, TagDirectory
 from .types import PREDEFINED, MemberType, LogixType, TypeSystem
 
 ENABLE = ("ENABLEIN", "ENABLEOUT")
@@ -445,7 +446,7 @@ class AoiCalls:
                 if depth == 0:
                     break
             parts = []
-            for part in _split_indexes(text[k + 1:end]):
+            for part in (piece.strip() for piece, _ in split_commas(text[k + 1:end])):
                 if re.fullmatch(r"[0-9]+", part) or part.upper() in self.hidden:
                     parts.append(part)
                     continue

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 from ..datatable import Address, DataTable
 from ..datatable.filetypes import MAX_ELEMENTS
+from .l5k_scan import split_commas
 from .model import Problem, Tag
 from .types import LogixType, TypeSystem
 
@@ -278,7 +279,7 @@ class TagDirectory:
             if index is not None:
                 if not dims:
                     raise PathError(f"{text[:m.start()].strip()} is not an array", m.start())
-                parts = _split_indexes(index)
+                parts = [part.strip() for part, _ in split_commas(index)]  # i, j+1: top-level commas
                 if len(parts) != len(dims):
                     raise PathError(f"{len(parts)} index{'es' if len(parts) != 1 else ''} for an array of "
                                     f"{len(dims)} dimension{'s' if len(dims) != 1 else ''}", m.start() + 1)
@@ -390,22 +391,6 @@ class TagDirectory:
             return Resolved(text, result_type, (), Address("B", leaf.file, item // WORD_BITS, None,
                                                            item % WORD_BITS), d, path, flat)
         return Resolved(text, result_type, (), Address(leaf.letter, leaf.file, item, None, bit), d, path, flat, bit)
-
-
-def _split_indexes(text: str) -> list[str]:
-    """``i, j+1`` -> ["i", "j+1"]: commas at the top level only (an index
-    expression may hold brackets of its own)."""
-    parts, depth, begin = [], 0, 0
-    for k, ch in enumerate(text):
-        if ch in "([":
-            depth += 1
-        elif ch in ")]":
-            depth -= 1
-        elif ch == "," and depth == 0:
-            parts.append(text[begin:k].strip())
-            begin = k + 1
-    parts.append(text[begin:].strip())
-    return parts
 
 
 class TagSymbols(dict):
