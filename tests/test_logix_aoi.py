@@ -18,7 +18,7 @@ from softplc_lite.runner import RunOptions, Runner
 
 from helpers.cli import softplc_here
 from helpers.logix_aoi import Aoi, Param, write_aoi_l5x
-from helpers.logix_l5x import Prog, Task, read_tag, write_tag
+from helpers.logix_l5x import Prog, Task, read_tag, write_tag, export_runner
 
 FIXTURES = Path(__file__).resolve().parent / "fixtures" / "logix"
 EXECUTORS = pytest.mark.parametrize("executor", ["compiled", "reference"])
@@ -40,7 +40,7 @@ SCALE_RUNGS = ["XIC(Go1)Scale(S1,In1,Out1,Cnt1,Done1)OTE(Eo1);", "XIC(Go2)Scale(
 
 def runner(tmp_path, aois, tags, rungs, executor) -> Runner:
     path = write_aoi_l5x(tmp_path / "aoi.L5X", aois, tags, [Prog("P", {"Main": rungs})], [Task("T", ["P"])])
-    return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+    return export_runner(path, executor)
 
 
 
@@ -233,7 +233,7 @@ def test_an_instance_in_l5k_data_packs_its_bools_first_and_nests_its_timer_array
                                     '"Read/Write">\n<Data Format="L5K">\n<![CDATA[[5,7,[[0,100,0],[0,200,0]],9]]]>\n'
                                     '</Data>\n</Tag>')
     path.write_text(text)
-    r = Runner(load_app(path), RunOptions(fresh=True, save_state=False))
+    r = export_runner(path)
     assert [read_tag(r, p) for p in ("Q.EnableIn", "Q.EnableOut", "Q.Flag", "Q.In", "Q.Tmrs[1].PRE", "Q.Last")] == \
         [1, 0, 1, 7, 200, 9]
     r.run(1)
@@ -252,7 +252,7 @@ def test_a_user_defined_type_may_hold_an_aoi_instance_and_an_aoi_a_local_of_such
     path = write_aoi_l5x(tmp_path / "cell.L5X", [keeper, TWICE], [("C", "Cell"), ("K", "Keeper")],
                          [Prog("P", {"Main": ["Twice(C.Doubler,21,C.Count);", "Keeper(K,4);"]})], [Task("T", ["P"])])
     path.write_text(re.sub(r"<DataTypes(/>|>\s*</DataTypes>)", cell, path.read_text(), count=1))
-    r = Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+    r = export_runner(path, executor)
     r.run(1)
     assert read_tag(r, "C.Count") == 42 and read_tag(r, "C.Doubler.Y") == 42 and read_tag(r, "K.Inner.Count") == 8
     r.close()
@@ -291,7 +291,7 @@ def test_an_export_without_enablein_and_enableout_parameters_still_has_them(tmp_
                          [Prog("P", {"Main": ["Bare(B,6)OTE(Go);"]})], [Task("T", ["P"])])
     text = path.read_text()
     path.write_text("\n".join(ln for ln in text.splitlines() if 'Name="Enable' not in ln))
-    r = Runner(load_app(path), RunOptions(fresh=True, save_state=False))
+    r = export_runner(path)
     r.run(1)
     assert read_tag(r, "B.Y") == 6 and read_tag(r, "B.EnableOut") == 1 and read_tag(r, "Go") == 1
     r.close()

@@ -8,10 +8,9 @@ from __future__ import annotations
 
 import pytest
 
-from softplc_lite.app import load_app
-from softplc_lite.runner import RunOptions, Runner
+from softplc_lite.runner import Runner
 
-from helpers.logix_l5x import Prog, Task, write_l5x
+from helpers.logix_l5x import Prog, Task, write_l5x, export_runner
 
 TAGS = [("i", "DINT"), ("j", "DINT"), ("n", "DINT"), ("Arr", "DINT[5]"), ("Grid", "INT[2,3]"),
         ("Word", "DINT"), ("Bits", "BOOL[32]"), ("Out", "DINT"), ("Flag", "BOOL")]
@@ -19,7 +18,7 @@ TAGS = [("i", "DINT"), ("j", "DINT"), ("n", "DINT"), ("Arr", "DINT[5]"), ("Grid"
 
 def run(tmp_path, rungs: list[str], executor: str, values: dict, scans: int = 1) -> Runner:
     path = write_l5x(tmp_path / "idx.L5X", TAGS, [Prog("P", {"Main": rungs})], [Task("T", ["P"])])
-    r = Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+    r = export_runner(path, executor)
     names = r.app.program.symbols
     for tag, value in values.items():
         r.table.write(names.resolve_path(tag), value)

@@ -8,9 +8,9 @@ from __future__ import annotations
 import pytest
 
 from softplc_lite.app import AppError, load_app
-from softplc_lite.runner import RunOptions, Runner
+from softplc_lite.runner import Runner
 
-from helpers.logix_l5x import Prog, Task, write_l5x
+from helpers.logix_l5x import Prog, Task, write_l5x, export_runner
 
 EXECUTORS = pytest.mark.parametrize("executor", ["compiled", "reference"])
 
@@ -80,7 +80,7 @@ TAGS = [("D", "DINT"), ("E", "DINT"), ("F", "REAL"), ("G", "REAL"), ("I", "INT")
 
 def runner(tmp_path, rungs, executor) -> Runner:
     path = write_l5x(tmp_path / "b.L5X", TAGS, [Prog("P", {"Main": rungs})], [Task("T", ["P"])])
-    return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+    return export_runner(path, executor)
 
 
 @EXECUTORS

@@ -12,7 +12,7 @@ import pytest
 from softplc_lite.app import AppError, load_app
 from softplc_lite.runner import RunOptions, Runner
 
-from helpers.logix_l5x import Prog, Task, write_l5x, read_tag, write_tag
+from helpers.logix_l5x import Prog, Task, write_l5x, read_tag, write_tag, export_runner
 
 EXECUTORS = pytest.mark.parametrize("executor", ["compiled", "reference"])
 TYPES = """<DataType Name="Pt" Family="NoFamily" Class="User"><Members>
@@ -43,7 +43,7 @@ TAGS = [("A", "DINT[5]"), ("B", "DINT[5]"), ("I", "INT[4]"), ("R", "REAL[3]"), (
 
 def runner(tmp_path, rungs, executor="compiled") -> Runner:
     path = write_l5x(tmp_path / "x.L5X", TAGS, [Prog("P", {"Main": rungs})], [Task("T", ["P"])], data_types=TYPES)
-    return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+    return export_runner(path, executor)
 
 
 

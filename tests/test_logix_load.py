@@ -15,6 +15,7 @@ import pytest
 from softplc_lite.app import AppError, load_app
 from softplc_lite.runner import RunOptions, Runner
 
+from helpers.logix_l5x import export_runner
 from helpers.cli import softplc_here
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -30,7 +31,7 @@ def tank_line(tmp_path: Path, edit=None) -> Path:
 
 
 def runner_of(path: Path, executor: str) -> Runner:
-    return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+    return export_runner(path, executor)
 
 
 @pytest.mark.parametrize("executor", ["compiled", "reference"])

@@ -6,7 +6,6 @@ does not describe is not run, with a warning, never an error."""
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import pytest
 

@@ -31,7 +31,7 @@ def _dec(data):
 
 def _expected_l5x() -> Project:
     """What reader_controller.L5X says, its data read in decorated form."""
-    rw, ro = "Read/Write", "Read Only"
+    ro = "Read Only"
     return Project(
         source="reader_controller.L5X", format="L5X", target_type="Controller", target_name="Mixer",
         controller="Mixer", processor_type="1769-L33ER", software_revision="32.11",

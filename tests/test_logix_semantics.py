@@ -8,11 +8,10 @@ from __future__ import annotations
 
 import pytest
 
-from softplc_lite.app import load_app
 from softplc_lite.ladder import status as S
-from softplc_lite.runner import RunOptions, Runner
+from softplc_lite.runner import Runner
 
-from helpers.logix_l5x import Prog, Task, write_l5x, read_tag, write_tag
+from helpers.logix_l5x import Prog, Task, write_l5x, read_tag, write_tag, export_runner
 
 TAGS = [("D", "DINT"), ("D2", "DINT"), ("I", "INT"), ("Si", "SINT"), ("R", "REAL"), ("Big", "DINT"),
         ("Trig", "BOOL"), ("Store", "BOOL"), ("Pulse", "BOOL"), ("Once", "BOOL"), ("Scans", "DINT"),
@@ -22,7 +21,7 @@ EXECUTORS = pytest.mark.parametrize("executor", ["compiled", "reference"])
 
 def runner(tmp_path, rungs, executor) -> Runner:
     path = write_l5x(tmp_path / "sem.L5X", TAGS, [Prog("P", {"Main": rungs})], [Task("T", ["P"])])
-    return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+    return export_runner(path, executor)
 
 
 

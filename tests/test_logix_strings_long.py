@@ -10,7 +10,7 @@ import pytest
 from softplc_lite.app import load_app
 from softplc_lite.runner import RunOptions, Runner
 
-from helpers.logix_l5x import Prog, Task, write_l5x
+from helpers.logix_l5x import Prog, Task, write_l5x, export_runner
 
 EXECUTORS = pytest.mark.parametrize("executor", ["compiled", "reference"])
 TYPES = """<DataType Name="STRING_200" Family="StringFamily" Class="User"><Members>
@@ -29,7 +29,7 @@ LONG_TEXT = "x" * 90 + "end"
 
 def runner(tmp_path, rungs, executor="compiled", tags=TAGS) -> Runner:
     path = write_l5x(tmp_path / "x.L5X", tags, [Prog("P", {"Main": rungs})], [Task("T", ["P"])], data_types=TYPES)
-    return Runner(load_app(path), RunOptions(executor=executor, fresh=True, save_state=False))
+    return export_runner(path, executor)
 
 
 def read(r, tag):
@@ -74,7 +74,7 @@ def test_a_long_strings_initial_value_is_loaded(tmp_path):
         '<Tag Name="L1" TagType="Base" DataType="STRING_200" Constant="false" ExternalAccess="Read/Write">'
         f'<Data Format="String" Length="93"><![CDATA[\'{LONG_TEXT}\']]></Data></Tag>')
     path.write_text(text, encoding="utf-8")
-    r = Runner(load_app(path), RunOptions(fresh=True, save_state=False))
+    r = export_runner(path)
     assert read(r, "L1") == LONG_TEXT
     r.close()
 
