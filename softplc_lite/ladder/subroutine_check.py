@@ -54,12 +54,18 @@ class SubroutineChecks:
         of its first rung) and its RETs with values, from the parsed text."""
         shape = self._shapes.get(number)  # every JSR to a file asks: walk it once
         if shape is None:
-            rungs = self.program.files[number].rungs
-            first = rungs[0].elements[0] if rungs and rungs[0].elements else None
-            sbr = first if isinstance(first, Instruction) and first.mnemonic == "SBR" and first.operands else None
-            rets = [ins for rung in rungs for ins in walk(rung.elements) if ins.mnemonic == "RET" and ins.operands]
-            shape = self._shapes[number] = (sbr, rets)
+            shape = self._shapes[number] = subroutine_shape(self.program, number)
         return shape
+
+
+def subroutine_shape(program, number: int) -> tuple[Instruction | None, list[Instruction]]:
+    """Program file ``number``'s SBR with parameters (the first instruction
+    of its first rung) and its RETs with values."""
+    rungs = program.files[number].rungs
+    first = rungs[0].elements[0] if rungs and rungs[0].elements else None
+    sbr = first if isinstance(first, Instruction) and first.mnemonic == "SBR" and first.operands else None
+    rets = [ins for rung in rungs for ins in walk(rung.elements) if ins.mnemonic == "RET" and ins.operands]
+    return sbr, rets
 
 
 def plural(n: int) -> str:

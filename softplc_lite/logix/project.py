@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from ..datatable import DataTable
 from ..ladder.ast import MAIN_FILE, Const, DataDecl, Instruction, Program, ProgramFile, Rung, instructions_of, walk
 from ..ladder.instr.logix import FAULT_JSR_PARAMETERS
+from ..ladder.subroutine_check import subroutine_shape
 from . import model
 from .aoi import AoiCalls, add_types
 from .initial import ValueWriter, apply_initial, data_files
@@ -166,11 +167,7 @@ def _mismatched_calls(program: Program, warnings: list) -> None:
 
     def shape(number: int):
         if number not in shapes:
-            rungs = program.files[number].rungs if number in program.files else []
-            first = rungs[0].elements[0] if rungs and rungs[0].elements else None
-            sbr = first if isinstance(first, Instruction) and first.mnemonic == "SBR" else None
-            rets = [ins for rung in rungs for ins in instructions_of(rung.elements)
-                    if ins.mnemonic == "RET" and ins.operands]
+            sbr, rets = subroutine_shape(program, number) if number in program.files else (None, [])
             shapes[number] = (len(sbr.operands) if sbr is not None else 0, [len(r.operands) for r in rets])
         return shapes[number]
 
