@@ -382,6 +382,34 @@ class ProgramFile:
     name: str | None
     rungs: list[Rung]
     pos: Pos = _pos()
+    listing: "Listing | None" = None  # a file made from text of another language (Structured Text)
+
+
+@dataclass(frozen=True)
+class Arm:
+    """One way through an IF or CASE of a :class:`Listing`: taken when rung
+    ``rung`` ran with the outcome ``taken_when`` (a condition's rung that
+    did not jump), or, ``taken_when`` None, when it ran at all (a label an
+    ELSE starts at)."""
+
+    rung: int
+    taken_when: bool | None
+    label: str  # what the arm is in the text: "IF", "ELSIF", "ELSE", "CASE 1..3", "no arm"
+    line: int  # its line in the listing, from 0
+
+
+@dataclass
+class Listing:
+    """The text a program file was made from, when it was not ladder (a
+    Logix Structured Text routine becomes rungs: logix/st_routine.py): the
+    watch view shows the text, coverage counts its statements and arms.
+    ``rung_lines[k]``: the line (from 0) rung k was made from;
+    ``statements``: the rungs that begin a statement."""
+
+    lines: list[tuple[Pos, str]]
+    rung_lines: list[int]
+    statements: list[int]
+    arms: list[Arm]
 
 
 @dataclass

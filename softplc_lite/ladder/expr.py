@@ -3,7 +3,9 @@ compiler (which turns an expression tree into Python source) and the
 reference interpreter (which walks the tree).
 
 Operators (PLC-5 CPT/CMP): ``+ - *``, ``|`` (divide; ``/`` with spaces
-around it is accepted too), ``MOD``, ``**``, ``AND OR XOR NOT`` (16-bit
+around it is accepted too), ``MOD``, ``//`` (an integer quotient truncated
+toward zero: Logix Structured Text's ``/`` of integers, never parsed from
+PLC-5 text), ``**``, ``AND OR XOR NOT`` (16-bit
 bitwise), unary ``-``, comparisons ``= <> < <= > >=`` (CMP only), and the
 functions in :data:`FUNCTIONS`.
 """
@@ -165,6 +167,8 @@ def to_python(node, operand_code: Callable[[AddressRef], str]) -> str:
         return f"_x_mul({a}, {b})" if int_bits(node) >= 1000 else f"({a} * {b})"
     if op == "|":
         return f"_x_div({a}, {b})"
+    if op == "//":
+        return f"_x_tdiv({a}, {b})"
     if op == "MOD":
         return f"_x_mod({a}, {b})"
     if op == "**":
@@ -199,6 +203,8 @@ def evaluate(node, read: Callable[[AddressRef], int | float], machine):
         return _mul(a, b)
     if op == "|":
         return machine.divide(a, b)
+    if op == "//":
+        return machine.divide_truncated(a, b)
     if op == "MOD":
         return machine.modulo(a, b)
     if op == "**":
@@ -214,7 +220,8 @@ def evaluate(node, read: Callable[[AddressRef], int | float], machine):
 
 def namespace(machine) -> dict[str, object]:
     """The helper names compiled expressions use."""
-    ns: dict[str, object] = {"_x_mul": _mul, "_x_div": machine.divide, "_x_mod": machine.modulo, "_x_pow": machine.power, "_int": _int}
+    ns: dict[str, object] = {"_x_mul": _mul, "_x_div": machine.divide, "_x_tdiv": machine.divide_truncated,
+                               "_x_mod": machine.modulo, "_x_pow": machine.power, "_int": _int}
     for name, fn in FUNCTIONS.items():
         ns[f"_fn_{name}"] = fn
     return ns

@@ -29,7 +29,7 @@ STYLES = ("mnemonic", "neutral")
 
 # Binding strength of expression operators (higher binds tighter), as in ladder.lark.
 _PREC = {"=": 1, "<>": 1, "<": 1, "<=": 1, ">": 1, ">=": 1, "OR": 2, "XOR": 3, "AND": 4,
-         "+": 5, "-": 5, "*": 6, "|": 6, "MOD": 6, "**": 7}
+         "+": 5, "-": 5, "*": 6, "|": 6, "//": 6, "MOD": 6, "**": 7}
 _UNARY, _ATOM = 8, 9
 
 

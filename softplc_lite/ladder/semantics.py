@@ -243,6 +243,16 @@ class Machine:
             return q if (a >= 0) == (b >= 0) else -q
         return a / b
 
+    def divide_truncated(self, a, b):
+        """Logix division of integers: the quotient truncated toward zero
+        (1756-RM003, "Divide (DIV)"); a float operand divides as ``/``."""
+        if b == 0:
+            return self.div_zero(a)
+        if isinstance(a, int) and isinstance(b, int):
+            q = abs(a) // abs(b)
+            return q if (a >= 0) == (b >= 0) else -q
+        return a / b
+
     def mod(self, a, b, d: array, i: int) -> None:
         self.store(self.modulo(a, b), d, i)
 

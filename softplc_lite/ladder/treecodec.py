@@ -71,7 +71,7 @@ def encode(program: Program) -> tuple:
     """(plain data, pickle bytes of the addresses and other objects)."""
     enc = _Encoder()
     files = tuple((f.number, tuple(enc.rung(r) for r in f.rungs)) for f in program.files.values())
-    shell = Program({n: A.ProgramFile(f.number, f.name, [], f.pos) for n, f in program.files.items()},
+    shell = Program({n: A.ProgramFile(f.number, f.name, [], f.pos, f.listing) for n, f in program.files.items()},
                     program.data, program.symbols)
     extra = pickle.dumps((enc.addresses, enc.others, shell), protocol=pickle.HIGHEST_PROTOCOL)
     return (tuple(enc.sources), files), extra

@@ -28,7 +28,7 @@ docs/logix.md, "Add-On Instructions", says it for users; the rules:
   in the first scan (S:FS), before the Logic: the engine has no prescan. A
   call inside an AOI's logic (nesting) is made the same way.
 - **Not run**: a source-protected AOI (its logic cannot be read), one whose
-  Logic is not RLL, one whose instance type is not held, one with an InOut
+  Logic is neither RLL nor ST, one whose instance type is not held, one with an InOut
   parameter of a type not held (MODULE): each call is a warning and its rung
   is not run. A call's wrong operand count or argument kind, or an AOI that
   calls itself, is an error at the call.
@@ -40,12 +40,13 @@ from __future__ import annotations
 
 import re
 
-from ..ladder.ast import AddressRef, Branch, Const, Instruction, Pos, ProgramFile, Rung
+from ..ladder.ast import AddressRef, Branch, Const, Instruction, Pos, ProgramFile
 from . import model
 from .expr import ExprError, number, parse_expression
 from .initial import apply_initial
 from .l5k_scan import split_commas
-from .rungs import RoutineContext, _at, _resolve_ref, translate_rung
+from .languages import LANGUAGES, routine_rungs
+from .rungs import RoutineContext, _at, _resolve_ref
 from .tags import _NAME, STATUS_FLAGS, Declared, Leaf, NotRun, PathError, Resolved, TagDirectory
 from .types import PREDEFINED, MemberType, LogixType, TypeSystem
 
@@ -279,7 +280,7 @@ class AoiCalls:
         logic = routines.get("LOGIC")
         if logic is None or logic.encoded:
             return not_run("its Logic routine is not in the export")
-        if logic.kind != "RLL":
+        if logic.kind not in LANGUAGES:
             return not_run(f"its Logic routine is {logic.kind}: not yet run by softplc_lite")
         if aoi.name.upper() in self.stack:
             chain = " -> ".join(self.defs[k].name for k in self.stack[self.stack.index(aoi.name.upper()):] +
@@ -394,7 +395,7 @@ class AoiCalls:
         routine = next((r for r in aoi.routines if r.name.upper() == name), None)
         if routine is None or (aoi.scan_modes is not None and name not in aoi.scan_modes):
             return None
-        if routine.kind != "RLL" or routine.encoded:
+        if routine.kind not in LANGUAGES or routine.encoded:
             kind = "source protected" if routine.encoded else routine.kind
             ctx.warn(pos, f"{label}: its {routine.name} routine is {kind}: not run by softplc_lite")
             return None
@@ -468,11 +469,8 @@ class AoiCalls:
         inner = RoutineContext(names, ctx.scope, {}, ctx.source, f"{aoi.name}.{routine.name}")
         inner.aoi = self
         self.stack.append(aoi.name.upper())
-        rungs = []
         try:
-            for r in routine.rungs:
-                out = translate_rung(r, inner)
-                rungs.append(out if out is not None else Rung([Instruction("NOP", [], r.pos)], r.comment, r.pos))
+            rungs, listing = routine_rungs(routine, inner)
         finally:
             self.stack.pop()
         for source, into in ((inner.problems, ctx.problems), (inner.warnings, ctx.warnings)):
@@ -485,7 +483,7 @@ class AoiCalls:
         shown = re.sub(r"__AOI[0-9]+", lambda m: self.hidden[m.group(0)].tag.name
                        if isinstance(self.hidden.get(m.group(0)), Declared) else "?", inst)
         name = f"{ctx.scope + '.' if ctx.scope else ''}{aoi.name}.{routine.name}({shown})"
-        self.made.append((ProgramFile(0, name, rungs, routine.pos), jsr))
+        self.made.append((ProgramFile(0, name, rungs, routine.pos, listing), jsr))
         return jsr
 
     def check_uncalled(self, source: str, problems: list, warnings: list) -> None:
@@ -497,7 +495,7 @@ class AoiCalls:
             routines = {r.name.upper(): r for r in aoi.routines}
             logic = routines.get("LOGIC")
             if key in self.called or aoi.encoded or t is None or t.kind != "struct" or logic is None \
-                    or logic.kind != "RLL" or logic.encoded:
+                    or logic.kind not in LANGUAGES or logic.encoded:
                 continue
             inst = self._hidden_tag(aoi.name, t, ())
             mapping = {m.name.upper(): f"{inst}.{m.name}" for m in _members(aoi)}
@@ -510,7 +508,7 @@ class AoiCalls:
             ctx = RoutineContext(self.directory, None, {}, source, aoi.name)
             for name in ("LOGIC", "ENABLEINFALSE", "PRESCAN"):
                 r = routines.get(name)
-                if r is not None and r.kind == "RLL" and not r.encoded:
+                if r is not None and r.kind in LANGUAGES and not r.encoded:
                     self._routine(aoi, r, mapping, "not called", ctx, r.pos)
             problems += ctx.problems
             warnings += ctx.warnings

@@ -21,14 +21,16 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from ..datatable import DataTable
-from ..ladder.ast import MAIN_FILE, Const, DataDecl, Instruction, Program, ProgramFile, Rung, instructions_of, walk
+from ..ladder.ast import (MAIN_FILE, Const, DataDecl, Instruction, Listing, Program, ProgramFile, Rung, instructions_of,
+                          walk)
 from ..ladder.instr.logix import FAULT_JSR_PARAMETERS
 from ..ladder.subroutine_check import subroutine_shape
 from . import model
 from .aoi import AoiCalls, add_types
 from .initial import ValueWriter, apply_initial, data_files
 from .modules import declare_module_tags
-from .rungs import RoutineContext, translate_rung
+from .languages import routine_rungs
+from .rungs import RoutineContext
 from .subroutines import Subroutines
 from .tags import TagDirectory, TagSymbols
 from .tasks import Schedule
@@ -51,6 +53,8 @@ class LogixProgram:
     # RLL rungs of the export: how many, how many were made into ladder rungs that run, how many are
     # kept as a NOP (a warning says why), how many have errors (benchmarks/logix_corpus.py counts them)
     rungs: dict[str, int] = field(default_factory=lambda: {"total": 0, "run": 0, "not run": 0, "errors": 0})
+    # ST statements, counted alike
+    statements: dict[str, int] = field(default_factory=lambda: {"total": 0, "run": 0, "not run": 0, "errors": 0})
 
 
 def build_program(project: model.Project) -> LogixProgram:
@@ -90,10 +94,10 @@ def build_program(project: model.Project) -> LogixProgram:
         calls = Subroutines(prog, directory)
         for routine in prog.routines:
             file_number = routines[routine.name.upper()]
-            rungs = _routine_rungs(routine, prog, directory, routines, project.source, problems, warnings,
-                                   result.rungs, not_passed, file_number, aois, calls)
+            rungs, listing = _routine_rungs(routine, prog, directory, routines, project.source, problems, warnings,
+                                            result, not_passed, file_number, aois, calls)
             result.program.files[file_number] = ProgramFile(file_number, f"{prog.name}.{routine.name}", rungs,
-                                                            routine.pos)
+                                                            routine.pos, listing)
         _calls_not_run(prog, routines, result.program.files, not_passed, warnings, result.rungs)
     aois.check_uncalled(project.source, problems, warnings)
     made = aois.files(number)
@@ -110,31 +114,22 @@ def build_program(project: model.Project) -> LogixProgram:
     return result
 
 
-def _routine_rungs(routine, prog, directory, routines, source, problems, warnings, counts, not_passed,
-                   file_number, aois=None, calls=None) -> list[Rung]:
-    if routine.kind != "RLL":
+def _routine_rungs(routine, prog, directory, routines, source, problems, warnings, result, not_passed,
+                   file_number, aois=None, calls=None) -> tuple[list[Rung], Listing | None]:
+    if routine.kind not in ("RLL", "ST"):
         kind = NOT_RUN_KINDS.get(routine.kind, routine.kind)
         warnings.append(model.Problem(routine.pos, f"routine {prog.name}.{routine.name} is {kind}: not yet run "
                                                    f"by softplc_lite"))
-        return []
+        return [], None
     ctx = RoutineContext(directory, prog.name, routines, source, f"{prog.name}.{routine.name}")
     ctx.aoi = aois
     ctx.calls, ctx.name = calls, routine.name
-    rungs = []
-    for rung in routine.rungs:
-        translated = translate_rung(rung, ctx)
-        counts["total"] += 1
-        if translated is None:  # its problems are errors: the program does not run
-            translated = Rung([Instruction("NOP", [], rung.pos)], rung.comment, rung.pos)
-            counts["errors"] += 1
-        else:
-            counts["not run" if ctx.skip else "run"] += 1
-        rungs.append(translated)
+    rungs, listing = routine_rungs(routine, ctx, result.rungs, result.statements)
     problems += ctx.problems
     warnings += ctx.warnings
     if ctx.parameters_not_run:
         not_passed.add(file_number)
-    return rungs
+    return rungs, listing
 
 
 def _calls_not_run(prog, routines, files, not_passed, warnings, counts) -> None:

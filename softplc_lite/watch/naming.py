@@ -18,7 +18,7 @@ from ..ladder.instr.logix import LOGIX_NAMES
 from ..logix.names import OperandNames
 from ..logix.tags import TagSymbols
 
-LOGIX_OPERATORS = {"|": "/"}  # the ladder's operators Logix writes otherwise (1756-RM003, "CPT")
+LOGIX_OPERATORS = {"|": "/", "//": "/"}  # the ladder's operators Logix writes otherwise (1756-RM003, "CPT")
 
 
 class SymbolNames:

@@ -12,7 +12,7 @@ from xml.sax.saxutils import escape
 @dataclass
 class Prog:
     name: str
-    routines: dict[str, list[str]]  # routine name -> rung texts, in order
+    routines: dict[str, list[str] | str]  # routine name -> rung texts, in order; or Structured Text, one string
     main: str | None = None  # the first routine when None
     disabled: bool = False
     tags: list[tuple[str, str]] = field(default_factory=list)  # (name, data type)
@@ -54,6 +54,12 @@ def l5x_text(tags: list[tuple[str, str]], programs: list[Prog], tasks: list[Task
                    f'Disabled="{str(p.disabled).lower()}" UseAsFolder="false">')
         out += ["<Tags>"] + [_tag(n, t) for n, t in p.tags] + ["</Tags>", "<Routines>"]
         for routine, rungs in p.routines.items():
+            if isinstance(rungs, str):
+                out += [f'<Routine Name="{routine}" Type="ST">', "<STContent>"]
+                for k, line in enumerate(rungs.split("\n")):
+                    out += [f'<Line Number="{k}">', f"<![CDATA[{line}]]>", "</Line>"]
+                out += ["</STContent>", "</Routine>"]
+                continue
             out += [f'<Routine Name="{routine}" Type="RLL">', "<RLLContent>"]
             for k, text in enumerate(rungs):
                 out += [f'<Rung Number="{k}" Type="N">', "<Text>", f"<![CDATA[{text}]]>", "</Text>", "</Rung>"]
