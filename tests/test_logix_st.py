@@ -203,3 +203,21 @@ def test_what_is_not_run_is_a_warning_and_the_rest_runs(tmp_path):
     assert read_tag(r, "Count") == 2
     said = [str(w) for w in r.app.logix.warnings]
     assert any("MSG" in w for w in said)
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_a_bool_in_an_expression_is_0_or_1(tmp_path, executor):
+    # BOOL tags are bits of words in the ladder: in ST's CMP and CPT they read as 0 or 1
+    st = ("IF NOT Flag AND NOT Big THEN Out := 1; END_IF;\n"
+          "n := Out * 10 + Flag - Big;\nSum := Out;\nr := Out + 0.5;\nIF Flag = Big THEN Sel := 7; END_IF;")
+    r = run_st(tmp_path, executor, st, values={"Flag": 0, "Big": 0})
+    assert [read_tag(r, t) for t in ("Out", "n", "Sum", "r", "Sel")] == [1, 10, 1, 1.5, 7]
+    r = run_st(tmp_path, executor, st, values={"Flag": 1, "Big": 0, "Out": 0})
+    assert [read_tag(r, t) for t in ("Out", "n", "Sum", "Sel")] == [0, 1, 0, 0]
+
+
+def test_a_bool_in_a_ladder_expression_is_still_refused(tmp_path):
+    path = write_l5x(tmp_path / "rll.L5X", TAGS, [Prog("MainProgram", {"Main": ["CPT(n,Flag+1);"]})],
+                     [Task("T", ["MainProgram"])])
+    with pytest.raises(AppError, match="is a bit; expressions take words"):
+        load_app(path)

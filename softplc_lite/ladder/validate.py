@@ -102,6 +102,7 @@ class _Checker(SubroutineChecks):
         self.symbols = SymbolIndex(program.symbols)
         self._shapes: dict[int, tuple] = {}  # subroutine_shape, per program file
         self._plans: dict[str, _Plan | None] = {}  # plan, per mnemonic as written
+        self.bits_are_values = False  # in the file being checked: a Structured Text routine's rungs
 
     def error(self, pos, message: str) -> None:
         self.errors.append(LadderError(pos, message))
@@ -167,7 +168,10 @@ class _Checker(SubroutineChecks):
             return None
         ok = True
         for leaf in leaves(operand):
-            if isinstance(leaf, AddressRef) and leaf.address.kind not in _NUMERIC:
+            # A BOOL is 0 or 1 in a Structured Text expression (1756-PM007, "Expressions"); the
+            # executors read a bit leaf so. Ladder text keeps PLC-5's rule: words, floats, numbers.
+            if isinstance(leaf, AddressRef) and leaf.address.kind not in _NUMERIC \
+                    and not (self.bits_are_values and leaf.address.kind is ValueKind.BIT):
                 self.error(leaf.pos, f"{leaf.address} is a {leaf.address.kind.value}; expressions "
                            "take words, floats and numbers")
                 ok = False
@@ -413,6 +417,7 @@ class _Checker(SubroutineChecks):
             self.error(first.pos, "the program has no main file 2 (rungs before any FILE header go there)")
         resolved = Program(data=prog.data, symbols=prog.symbols)
         for number, pfile in prog.files.items():
+            self.bits_are_values = pfile.listing is not None
             labels: dict[int, Rung] = {}
             for rung in pfile.rungs:
                 if rung.elements and isinstance(rung.elements[0], Instruction) and rung.elements[0].mnemonic == "LBL":
