@@ -1,7 +1,9 @@
 """How much of the Studio 5000 exports out there softplc_lite runs: over a
 set of exports, the share of files that load, the share of their RLL rungs
-that are made into rungs that run, and the share of files that run 1,000
-scans without a major fault; with the causes of the rest, counted.
+that are made into rungs that run, the share of their Structured Text
+statements that run, and the share of files that run 1,000 scans without a
+major fault; with the causes of the rest, counted (those in ST routines
+apart, by the construct or instruction they name).
 
     python benchmarks/logix_corpus.py                       # the exports in this repository
     python benchmarks/logix_corpus.py --list FILES.txt      # a gathered corpus: one path a line
@@ -59,6 +61,45 @@ def _cause(text: str) -> str:
     return text[:110]
 
 
+def _st_cause(text: str) -> str:
+    """An ST problem's kind: as ``_cause``, the tag path it starts with
+    taken out too, so the construct or instruction it names is what counts."""
+    text = re.sub(r"^routine \S+: ", "", text)
+    text = re.sub(r"^[A-Za-z_][\w:]*(?:\.[\w.]*|\[[^\]]*\])[\w.\[\]]*: ", "", text)
+    return _cause(text)
+
+
+def _st_spans(project) -> list[tuple[int, int]]:
+    """The export's lines each Structured Text routine (a program's or an
+    Add-On Instruction's) spans: a problem placed there is the ST's."""
+    spans = []
+    routines = [r for p in project.programs for r in p.routines]
+    routines += [r for a in project.add_on_instructions for r in a.routines]
+    for r in routines:
+        if r.kind == "ST" and r.lines:
+            lines = [x.pos.line for x in r.lines if x.pos.line]
+            if lines:
+                last = r.lines[-1]
+                spans.append((min(lines + [r.pos.line or lines[0]]), max(lines) + last.text.count("\n")))
+    return spans
+
+
+def _in_st(problem, spans) -> bool:
+    line = getattr(getattr(problem, "pos", None), "line", 0) or 0
+    return any(a <= line <= b for a, b in spans)
+
+
+def _st_fault(app, fault) -> str | None:
+    """The ST line a fault happened on (``routine:line: text``), if its
+    program file is a Structured Text routine."""
+    pfile = app.program.files.get(fault.file) if fault.file is not None else None
+    listing = getattr(pfile, "listing", None)
+    if listing is None or fault.rung is None or fault.rung >= len(listing.rung_lines):
+        return None
+    pos, text = listing.lines[listing.rung_lines[fault.rung]]
+    return f"{pfile.name}:{pos.line}: {text.strip()[:80]}"
+
+
 def measure_one(path: str) -> dict:
     """One export: read, made into a program, checked, run; what happened."""
     from softplc_lite.app import AppError, load_app
@@ -75,12 +116,24 @@ def measure_one(path: str) -> dict:
         out.update(stage="read", causes=[_cause(p.message) for p in e.problems][:20])
         return out
     made = build_program(project)
+    spans = _st_spans(project)
+    out["st_routines"] = len(spans)
     out["rungs"] = dict(made.rungs)
-    out["warnings"] = [_cause(w.message) for w in made.warnings]
+    # None where the loader does not count ST statements (one that does not run ST)
+    out["statements"] = dict(made.statements) if hasattr(made, "statements") else None
+    out["warnings"] = [_cause(w.message) for w in made.warnings if not _in_st(w, spans)]
+    out["st_warnings"] = [_st_cause(w.message) for w in made.warnings if _in_st(w, spans)]
+    out["st_errors"] = [_st_cause(p.message) for p in made.problems if _in_st(p, spans)]
+    out["st_first_error"] = next((f"{p.pos.line}:{p.pos.column}: {p.message}"[:200]
+                                  for p in made.problems if _in_st(p, spans)), None)
     try:
         app = load_app(path)
     except AppError as e:
-        out.update(stage="load", causes=[_cause(getattr(x, "message", str(x))) for x in (e.errors or [str(e)])][:50])
+        errors = e.errors or [str(e)]
+        out.update(stage="load", causes=[_cause(getattr(x, "message", str(x))) for x in errors if not _in_st(x, spans)][:50])
+        out["st_causes"] = [_st_cause(getattr(x, "message", str(x))) for x in errors if _in_st(x, spans)][:50]
+        out["st_first_error"] = out["st_first_error"] or next(
+            (f"{x.pos.line}:{x.pos.column}: {x.message}"[:200] for x in errors if _in_st(x, spans)), None)
         return out
     out["load_s"] = time.perf_counter() - t0
     runner = Runner(app, RunOptions(fresh=True, save_state=False))
@@ -91,6 +144,9 @@ def measure_one(path: str) -> dict:
         fault = runner.engine.fault
         out.update(stage="ran" if fault is None else "faulted", scans=runner.engine.scans,
                    causes=[] if fault is None else [_cause(str(fault))])
+        if fault is not None:
+            out["st_fault"] = _st_fault(app, fault)
+            out["fault"] = str(fault)[:200]
     finally:
         runner.close()
     return out
@@ -125,6 +181,41 @@ def measure(path: Path) -> dict:
     return result
 
 
+def _print_st(results: list[dict], statements: Counter) -> None:
+    with_st = [r for r in results if r.get("st_routines")]
+    routines = sum(r["st_routines"] for r in with_st)
+    print(f"  Structured Text: {routines} routines in {len(with_st)} exports", end="")
+    if not any(r.get("statements") is not None for r in results):
+        print(": this version does not count ST statements (it runs none)")
+        return
+    total = statements["total"]
+    print(f"; ST statements: {total}: run {statements['run']} ({100 * statements['run'] / max(total, 1):.1f}%), "
+          f"not run {statements['not run']} ({100 * statements['not run'] / max(total, 1):.1f}%), "
+          f"with errors {statements['errors']} ({100 * statements['errors'] / max(total, 1):.1f}%)")
+
+
+def _print_st_causes(results: list[dict]) -> None:
+    """What stops the ST: warnings (not run) and errors by kind, then each
+    export that does not load or faults because of its ST, with the message."""
+    for title, key in (("ST: what is not run (files with the warning)", "st_warnings"),
+                       ("ST: errors of the translation (files with the error)", "st_errors"),
+                       ("ST: errors of the check of its rungs (files with the error)", "st_causes")):
+        counted = Counter(c for r in results for c in set(r.get(key, [])))
+        if counted:
+            print(f"  {title}:")
+            for cause, count in counted.most_common(30):
+                print(f"    {count:4}  {cause}")
+    stopped = [r for r in results if r["stage"] == "load" and r.get("st_causes") or r.get("st_fault")]
+    if stopped:
+        print("  exports that do not load or fault because of their ST:")
+        for r in stopped:
+            if r.get("st_fault"):
+                print(f"    faults  {r['file']}: {r['st_fault']}: {r['fault']}")
+            else:
+                alone = "" if not r.get("causes") else f" (and {len(r['causes'])} other problems)"
+                print(f"    no load {r['file']}: {r['st_first_error']}{alone}")
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("paths", nargs="*")
@@ -141,9 +232,10 @@ def main() -> int:
     n = len(results)
     stages = Counter(r["stage"] for r in results)
     loaded = sum(1 for r in results if r["stage"] in ("ran", "faulted"))
-    rungs = Counter()
+    rungs, statements = Counter(), Counter()
     for r in results:
         rungs.update(r["rungs"])
+        statements.update(r.get("statements") or {})
     print(f"{n} exports")
     print(f"  load: {loaded} ({100 * loaded / max(n, 1):.1f}%)   (read but not loaded: {stages['load']}, "
           f"not read: {stages['read']}, crashed: {stages['crashed']}, timed out: {stages['timed out']})")
@@ -151,6 +243,7 @@ def main() -> int:
     print(f"  RLL rungs: {total}: made into rungs that run {rungs['run']} ({100 * rungs['run'] / max(total, 1):.1f}%), "
           f"kept as NOP (not run yet) {rungs['not run']} ({100 * rungs['not run'] / max(total, 1):.1f}%), "
           f"with errors {rungs['errors']} ({100 * rungs['errors'] / max(total, 1):.1f}%)")
+    _print_st(results, statements)
     print(f"  ran {SCANS} scans without a major fault: {stages['ran']} ({100 * stages['ran'] / max(n, 1):.1f}% of all, "
           f"{100 * stages['ran'] / max(loaded, 1):.1f}% of those loaded); faulted: {stages['faulted']}")
     ran = [r for r in results if r["stage"] in ("ran", "faulted") and r["rungs"]["total"]]
@@ -167,7 +260,9 @@ def main() -> int:
             print(f"  {title}:")
             for cause, count in counted.most_common(25):
                 print(f"    {count:4}  {cause}")
-    figures = {"files": n, "stages": dict(stages), "rungs": dict(rungs), "results": results}
+    _print_st_causes(results)
+    figures = {"files": n, "stages": dict(stages), "rungs": dict(rungs), "statements": dict(statements),
+               "results": results}
     C.save_figures("logix_corpus", figures, args.no_save, args.json)
     return 0
 
