@@ -73,5 +73,7 @@ def test_an_l5k_export_prints_the_same_form():
     assert lines[:4] == ["PROGRAM MainProgram", "    ROUTINE MainRoutine",
                          '        RC: "Fill for five seconds while the tank runs";',
                          "        N: XIC(Tank1.Running)TON(T1,?,?);"]
-    assert "    ROUTINE Calc" in lines and "        // Structured Text: fmt prints RLL routines" in lines
+    at = lines.index("    ST_ROUTINE Calc")  # the L5K form of an ST routine: its lines, each after a '
+    assert lines[at:at + 4] == ["    ST_ROUTINE Calc", "        'Count := Count + 1;", "        'Levels[1] := Count;",
+                                "    END_ST_ROUTINE"]
     assert lines.count("END_PROGRAM") == 2

@@ -4,12 +4,13 @@ never the export rewritten (docs/logix.md, "fmt and an export").
 The export is Studio 5000's file: its layout, its data and what it holds
 beside the rungs are Studio's to write, so fmt neither rewrites nor checks
 the layout of an export (``--write`` and ``--check`` refuse one, a choice).
-What it prints is each program's RLL routines in the routine form of an L5K
-export (1756-RM084, "Logix 5000 Controllers Import/Export": ``ROUTINE``
-blocks of ``RC:`` rung comments and ``N:`` rungs), one rung a line, its
-neutral text as the export has it (tag names, ``?`` operands and all), its
-surrounding blanks trimmed. A routine in another language is named with
-what it is. An export softplc check refuses is refused the same way, every
+What it prints is each program's RLL and ST routines in the routine forms
+of an L5K export (1756-RM084, "Logix 5000 Controllers Import/Export":
+``ROUTINE`` blocks of ``RC:`` rung comments and ``N:`` rungs, one rung a
+line, its neutral text as the export has it, tag names, ``?`` operands and
+all, its surrounding blanks trimmed; ``ST_ROUTINE`` blocks of the routine's
+lines as written, each after a ``'``). A routine in another language (FBD,
+SFC) is named with what it is. An export softplc check refuses is refused the same way, every
 problem at once.
 """
 
@@ -23,7 +24,7 @@ from ..logix.model import ExportError, Project
 from ..logix.project import build_program
 
 SUFFIXES = (".l5x", ".l5k")
-LANGUAGES = {"ST": "Structured Text", "FBD": "Function Block Diagram", "SFC": "Sequential Function Chart"}
+LANGUAGES = {"FBD": "Function Block Diagram", "SFC": "Sequential Function Chart"}
 
 
 def is_export(path: str) -> bool:
@@ -56,9 +57,14 @@ def routines_text(project: Project) -> str:
     for prog in project.programs:
         out.append(f"PROGRAM {prog.name}")
         for routine in prog.routines:
+            if routine.kind == "ST" and not routine.encoded:
+                out.append(f"    ST_ROUTINE {routine.name}")
+                out += [f"        '{line.text.rstrip()}" for line in routine.lines]
+                out.append("    END_ST_ROUTINE")
+                continue
             out.append(f"    ROUTINE {routine.name}")
             if routine.kind != "RLL":
-                out.append(f"        // {LANGUAGES.get(routine.kind, routine.kind)}: fmt prints RLL routines")
+                out.append(f"        // {LANGUAGES.get(routine.kind, routine.kind)}: fmt prints RLL and ST routines")
             elif routine.encoded:
                 out.append("        // source-protected: its rungs cannot be read")
             for rung in routine.rungs if routine.kind == "RLL" else ():
