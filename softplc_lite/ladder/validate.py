@@ -179,7 +179,7 @@ class _Checker(SubroutineChecks):
         if mnemonic in ("CMP", "FSC") and not top_is_compare:
             self.error(_pos(operand), f"{mnemonic} needs a comparison (=, <>, <, <=, >, >=) at the top of its expression")
             ok = False
-        if mnemonic not in ("CMP", "FSC") and _has_compare(operand):
+        if mnemonic not in ("CMP", "FSC") and _has_compare(operand) and not self.bits_are_values:
             self.error(_pos(operand), f"{mnemonic} computes a value; comparisons belong in CMP")
             ok = False
         return operand if ok else None
