@@ -168,6 +168,21 @@ class CompiledFile:
         self.tables.update(old.tables)
         return self.block_index(rung)
 
+    def split_rungs(self) -> None:
+        """Make every rung a block of its own (each old block compiled again,
+        rung by rung): the watch view wraps each to see which rungs ran. The
+        file scans as before; a block call a rung is the cost, paid only
+        by a file split so."""
+        if len(self.blocks) == self.rung_count:
+            return
+        parts = CompiledFile(self.number, self.rung_count, self.has_mcr, self.compiler)
+        for rung in range(self.rung_count):
+            parts.add(self.compiler.block(rung, rung + 1))
+        self.blocks[:] = parts.blocks
+        self.starts[:] = parts.starts
+        self.modules[:] = parts.modules
+        self.tables = parts.tables
+
     # -- for people and tests ---------------------------------------------------------------------
     @property
     def source(self) -> str:

@@ -7,7 +7,10 @@
   one rung's callable, so rungs without a breakpoint cost nothing; the
   rung condition is evaluated on the values the rung reads, just before
   it runs (a self-resetting timer, ``XIO T4:0/DN TON T4:0``, is true in
-  the scan its DN goes on and false in the next).
+  the scan its DN goes on and false in the next). In a Structured Text
+  routine (its rungs are its statements, st_view.py) the breakpoint is on
+  a line's first rung and stops when that rung runs at all: a statement
+  has no rung condition (an IF's test rung is false when the IF is taken).
 - **Condition breakpoint** (``--break-when "N7:0 > 100"``, ``--break-when
   R6:0/ER``): a CMP-style expression, or a bit address, checked after each
   scan; running stops when it goes from false to true.
@@ -145,13 +148,15 @@ class Breakpoints:
         k = compiled.isolate(rung)
         original = compiled.blocks[k]
         self._original[key] = original
-        source = self.engine.program.files[file].rungs[rung]
+        pfile = self.engine.program.files[file]
+        source = pfile.rungs[rung]
         table = self.engine.table
+        power = self.rung_power if pfile.listing is None else None
 
         def watched(c, original=original, source=source, key=key):
             # the rung condition on the values the rung reads: before it runs, so a
             # rung that writes what it reads (XIO T4:0/DN TON T4:0) is judged as scanned
-            energized = c and (self.rung_power is None or bool(self.rung_power(source, table).out))
+            energized = c and (power is None or bool(power(source, table).out))
             result = original(c)
             if energized:
                 self.hits.append(Hit(self.engine.scans + 1, key[0], key[1]))

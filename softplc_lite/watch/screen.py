@@ -212,7 +212,13 @@ class RungsPanel:
         files = s.app.program.files
         label, labels = s.naming.what_files
         line.append(f" {label} {s.naming.file_label(files[s.file])}", style="bold underline")
-        line.append(f"  rung {s.selected} of {len(s.rungs)}", style="bold")
+        st = s.listing
+        if st is None:
+            line.append(f"  rung {s.selected} of {len(s.rungs)}", style="bold")
+        else:  # a Structured Text routine is shown as its text (st_view.py)
+            line.append(f"  line {st.line_of(s.selected) + 1} of {st.count}", style="bold")
+            ran = f"  ● ran in scan {s.engine.scans}" if s.history.live else "  ● ran: newest scan only, not shown"
+            line.append(ran, style="dim")
         line.append(f"  comments {s.comments}" if s.comments != "full" else "", style="dim")
         if len(files) > 1:
             line.append(f"  {labels}: " + "  ".join(s.naming.file_label(files[n]) for n in s.files), style="dim")
@@ -293,6 +299,17 @@ def rung_view(session: WatchSession, height: int):
 
     s = session
     pfile = s.app.program.files[s.file] if s.file is not None else ProgramFile(2, None, [])  # none: "(no rungs)"
+    st = s.listing
+    if st is not None:  # a Structured Text routine: its text, values and the lines that ran (st_view.py)
+        from .st_view import StView
+
+        def scrolled(top: int) -> None:
+            s.top = top
+
+        ran = s.ran.last_scan(s.file) if s.history.live else None
+        return StView(pfile, st, s.engine.table, s.naming.for_file(s.file), ran, s.selected, top=s.top,
+                      height=height, breakpoints=frozenset(s.breaks.rungs), forced=frozenset(s.forces.forces),
+                      scrolled=scrolled)
     return ProgramFileView(pfile, s.engine.table, symbols=s.naming.for_file(s.file),
                            first=s.top, selected=s.selected, breakpoints=frozenset(s.breaks.rungs),
                            forced=frozenset(s.forces.forces), height=height, instructions=s.app.instructions,

@@ -24,6 +24,8 @@ from .forces import Forces, parse_force
 from . import trendview
 from .history import History
 from .naming import Naming
+from .st_ran import RanRungs
+from .st_view import goto_line, st_lines
 from .watchlist import WatchList
 from .xref import Finding, XrefIndex
 
@@ -72,6 +74,8 @@ class WatchSession:
         except BaseException:
             engine.close()  # a bad --force/--break-when/--watch: release the ports opened
             raise
+        self.ran = RanRungs(engine)  # which rungs of the ST routines ran (st_ran.py); before any breakpoint
+        self._st = None  # the shown ST file's lines (listing)
         if engine.mode is not Mode.RUN:
             engine.set_mode(Mode.RUN)
         self.running = False
@@ -81,6 +85,8 @@ class WatchSession:
         # the shown program file: 2 (the main one), else the first; None when there is none
         self.file: int | None = self.naming.first_file(self.files)
         self.selected = 0  # selected rung of the shown file
+        if self.listing is not None:  # an ST routine's: its first line with a statement
+            self.selected = self.listing.normal(0)
         self.top = 0  # first rung shown
         self.message = ""
         self.comments = COMMENTS[0]
@@ -211,7 +217,19 @@ class WatchSession:
         """The shown file's rungs (none when the program has no file)."""
         return self.app.program.files[self.file].rungs if self.file is not None else []
 
+    @property
+    def listing(self):
+        """The shown file's lines when it is a Structured Text routine
+        (st_view.StLines; the selection is then a line's first rung), else None."""
+        self._st = st_lines(self.app.program.files[self.file] if self.file is not None else None, self._st)
+        return self._st
+
     def move(self, delta: int) -> None:
+        st = self.listing
+        if st is not None:  # by lines holding statements; the view scrolls the line into sight (st_view.py)
+            self.selected = st.step(self.selected, delta)
+            self.top = min(self.top, st.line_of(self.selected))
+            return
         self.selected = max(0, min(len(self.rungs) - 1, self.selected + delta))
         if self.selected < self.top:
             self.top = self.selected
@@ -219,12 +237,18 @@ class WatchSession:
     def goto(self, rung: int) -> None:
         self.selected = max(0, min(len(self.rungs) - 1, rung))
         self.top = self.selected
+        if self.listing is not None:  # the top is a line of the text
+            self.selected = self.listing.normal(self.selected)
+            self.top = self.listing.line_of(self.selected)
 
     def goto_text(self, text: str) -> None:
         """The ``g`` prompt: a rung number of the shown file."""
         count = len(self.rungs)
         if not count:
             self.message = "no rung to go to"
+            return
+        if self.listing is not None:
+            goto_line(self, self.listing, text)
             return
         try:
             rung = int(text.strip())
@@ -252,6 +276,8 @@ class WatchSession:
         k = self.files.index(self.file)
         self.file = self.files[(k + 1) % len(self.files)]
         self.selected = self.top = 0
+        if self.listing is not None:
+            self.selected = self.listing.normal(0)
 
     # -- find and cross-reference, the data-file monitor (docs/watch.md) ---------------------
     def find(self, text: str) -> None:
@@ -364,6 +390,7 @@ class WatchSession:
     def _program_replaced(self, changes) -> str:
         """The view follows the new program: files, the selected rung (where
         it went), breakpoints, the last find. Returns what the message adds."""
+        self.ran.install()  # the new program's blocks, before the breakpoints wrap them
         dropped = self.breaks.program_replaced(changes)
         self.files = sorted(self.app.program.files)
         if self.file not in self.files:
