@@ -18,6 +18,10 @@ A ``Coverage`` collects, over every scan of every run recorded into it:
   An output (OTE, timers, math, JSR, ...) is "on" when power reached it,
   "off" when it did not. LBL and SBR test nothing and are not counted.
 
+A file made from Structured Text is measured the same way, rung by rung;
+its reporters read the rungs as the text's statements and arms
+(testing/coverage_st.py).
+
 How: a run with coverage scans with the reference interpreter
 (ladder/interpreter.py) through ``Recorder``, a subclass that counts as it
 goes; the compiled executor, the fast path every other run takes, has no
@@ -31,7 +35,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..ladder.ast import Branch, Instruction, Program
+from ..ladder.ast import Branch, Instruction, Listing, Program
 from ..ladder.compiler import EndScan
 from ..ladder.instructions import lookup
 from ..ladder.interpreter import Interpreter, _Jump, interpret_file
@@ -71,6 +75,7 @@ class FileInfo:
     name: str | None
     source: str  # the .lad file it was read from
     rungs: list[RungInfo] = field(default_factory=list)
+    listing: Listing | None = None  # the text the file was made from, when not ladder (testing/coverage_st.py)
 
 
 def _elements(rung_elements, found: list) -> None:
@@ -141,7 +146,7 @@ class Coverage:
             if _shape(self.files[number]) != [len(_flat(r.elements)) for r in pfile.rungs]:
                 raise ValueError(f"coverage of program file {number}: another program was recorded into it")
             return
-        info = FileInfo(number, pfile.name, pfile.pos.source, [])
+        info = FileInfo(number, pfile.name, pfile.pos.source, [], pfile.listing)
         has_mcr = any(isinstance(el, Instruction) and el.mnemonic == "MCR" for r in pfile.rungs for el in r.elements)
         for r, rung in enumerate(pfile.rungs):
             pos = rung.pos

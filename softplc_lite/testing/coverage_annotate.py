@@ -9,7 +9,16 @@ any other line (comments, declarations, FILE headers). A mark line reads
 ``  ^^^^^^^ never true``: a condition never seen true (or ``never false``),
 an output ``never on`` or ``never off``, a leg ``never powered`` (carets
 under the whole leg), the rung ``rung never true`` or ``rung never false``
-(one caret at its start)."""
+(one caret at its start).
+
+A program file made from Structured Text is marked by its text's lines
+instead (testing/coverage_st.py): the gutter of a line where statements
+start or arms are tested says ``> `` all covered, ``! `` something not,
+``- `` nothing there ran; a mark line ``^ never run`` under a statement
+that never ran on a line where others did, ``^ never taken: ELSIF`` under
+an arm never taken (``no arm (every test false)`` for an IF or CASE that
+always took one; ``FOR body``, ``WHILE body``, ``REPEAT again`` for a
+loop)."""
 
 from __future__ import annotations
 
@@ -18,7 +27,8 @@ import re
 from pathlib import Path
 
 from ..textfile import read_text
-from .coverage import Coverage, RungInfo
+from . import coverage_st
+from .coverage import Coverage, FileInfo, RungInfo
 from .coverage_outcomes import rung_outcomes
 
 BRANCH_WORDS = {"BST", "NXB", "BND", "SOR", "EOR"}
@@ -69,8 +79,12 @@ def annotate_source(cov: Coverage, source: str) -> str:
         lines.pop()
     rungs_at: dict[int, list[RungInfo]] = {}
     marks: dict[int, list[str]] = {}
+    gutters: dict[int, str] = {}  # Structured Text lines
     for info in cov.files.values():
         if os.path.abspath(info.source) != os.path.abspath(source):
+            continue
+        if info.listing is not None:
+            _text_marks(cov, info, gutters, marks)
             continue
         for rung in info.rungs:
             rungs_at.setdefault(rung.line, []).append(rung)
@@ -80,7 +94,9 @@ def annotate_source(cov: Coverage, source: str) -> str:
     out = []
     for number, text in enumerate(lines, 1):
         rungs = rungs_at.get(number, [])
-        if not rungs:
+        if number in gutters:
+            gutter = gutters[number]
+        elif not rungs:
             gutter = "  "
         elif not all(cov.executed(r.key) for r in rungs):
             gutter = "- "
@@ -91,6 +107,28 @@ def annotate_source(cov: Coverage, source: str) -> str:
         out.append((gutter + text).rstrip())
         out += ["  " + m for m in marks.get(number, [])]
     return "\n".join(out) + "\n"
+
+
+def _text_marks(cov: Coverage, info: FileInfo, gutters: dict[int, str], marks: dict[int, list[str]]) -> None:
+    """The gutters and mark lines of a Structured Text file's lines."""
+    found: dict[int, list[tuple[int, str]]] = {}  # line -> (column from 0, its mark)
+    ran: dict[int, list[bool]] = {}  # line -> whether each statement and arm test there ran
+    for s in coverage_st.statements(cov, info):
+        ran.setdefault(s.line, []).append(s.covered)
+        if not s.covered:
+            found.setdefault(s.line, []).append((s.column, "never run"))
+    for a in coverage_st.arms(cov, info):
+        ran.setdefault(a.line, []).append(a.ran)
+        if not a.covered:
+            found.setdefault(a.line, []).append((a.column, a.missing))
+    for line, flags in ran.items():
+        if not any(flags):
+            gutters[line] = "- "  # nothing there ran: nothing else is said of it
+            continue
+        ms = found.get(line, [])
+        gutters[line] = "! " if ms else "> "
+        for column, text in sorted(ms):
+            marks.setdefault(line, []).append(" " * max(column - 1, 0) + "^ " + text)
 
 
 def annotate(cov: Coverage, directory: str | Path) -> list[Path]:

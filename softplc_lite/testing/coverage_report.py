@@ -8,6 +8,11 @@ on and off. "Total" is everything covered over everything there is, a rung
 as a line and every outcome as a branch, as coverage.py's total counts
 statements and branches together; ``--fail-under`` compares it exactly (not
 the rounded figure shown).
+
+A file made from Structured Text counts its statements instead of rungs
+(a statement once, its first rung ran: "Statements") and the arms of its
+IFs, CASEs and loops instead of rung outcomes, legs, conditions and
+outputs (an arm once, taken: "Branches"; testing/coverage_st.py).
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ from rich.console import Console
 from rich.measure import Measurement
 from rich.table import Table
 
+from . import coverage_st
 from .coverage import Coverage, FileInfo
 from .coverage_outcomes import rung_outcomes
 
@@ -38,6 +44,10 @@ class Figures:
     conditions_seen: int = 0
     outputs: int = 0  # 2 an output instruction: on and off
     outputs_seen: int = 0
+    statements: int = 0  # Structured Text: 1 a statement, run
+    statements_run: int = 0
+    arms: int = 0  # Structured Text: 1 an arm of an IF, CASE or loop, taken
+    arms_taken: int = 0
 
     def add(self, other: "Figures") -> None:
         for f in fields(self):
@@ -45,20 +55,30 @@ class Figures:
 
     @property
     def branches(self) -> int:
-        """Every outcome (rung true/false, legs, conditions, outputs): a report's branches."""
-        return self.outcomes + self.legs + self.conditions + self.outputs
+        """Every outcome (rung true/false, legs, conditions, outputs; the arms
+        of Structured Text): a report's branches."""
+        return self.outcomes + self.legs + self.conditions + self.outputs + self.arms
 
     @property
     def branches_seen(self) -> int:
-        return self.outcomes_seen + self.legs_powered + self.conditions_seen + self.outputs_seen
+        return self.outcomes_seen + self.legs_powered + self.conditions_seen + self.outputs_seen + self.arms_taken
+
+    @property
+    def lines(self) -> int:
+        """What a report counts as lines: rungs, and Structured Text's statements."""
+        return self.rungs + self.statements
+
+    @property
+    def lines_run(self) -> int:
+        return self.rungs_run + self.statements_run
 
     @property
     def covered(self) -> int:
-        return self.rungs_run + self.branches_seen
+        return self.lines_run + self.branches_seen
 
     @property
     def total(self) -> int:
-        return self.rungs + self.branches
+        return self.lines + self.branches
 
     @property
     def percent(self) -> float:
@@ -79,6 +99,14 @@ def file_figures(cov: Coverage, info: FileInfo) -> Figures:
     """The figures of one program file, from the outcomes coverage_outcomes
     lists (the ones that can happen), so every report counts the same."""
     fig = Figures()
+    if info.listing is not None:
+        for s in coverage_st.statements(cov, info):
+            fig.statements += 1
+            fig.statements_run += s.covered
+        for a in coverage_st.arms(cov, info):
+            fig.arms += 1
+            fig.arms_taken += a.covered
+        return fig
     for rung in info.rungs:
         fig.rungs += 1
         fig.rungs_run += cov.executed(rung.key)
@@ -113,22 +141,61 @@ def file_label(info: FileInfo) -> str:
 
 
 def summary_table(cov: Coverage) -> Table:
+    """One row a program file; the Statements and Branches columns only when
+    a file is Structured Text, each file's row filled in its own columns."""
     per_file, total = figures(cov)
+    ladder = any(cov.files[n].listing is None for n in per_file)
+    text = any(cov.files[n].listing is not None for n in per_file)
     table = Table(box=box.SIMPLE_HEAD, show_edge=False, pad_edge=False, title=None)
     table.add_column("File")
     table.add_column("Source")
-    for name in ("Rungs", "Rung T/F", "Legs", "Conditions", "Outputs", "Total"):
+    columns = []
+    if ladder or not text:
+        columns += [("Rungs", "rungs_run", "rungs"), ("Rung T/F", "outcomes_seen", "outcomes"),
+                    ("Legs", "legs_powered", "legs"), ("Conditions", "conditions_seen", "conditions"),
+                    ("Outputs", "outputs_seen", "outputs")]
+    if text:
+        columns += [("Statements", "statements_run", "statements"), ("Branches", "arms_taken", "arms")]
+    for name, _, _ in columns:
         table.add_column(name, justify="right")
+    table.add_column("Total", justify="right")
 
-    def row(label, source, fig: Figures, **kw):
-        table.add_row(label, source, f"{fig.rungs_run}/{fig.rungs}", f"{fig.outcomes_seen}/{fig.outcomes}",
-                      f"{fig.legs_powered}/{fig.legs}", f"{fig.conditions_seen}/{fig.conditions}",
-                      f"{fig.outputs_seen}/{fig.outputs}", percent_text(fig.covered, fig.total), **kw)
+    def row(label, source, fig: Figures, st: bool | None):
+        cells = []
+        for name, seen, of in columns:
+            mine = st is None or (name in ("Statements", "Branches")) == st
+            cells.append(f"{getattr(fig, seen)}/{getattr(fig, of)}" if mine else "")
+        table.add_row(label, source, *cells, percent_text(fig.covered, fig.total))
     for number, fig in per_file.items():
-        row(file_label(cov.files[number]), Path(cov.files[number].source).name, fig)
+        info = cov.files[number]
+        row(file_label(info), Path(info.source).name, fig, info.listing is not None)
     if len(per_file) > 1:
-        row("TOTAL", "", total)
+        row("TOTAL", "", total, None)
     return table
+
+
+def missing_lines(cov: Coverage) -> list[str]:
+    """Under the table, for each Structured Text file with something not
+    covered: its statements never run and its arms never taken, by their
+    place in the export (as coverage.py's report shows missing lines)."""
+    out = []
+    for number in sorted(cov.files):
+        info = cov.files[number]
+        if info.listing is None:
+            continue
+        name = Path(info.source).name
+        parts = []
+        never = [s for s in coverage_st.statements(cov, info) if not s.covered]
+        if never:
+            lines = list(dict.fromkeys(s.line for s in never))
+            parts.append(f"statements never run: {'line' if len(lines) == 1 else 'lines'} "
+                         + ", ".join(map(str, lines)))
+        missed = [a for a in coverage_st.arms(cov, info) if not a.covered]
+        if missed:
+            parts.append("arms never taken: " + ", ".join(f"{a.arm.label} (line {a.line})" for a in missed))
+        if parts:
+            out.append(f"{file_label(info)} ({name}): " + "; ".join(parts))
+    return out
 
 
 def print_summary(cov: Coverage, console: Console) -> None:
@@ -140,5 +207,7 @@ def print_summary(cov: Coverage, console: Console) -> None:
     console.width = max(width, narrow)
     try:
         console.print(table)
+        for line in missing_lines(cov):
+            console.print(line, highlight=False, markup=False, soft_wrap=True)
     finally:
         console.width = narrow
