@@ -6,6 +6,8 @@ Positional data (L5K) lists a structure's members in the type's order,
 hidden members included and BOOL members left out: their values are the
 bits of their host, as Logix stores them (1756-RM084, "Tag data in L5K
 format"). An array's elements come in row-major order, flat or nested.
+The positional value of a function-block structure (FBD_TIMER ...) is not
+read: its layout is not published (types.py).
 """
 
 from __future__ import annotations
@@ -167,6 +169,8 @@ def apply_initial(d: Declared, writer: ValueWriter, problems: list[Problem]) -> 
     def struct(t: LogixType, path, k, value):
         if not isinstance(value, (dict, list)):
             bad(f"expected the members of a {t.name}, found {value!r}")
+            return
+        if positional and not t.positional:  # a layout of Logix's own (types.py): the value is not read
             return
         stored = [m for m in t.members if m.host is None]
         for index, m in enumerate(stored):

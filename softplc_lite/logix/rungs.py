@@ -15,14 +15,14 @@ in the structure (``TON(T1,?,?)``: written as ``?`` or a value, not used).
 
 Instructions whose operands need more than a letter (``HANDLERS``: COP, CPS and
 FLL by member, the string instructions, SIZE, compares and moves of strings,
-BTD, SWPB, TRN, GSV and SSV) are translated by copy.py, strings.py, bits.py and
-system.py.
+BTD, SWPB, TRN, GSV and SSV, the function-block TONR ... OSFI) are translated
+by copy.py, strings.py, bits.py, system.py and fbd.py.
 """
 
 from __future__ import annotations
 
 from ..ladder.ast import AddressRef, Branch, Const, Instruction, Pos, Rung
-from . import bits, copy, model, strings, subroutines, system
+from . import bits, copy, fbd, model, strings, subroutines, system
 from .expr import ExprError, number, parse_expression
 from .neutral import NBranch, NeutralError, parse_rung
 from .tags import NotRun, PathError, TagDirectory
@@ -54,7 +54,8 @@ NOT_RUN_REASON = {"MSG": "a message to another device; softplc_lite has no netwo
 HANDLERS = {**{m: copy.translate for m in ("COP", "CPS", "FLL")},
             **{m: strings.translate for m in (*strings.PLAN, "SIZE", *strings.COMPARES, "MOV", "MOVE")},
             "GSV": system.translate, "SSV": system.translate,
-            **{m: bits.translate for m in ("BTD", "SWPB", "TRN")}}
+            **{m: bits.translate for m in ("BTD", "SWPB", "TRN")},
+            **{m: fbd.translate for m in fbd.CALLS}}
 
 
 class RoutineContext:
@@ -77,6 +78,7 @@ class RoutineContext:
         self.aoi = None  # the project's Add-On Instructions (logix/aoi.py AoiCalls): calls to them
         self.calls = None  # the program's routines' parameter plans (logix/subroutines.py Subroutines)
         self.name = routine  # the routine's own name in its program
+        self.language = "RLL"  # or "ST" (st_routine.py): the function-block instructions are ST's alone
 
     def warn(self, pos: Pos, message: str) -> None:
         self.warnings.append(model.Problem(pos, f"routine {self.routine}: {message}"))

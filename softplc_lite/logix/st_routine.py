@@ -56,6 +56,7 @@ class StRoutine:
     def __init__(self, routine: model.Routine, ctx) -> None:
         self.routine = routine
         self.ctx = ctx
+        ctx.language = "ST"
         self.x = Expressions(ctx)
         self.rungs: list[Rung] = []
         self.rung_lines: list[int] = []

@@ -1,6 +1,7 @@
 """Logix data types as softplc_lite lays them out: the atomic types, the
-predefined structures (TIMER, COUNTER, CONTROL, STRING) and an export's
-user-defined types, each resolved once into a ``LogixType``.
+predefined structures (TIMER, COUNTER, CONTROL, STRING, the function-block
+FBD_TIMER, FBD_COUNTER and FBD_ONESHOT) and an export's user-defined types,
+each resolved once into a ``LogixType``.
 
 A structure's members are listed as Logix lists them (1756-PM020, Logix 5000
 Controllers I/O and Tag Data: "Data Types"): a BOOL member of a user-defined
@@ -10,6 +11,17 @@ are bits of their first DINT (EN is bit 31, TT 30, DN 29 ...), which an export
 never names, so softplc_lite calls it ``CTL`` (a choice: hidden, as Logix
 hides it). STRING (and every type of the string family) is LEN and DATA;
 softplc_lite keeps a string whole in an ST element (docs/logix.md).
+
+FBD_TIMER, FBD_COUNTER and FBD_ONESHOT have the members 1756-RM003 lists
+for TONR/TOFR/RTOR, CTUD and OSRI/OSFI ("FBD_TIMER Structure" ...); Logix
+does not publish where their BOOLs are stored, so softplc_lite packs them
+into one hidden DINT, ``CTL`` again (EnableIn bit 0, then each BOOL in
+RM003's order: ladder/instr/logix_fbd.py's ``TIMER_BITS`` ...; a choice),
+with the edge memories of CTUD and the one-shots (the one-shot's hidden
+storage bit) as bits 16 and 17 of it that no member names. InstructFault and PresetInv are bits 0 and 1 of Status, as
+RM003 says (Status.0, Status.1). An export's positional (L5K) value of one
+of these types is not read, since its layout is Logix's own
+(``LogixType.positional``); the decorated value (an L5X's) is, by name.
 """
 
 from __future__ import annotations
@@ -17,6 +29,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
+from ..ladder.instr.logix_fbd import COUNTER_BITS, ONESHOT_BITS, STATUS_BITS, TIMER_BITS
 from .model import DataType, Problem
 
 # Atomic type -> (data table file type letter, bits). BOOL tags are bits of B
@@ -64,6 +77,7 @@ class LogixType:
     by_name: dict[str, MemberType] = field(default_factory=dict)
     chars: int = 0
     builtin: bool = False
+    positional: bool = True  # an export's positional (L5K) value is read in ``members``' order
 
     def member(self, name: str) -> MemberType | None:
         return self.by_name.get(name.upper())
@@ -76,8 +90,8 @@ class LogixType:
         return [m for m in self.members if not m.hidden]
 
 
-def _struct(name: str, members: list[MemberType]) -> LogixType:
-    t = LogixType(name, "struct", members=members, builtin=True)
+def _struct(name: str, members: list[MemberType], positional: bool = True) -> LogixType:
+    t = LogixType(name, "struct", members=members, builtin=True, positional=positional)
     t.by_name = {m.name.upper(): m for m in members}
     return t
 
@@ -93,7 +107,17 @@ def _dint(name: str, hidden: bool = False) -> MemberType:
     return MemberType(name, _ATOMIC_TYPES["DINT"], hidden=hidden)
 
 
-# 1756-RM003 (Logix 5000 Controllers General Instructions): TIMER, COUNTER and CONTROL structures.
+def _fbd(name: str, bits: tuple[str, ...], dints: tuple[str, ...], status: bool = False) -> LogixType:
+    """A function-block structure: ``bits`` in CTL from bit 0, then ``dints``
+    (and, for the timers, Status with InstructFault and PresetInv)."""
+    members = [_dint("CTL", True), *(_dint(n) for n in dints), *_status("CTL", *((n, k) for k, n in enumerate(bits)))]
+    if status:
+        members += [_dint("Status"), *_status("Status", *STATUS_BITS)]
+    return _struct(name, members, positional=False)
+
+
+# 1756-RM003 (Logix 5000 Controllers General Instructions): TIMER, COUNTER and CONTROL structures,
+# and the FBD_TIMER, FBD_COUNTER and FBD_ONESHOT structures of TONR, TOFR, RTOR, CTUD, OSRI, OSFI.
 PREDEFINED: dict[str, LogixType] = {
     **_ATOMIC_TYPES,
     "TIMER": _struct("TIMER", [_dint("CTL", True), _dint("PRE"), _dint("ACC"),
@@ -104,6 +128,9 @@ PREDEFINED: dict[str, LogixType] = {
                                    *_status("CTL", ("EN", 31), ("EU", 30), ("DN", 29), ("EM", 28), ("ER", 27),
                                             ("UL", 26), ("IN", 25), ("FD", 24))]),
     "STRING": LogixType("STRING", "string", letter="ST", chars=STRING_CHARS, builtin=True),
+    "FBD_TIMER": _fbd("FBD_TIMER", TIMER_BITS, ("PRE", "ACC"), status=True),
+    "FBD_COUNTER": _fbd("FBD_COUNTER", COUNTER_BITS, ("PRE", "ACC")),
+    "FBD_ONESHOT": _fbd("FBD_ONESHOT", ONESHOT_BITS, ()),
     # MESSAGE: the members a rung reads of a MSG's tag; softplc_lite sends no message (MSG is not
     # run), so its status bits stay as the export or the program leaves them (docs/logix.md).
     "MESSAGE": _struct("MESSAGE", [MemberType("FLAGS", _ATOMIC_TYPES["INT"]),

@@ -15,7 +15,8 @@ from ..bound import BoundInstruction
 
 # Group modules, in the order docs/instructions.md lists them.
 _GROUPS = ("misc", "mathfn", "convert", "pid", "shift", "sequencer", "filemath", "logix", "logix_task", "logix_aoi",
-           "logix_data", "logix_string", "logix_system", "logix_bits", "logix_st")
+           "logix_data", "logix_string", "logix_system", "logix_bits", "logix_st",
+           "logix_fbd")
 
 
 def _collect() -> dict[str, BoundInstruction]:

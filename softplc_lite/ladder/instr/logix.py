@@ -43,6 +43,7 @@ from ..semantics import MajorFault
 from ..specs import InstructionSpec, K, OperandSpec
 from .logix_bits import LOGIX_NAMES as _BITS_NAMES
 from .logix_data import LOGIX_NAMES as _DATA_NAMES
+from .logix_fbd import LOGIX_NAMES as _FBD_NAMES
 from .logix_st import LOGIX_NAMES as _ST_NAMES
 from .logix_string import LOGIX_NAMES as _STRING_NAMES
 from .logix_system import LOGIX_NAMES as _SYSTEM_NAMES
@@ -80,7 +81,7 @@ FAULT_JSR_PARAMETERS = 31  # major fault type 4 code 31, invalid JSR parameter (
 # What LFLT says, by code: a rung Logix lets load but faults on when it runs.
 RUN_TIME_FAULTS = {FAULT_JSR_PARAMETERS: "JSR parameters that do not match the routine's SBR or RET: major fault "
                                          "type 4, code 31 (invalid JSR parameter)"}
-LOGIX_NAMES.update(_DATA_NAMES, **_STRING_NAMES, **_SYSTEM_NAMES, **_BITS_NAMES, **_ST_NAMES)
+LOGIX_NAMES.update(_DATA_NAMES, **_STRING_NAMES, **_SYSTEM_NAMES, **_BITS_NAMES, **_ST_NAMES, **_FBD_NAMES)
 FAULT_SUBSCRIPT = 20  # major fault type 4 code 20: an array subscript out of range (1756-PM014)
 
 

@@ -5,7 +5,7 @@ paths, lays out structures and lists the tags without the directory.
 
 Each tag keeps its export name, scope, dimensions and External Access; each
 atomic leaf the data table file and first item the directory gave it. Each
-structure type (a user-defined type, TIMER, COUNTER, CONTROL) becomes a CIP
+structure type (a user-defined type, TIMER, COUNTER, CONTROL, FBD_TIMER ...) becomes a CIP
 template: its members with their byte offsets in the structure as a client
 sees it. The byte layout is a softplc_lite choice that follows the rules a
 Logix controller's templates show (each atomic member at a multiple of its
@@ -30,7 +30,8 @@ STRING_SIZE = 88  # DINT LEN + SINT[82] DATA + 2 bytes of padding
 # the 0x100..0xEFF range CIP leaves to user types (pycomm3 names a
 # template outside it by its first name, as Logix's predefined ones are
 # named). The numbers are a softplc_lite choice.
-PREDEFINED_INSTANCES = {"TIMER": 0x0F83, "COUNTER": 0x0F82, "CONTROL": 0x0F81}
+PREDEFINED_INSTANCES = {"TIMER": 0x0F83, "COUNTER": 0x0F82, "CONTROL": 0x0F81,
+                        "FBD_TIMER": 0x0F84, "FBD_COUNTER": 0x0F85, "FBD_ONESHOT": 0x0F86}
 FIRST_USER_INSTANCE = 0x100
 ACCESS = {"READ/WRITE": "rw", "READ ONLY": "ro", "NONE": "none"}
 
