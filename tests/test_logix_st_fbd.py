@@ -3,8 +3,8 @@ TOFR, RTOR on an FBD_TIMER; CTUD on an FBD_COUNTER; OSRI, OSFI on an
 FBD_ONESHOT): ladder/instr/logix_fbd.py's rules, logix/fbd.py's
 translation, docs/logix.md "Function-block instructions in Structured
 Text". Hand-written exports in tmp_path, run on both executors over
-simulated 10 ms scans, their members read as tags, by the command line and
-over EtherNet/IP."""
+simulated 10 ms scans, their members read as tags, by the command line, in
+the watch view's tag monitor and over EtherNet/IP."""
 
 from __future__ import annotations
 
@@ -16,6 +16,9 @@ from helpers.enips_apps import tank_line
 from helpers.logix_l5x import Prog, Task, export_runner, l5x_text, read_tag, write_l5x, write_tag
 from helpers.modbtcps_apps import Running
 from softplc_lite.app import AppError, load_app
+from softplc_lite.runner import RunOptions
+from softplc_lite.watch.session import WatchOptions, WatchSession
+from softplc_lite.watch.snapshot import render
 
 EXECUTORS = ["compiled", "reference"]
 TAGS = [("Tm", "FBD_TIMER"), ("Run", "BOOL"), ("Rst", "BOOL"), ("Pre", "DINT"), ("Cn", "FBD_COUNTER"),
@@ -200,3 +203,21 @@ def test_fbd_timer_members_are_tags_over_ethernet_ip(tmp_path):
             assert driver.read("Tm.TT").value is True
     finally:
         plc.stop()
+
+
+def test_the_watch_tag_monitor_opens_an_fbd_timer_as_a_timer(tmp_path):
+    path = write_l5x(tmp_path / "fbd.L5X", TAGS, [Prog("MainProgram", {"Main": timer_st("TONR")})],
+                     [Task("T", ["MainProgram"])])
+    s = WatchSession(load_app(path, tmp_path / "state"),
+                     WatchOptions(run=RunOptions(fresh=True, sets=("Run=1", "Pre=1000")), online=False))
+    try:
+        for _ in range(4):
+            s.scan()
+        s.show_file("Tm")
+        text = render(s, 100, 30).export_text()
+        rows = {line.split()[0]: line.split()[1:] for line in text.splitlines() if line.strip().startswith("Tm.")}
+        assert rows["Tm.ACC"] == ["DINT", "30"] and rows["Tm.TT"] == ["BOOL", "1"], text
+        assert rows["Tm.TimerEnable"] == ["BOOL", "1"] and rows["Tm.PRE"] == ["DINT", "1000"]
+        assert "Tm.CTL" not in rows  # hidden, as a TIMER's
+    finally:
+        s.quit()
