@@ -13,6 +13,7 @@ from pycomm3 import LogixDriver
 
 from helpers.cli import softplc
 from helpers.enips_apps import tank_line
+from helpers.logix_aoi import Aoi, Param, write_aoi_l5x
 from helpers.logix_l5x import Prog, Task, export_runner, l5x_text, read_tag, write_l5x, write_tag
 from helpers.modbtcps_apps import Running
 from softplc_lite.app import AppError, load_app
@@ -221,3 +222,26 @@ def test_the_watch_tag_monitor_opens_an_fbd_timer_as_a_timer(tmp_path):
         assert "Tm.CTL" not in rows  # hidden, as a TIMER's
     finally:
         s.quit()
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_an_add_on_instruction_in_st_times_with_a_local_fbd_timer_per_instance(tmp_path, executor):
+    debounce = Aoi("Debounce", [Param("In", "BOOL", "Input"), Param("Out", "BOOL", "Output")],
+                   {"Logic": ["NOP();"]}, [("Dly", "FBD_TIMER", None)])
+    st = "Dly.PRE := 30;\nDly.TimerEnable := In;\nTONR(Dly);\nOut := Dly.DN;"
+    lines = "".join(f'<Line Number="{k}"><![CDATA[{t}]]></Line>' for k, t in enumerate(st.split("\n")))
+    path = write_aoi_l5x(tmp_path / "aoi.L5X", [debounce],
+                         [("D1", "Debounce"), ("D2", "Debounce"), ("Sig", "BOOL"), ("Q1", "BOOL"), ("Q2", "BOOL")],
+                         [Prog("P", {"Main": ["Debounce(D1,Sig,Q1);", "Debounce(D2,0,Q2);"]})], [Task("T", ["P"])])
+    text = path.read_text(encoding="utf-8")
+    rll = ('<Routine Name="Logic" Type="RLL">\n<RLLContent>\n<Rung Number="0" Type="N">\n<Text>\n'
+           '<![CDATA[NOP();]]>\n</Text>\n</Rung>\n</RLLContent>')
+    assert rll in text
+    path.write_text(text.replace(rll, f'<Routine Name="Logic" Type="ST">\n<STContent>{lines}</STContent>'),
+                    encoding="utf-8")
+    r = export_runner(path, executor)
+    write_tag(r, "Sig", 1)
+    r.run(3)
+    assert (read_tag(r, "Q1"), read_tag(r, "D1.Dly.ACC")) == (0, 20)
+    r.run(1)
+    assert (read_tag(r, "Q1"), read_tag(r, "D1.Dly.DN"), read_tag(r, "Q2"), read_tag(r, "D2.Dly.ACC")) == (1, 1, 0, 0)
