@@ -1,7 +1,8 @@
 """Random Structured Text routines (hypothesis strategies) over a fixed set
 of tags, for the executor differential test: typed expressions (integers,
 REALs, BOOLs) with every operator and function of logix/st_expr.py, and
-statements of every kind, loops bounded so that a routine ends (a loop
+statements of every kind, calls of the function-block instructions (TONR
+... OSFI) on their own tags, loops bounded so that a routine ends (a loop
 that would not is another test's: the watchdog's)."""
 
 from __future__ import annotations
@@ -13,8 +14,9 @@ REALS = ("x", "y")
 BOOLS = ("p", "q", "Flags.3", "w.0")
 TAGS = [("a", "DINT"), ("b", "DINT"), ("c", "DINT"), ("w", "INT"), ("s", "SINT"), ("x", "REAL"), ("y", "REAL"),
         ("p", "BOOL"), ("q", "BOOL"), ("Flags", "DINT"), ("arr", "DINT[4]")] + \
-    [(f"{v}{d}", "DINT") for v in "kg" for d in (1, 2)]  # each nesting depth's loop counts
-INITIAL = [name for name, _ in TAGS if name not in ("arr",)]
+    [(f"{v}{d}", "DINT") for v in "kg" for d in (1, 2)] + \
+    [("Tm", "FBD_TIMER"), ("Cn", "FBD_COUNTER"), ("Os", "FBD_ONESHOT")]  # the function-block instructions'
+INITIAL = [name for name, t in TAGS if name not in ("arr",) and not t.startswith("FBD_")]
 
 small_ints = st.integers(-20, 20)
 
@@ -78,12 +80,28 @@ def assignment():
     )
 
 
+def fbd_call():
+    """A function-block instruction's inputs set, then its call (its
+    outputs are read by later statements as any BOOL or DINT)."""
+    return st.one_of(
+        st.tuples(bool_expr(1), bool_expr(0), int_expr(1), st.sampled_from(["TONR", "TOFR", "RTOR"])).map(
+            lambda t: f"Tm.TimerEnable := {t[0]};\nTm.Reset := {t[1]};\nTm.PRE := {t[2]};\n{t[3]}(Tm);\n"
+                      f"p := Tm.DN XOR Tm.TT;\nc := c + Tm.ACC;"),
+        st.tuples(bool_expr(1), bool_expr(1), bool_expr(0), int_expr(0)).map(
+            lambda t: f"Cn.CUEnable := {t[0]};\nCn.CDEnable := {t[1]};\nCn.Reset := {t[2]};\nCn.PRE := {t[3]};\n"
+                      f"CTUD(Cn);\nq := Cn.DN OR Cn.OV;\nc := c + Cn.ACC;"),
+        st.tuples(bool_expr(1), st.sampled_from(["OSRI", "OSFI"])).map(
+            lambda t: f"Os.InputBit := {t[0]};\n{t[1]}(Os);\nIF Os.OutputBit THEN a := a + 1; END_IF;"),
+    )
+
+
 def statements(depth: int = 2):
     if depth == 0:
         return st.lists(assignment(), min_size=1, max_size=3).map("\n".join)
     body = statements(depth - 1)
     return st.lists(st.one_of(
         assignment(),
+        fbd_call(),
         st.tuples(bool_expr(), body, st.lists(st.tuples(bool_expr(1), body), max_size=2),
                   st.one_of(st.none(), body)).map(_if),
         st.tuples(int_expr(1), st.lists(st.tuples(st.lists(small_ints, min_size=1, max_size=2), body), min_size=1,
