@@ -221,3 +221,17 @@ def test_a_bool_in_a_ladder_expression_is_still_refused(tmp_path):
                      [Task("T", ["MainProgram"])])
     with pytest.raises(AppError, match="is a bit; expressions take words"):
         load_app(path)
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_a_bool_assignment_sets_and_clears_every_bit_of_a_word_the_sign_bit_too(tmp_path, executor):
+    # BOOL tags share words: 16 of them fill one, the sixteenth its sign bit (and so on for SINT and DINT hosts)
+    tags = [(f"b{k}", "BOOL") for k in range(16)] + [("w", "INT"), ("s", "SINT"), ("n", "DINT"), ("Count", "DINT")]
+    st = "".join(f"b{k} := Count = 1;\n" for k in range(16)) + "w.15 := Count = 1;\ns.7 := Count = 1;\nn.31 := Count = 1;"
+    r = run_st(tmp_path, executor, st, tags=tags, values={"Count": 1})
+    assert [read_tag(r, f"b{k}") for k in range(16)] == [1] * 16 and r.engine.fault is None
+    assert (read_tag(r, "w"), read_tag(r, "s"), read_tag(r, "n")) == (-32768, -128, -2 ** 31)
+    write_tag(r, "Count", 0)
+    r.run(1)
+    assert [read_tag(r, f"b{k}") for k in range(16)] == [0] * 16 and r.engine.fault is None
+    assert (read_tag(r, "w"), read_tag(r, "s"), read_tag(r, "n")) == (0, 0, 0)

@@ -13,6 +13,7 @@ the condition false it writes nothing.
 
 from __future__ import annotations
 
+from ...datatable import data_bit_mask
 from ..bound import BoundInstruction
 from ..specs import InstructionSpec, K, OperandSpec
 
@@ -27,10 +28,11 @@ def _assign_bit(instr, access):
     def run(c: bool) -> bool:
         if c:
             d, i, bit = dest()
+            mask = data_bit_mask(d, bit)  # bit 15 of a signed word is its sign: the mask is negative
             if value():
-                d[i] |= 1 << bit
+                d[i] |= mask
             else:
-                d[i] &= ~(1 << bit)
+                d[i] &= ~mask
         return c
     return run
 
