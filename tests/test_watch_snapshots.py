@@ -83,6 +83,8 @@ CASES = [
     # a Studio 5000 export: tag paths, Logix names, routines (docs/logix.md, "Watching a Logix app")
     Case("tank_line", "logix/tank_line.L5X", 300, watch=("Tanks[0].Level", "Tanks[1].Level", "Batches.ACC"),
          sets=("Start=1",)),
+    # a Structured Text routine: its text, tag values and the lines run (docs/watch.md, "Watching Structured Text")
+    Case("st_tank", "logix/st_tank.L5X", 30, watch=("Level",)),
 ]
 
 PARAMS = [pytest.param(case, w, h, id=f"{case.name}-{w}x{h}") for case in CASES for w, h in case.sizes]

@@ -217,7 +217,7 @@ class RungsPanel:
             line.append(f"  rung {s.selected} of {len(s.rungs)}", style="bold")
         else:  # a Structured Text routine is shown as its text (st_view.py)
             line.append(f"  line {st.line_of(s.selected) + 1} of {st.count}", style="bold")
-            ran = f"  ● ran in scan {s.engine.scans}" if s.history.live else "  ● ran: newest scan only, not shown"
+            ran = f"  ● ran in scan {s.engine.scans}" if s.history.live else "  ● marks: live only"
             line.append(ran, style="dim")
         line.append(f"  comments {s.comments}" if s.comments != "full" else "", style="dim")
         if len(files) > 1:

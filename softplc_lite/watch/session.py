@@ -25,7 +25,7 @@ from . import trendview
 from .history import History
 from .naming import Naming
 from .st_ran import RanRungs
-from .st_view import goto_line, st_lines
+from .st_view import goto_line, hit_said, st_lines
 from .watchlist import WatchList
 from .xref import Finding, XrefIndex
 
@@ -128,7 +128,7 @@ class WatchSession:
         if hit is not None:
             self.running = False
             self.last_hit = hit
-            self.message = str(hit)
+            self.message = hit_said(hit, self.app.program, self.naming)
             if hit.file is not None:
                 self.file, self.selected = hit.file, hit.rung
                 self.top = min(self.top, hit.rung)
@@ -237,9 +237,9 @@ class WatchSession:
     def goto(self, rung: int) -> None:
         self.selected = max(0, min(len(self.rungs) - 1, rung))
         self.top = self.selected
-        if self.listing is not None:  # the top is a line of the text
+        if self.listing is not None:  # the top is a line of the text, the comment above the selected one first
             self.selected = self.listing.normal(self.selected)
-            self.top = self.listing.line_of(self.selected)
+            self.top = self.listing.top_for(self.selected)
 
     def goto_text(self, text: str) -> None:
         """The ``g`` prompt: a rung number of the shown file."""

@@ -26,7 +26,7 @@ class RanRungs:
 
     def __init__(self, engine) -> None:
         self.engine = engine
-        self.ran: dict[int, list[int]] = {}
+        self.ran: dict[int, list[int | None]] = {}
         self.install()
 
     def install(self) -> None:
@@ -41,7 +41,7 @@ class RanRungs:
                 continue
             compiled = engine.files[number][0]
             compiled.split_rungs()
-            ran = self.ran[number] = [-1] * len(pfile.rungs)
+            ran = self.ran[number] = [None] * len(pfile.rungs)
             blocks = compiled.blocks
             for rung in range(len(blocks)):
                 blocks[rung] = _recording(blocks[rung], ran, rung, engine)
@@ -56,7 +56,7 @@ class RanRungs:
         return {rung for rung, when in enumerate(ran) if when == scan}
 
 
-def _recording(block, ran: list[int], rung: int, engine):
+def _recording(block, ran: list[int | None], rung: int, engine):
     def recorded(c):
         ran[rung] = engine.scans
         return block(c)

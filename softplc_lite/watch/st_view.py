@@ -85,6 +85,13 @@ class StLines:
         chosen = after[0] if after else (self.code[-1] if self.code else None)
         return self.rungs[chosen][0] if chosen is not None else 0
 
+    def top_for(self, rung: int) -> int:
+        """The first line to show ``rung``'s line at the top: the lines
+        before it that hold no statement (its comment) come with it."""
+        line = self.line_of(rung)
+        before = [k for k in self.code if k < line]
+        return before[-1] + 1 if before else 0
+
     def step(self, rung: int, delta: int) -> int:
         """The first rung of the line holding statements ``delta`` such lines
         from ``rung``'s line (↑/↓ move by lines, not by rungs)."""
@@ -113,6 +120,15 @@ def goto_line(session, lines: StLines, text: str) -> None:
     session.goto(lines.at_line(max(line, 1) - 1))
     shown = lines.line_of(session.selected) + 1
     session.message = "" if shown == line else f"go to line {line}: at line {shown}, the next line with a statement"
+
+
+def hit_said(hit, program, naming) -> str:
+    """A breakpoint's stop as the message line says it: a line of an ST
+    routine by its routine and line number, anything else as Hit says it."""
+    pfile = program.files.get(hit.file) if hit.file is not None else None
+    if pfile is None or pfile.listing is None or not 0 <= hit.rung < len(pfile.listing.rung_lines):
+        return str(hit)
+    return f"break: {naming.where(hit.file)} line {pfile.listing.rung_lines[hit.rung] + 1} ran at scan {hit.scan}"
 
 
 class StView:
