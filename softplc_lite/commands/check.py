@@ -30,8 +30,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"{count} problem{'s' if count != 1 else ''} found", file=sys.stderr)
         return EXIT_ERROR
     print_warnings(app.warnings)
-    rungs = sum(len(f.rungs) for f in app.program.files.values())
-    extra = "".join(f", module {m.name}" for m in app.modules)
+    # A Structured Text routine's file is made of rungs too; its statements are what a user wrote.
+    rungs = sum(len(f.rungs) for f in app.program.files.values() if f.listing is None)
+    statements = sum(len(f.listing.statements) for f in app.program.files.values() if f.listing is not None)
+    extra = f", {statements} ST statement{'s' if statements != 1 else ''}" if statements else ""
+    extra += "".join(f", module {m.name}" for m in app.modules)
     if app.warnings:
         extra += f", {len(app.warnings)} warning{'s' if len(app.warnings) != 1 else ''}"
     print(f"{app.name}: ok ({len(app.program.files)} program file{'s' if len(app.program.files) != 1 else ''}, "

@@ -198,6 +198,11 @@ class StRoutine:
             raise StProblem(s.pos, f"{s.name} is a ladder instruction Structured Text does not have (1756-PM007, "
                                    f"\"Structured Text Instructions\"): expected an assignment, a function, or the "
                                    f"instruction's function-block form")
+        if self.ctx.aoi is not None and self.ctx.aoi.defines(name):
+            for a in s.args[1:]:
+                if a is not None and not isinstance(a, (A.TagRef, A.Const)):
+                    raise StProblem(a.pos, f"{s.name}: an expression as an argument ({render(a)}): softplc_lite "
+                                           f"passes a tag or a number to an Add-On Instruction", not_run=True)
         self.instruction(s)
 
     def instruction(self, s: A.Call) -> None:
