@@ -250,3 +250,30 @@ def test_the_cli_snapshot_is_the_golden_view(tmp_path):
     assert r.returncode == 0, r.stderr
     text = "".join(line.rstrip() + "\n" for line in out.read_text(encoding="utf-8").splitlines())
     assert text == (GOLDENS / "st_tank-80x24.txt").read_text(encoding="utf-8")
+
+
+def test_a_line_shows_the_tags_a_user_wrote_not_the_translations_own(tmp_path):
+    """A CASE on an expression keeps its selector in a hidden tag, a TONR's FBD_TIMER packs its bits
+    in a hidden control word: neither is shown; the members the line names are."""
+    text = """(* a block comment *)
+CASE Count + 1 OF
+  1: Sel := 1;
+ELSE Sel := 3;
+END_CASE;
+TONR(T1);
+T1.PRE := 500; T1.TimerEnable := 1;
+Count := Count + 1; // an inline comment"""
+    tags = [("Count", "DINT"), ("Sel", "DINT"), ("T1", "FBD_TIMER")]
+    path = write_l5x(tmp_path / "t.L5X", tags, [Prog("MainProgram", {"Main": text})], [Task("T", ["MainProgram"])])
+    s = _session(path, tmp_path / "state", "compiled")
+    try:
+        for _ in range(3):
+            s.scan()
+        lines = _screen(s, 100, 24)
+        row = {int(line[4:].split()[0]): line for line in lines[3:11]}
+        assert row[2].split("OF", 1)[1].split() == ["Count=3"]
+        assert row[6].split(";", 1)[1].split() == ["T1.PRE=500", "T1.ACC=10", "T1.Status=0"]
+        assert row[8].endswith("Count=3") and row[8].startswith("  ● 8 Count := Count + 1; // an inline comment")
+        assert not row[1][2].strip() and row[4][2] == "●"  # the CASE on 3: its ELSE
+    finally:
+        s.quit()

@@ -166,7 +166,7 @@ class StView:
                     for ref in address_refs(op) if not isinstance(op, AddressRef) else (op,):
                         address = ref.address
                         name = self.names.name(address)
-                        if not name or name in seen or address.kind in _STRUCTS:
+                        if not name or name in seen or address.kind in _STRUCTS or self.hidden(address):
                             continue  # a hidden tag of the translation (a CASE's selector) has no name
                         seen.add(name)
                         item = [(f"{name}=", None), self.value(address)]
@@ -174,6 +174,15 @@ class StView:
                             item.append((" F", FORCED))
                         out.append(item)
         return out
+
+    def hidden(self, address) -> bool:
+        """A timer's or counter's control word (``T1.CTL``, its bits packed):
+        the tag monitor leaves it out too; its members are shown by name."""
+        operands = getattr(self.names, "operands", None)
+        if operands is None:
+            return False
+        full = operands.name_of(address, self.names.scope)
+        return bool(full) and full.upper().endswith(".CTL")
 
     def value(self, address) -> tuple[str, Style | None]:
         try:
