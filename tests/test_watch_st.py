@@ -277,3 +277,20 @@ Count := Count + 1; // an inline comment"""
         assert not row[1][2].strip() and row[4][2] == "●"  # the CASE on 3: its ELSE
     finally:
         s.quit()
+
+
+@pytest.mark.parametrize("executor", EXECUTORS)
+def test_a_fault_in_a_statement_is_shown_at_its_line(executor, tmp_path):
+    text = "// walks past the array's end\ni := i + 1;\nArr[i] := 1;"
+    path = write_l5x(tmp_path / "t.L5X", [("i", "DINT"), ("Arr", "DINT[5]")], [Prog("MainProgram", {"Main": text})],
+                     [Task("T", ["MainProgram"])])
+    s = _session(path, tmp_path / "state", executor)
+    try:
+        for _ in range(6):
+            s.scan()
+        lines = _screen(s, 100, 24)
+        assert " FAULTED  fault 20: MainProgram.Main line 3 " in lines[0]
+        assert lines[2].startswith(" routine MainProgram.Main  line 3 of 3  ● ran in scan 5")
+        assert any(line.startswith("> ● 3 Arr[i] := 1;  Arr[i]=?") for line in lines)
+    finally:
+        s.quit()

@@ -125,7 +125,7 @@ class StatusBar:
         line.append(f" {e.mode.name} ", style=mode_style)
         fault = e.fault if e.mode is Mode.FAULTED else None
         if fault is not None:  # where, first: the rest of the line may be cut
-            line.append(f" {_fault_place(fault)} ", style="bold red")
+            line.append(f" {_fault_place(fault, s)} ", style="bold red")
         if s.history.live:
             line.append(f" scan {e.scans}")
         else:
@@ -156,9 +156,15 @@ class StatusBar:
         yield second
 
 
-def _fault_place(fault) -> str:
-    """``fault 20: file 2 rung 2 MOV``: which fault, and where."""
+def _fault_place(fault, session) -> str:
+    """``fault 20: file 2 rung 2 MOV``: which fault, and where; in a
+    Structured Text routine the line (``fault 20: MainProgram.Fill line
+    3``): its rungs and their instructions are the translation's."""
     where = f"fault {fault.code}"
+    pfile = session.app.program.files.get(fault.file) if fault.file is not None else None
+    listing = pfile.listing if pfile is not None else None
+    if listing is not None and fault.rung is not None and 0 <= fault.rung < len(listing.rung_lines):
+        return f"{where}: {session.naming.where(fault.file)} line {listing.rung_lines[fault.rung] + 1}"
     if fault.file is not None:
         where += f": file {fault.file} rung {fault.rung}"
         if fault.instruction:
