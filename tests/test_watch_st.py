@@ -294,3 +294,19 @@ def test_a_fault_in_a_statement_is_shown_at_its_line(executor, tmp_path):
         assert any(line.startswith("> ● 3 Arr[i] := 1;  Arr[i]=?") for line in lines)
     finally:
         s.quit()
+
+
+def test_find_names_the_lines_of_an_st_routine(tmp_path):
+    s = _session(ST_TANK, tmp_path, "compiled")
+    try:
+        s.scan()
+        s.find("Level")
+        assert s.message == "Level (F10:0) 1 of 7: MainProgram.MainRoutine line 2  Level  write"
+        text = "\n".join(_screen(s, 80, 40))
+        assert "  MainProgram.MainRoutine line 5  Level  write" in text and " rung " not in text
+        for _ in range(3):
+            s.next_use()
+        assert s.message.endswith("line 5  Level  write")
+        assert next(line for line in _screen(s) if line.startswith(">")).startswith(">    5     Level := 0.0;")
+    finally:
+        s.quit()

@@ -116,6 +116,9 @@ class Use:
         (naming.py), which names a Logix app's routines, instructions and
         operands its way."""
         where, mnemonic, address = self._parts(naming)
+        line = self._line(naming)
+        if line is not None:
+            return f"{where} line {line}  {address}  {self.how}"
         return (f"{where} rung {self.rung}  instruction {self.instruction + 1} {mnemonic}  "
                 f"operand {self.operand + 1} {address}  {self.how}")
 
@@ -135,7 +138,19 @@ class Use:
         """Where, short, for a narrow list (the how goes first there):
         ``file 2 rung 3  OTL B3/0``."""
         where, mnemonic, address = self._parts(naming)
+        line = self._line(naming)
+        if line is not None:
+            return f"{where} line {line}  {address}"
         return f"{where} rung {self.rung}  {mnemonic} {address}"
+
+    def _line(self, naming) -> int | None:
+        """The line (from 1) of a Structured Text routine the use is on: its
+        rungs and instructions are the translation's, its lines the user's."""
+        pfile = naming.app.program.files.get(self.file) if naming is not None else None
+        listing = getattr(pfile, "listing", None)
+        if listing is None or not 0 <= self.rung < len(listing.rung_lines):
+            return None
+        return listing.rung_lines[self.rung] + 1
 
 
 class _Target:
