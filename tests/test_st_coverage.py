@@ -62,9 +62,9 @@ def test_the_shipped_scenarios_miss_only_the_case_else(tmp_path):
     export = mixer_copy(tmp_path, (ROOT / "programs/logix/mixer.tests/batch.plctest").read_text(encoding="utf-8"))
     assert all(r.passed for r in run_file(export, tmp_path / "mixer.tests" / "t.plctest", coverage=cov))
     fig = figures(cov)[0][SEQUENCE]
-    # 22 statements: the two of the CASE's ELSE never run; 13 arms (4 CASE labels, 4 IFs and their
+    # 21 statements: the two of the CASE's ELSE never run; 13 arms (4 CASE labels, 4 IFs and their
     # "no arm", the ELSE): the ELSE is the one never taken (no step makes a state past 3).
-    assert (fig.statements_run, fig.statements, fig.arms_taken, fig.arms) == (20, 22, 12, 13)
+    assert (fig.statements_run, fig.statements, fig.arms_taken, fig.arms) == (19, 21, 12, 13)
     assert (fig.rungs, fig.legs, fig.conditions) == (0, 0, 0)  # its rungs are counted as the text
     assert missed_arms(cov) == [("ELSE", line_of("ELSE"))]
 
@@ -72,13 +72,14 @@ def test_the_shipped_scenarios_miss_only_the_case_else(tmp_path):
 def test_arms_a_scenario_set_misses(partial):
     _, cov = partial
     fig = figures(cov)[0][SEQUENCE]
-    # Run: the CASE, idle's 3, fill's 5, mix's first 2, the 3 after END_CASE; not run: State := 3,
+    # Run: the CASE, idle's 2, fill's 5, mix's first 2, the 3 after END_CASE; not run: State := 3,
     # drain's 5 and the ELSE's 2.
-    assert (fig.statements_run, fig.statements) == (14, 22)
-    # Taken: CASE 0, 1, 2; IF Ready; fill's IF and no arm; mix's no arm.
+    assert (fig.statements_run, fig.statements) == (13, 21)
+    # Taken: CASE 0, 1, 2; idle's IF (never its no arm: the mixer runs from the first scan); fill's
+    # IF and no arm; mix's no arm.
     assert (fig.arms_taken, fig.arms) == (7, 13)
-    assert fig.covered == 21 and fig.total == 35
-    assert missed_arms(cov) == [("no arm", line_of("    IF Ready THEN")),
+    assert fig.covered == 20 and fig.total == 34
+    assert missed_arms(cov) == [("no arm", line_of("    IF Running AND NOT Fault THEN")),
                                 ("IF", line_of("    IF MixCount > MixScans THEN")),
                                 ("CASE 3", line_of("  3:  // drain, then count the batch")),
                                 ("IF", line_of("    IF Level <= 0.0 THEN")),
@@ -94,7 +95,7 @@ def test_the_summary_names_statements_and_branches_beside_rungs(partial):
     header = next(line for line in lines if line.startswith("File"))
     assert header.split()[-3:] == ["Statements", "Branches", "Total"] and "Rungs" in header
     row = next(line for line in lines if line.startswith("4 MainProgram.Sequence")).split()
-    assert row[-3:] == ["14/22", "7/13", "60%"]
+    assert row[-3:] == ["13/21", "7/13", "59%"]
     drain = line_of("    IF Level <= 0.0 THEN")
     missing = next(line for line in lines if line.startswith("4 MainProgram.Sequence (mixer.L5X):"))
     assert f"no arm (line {drain})" in missing and f"ELSE (line {line_of('ELSE')})" in missing
@@ -119,7 +120,7 @@ def test_the_annotated_export_marks_st_lines(partial):
     gutter, marks = marked("    IF MixCount > MixScans THEN")
     column = len("  <![CDATA[    ")  # under the IF
     assert gutter == "! " and marks == [" " * column + "^ never taken: IF"]
-    assert marked("    IF Ready THEN") == ("! ", [" " * column + "^ never taken: no arm (every test false)"])
+    assert marked("    IF Running AND NOT Fault THEN") == ("! ", [" " * column + "^ never taken: no arm (every test false)"])
     assert marked("ELSE") == ("! ", [" " * len("  <![CDATA[") + "^ never taken: ELSE"])
     assert marked("  Fault := 1;  // a state no step makes")[0] == "- "
     assert marked("END_CASE;") == ("  ", [])  # no statement starts there
@@ -144,11 +145,11 @@ def test_lcov_lines_and_arms(partial):
     # The export's record: MainRoutine's rungs and outcomes beside the routine's lines and arms.
     ladder = figures(cov)[0][3]
     assert totals["BRF"] == str(13 + ladder.branches) and totals["BRH"] == str(7 + ladder.branches_seen)
-    # The routine's lines: the 22 statements' (each on a line of its own; the CASE's is its first
+    # The routine's lines: the 21 statements' (each on a line of its own; the CASE's is its first
     # test, on the line of label 0), labels 1, 2 and 3, and the ELSE.
     st_lines = set(da) - {str(line_of("[XIC(Start) ,XIC(Running) ]XIO(Stop)OTE(Running);")),
                           str(line_of("JSR(Sequence,0);"))}
-    assert len(st_lines) == 26 and totals["LF"] == str(len(da))
+    assert len(st_lines) == 25 and totals["LF"] == str(len(da))
 
 
 def test_cobertura_class_of_the_routine(partial):

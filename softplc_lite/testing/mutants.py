@@ -8,6 +8,10 @@ A mutant keeps only the rung it changes (``rung``, None when the rung is
 deleted): ``apply`` builds the whole program from the original, so the
 mutants of a large program cost little memory and little to send to a
 worker process.
+
+A program file made from Structured Text gets the mutants of its text's
+operators and constants instead (testing/st_mutants.py), described as the
+text shows them.
 """
 
 from __future__ import annotations
@@ -20,13 +24,14 @@ from ..ladder.ast import BinOp, Branch, Call, Const, Instruction, Placeholder, P
 from ..ladder.fmt import format_instruction, format_series
 from ..ladder.instructions import BUILTIN, InstructionSet
 from ..ladder.specs import K
+from .st_mutants import ARITHMETIC, LOGIC, st_mutants
 
 RungKey = tuple[int, int]  # (program file number, rung index in the file)
 
 # Each operator's name, as reports and docs call it.
 CONTACT, LATCH, OUTPUT, LEG, COMPARE, CONSTANT, RUNG = (
     "contact", "latch", "output", "leg", "compare", "constant", "rung")
-OPERATORS = (CONTACT, LATCH, OUTPUT, LEG, COMPARE, CONSTANT, RUNG)
+OPERATORS = (CONTACT, LATCH, OUTPUT, LEG, COMPARE, CONSTANT, RUNG, ARITHMETIC, LOGIC)  # the last two: ST's
 
 _SWAPS = {"XIC": ("XIO", CONTACT), "XIO": ("XIC", CONTACT), "OTL": ("OTU", LATCH), "OTU": ("OTL", LATCH)}
 # A comparison's neighbour (a choice): the operator an off-by-one or a
@@ -71,7 +76,12 @@ def mutants(program: Program, instructions: InstructionSet = BUILTIN) -> list[Mu
     """Every mutant of a parsed program, in file, rung and element order."""
     found: list[Mutant] = []
     for number in sorted(program.files):
-        rungs = program.files[number].rungs
+        pfile = program.files[number]
+        if pfile.listing is not None:  # Structured Text: its operators and constants, as the text shows them
+            for index, m in st_mutants(pfile, instructions):
+                found.append(Mutant(len(found), m.operator, (number, index), m.pos, m.description, m.rung))
+            continue
+        rungs = pfile.rungs
         for index, rung in enumerate(rungs):
             for operator, description, pos, elements in _series(rung.elements, instructions):
                 found.append(Mutant(len(found), operator, (number, index), pos, description,

@@ -1,7 +1,8 @@
 """The report of a mutation run: each surviving mutant with the change
 (``XIC Start -> XIO Start``), where it is, and its rung drawn as the watch
 view draws it (the mutated rung with the change marked, or the deleted
-one), then the score and the counts of every outcome."""
+one; a Structured Text mutant's line of text, a caret under the change),
+then the score and the counts of every outcome."""
 
 from __future__ import annotations
 
@@ -94,10 +95,28 @@ def survivor_view(report: MutationReport, mutant: Mutant, original: dict | None 
         return ChangedRung(view(plc.runner.app.program.files[number].rungs[index], plc.table), before)
 
 
+def text_view(report: MutationReport, mutant: Mutant) -> Text:
+    """A surviving mutant of Structured Text: the line of the text it is on,
+    a caret under where the change is (the routine's listing, as the
+    annotated export shows it)."""
+    listing = report.source.files[mutant.key[0]].listing
+    for pos, line in listing.lines:
+        if pos.line == mutant.pos.line:
+            column = max(mutant.pos.column - pos.column, 0)
+            return Text(f"  {line.rstrip()}\n  {' ' * column}^")
+    return Text("")
+
+
 def print_report(report: MutationReport, out: Console, survivors: bool = True) -> None:
     original: dict = {}
     if survivors:
         for mutant, outcome in report.with_status(SURVIVED):
+            pfile = report.source.files[mutant.key[0]]
+            if pfile.listing is not None:  # the routine by name, the change by its text's line
+                out.print(f"[yellow]SURVIVED[/] {escape(str(mutant.pos))}: {escape(pfile.name or '')} "
+                          f"[bold]{escape(mutant.description)}[/] ({mutant.operator})")
+                out.print(text_view(report, mutant))
+                continue
             file = f"file {mutant.key[0]} " if mutant.key[0] != 2 else ""
             out.print(f"[yellow]SURVIVED[/] {escape(str(mutant.pos))}: {file}rung {mutant.key[1]}: "
                       f"[bold]{escape(mutant.description)}[/] ({mutant.operator})")
@@ -125,7 +144,11 @@ def print_report(report: MutationReport, out: Console, survivors: bool = True) -
 
 def _rung_place(report: MutationReport, key) -> str:
     number, index = key
-    pos = report.source.files[number].rungs[index].pos
+    pfile = report.source.files[number]
+    pos = pfile.rungs[index].pos
+    if pfile.listing is not None:
+        line = pfile.listing.rung_lines[index] + 1
+        return f"{pos.source}:{pos.line} ({pfile.name} line {line})"
     return f"{pos.source}:{pos.line} (rung {index})" if number == 2 else \
         f"{pos.source}:{pos.line} (file {number} rung {index})"
 
