@@ -310,3 +310,20 @@ def test_find_names_the_lines_of_an_st_routine(tmp_path):
         assert next(line for line in _screen(s) if line.startswith(">")).startswith(">    5     Level := 0.0;")
     finally:
         s.quit()
+
+
+def test_the_g_key_asks_for_a_line_in_an_st_routine(tmp_path):
+    from softplc_lite.watch.terminal import Controller
+
+    s = _session(ST_TANK, tmp_path, "compiled")
+    try:
+        c = Controller(s)
+        c.key("g")
+        assert c.prompt == "go to line: "
+        for k in "12\r":
+            c.key(k)
+        assert s.listing.line_of(s.selected) == 11 and s.message == ""
+        c.key("down")
+        assert s.listing.line_of(s.selected) == 13  # line 14: the ELSE line holds no statement
+    finally:
+        s.quit()

@@ -58,7 +58,7 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("up/down, k/j", ("up", "k", "down", "j"), "move", "select the rung above / below"),
     Binding("PgUp/PgDn", ("pgup", "pgdown"), "move", "ten rungs up / down"),
     Binding("Home/End", ("home", "end"), "ends", "first / last rung of the file"),
-    Binding("g", ("g",), "goto", "go to a rung (asks for its number)"),
+    Binding("g", ("g",), "goto", "go to a rung (asks for its number; a line in a Structured Text routine)"),
     Binding("f", ("f",), "next_file", "show the next program file"),
     Binding("c", ("c",), "comments", "rung comments: full, first line, hidden (cycles)"),
     Binding("b", ("b",), "breakpoint", "toggle a breakpoint on the selected rung"),
@@ -84,7 +84,7 @@ BINDINGS: tuple[Binding, ...] = (
 KEYS: tuple[tuple[str, str], ...] = tuple((b.label, b.help) for b in BINDINGS)
 _ACTIONS = {k: b.action for b in BINDINGS for k in b.keys}
 # The prompts: kind -> the text before what is typed.
-PROMPTS = {"g": "go to rung: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: ",
+PROMPTS = {"g": "go to rung: ", "line": "go to line: ", "F": "force ADDR=1 or ADDR=0: ", "U": "remove the force on ADDR: ",
            "M": "mode (program, run, test): ", "=": "set ADDR = VALUE: ", "t": "toggle bit: ",
            "/": "find address or symbol: ", "d": "data file (N7, T4, ST9; N7:20): ",
            "tags": "tag (Tanks, Tanks[1]; Enter: every tag) or data file (F12): ",  # d in a Logix app
@@ -186,7 +186,7 @@ class Controller:
         self.session.first_rung() if k == "home" else self.session.last_rung()
 
     def _do_goto(self, k: str) -> None:
-        self._ask("g")
+        self._ask("line" if self.session.listing is not None else "g")  # a Structured Text routine: by line
 
     def _do_next_file(self, k: str) -> None:
         self.session.next_file()
@@ -271,7 +271,7 @@ class Controller:
     def _submit(self, kind: str, text: str) -> None:
         s = self.session
         try:
-            if kind == "g":
+            if kind in ("g", "line"):
                 s.goto_text(text)
             elif kind == "F":
                 s.force(text)
