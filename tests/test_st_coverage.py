@@ -35,6 +35,13 @@ def line_of(text: str) -> int:
     return next(k for k, line in enumerate(lines, 1) if line == f"<![CDATA[{text}]]>")
 
 
+def routine_line(text: str) -> int:
+    """The routine's own number (from 1) of its line ``text``."""
+    lines = MIXER.read_text(encoding="utf-8").split("\n")
+    first = next(k for k, line in enumerate(lines) if line.startswith("<![CDATA[// One step"))
+    return (line_of(text) - first - 1) // 3 + 1  # each <Line> three lines of the export
+
+
 def mixer_copy(tmp_path: Path, scenario: str) -> Path:
     export = tmp_path / "mixer.L5X"
     shutil.copy(MIXER, export)
@@ -96,10 +103,12 @@ def test_the_summary_names_statements_and_branches_beside_rungs(partial):
     assert header.split()[-3:] == ["Statements", "Branches", "Total"] and "Rungs" in header
     row = next(line for line in lines if line.startswith("4 MainProgram.Sequence")).split()
     assert row[-3:] == ["13/21", "7/13", "59%"]
-    drain = line_of("    IF Level <= 0.0 THEN")
-    missing = next(line for line in lines if line.startswith("4 MainProgram.Sequence (mixer.L5X):"))
-    assert f"no arm (line {drain})" in missing and f"ELSE (line {line_of('ELSE')})" in missing
-    assert f"lines {line_of('      State := 3;')}, {line_of('    Level := Level - DrainRate;')}" in missing
+    missing = next(line for line in lines if line.startswith("4 MainProgram.Sequence:"))
+    # by the routine's own line numbers: its lines from 1
+    assert missing == ("4 MainProgram.Sequence: statements never run: lines 17, 20, 21, 22, 23, 24, 27, 28; "
+                       "arms never taken: no arm (line 4), IF (line 16), CASE 3 (line 19), IF (line 21), "
+                       "no arm (line 21), ELSE (line 26)")
+    assert routine_line("      State := 3;") == 17 and routine_line("ELSE") == 26
 
 
 def test_the_annotated_export_marks_st_lines(partial):

@@ -176,25 +176,26 @@ def summary_table(cov: Coverage) -> Table:
 
 def missing_lines(cov: Coverage) -> list[str]:
     """Under the table, for each Structured Text file with something not
-    covered: its statements never run and its arms never taken, by their
-    place in the export (as coverage.py's report shows missing lines)."""
+    covered: its statements never run and its arms never taken, by the
+    routine's own line numbers (as the mutants and the watch view number
+    them), as coverage.py's report shows missing lines."""
     out = []
     for number in sorted(cov.files):
         info = cov.files[number]
         if info.listing is None:
             continue
-        name = Path(info.source).name
         parts = []
-        never = [s for s in coverage_st.statements(cov, info) if not s.covered]
+        never = list(dict.fromkeys(coverage_st.routine_line(info, s.line)
+                                   for s in coverage_st.statements(cov, info) if not s.covered))
         if never:
-            lines = list(dict.fromkeys(s.line for s in never))
-            parts.append(f"statements never run: {'line' if len(lines) == 1 else 'lines'} "
-                         + ", ".join(map(str, lines)))
+            parts.append(f"statements never run: {'line' if len(never) == 1 else 'lines'} "
+                         + ", ".join(map(str, never)))
         missed = [a for a in coverage_st.arms(cov, info) if not a.covered]
         if missed:
-            parts.append("arms never taken: " + ", ".join(f"{a.arm.label} (line {a.line})" for a in missed))
+            parts.append("arms never taken: " + ", ".join(
+                f"{a.arm.label} (line {coverage_st.routine_line(info, a.line)})" for a in missed))
         if parts:
-            out.append(f"{file_label(info)} ({name}): " + "; ".join(parts))
+            out.append(f"{file_label(info)}: " + "; ".join(parts))
     return out
 
 

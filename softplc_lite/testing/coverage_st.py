@@ -101,6 +101,15 @@ def _pos(info: FileInfo, rung: int) -> tuple[int, int]:
     return r.line, r.column
 
 
+def routine_line(info: FileInfo, line: int) -> int:
+    """The routine's own number (from 1, as Studio 5000's editor and the
+    watch view number them) of the export's line ``line``."""
+    for k, (pos, _) in enumerate(info.listing.lines):
+        if pos.line == line:
+            return k + 1
+    return 0
+
+
 def _else_pos(info: FileInfo, arm: Arm) -> tuple[int, int]:
     """Where an ELSE is: the word ELSE on the lines from the last test's
     (``arm.line``) to its body's first (its label rung's), the nearest to
