@@ -71,6 +71,39 @@ def test_access_expression_reads_indexed_addresses_through_s24(access_class):
     assert compute() == 81
 
 
+@pytest.mark.parametrize("access_class", [BoundAccess, ReferenceAccess])
+def test_access_expression_reads_words_bits_floats_indirect_and_a_leaf_twice(access_class):
+    table = DataTable()
+    table.reference("N7:9")
+    table.reference("F8:2")
+    table.reference("B3/17")
+    access = access_class(table, Machine(table))
+    ref = AddressRef(parse_address("N7:[N7:0]"))
+    node = parse_expression("N7:1 * B3/17 + F8:1 - N7:2 + (N7:3 AND 6)", Pos("<test>", 1, 1))
+    twice = type(node)("+", ref, ref, Pos("<test>", 1, 1))  # one leaf object in two places, as CASE's test makes
+    compute, doubled = access.expression(node), access.expression(twice)
+    for address, value in (("N7:0", 5), ("N7:1", 7), ("B3/17", 1), ("F8:1", 0.5), ("N7:2", 10), ("N7:3", 13),
+                           ("N7:5", 21)):
+        table.write(address, value)
+    assert compute() == 7 + 0.5 - 10 + 4
+    assert doubled() == 42
+    table.write("N7:0", 2)
+    table.write("B3/17", 0)
+    assert doubled() == 20 and compute() == 0 + 0.5 - 10 + 4
+
+
+def test_the_compiled_access_makes_an_expression_code_not_a_walk(monkeypatch):
+    import softplc_lite.ladder.bound as bound_module
+
+    walks = []
+    monkeypatch.setattr(bound_module, "evaluate", lambda *a: walks.append(a) or 0)
+    table = DataTable()
+    compute = BoundAccess(table, Machine(table)).expression(parse_expression("N7:0 + B3/1 * 3", Pos("<test>", 1, 1)))
+    table.write("N7:0", 4)
+    table.write("B3/1", 1)
+    assert compute() == 7 and walks == []
+
+
 def test_block_faults_past_the_end_of_the_file():
     d = DataTable().file("N7").data
     block(d, 0, len(d), "#N7:0")

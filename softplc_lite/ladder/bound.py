@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING, Callable
 from ..datatable import Address, DataTable
 from ..datatable.errors import AddressRangeError
 from .ast import AddressRef, Const, Instruction, address_refs
-from .expr import evaluate
+from .expr import evaluate, namespace, to_python
 from .resolvers import address_fault
 from .semantics import Machine, MajorFault
 from . import status as S
@@ -175,9 +175,34 @@ class Operand:
 
 
 class BoundAccess(Access):
-    """The compiled path: a direct address is resolved once, at load."""
+    """The compiled path: a direct address is resolved once, at load, and an
+    expression is made Python code once (the compiler's form of CPT's,
+    expr.to_python) instead of a tree walked at each call."""
 
     cache_direct = True
+
+    def expression(self, node) -> Callable[[], int | float]:
+        if isinstance(node, (Const, AddressRef)):
+            return self.value(node)
+        ns: dict[str, object] = namespace(self.machine)
+        names: dict[int, str] = {}
+        resolve = []  # every address that is not fixed resolved first, in tree order, as Access.expression does
+        for leaf in address_refs(node):
+            if id(leaf) in names:
+                continue
+            k = len(names)
+            fixed = self.fixed(leaf)
+            if fixed is not None:
+                d, i, bit = fixed
+                ns[f"_d{k}"] = d
+                names[id(leaf)] = f"_d{k}[{i}]" if bit is None else f"((_d{k}[{i}] >> {bit}) & 1)"
+            else:
+                ns[f"_g{k}"] = self.location(leaf)
+                resolve.append(f"    _d{k}, _i{k}, _b{k} = _g{k}()\n")
+                names[id(leaf)] = f"(_d{k}[_i{k}] if _b{k} is None else (_d{k}[_i{k}] >> _b{k}) & 1)"
+        body = to_python(node, lambda ref: names[id(ref)])
+        exec(compile(f"def compute():\n{''.join(resolve)}    return {body}\n", "<bound expression>", "exec"), ns)
+        return ns["compute"]
 
 
 class ReferenceAccess(Access):
