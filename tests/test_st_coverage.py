@@ -7,6 +7,7 @@ from the routine's text (comments below)."""
 from __future__ import annotations
 
 import shutil
+import subprocess
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -159,6 +160,19 @@ def test_lcov_lines_and_arms(partial):
     st_lines = set(da) - {str(line_of("[XIC(Start) ,XIC(Running) ]XIO(Stop)OTE(Running);")),
                           str(line_of("JSR(Sequence,0);"))}
     assert len(st_lines) == 25 and totals["LF"] == str(len(da))
+
+
+@pytest.mark.skipif(shutil.which("genhtml") is None, reason="genhtml (lcov) is not installed")
+def test_genhtml_reads_the_exports_tracefile(partial, tmp_path):
+    """Every record is a file a CI tool can show: the export (the continuous task the loader made
+    has no file, and no record)."""
+    _, cov = partial
+    text = lcov(cov)
+    assert [line for line in text.splitlines() if line.startswith("SF:")] == [f"SF:{partial[0]}"]
+    (tmp_path / "m.info").write_text(text, encoding="utf-8")
+    subprocess.run(["genhtml", "--branch-coverage", "-q", "-o", str(tmp_path / "html"), str(tmp_path / "m.info")],
+                   capture_output=True, text=True, check=True)
+    assert (tmp_path / "html" / "index.html").is_file()
 
 
 def test_cobertura_class_of_the_routine(partial):

@@ -36,11 +36,16 @@ COBERTURA_DTD = "http://cobertura.sourceforge.net/xml/coverage-04.dtd"
 
 def _sources(covs: tuple[Coverage, ...]) -> dict[str, list[tuple[Coverage, FileInfo]]]:
     """Absolute .lad path -> its program files (with the measurement each
-    is in: several apps' may go in one report), in file number order."""
+    is in: several apps' may go in one report), in file number order. A
+    file the program made itself (a Logix export's continuous task, at
+    ``<generated>``) has no source a CI tool could show: left out, as the
+    annotated listing leaves it out."""
     by_source: dict[str, list[tuple[Coverage, FileInfo]]] = {}
     for cov in covs:
         for number in sorted(cov.files):
             info = cov.files[number]
+            if not os.path.isfile(info.source):
+                continue
             by_source.setdefault(os.path.abspath(info.source), []).append((cov, info))
     return by_source
 
