@@ -92,6 +92,23 @@ def test_access_expression_reads_words_bits_floats_indirect_and_a_leaf_twice(acc
     assert doubled() == 20 and compute() == 0 + 0.5 - 10 + 4
 
 
+@pytest.mark.parametrize("access_class", [BoundAccess, ReferenceAccess])
+def test_access_gives_an_indirect_bit_its_number_the_top_bit_too(access_class):
+    table = DataTable()
+    table.reference("N7:2")
+    table.reference("B3:3")
+    table.create_file("L", 9, 2)
+    access = access_class(table, Machine(table))
+    word_bit, long_bit = (access.location(AddressRef(parse_address(a))) for a in ("B3:[N7:0]/[N7:1]", "L9:[N7:0]/[N7:2]"))
+    for element, bit, top in ((1, 15, 31), (0, 3, 30), (1, 0, 0)):
+        for address, value in (("N7:0", element), ("N7:1", bit), ("N7:2", top)):
+            table.write(address, value)
+        assert word_bit()[1:] == (element, bit) and long_bit()[1:] == (element, top)
+    table.write("N7:1", 16)
+    with pytest.raises(MajorFault):
+        word_bit()
+
+
 def test_the_compiled_access_makes_an_expression_code_not_a_walk(monkeypatch):
     import softplc_lite.ladder.bound as bound_module
 

@@ -39,11 +39,11 @@ from array import array
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Callable
 
-from ..datatable import Address, DataTable
+from ..datatable import Address, DataTable, item_bit_mask
 from ..datatable.errors import AddressRangeError
 from .ast import AddressRef, Const, Instruction, address_refs
 from .expr import evaluate, namespace, to_python
-from .resolvers import address_fault
+from .resolvers import address_fault, resolver
 from .semantics import Machine, MajorFault
 from . import status as S
 
@@ -174,12 +174,31 @@ class Operand:
         return str(self.address) if self.address is not None else repr(self.constant)
 
 
+# A bit's mask in an item of any width (what resolvers.resolver gives) -> the bit's number: the
+# masks of the widths differ only in their top bit, negative (-128, -32768, -2**31, -2**63).
+_BIT_OF_MASK = {item_bit_mask(b, size): b for size in (1, 2, 4, 8) for b in range(8 * size)}
+
+
 class BoundAccess(Access):
     """The compiled path: a direct address is resolved once, at load, and an
     expression is made Python code once (the compiler's form of CPT's,
     expr.to_python) instead of a tree walked at each call."""
 
     cache_direct = True
+
+    def location(self, operand) -> Callable[[], Location]:
+        """An indirect or indexed address through the compiler's resolver
+        (resolvers.resolver: fast paths for the common shapes), its bit mask
+        given back as the bit's number."""
+        if not isinstance(operand, AddressRef) or self.fixed(operand) is not None:
+            return super().location(operand)
+        locate = resolver(self.table, operand.address)
+        bit_of = _BIT_OF_MASK
+
+        def get() -> Location:
+            d, i, mask = locate()
+            return d, i, (None if mask is None else bit_of[mask])
+        return get
 
     def expression(self, node) -> Callable[[], int | float]:
         if isinstance(node, (Const, AddressRef)):
