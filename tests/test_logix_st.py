@@ -235,3 +235,17 @@ def test_a_bool_assignment_sets_and_clears_every_bit_of_a_word_the_sign_bit_too(
     r.run(1)
     assert [read_tag(r, f"b{k}") for k in range(16)] == [0] * 16 and r.engine.fault is None
     assert (read_tag(r, "w"), read_tag(r, "s"), read_tag(r, "n")) == (0, 0, 0)
+
+
+def test_a_statement_not_run_inside_an_if_leaves_the_rest_of_the_routine_running(tmp_path):
+    tags = TAGS + [("a", "STRING")]
+    st = ("IF Count > 100 THEN n := 1;\nELSIF a = 3 THEN n := 2;\nEND_IF;\n"  # a STRING in an expression
+          "IF Count > 1 THEN Sel := 5; IF a > 1 THEN Sum := 1; END_IF; Big := 1; END_IF;\n"
+          "Count := Count + 1;")
+    r = export_runner(st_export(tmp_path, st, tags=tags))
+    r.run(3)
+    assert (read_tag(r, "Count"), read_tag(r, "Sel"), read_tag(r, "Big"), read_tag(r, "n")) == (3, 5, 1, 0)
+    warnings = [str(w) for w in r.app.logix.warnings]
+    assert sum("the statement is not run" in w for w in warnings) == 2, warnings
+    counts = r.app.logix.statements
+    assert counts["not run"] == 2 and counts["errors"] == 0 and counts["total"] == counts["run"] + 2

@@ -95,7 +95,7 @@ class Expressions:
             if not e.selectors and e.base.upper() in ("TRUE", "FALSE"):
                 return Const(1 if e.base.upper() == "TRUE" else 0, e.pos), "BOOL"
             r = self.tag(e)
-            if r.address is None:
+            if r.address is None or r.type.kind == "string":
                 kind = f"{r.type.name} array" if r.dims else r.type.name
                 if r.type.kind == "string" and not r.dims:
                     raise StProblem(e.pos, f"{e.text} is a {kind}: softplc_lite runs strings in ST through "

@@ -140,16 +140,26 @@ class StRoutine:
         self.ctx.skip = False
         self.ctx.before = []
         mark = len(self.rungs)
+        saved = (len(self.arms), len(self.starts), len(self.clear_first), self.pending)
+        compound = isinstance(s, (A.If, A.Case, A.For, A.While, A.Repeat))
+        failed = None
         try:
-            kind = type(s).__name__
-            getattr(self, f"st_{kind.lower()}")(s)
+            getattr(self, f"st_{type(s).__name__.lower()}")(s)
         except StProblem as e:
+            failed = e
             (self.ctx.warn if e.not_run else self.ctx.problem)(e.pos, f"{e}" +
                                                                 ("; the statement is not run" if e.not_run else ""))
-            if e.not_run:
-                self.ctx.skip = True
+            # What the statement made before the problem goes with it (an IF whose ELSIF fails
+            # would leave a JMP to a label never placed); what came before it stays.
+            del self.rungs[mark:], self.rung_lines[mark:]
+            del self.arms[saved[0]:], self.starts[saved[1]:], self.clear_first[saved[2]:]
+            self.pending = saved[3]
         self._name_lines(problems, warnings, s.pos)
-        if len(self.ctx.problems) > problems:
+        if failed is not None:
+            self.statements["not run" if failed.not_run else "errors"] += 1
+        elif compound:  # its own statements counted themselves
+            self.statements["run"] += 1
+        elif len(self.ctx.problems) > problems:
             self.statements["errors"] += 1
         elif self.ctx.skip:
             self.statements["not run"] += 1
@@ -226,12 +236,11 @@ class StRoutine:
             raise StProblem(s.pos, "EXIT outside a FOR, WHILE or REPEAT loop")
         self.emit([self.jump(self.loops[-1], s.pos)], s.pos)
 
-    def test(self, cond, pos: Pos, label: int, jump_when_false: bool = True) -> int:
-        """A rung that jumps to ``label`` when ``cond`` fails (or holds)."""
+    def test(self, cond, pos: Pos, label: int) -> int:
+        """A rung that jumps to ``label`` when ``cond`` fails; its index."""
         self.ctx.before = []
         node = self.x.condition(cond)
-        test = self.unless(node, pos) if jump_when_false else self.when(node, pos)
-        return self.emit(self.ctx.before + test + [self.jump(label, pos)], pos)
+        return self.emit(self.ctx.before + self.unless(node, pos) + [self.jump(label, pos)], pos)
 
     def choose(self, tests, else_, pos: Pos) -> None:
         """IF and CASE alike: ``tests`` is [(make_test(label) -> rung, body,
