@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from helpers.watch_sessions import scan_to_break
 from softplc_lite.app import load_app
 from softplc_lite.datatable import Address
 from softplc_lite.runner import RunOptions
@@ -185,11 +186,7 @@ def test_break_when_find_set_and_force_take_tag_paths(tmp_path):
         assert s.message.startswith("SettleTimer.DN (L15:1/29) 1 of 2: MainProgram.MainRoutine rung 2")
         s.set_value("Start = 1")
         assert s.message == "set Start = 1"
-        hit = None
-        for _ in range(400):
-            hit = s.scan()
-            if hit is not None:
-                break
+        hit = scan_to_break(s, 400)
         assert hit is not None and s.engine.scans == 281  # 80 scans filling, 200 settling, one to count
         assert s.message == "break: Batches.ACC >= 1 became true at scan 281"
         assert (s.file, s.selected) == (3, 2)  # the break is shown in its routine

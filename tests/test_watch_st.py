@@ -24,6 +24,7 @@ from softplc_lite.watch.st_ran import RanRungs
 
 from helpers.cli import softplc_here
 from helpers.logix_l5x import Prog, Task, write_l5x
+from helpers.watch_sessions import scan_to_break
 
 ROOT = Path(__file__).resolve().parent.parent
 ST_TANK = ROOT / "programs" / "logix" / "st_tank.L5X"
@@ -188,11 +189,7 @@ def test_keys_move_by_lines_and_a_breakpoint_stops_where_a_line_runs(executor, t
         assert s.message == "go to line 8: at line 9, the next line with a statement"
         s.goto_text("x")
         assert s.message == "go to line 'x': expected a line number, 1 to 15"
-        hit = None
-        for _ in range(100):
-            hit = s.scan()
-            if hit is not None:
-                break
+        scan_to_break(s, 100)
         assert s.engine.scans == 40 and s.message == "break: MainProgram.MainRoutine line 4 ran at scan 40"
         assert _screen(s)[2].startswith(" routine MainProgram.MainRoutine  line 4 of 15")
     finally:

@@ -184,13 +184,7 @@ class _Context:
         return self.power.get(element)
 
     def value(self, address: Address) -> Run:
-        try:
-            value = self.table.read(address)
-            # D and A words show as BCD digits / two characters (their radix).
-            shown = word_shown(value, address.ftype) if address.kind is ValueKind.WORD else None
-            return (shown or _value_text(value), None)
-        except READ_FAILURES:
-            return ("?", FAULT)
+        return value_run(self.table, address)
 
     def is_output(self, element: Element) -> bool:
         """An output instruction, or a branch whose every leg ends in one
@@ -219,6 +213,18 @@ def _value_text(value) -> str:
         text = json.dumps(value)
         return text if len(text) <= STRING_MAX else text[:STRING_MAX - 4] + '..."'
     return str(value)
+
+
+def value_run(table: DataTable, address: Address) -> Run:
+    """An address's value as the watch view shows it, "?" in the fault
+    style when it cannot be read."""
+    try:
+        value = table.read(address)
+        # D and A words show as BCD digits / two characters (their radix).
+        shown = word_shown(value, address.ftype) if address.kind is ValueKind.WORD else None
+        return (shown or _value_text(value), None)
+    except READ_FAILURES:
+        return ("?", FAULT)
 
 
 # -- contacts and coils -----------------------------------------------------------------------

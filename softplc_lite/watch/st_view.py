@@ -40,10 +40,8 @@ from rich.segment import Segment
 from rich.style import Style
 
 from ..datatable import ValueKind
-from ..datatable.display import word_shown
 from ..ladder.ast import AddressRef, ProgramFile, address_refs, walk
-from .cells import BREAKPOINT, COMMENT, ENERGIZED, FAULT, FORCED, SELECTED, _value_text
-from .power import READ_FAILURES
+from .cells import BREAKPOINT, COMMENT, ENERGIZED, FORCED, SELECTED, value_run
 
 RAN = "●"
 VALUE_GAP = 2  # spaces between the text and its values, and between two values
@@ -185,12 +183,7 @@ class StView:
         return bool(full) and full.upper().endswith(".CTL")
 
     def value(self, address) -> tuple[str, Style | None]:
-        try:
-            value = self.table.read(address)
-            shown = word_shown(value, address.ftype) if address.kind is ValueKind.WORD else None
-            return (shown or _value_text(value), None)
-        except READ_FAILURES:
-            return ("?", FAULT)
+        return value_run(self.table, address)
 
     def gutter(self, line: int, digits: int) -> list[tuple[str, Style | None]]:
         rungs = self.lines.rungs.get(line, ())

@@ -32,3 +32,13 @@ def sessions(tmp_path: Path, program: str, files: dict[str, str] | None = None):
     yield make
     for s in made:
         s.quit()
+
+
+def scan_to_break(session: WatchSession, limit: int):
+    """Scan ``session`` until a breakpoint stops it (what ``scan`` returns
+    then), or ``limit`` scans: None."""
+    for _ in range(limit):
+        hit = session.scan()
+        if hit is not None:
+            return hit
+    return None
