@@ -23,7 +23,7 @@ BENCHMARKS = (
     "bench_comgenius_format",
     "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_modbus_server",
     "bench_enips_server", "bench_watch", "bench_trend_view", "bench_trends", "bench_scenarios", "bench_mutation",
-    "bench_logix",
+    "bench_logix", "bench_st",
 )
 
 
@@ -191,6 +191,12 @@ def main() -> int:
     if logix:
         lines.append(f"logix     {logix['export']} ({logix['rungs']} rungs): scan / its rungs as PLC-5 text "
                      f"{med(logix['ratio']):.2f} [{'PASS' if logix['verdict'] else 'MISS'} <= {logix['target']}]")
+
+    stb = load("bench_st")
+    if stb:
+        lines.append(f"st        {stb['units']} units of ST: scan / the same logic as ladder {med(stb['ratio_ladder']):.2f}, "
+                     f"/ straight-line Python {med(stb['ratio_python']):.1f} "
+                     f"[{'PASS' if stb['verdict'] else 'MISS'} <= {stb['target']}]")
 
     trends = load("bench_trends")
     if trends:
