@@ -126,26 +126,33 @@ def declare_module_tags(project: model.Project, directory: TagDirectory,
                                                 f"laid out; rungs that use them are not run"))
 
 
-def _absent(project: model.Project):
+def _absent(project: model.Project) -> "_Absent":
     """Why a module tag name (``Local:0:O``) that the export does not
     hold is used, or None for a name that is no module's: the export holds
     its modules without that tag's data (a slot with no module, a
     connection with no output), or no modules at all (a partial export)."""
     modules = {m.name.upper() for m in project.modules if m.name}
     modules |= {(m.parent or "").upper() for m in project.modules if m.parent}
-    partial = not project.modules
+    return _Absent(frozenset(modules), not project.modules)
 
-    def why(name: str) -> str | None:
+
+class _Absent:
+    """_absent's answer, an object rather than a closure so that the tag
+    directory holding it pickles (a failed test's drawing keeps it)."""
+
+    def __init__(self, modules: frozenset[str], partial: bool) -> None:
+        self.modules = modules
+        self.partial = partial
+
+    def __call__(self, name: str) -> str | None:
         head, colon, _ = name.partition(":")
         if not colon:
             return None
-        if partial:
+        if self.partial:
             return f"module tag {name}: the export holds no modules"
-        if head.upper() in modules:
+        if head.upper() in self.modules:
             return f"module tag {name}: the export's modules have no data for it"
         return None
-
-    return why
 
 
 def _why(project: model.Project, mt: model.ModuleTag) -> str:
