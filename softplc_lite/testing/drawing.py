@@ -10,28 +10,33 @@ renderable that draws each rung with the watch view's ``RungView``: power
 flow and live values as they were at that moment, the rung's comment, its
 forced bits marked ``F``, to the console's width. :func:`writer_rungs` finds
 the rungs that write an address or a symbol, from the program's
-cross-reference (watch/xref.py).
+cross-reference (watch/xref.py). A file made from Structured Text is drawn
+as its text instead: the lines those rungs were made from, with the heads
+of the arms they sit in and their tags' values (drawing_st.py).
 
 At most ``MAX_RUNGS`` rungs are drawn (a softplc_lite choice: four rungs of
 a typical width fit one screen beside the failure's own line), and ``and K
-more`` says how many were left out, with where they are.
+more`` says how many were left out, with where they are; a line of
+Structured Text counts as one rung, however many rungs it became.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from itertools import groupby
 
 from rich.console import Console, ConsoleOptions, RenderResult
 from rich.text import Text
 
 from ..datatable import DataTable
 from ..datatable.snapshot import decode, encode
-from ..ladder.ast import Program, Rung
+from ..ladder.ast import Program, ProgramFile, Rung
 from ..ladder.instructions import InstructionSet
 from ..watch.naming import names_in_file, routines_of
 from ..watch.rungs import COMMENT, HEADER, RungView
 from ..watch.xref import XrefIndex
+from .drawing_st import excerpt, line_of, line_places
 
 MAX_RUNGS = 4
 
@@ -53,23 +58,27 @@ class RungsAt:
     more: tuple[tuple[int, int], ...] = ()
     why_none: str = ""
     routines: tuple[tuple[int, str], ...] = ()  # a Logix app's: its rungs drawn by tag path (watch/naming.py)
+    texts: tuple[tuple[int, ProgramFile], ...] = ()  # the files made from Structured Text: drawn as lines
 
     def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
         if not self.rungs:
             yield Text(self.why_none or f"no rung to draw for {self.title}", style=COMMENT)
             return
         table = decode(self.table)
-        file = None
-        names = None
-        for number, k, rung in self.rungs:
-            if number != file:
-                file = number
-                names, label = names_in_file(self.symbols, self.routines, number)
-                yield Text(f"{label}, rungs that write {self.title}:", style=HEADER)
-            yield RungView(rung, k, table, symbols=names, forced=self.forced,
-                           instructions=self.instructions)
+        texts = dict(self.texts)
+        for number, group in groupby(self.rungs, key=lambda place: place[0]):
+            names, label = names_in_file(self.symbols, self.routines, number)
+            pfile = texts.get(number)
+            if pfile is not None:
+                yield Text(f"{label}, lines that write {self.title}:", style=HEADER)
+                yield excerpt(pfile, [k for _, k, _ in group], table, names, self.forced)
+                continue
+            yield Text(f"{label}, rungs that write {self.title}:", style=HEADER)
+            for _, k, rung in group:
+                yield RungView(rung, k, table, symbols=names, forced=self.forced, instructions=self.instructions)
         if self.more:
-            where = ", ".join(f"file {f} rung {r}" for f, r in self.more)
+            where = ", ".join(f"{names_in_file(self.symbols, self.routines, f)[1]} line {line_of(texts[f], r) + 1}"
+                              if f in texts else f"file {f} rung {r}" for f, r in self.more)
             yield Text(f"and {len(self.more)} more: {where}", style=COMMENT)
 
 
@@ -90,12 +99,14 @@ def draw_rungs(program: Program, table: DataTable, places: Iterable[tuple[int, i
     ``program``, to be drawn with ``table``'s values as they are now: at
     most ``limit`` of them, the rest listed as ``more``. ``forced``: the
     forced addresses (canonical text, ``I:0/0``)."""
-    places = list(places)
+    places = line_places(program.files, places)
     rungs = tuple((f, r, program.files[f].rungs[r]) for f, r in places[:max(limit, 0)])
+    texts = tuple((f, program.files[f]) for f in dict.fromkeys(f for f, _ in places)
+                  if program.files[f].listing is not None)
     if instructions is not None:  # its specs only: an app's set holds functions that do not pickle
         instructions = InstructionSet([s for s in instructions.all_specs() if s.module])
     return RungsAt(title, rungs, encode(table), program.symbols, frozenset(forced), instructions,
-                   tuple(places[len(rungs):]), why_none, routines_of(program))
+                   tuple(places[len(rungs):]), why_none, routines_of(program), texts)
 
 
 def writers_at(program: Program, table: DataTable, name: str, forced: Iterable[str] = (),

@@ -25,6 +25,9 @@ Structured Text")::
   statement uses them; beside the text when they fit, else under it;
 * a line too long for the width is folded, not cut.
 
+:class:`StExcerpt` draws a few chosen lines the same way, for a report
+(a failed test's, testing/drawing_st.py).
+
 The rungs are the statements' own: the rung the translation puts first, to
 clear ``[:=]`` destinations on the first scan, and a rung that is only a
 label a JMP lands on (the end of an IF) belong to no line.
@@ -139,7 +142,7 @@ class StView:
 
     def __init__(self, pfile: ProgramFile, lines: StLines, table, names, ran: set[int] | None, selected: int,
                  top: int = 0, height: int | None = None, breakpoints=frozenset(), forced=frozenset(),
-                 scrolled=None) -> None:
+                 scrolled=None, marked: frozenset[int] | None = None) -> None:
         self.pfile = pfile
         self.lines = lines
         self.table = table
@@ -151,6 +154,7 @@ class StView:
         self.breakpoints = breakpoints
         self.forced = forced
         self.scrolled = scrolled
+        self.marked = marked  # the lines the gutter marks ">" (None: the selected rung's)
         self.last_drawn = None  # the rungs panel's scrolling is this view's own (lines, not rungs)
 
     # -- one line's parts ---------------------------------------------------------------------
@@ -188,17 +192,18 @@ class StView:
     def gutter(self, line: int, digits: int) -> list[tuple[str, Style | None]]:
         rungs = self.lines.rungs.get(line, ())
         number = self.pfile.number
-        chosen = line == self.lines.line_of(self.selected)
+        chosen = line in self.marked if self.marked is not None else line == self.lines.line_of(self.selected)
         marked = any((number, r) in self.breakpoints or r in self.breakpoints for r in rungs)
         ran = self.ran is not None and any(r in self.ran for r in rungs)
         return [(">" if chosen else " ", SELECTED if chosen else None), ("*" if marked else " ", BREAKPOINT),
                 (RAN if ran else " ", ENERGIZED if ran else None), (" ", None),
                 (f"{line + 1:>{digits}} ", SELECTED if chosen else _LINE_NUMBER)]
 
-    def column(self, width: int, digits: int) -> int:
-        """Where values beside the text start: past the longest line, but
-        no further than two thirds of the width."""
-        longest = max((len(self.text(k)) for k in self.lines.rungs), default=0)
+    def column(self, width: int, digits: int, among: Iterable[int] | None = None) -> int:
+        """Where values beside the text start: past the longest line (of
+        ``among``, or of all holding a statement), but no further than two
+        thirds of the width."""
+        longest = max((len(self.text(k)) for k in (self.lines.rungs if among is None else among)), default=0)
         return min(_indent(digits) + longest + VALUE_GAP, width * 2 // 3)
 
     def text(self, line: int) -> str:
@@ -264,6 +269,28 @@ class StView:
                 yield from _segments(row)
                 yield Segment.line()
                 used += 1
+
+
+class StExcerpt:
+    """Some lines of an ST file, drawn as :class:`StView` draws them (the
+    routine's line numbers, each line's values beside or under it), for a
+    report that shows a few lines rather than a screen: ``lines`` (from 0)
+    in order, ``marked`` those the gutter marks ``>``; ``table``, ``names``
+    and ``forced`` as StView's."""
+
+    def __init__(self, pfile: ProgramFile, table, names, lines: Iterable[int], marked: Iterable[int] = (),
+                 forced=frozenset()) -> None:
+        self.view = StView(pfile, StLines(pfile), table, names, None, -1, forced=forced, marked=frozenset(marked))
+        self.shown = sorted(set(lines))
+
+    def __rich_console__(self, console: Console, options: ConsoleOptions) -> RenderResult:
+        width = max(options.max_width, 20)
+        digits = len(str(max(self.shown, default=0) + 1))
+        column = self.view.column(width, digits, self.shown)
+        for line in self.shown:
+            for row in self.view.rows(line, width, digits, column):
+                yield from _segments(row)
+                yield Segment.line()
 
 
 def _indent(digits: int) -> int:
