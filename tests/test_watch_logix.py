@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from helpers.watch_sessions import scan_to_break
+from helpers.watch_sessions import save_edit, scan_to_break
 from softplc_lite.app import load_app
 from softplc_lite.datatable import Address
 from softplc_lite.runner import RunOptions
@@ -211,9 +211,6 @@ def test_the_find_list_names_routines_instructions_and_tags(session):
 def test_a_re_exported_file_is_put_in_place_and_named_anew(tmp_path):
     """Online program edit: the export saved again (a rung changed, a tag added before the others, so
     every tag moves in the data table) is loaded as any app's edit, and the view names the new layout."""
-    import os
-    import time
-
     export = tmp_path / "tank_line.L5X"
     shutil.copy(TANK_LINE, export)
     s = WatchSession(load_app(export, tmp_path / "state"), WatchOptions(run=RunOptions(fresh=True)))
@@ -224,13 +221,7 @@ def test_a_re_exported_file_is_put_in_place_and_named_anew(tmp_path):
         text = text.replace("<Tags>\n<Tag Name=\"Start\"", "<Tags>\n<Tag Name=\"Hold\" TagType=\"Base\" "
                             "DataType=\"BOOL\" Radix=\"Decimal\" Constant=\"false\" ExternalAccess=\"Read/Write\"/>\n"
                             "<Tag Name=\"Start\"", 1)
-        before = export.stat().st_mtime_ns
-        export.write_text(text, encoding="utf-8")
-        os.utime(export, ns=(before, before + 10_000_000))
-        deadline = time.monotonic() + 10
-        while s.last_edit is None and time.monotonic() < deadline:
-            s.poll_online()
-            time.sleep(0.05)
+        save_edit(s, export, text)
         assert s.last_edit is not None and s.last_edit.applied, s.message
         s.goto(1)
         lines = _screen(s)

@@ -7,10 +7,8 @@ reference executor is held to the same goldens, and each rule on its own."""
 
 from __future__ import annotations
 
-import os
 import shutil
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -24,7 +22,7 @@ from softplc_lite.watch.st_ran import RanRungs
 
 from helpers.cli import softplc_here
 from helpers.logix_l5x import Prog, Task, write_l5x
-from helpers.watch_sessions import scan_to_break
+from helpers.watch_sessions import save_edit, scan_to_break
 
 ROOT = Path(__file__).resolve().parent.parent
 ST_TANK = ROOT / "programs" / "logix" / "st_tank.L5X"
@@ -217,13 +215,7 @@ def test_a_re_exported_routine_is_put_in_place_and_still_marked(tmp_path):
     s = WatchSession(load_app(export, tmp_path / "state"), WatchOptions(run=RunOptions(fresh=True)))
     try:
         s.scan()
-        before = export.stat().st_mtime_ns
-        export.write_text(export.read_text(encoding="utf-8").replace("Level + 2.5;", "Level + 5.0;"), encoding="utf-8")
-        os.utime(export, ns=(before, before + 10_000_000))
-        deadline = time.monotonic() + 10
-        while s.last_edit is None and time.monotonic() < deadline:
-            s.poll_online()
-            time.sleep(0.05)
+        save_edit(s, export, export.read_text(encoding="utf-8").replace("Level + 2.5;", "Level + 5.0;"))
         assert s.last_edit is not None and s.last_edit.applied, s.message
         s.scan()
         lines = _screen(s)

@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import itertools
+import os
+import time
 from pathlib import Path
 
 from softplc_lite.app import load_app
@@ -42,3 +44,15 @@ def scan_to_break(session: WatchSession, limit: int):
         if hit is not None:
             return hit
     return None
+
+
+def save_edit(session: WatchSession, path: Path, text: str, wait_s: float = 10.0) -> None:
+    """Write ``text`` over ``path`` as an editor saves it (a later mtime) and
+    poll ``session`` until its online edit is made (``session.last_edit``)."""
+    before = path.stat().st_mtime_ns
+    path.write_text(text, encoding="utf-8")
+    os.utime(path, ns=(before, before + 10_000_000))
+    deadline = time.monotonic() + wait_s
+    while session.last_edit is None and time.monotonic() < deadline:
+        session.poll_online()
+        time.sleep(0.05)
