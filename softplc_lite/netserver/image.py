@@ -172,6 +172,12 @@ class SharedImage:
         return COUNTER_ARRAY.unpack_from(self.mm, SEQUENCE.size)
 
     # -- the server's side --------------------------------------------------------------------
+    def sequence(self) -> int:
+        """The publication's sequence number: odd while the scan writes; a
+        new even number once per scan (a server that follows the scans, as
+        OPC UA's subscriptions do, looks here first)."""
+        return SEQUENCE.unpack_from(self.mm, 0)[0]
+
     def read(self, spans: list[tuple[int, int]]) -> list[bytes] | None:
         """The bytes of each (offset, length) span of the image, all from one
         publication; None if the scan was writing (the caller tries again)."""

@@ -1,0 +1,245 @@
+"""Every place OPCUAS touches asyncua, in one module.
+
+Written and tested against asyncua >=2.1,<2.2 (the range pyproject.toml
+pins: asyncua changes its API in minor releases). Beyond its documented
+API (``Server``: ``init``, ``set_endpoint``, ``set_security_policy``,
+``register_namespace``, ``start``, ``stop``; the ``ua`` types), OPCUAS
+relies on these internals:
+
+- ``Server.iserver`` (the ``InternalServer``): ``node_mgt_service.add_nodes``, to
+  make the address space in one call; ``aspace.write_attribute_value``
+  and ``aspace.read_attribute_value``, to publish a scan's values and to
+  tell a known node from an unknown one; its limits ``max_connections``
+  (one connection a session) and ``max_subscriptions``;
+- ``iserver.attribute_service.write``, taken over: every Write service
+  call comes here first (``Refuser``);
+- ``iserver.subscription_service.create_monitored_items`` and
+  ``subscriptions[..].monitored_item_srv._monitored_items``, to hold the
+  monitored items to the configured limit;
+- ``Server.bserver._server`` (the asyncio server), for the port bound, and
+  ``bserver.clients``, the connections open.
+
+Nothing else in OPCUAS imports asyncua. ``missing()`` says, in one line,
+what an installed asyncua lacks of this; the server process reports it
+instead of failing later with a traceback.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from datetime import datetime, timezone
+
+ASYNCUA_RANGE = ">=2.1,<2.2"
+
+try:
+    import asyncua
+    from asyncua import Server, ua
+    from asyncua.crypto.permission_rules import User, UserRole
+    from asyncua.server.address_space import AttributeService, NodeManagementService
+    from asyncua.server.internal_server import InternalServer
+    from asyncua.server.subscription_service import SubscriptionService
+except ImportError as _exc:  # the server process says this line, not a traceback
+    if isinstance(_exc, ModuleNotFoundError) and _exc.name == "asyncua":
+        raise ImportError(f"asyncua is not installed: OPCUAS needs asyncua{ASYNCUA_RANGE} "
+                          f"(pip install 'asyncua{ASYNCUA_RANGE}')") from None
+    raise ImportError(f"the installed asyncua lacks what OPCUAS uses ({_exc}): OPCUAS is written for "
+                      f"asyncua {ASYNCUA_RANGE} (pip install 'asyncua{ASYNCUA_RANGE}')") from None
+
+from .space import NAMESPACE, Space, decode  # noqa: E402
+
+_NEEDED = (
+    (Server, ("init", "set_endpoint", "set_security_policy", "register_namespace", "start", "stop")),
+    (AttributeService, ("write",)),
+    (SubscriptionService, ("create_monitored_items",)),
+    (InternalServer, ("write_attribute_value",)),
+    (NodeManagementService, ("add_nodes",)),
+)
+POLL_S = 0.002  # how often the server looks for a new scan in the image: a choice (docs/opcuas.md)
+VARIANT = {"Boolean": ua.VariantType.Boolean, "Int16": ua.VariantType.Int16, "Int32": ua.VariantType.Int32,
+           "Float": ua.VariantType.Float, "String": ua.VariantType.String, "SByte": ua.VariantType.SByte,
+           "Int64": ua.VariantType.Int64, "Mode": ua.VariantType.String}
+DATA_TYPE = {"Boolean": ua.ObjectIds.Boolean, "Int16": ua.ObjectIds.Int16, "Int32": ua.ObjectIds.Int32,
+             "Float": ua.ObjectIds.Float, "String": ua.ObjectIds.String, "SByte": ua.ObjectIds.SByte,
+             "Int64": ua.ObjectIds.Int64, "Mode": ua.ObjectIds.String}
+BAD_NOT_WRITABLE = ua.StatusCodes.BadNotWritable
+BAD_NODE_UNKNOWN = ua.StatusCodes.BadNodeIdUnknown
+BAD_TOO_MANY_ITEMS = ua.StatusCodes.BadTooManyMonitoredItems
+
+
+def missing() -> str | None:
+    """What the installed asyncua lacks of what this module uses, in one
+    line; None when it has everything."""
+    lacking = [f"{owner.__name__}.{name}" for owner, names in _NEEDED for name in names if not hasattr(owner, name)]
+    if not lacking:
+        return None
+    return (f"asyncua {getattr(asyncua, '__version__', '?')} lacks {', '.join(lacking)}: OPCUAS is written "
+            f"for asyncua {ASYNCUA_RANGE} (pip install 'asyncua{ASYNCUA_RANGE}')")
+
+
+def _add_items(space: Space, ns: int) -> list:
+    """The AddNodes items of the whole address space, parents first."""
+    items = []
+    obj_type = ua.NodeId(ua.ObjectIds.BaseObjectType)
+    var_type = ua.NodeId(ua.ObjectIds.BaseDataVariableType)
+    for o in space.objects:
+        attrs = ua.ObjectAttributes(DisplayName=ua.LocalizedText(o.name), Description=ua.LocalizedText(o.description))
+        parent = ua.NodeId(o.parent, ns) if o.parent else ua.NodeId(ua.ObjectIds.ObjectsFolder)
+        ref = ua.ObjectIds.HasComponent if o.parent else ua.ObjectIds.Organizes
+        items.append(ua.AddNodesItem(RequestedNewNodeId=ua.NodeId(o.node, ns),
+                                     BrowseName=ua.QualifiedName(o.name, ns), NodeClass=ua.NodeClass.Object,
+                                     ParentNodeId=parent, ReferenceTypeId=ua.NodeId(ref),
+                                     TypeDefinition=obj_type, NodeAttributes=attrs))
+    for v in space.variables:
+        attrs = ua.VariableAttributes(
+            DisplayName=ua.LocalizedText(v.name), Description=ua.LocalizedText(v.description),
+            Value=ua.Variant(_empty(v.kind), VARIANT[v.kind]), DataType=ua.NodeId(DATA_TYPE[v.kind]),
+            ValueRank=-1, AccessLevel=ua.AccessLevel.CurrentRead.mask,
+            UserAccessLevel=ua.AccessLevel.CurrentRead.mask)
+        items.append(ua.AddNodesItem(RequestedNewNodeId=ua.NodeId(v.node, ns), BrowseName=ua.QualifiedName(v.name, ns),
+                                     NodeClass=ua.NodeClass.Variable, ParentNodeId=ua.NodeId(v.parent, ns),
+                                     ReferenceTypeId=ua.NodeId(ua.ObjectIds.HasComponent),
+                                     TypeDefinition=var_type, NodeAttributes=attrs))
+    return items
+
+
+def _empty(kind: str):
+    return {"Boolean": False, "String": "", "Mode": "", "Float": 0.0}.get(kind, 0)
+
+
+class Listener:
+    """asyncua's server, as the network-server layer's listener
+    (netserver.protocol.Listener): ``start`` makes the address space and
+    listens, then follows the scans the image publishes."""
+
+    def __init__(self, server, space: Space, config, counters) -> None:
+        self.plc_server = server
+        self.space = space
+        self.config = config
+        self.counters = counters  # (refused writes, refused monitored items, refused subscriptions)
+        self.ua: Server | None = None
+        self.ns = 2
+        self.task: asyncio.Task | None = None
+        self.nodes: list = []
+        self.notified = 0  # values published to asyncua: one per variable per scan at most
+
+    async def start(self) -> int:
+        for name in ("asyncua", "asyncua.server", "asyncua.uaprotocol"):
+            logging.getLogger(name).setLevel(logging.CRITICAL)  # this server says what matters, counted
+        s = self.plc_server.settings
+        server = self.ua = Server()
+        await server.init()
+        host = f"[{s.host}]" if ":" in s.host else s.host
+        server.set_endpoint(f"opc.tcp://{host}:{s.port}/")
+        server.set_server_name(f"softplc_lite {self.space.app}")
+        server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+        self.ns = await server.register_namespace(NAMESPACE)
+        iserver = server.iserver
+        iserver.max_connections = self.config.max_sessions
+        iserver.max_subscriptions = self.config.max_subscriptions
+        iserver.allow_remote_admin = False  # a client calling itself "admin" gets no more than another
+        results = iserver.node_mgt_service.add_nodes(_add_items(self.space, self.ns))
+        bad = [r.StatusCode for r in results if not r.StatusCode.is_good()]
+        if bad:
+            raise RuntimeError(f"asyncua refused {len(bad)} nodes of the address space ({bad[0].name})")
+        self.nodes = [ua.NodeId(v.node, self.ns) for v in self.space.variables]
+        self._take_over(iserver)
+        await server.start()
+        self.task = asyncio.get_running_loop().create_task(self.follow())
+        return server.bserver._server.sockets[0].getsockname()[1]
+
+    async def stop(self) -> None:
+        if self.task is not None:
+            self.task.cancel()
+        if self.ua is not None:
+            await self.ua.stop()
+
+    # -- the scans ---------------------------------------------------------------------------
+    async def follow(self) -> None:
+        """Publish each scan's values as the image holds them, the changed
+        ones only: a monitored item gets at most one change a scan."""
+        image, space = self.plc_server.image, self.space
+        aspace = self.ua.iserver.aspace
+        by_slot: list[list[int]] = [[] for _ in space.slots]
+        for i, v in enumerate(space.variables):
+            by_slot[v.slot].append(i)
+        spans = [(0, space.image_bytes)]
+        last_seq, last_raw, values = None, None, [None] * len(space.variables)
+        value_id = ua.AttributeIds.Value
+        while True:
+            seq = image.sequence()
+            if seq != last_seq and not seq & 1:
+                raws = image.read(spans)
+                if raws is None:
+                    await asyncio.sleep(0)
+                    continue
+                last_seq, raw = seq, raws[0]
+                now = datetime.now(timezone.utc)
+                for k, slot in enumerate(space.slots):
+                    end = slot.offset + slot.items * slot.itemsize
+                    if last_raw is not None and raw[slot.offset:end] == last_raw[slot.offset:end]:
+                        continue
+                    for i in by_slot[k]:
+                        v = space.variables[i]
+                        value = decode(v, raw)
+                        if value != values[i] or last_raw is None:
+                            values[i] = value
+                            dv = ua.DataValue(ua.Variant(value, VARIANT[v.kind]), SourceTimestamp=now,
+                                              ServerTimestamp=now)
+                            await aspace.write_attribute_value(self.nodes[i], value_id, dv)
+                            self.notified += 1
+                last_raw = raw
+                self.plc_server.image.set(0, len(self.ua.bserver.clients))  # counters.CONNECTED
+            await asyncio.sleep(POLL_S)
+
+    # -- refusals ----------------------------------------------------------------------------
+    def _take_over(self, iserver) -> None:
+        aspace = iserver.aspace
+        service = iserver.attribute_service
+        original_write = service.write
+        ns = self.ns
+        refused_write, refused_items, _ = self.counters
+        count = self.plc_server.count
+
+        async def write(params, user=User(role=UserRole.User)):
+            """Every Write: a node of the PLC's is read-only (BadNotWritable:
+            its AccessLevel has no CurrentWrite, OPC 10000-4 5.10.4); an
+            unknown node BadNodeIdUnknown; asyncua's own nodes as asyncua
+            rules for a user who is not its admin. Only asyncua's own
+            internal session is admin (``allow_remote_admin`` is off)."""
+            if user.role == UserRole.Admin:
+                return await original_write(params, user)
+            results = []
+            for wv in params.NodesToWrite:
+                known = aspace.read_attribute_value(wv.NodeId, ua.AttributeIds.NodeClass)
+                if known.StatusCode is not None and not known.StatusCode.is_good():
+                    count(refused_write, f"write to {wv.NodeId.to_string()}: no such node")
+                    results.append(ua.StatusCode(BAD_NODE_UNKNOWN))
+                elif wv.NodeId.NamespaceIndex == ns:
+                    count(refused_write, f"write to {wv.NodeId.to_string()}: read-only")
+                    results.append(ua.StatusCode(BAD_NOT_WRITABLE))
+                else:
+                    one = ua.WriteParameters(NodesToWrite=[wv])
+                    results += await original_write(one, User(role=UserRole.User))
+            return results
+
+        service.write = write
+        subs = iserver.subscription_service
+        original_items = subs.create_monitored_items
+        limit = self.config.max_monitored_items
+
+        async def create_monitored_items(params):
+            held = sum(len(s.monitored_item_srv._monitored_items) for s in subs.subscriptions.values())
+            room = max(0, limit - held)
+            asked = list(params.ItemsToCreate)
+            if len(asked) <= room:
+                return await original_items(params)
+            taken = params.__class__(SubscriptionId=params.SubscriptionId,
+                                     TimestampsToReturn=params.TimestampsToReturn, ItemsToCreate=asked[:room])
+            results = await original_items(taken) if room else []
+            for _ in asked[room:]:
+                count(refused_items, f"monitored item over maxMonitoredItems={limit}")
+                results.append(ua.MonitoredItemCreateResult(StatusCode=ua.StatusCode(BAD_TOO_MANY_ITEMS)))
+            return results
+
+        subs.create_monitored_items = create_monitored_items

@@ -1,0 +1,61 @@
+"""The OPCUAS module (TLM): an OPC UA server over the data table, for SCADA
+and IIoT platforms (docs/opcuas.md).
+
+Registered like any third-party module, in pyproject.toml::
+
+    [project.entry-points."softplc_lite.tlms"]
+    OPCUAS = "softplc_lite.tlm.opcuas:OpcUaServer"
+
+It reads OPCUAS.XML (config.py). An engine that takes it (``attach``) lays
+out the address space (space.py) over its data table and program symbols:
+a program that is compiled, checked or rendered starts no server. The
+server is the network-server layer's (its process, the shared image, the
+counters) with asyncua serving OPC UA (asyncua_glue.py).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping
+
+from ..netmodule import NetServerModule
+from . import status as S
+from .config import CONFIG_FILE, ServerConfig, config_references, load_config
+from .protocol import OpcUaProtocol
+from .space import build_space
+
+WHERE = "OPCUAS.XML address and port; docs/opcuas.md"
+
+
+class OpcUaServer(NetServerModule):
+    name = "OPCUAS"
+    title = "OPC UA server over the data table and symbols (for SCADA and IIoT)"
+    config_file = CONFIG_FILE
+    libraries = ("asyncua",)  # imported by the server process only: the load checks it is installed (registry)
+
+    def __init__(self, config: ServerConfig | None = None) -> None:
+        self.config = config or ServerConfig()
+        self.app_name = "APP"
+        self.engine = None
+        self.server = None
+        self.space = None
+
+    def configure(self, app_dir: Path | None) -> list[str]:
+        if app_dir is not None:
+            self.config = load_config(app_dir)
+            self.app_name = Path(app_dir).resolve().name
+        return list(self.config.warnings)
+
+    def config_references(self) -> list:
+        return config_references(self.config)
+
+    def attach(self, engine, options: Mapping[str, object]) -> list[str]:
+        self.engine = engine
+        table = engine.table
+        self.reference_config(table)
+        program = getattr(engine, "program", None)
+        symbols = program.symbols if program is not None else {}
+        self.space = build_space(table, self.app_name, self.config, symbols)
+        self.serve(table, OpcUaProtocol(self.config, self.space), WHERE, S.LAYOUT)
+        return [f"OPCUAS: {why}: not served to clients" for why in self.space.skipped]
+

@@ -1,0 +1,11 @@
+"""The OPCUAS server process (``python -m softplc_lite.tlm.opcuas.serverproc
+OUT_FD IMAGE_FD``): the network-server layer's process (netserver/process.py),
+under a name that says whose it is. asyncua serves OPC UA, through
+asyncua_glue.py."""
+
+import sys
+
+from ...netserver.process import main
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,30 @@
+"""OPCUAS's status words: the 16 words the ladder reads, and the counters
+they copy (the server's, netserver/counters.py, and OPC UA's own).
+
+The layout is a softplc choice in MODBTCPS's shape (docs/opcuas.md,
+"Status words"), so a rung that alarms on one server's refusals reads
+another's at the same offsets where they mean the same.
+"""
+
+from __future__ import annotations
+
+from ...netserver.counters import (  # noqa: F401 - the counters and words by name, for the tests
+    COMMON_COPIED, STATUS_WORDS, W_BITS, W_CONNECTED, W_RATE, W_REFUSALS, W_WRITES_APPLIED,
+    CONNECTED, IDLE, MALFORMED, OWN, REFUSED_LIMIT, REFUSED_NETWORK, REFUSED_RATE, StatusWords)
+
+# OPC UA's own counters, after the server's.
+REFUSED_WRITES = OWN  # Write operations refused: a read-only node (BadNotWritable), an unknown one (BadNodeIdUnknown)
+REFUSED_ITEMS = OWN + 1  # monitored items over maxMonitoredItems (BadTooManyMonitoredItems)
+REFUSED_SUBSCRIPTIONS = OWN + 2  # subscriptions over maxSubscriptions (BadTooManySubscriptions)
+
+W_REFUSED_WRITES = 8
+W_REFUSED_ITEMS = 9
+W_REFUSED_SUBSCRIPTIONS = 10
+
+COPIED = COMMON_COPIED + ((W_REFUSED_WRITES, REFUSED_WRITES), (W_REFUSED_ITEMS, REFUSED_ITEMS),
+                          (W_REFUSED_SUBSCRIPTIONS, REFUSED_SUBSCRIPTIONS))
+REFUSAL_NAMES = (("session limit", REFUSED_LIMIT), ("write refused", REFUSED_WRITES),
+                 ("monitored item limit", REFUSED_ITEMS), ("subscription limit", REFUSED_SUBSCRIPTIONS))
+
+LAYOUT = StatusWords(bits=W_BITS, rate=W_RATE, writes_applied=W_WRITES_APPLIED, refusals=W_REFUSALS,
+                     copied=COPIED, refusal_names=REFUSAL_NAMES, words=STATUS_WORDS)
