@@ -6,9 +6,12 @@ change of a counter the ladder increments, one notification a scan."""
 from __future__ import annotations
 
 import asyncio
+import threading
+import time
 
 import pytest
 
+from helpers.modbtcps_apps import LIMIT_S
 from helpers.opcua_apps import OpcUaApps, client_run, register
 
 asyncua = pytest.importorskip("asyncua")
@@ -74,3 +77,93 @@ def test_writes_are_refused_with_their_status_codes(apps):
     assert codes == {"Count": "BadNotWritable", "N7:5": "BadNotWritable", "$PLC.Mode": "BadNotWritable",
                      "N7:9999x": "BadNodeIdUnknown"}
     r.wait_for(lambda: r.status(8) == 4, "the refusals counted in status word 8")
+
+
+def test_the_address_space_browses_from_the_app_down_to_bits_with_descriptions(apps):
+    r = apps.start()
+
+    async def work(client):
+        ns = await client.get_namespace_index(NS)
+        names = lambda nodes: asyncio.gather(*(n.read_browse_name() for n in nodes))  # noqa: E731
+        top = [q.Name for q in await names(await client.nodes.objects.get_children())]
+        app = client.get_node(f"ns={ns};s=$APP")
+        under_app = {q.Name for q in await names(await app.get_children())}
+        files = {q.Name for q in await names(await client.get_node(f"ns={ns};s=$DataFiles").get_children())}
+        n7 = [q.Name for q in await names(await client.get_node(f"ns={ns};s=N7").get_children())]
+        bits = [q.Name for q in await names(await client.get_node(f"ns={ns};s=B3:0").get_children())]
+        timer = {q.Name for q in await names(await client.get_node(f"ns={ns};s=T4:0").get_children())}
+        described = [(await client.get_node(f"ns={ns};s={t}").read_description()).Text for t in ("Count", "N7:5")]
+        return top, (await app.read_browse_name()).Name, under_app, files, n7, bits, timer, described
+
+    top, app_name, under_app, files, n7, bits, timer, described = client_run(r.port, work)
+    assert app_name == "app1" and "app1" in top
+    assert {"DataFiles", "PLC", "Count", "Speed", "Note", "Run", "Dwell", "Total"} <= under_app
+    assert {"O0", "I1", "S2", "B3", "T4", "N7", "F8", "ST9", "L12", "N40"} <= files
+    assert n7[:6] == ["N7:0", "N7:1", "N7:2", "N7:3", "N7:4", "N7:5"]
+    assert bits == [str(b) for b in range(16)]
+    assert timer == {"PRE", "ACC", "EN", "TT", "DN"}
+    assert described == ["N7:5", "Symbol Count"]
+
+
+def test_a_subscription_gets_every_change_of_a_counter_once_a_scan(apps):
+    # the counter adds 1 each 100 ms scan of the wall clock; the values notified must run on by
+    # one each, none twice, none missed; a word the ladder never changes is notified once
+    r = apps.start(scan_ms=100)
+
+    class Handler:
+        def __init__(self):
+            self.seen: dict[str, list] = {"Count": [], "N7:0": []}
+
+        def datachange_notification(self, node, value, data):
+            self.seen[node.nodeid.Identifier].append(value)
+
+    async def work(client):
+        handler = Handler()
+        sub = await client.create_subscription(20, handler)
+        await sub.subscribe_data_change([await _node(client, "Count"), await _node(client, "N7:0")], queuesize=100)
+        for _ in range(600):
+            if len(handler.seen["Count"]) >= 12:
+                break
+            await asyncio.sleep(0.05)
+        await sub.delete()
+        return handler.seen
+
+    seen = client_run(r.port, work)
+    counts = seen["Count"]
+    assert len(counts) >= 12
+    assert counts == list(range(counts[0], counts[0] + len(counts))), counts
+    assert seen["N7:0"] == [0]
+
+
+@pytest.mark.parametrize("mode", ["PROGRAM", "TEST"])
+def test_the_mode_variable_follows_the_engine(apps, mode):
+    from softplc_lite.ladder.engine import Mode
+
+    r = apps.start()
+    r.runner.request_stop()
+    r.thread.join(LIMIT_S)
+    r.engine.set_mode(Mode.PROGRAM)
+    r.engine.set_mode(Mode[mode])
+    stop = threading.Event()
+
+    def scan() -> None:
+        while not stop.is_set():
+            r.engine.scan()
+            time.sleep(0.005)
+
+    t = threading.Thread(target=scan, daemon=True)
+    t.start()
+
+    async def work(client):
+        node = await _node(client, "$PLC.Mode")
+        for _ in range(200):
+            if await node.read_value() == mode:
+                break
+            await asyncio.sleep(0.02)
+        return await node.read_value(), await (await _node(client, "$PLC.FaultCode")).read_value()
+
+    try:
+        assert client_run(r.port, work) == (mode, 0)
+    finally:
+        stop.set()
+        t.join(LIMIT_S)

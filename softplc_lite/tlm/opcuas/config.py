@@ -58,15 +58,15 @@ class ServerConfig:
     debug: int = 0
     warnings: list[str] = field(default_factory=list)
 
-    # what the network-server layer's Settings take (tlm/netmodule.settings_of)
-    allow: tuple = LOOPBACK  # not consulted: asyncua accepts the connections (docs/opcuas.md, "Choices")
+    # what the network-server layer's Settings take (tlm/netmodule.settings_of); asyncua accepts the
+    # connections and answers the requests, so the layer's allow-list, rate and idle rules are not consulted
+    allow: tuple = LOOPBACK
+    max_requests_per_second: int = 100_000
+    idle_timeout_ms: int = 3_600_000
 
     @property
     def max_connections(self) -> int:
-        return self.max_sessions
-
-    max_requests_per_second: int = 100_000
-    idle_timeout_ms: int = 3_600_000
+        return self.max_sessions  # one session a connection: asyncua's connection limit holds the sessions
 
 
 def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:

@@ -1,0 +1,68 @@
+"""OPCUAS.XML checked: defaults, every problem at once with file, line and
+column, and `softplc check` meeting it through MODULES.LST."""
+
+from __future__ import annotations
+
+import pytest
+
+from softplc_lite.tlm.errors import ModuleError, ModuleErrors
+from softplc_lite.tlm.opcuas.config import load_config, parse_config
+
+from helpers.apps import make_app
+from helpers.cli import softplc_here
+from helpers.opcua_apps import register
+
+
+def test_an_empty_root_takes_the_defaults():
+    c = parse_config(b"<OpcUaServer/>")
+    assert (c.host, c.port, c.symbols, c.data_files, c.tags) == ("127.0.0.1", 4840, True, True, True)
+    assert (c.max_sessions, c.max_subscriptions, c.max_monitored_items, c.status) == (10, 100, 10_000, None)
+    assert c.warnings == []
+
+
+def test_every_attribute_is_read():
+    c = parse_config(b'<OpcUaServer address="::1" port="4841" symbols="no" dataFiles="yes" tags="no" '
+                     b'maxSessions="2" maxSubscriptions="3" maxMonitoredItems="4" status="N40:0" debug="1"/>')
+    assert (c.host, c.port, c.symbols, c.data_files, c.tags) == ("::1", 4841, False, True, False)
+    assert (c.max_sessions, c.max_subscriptions, c.max_monitored_items, str(c.status), c.debug) == \
+        (2, 3, 4, "N40:0", 1)
+
+
+def test_every_problem_is_located_at_once():
+    with pytest.raises(ModuleErrors) as info:
+        parse_config(b'<OpcUaServer port="0" maxSessions="x"\n  status="F8:0" colour="red">\n'
+                     b'  <Writable address="N7:0"/>\n</OpcUaServer>', "OPCUAS.XML")
+    text = [str(p) for p in info.value.problems]
+    assert any(t.startswith("OPCUAS.XML:1:14: port='0'") for t in text), text
+    assert any(t.startswith("OPCUAS.XML:1:23: maxSessions='x'") for t in text), text
+    assert any(t.startswith("OPCUAS.XML:2:3: status='F8:0'") for t in text), text
+    assert any("OPCUAS.XML:2:17: <OpcUaServer> has no attribute 'colour'" in t for t in text), text
+    assert any(t.startswith("OPCUAS.XML:3:3:") and "Writable" in t for t in text), text
+
+
+def test_exposing_nothing_is_refused_and_listening_wide_is_warned():
+    with pytest.raises(ModuleErrors) as info:
+        parse_config(b'<OpcUaServer symbols="no" dataFiles="no" tags="no"/>')
+    assert "expose nothing" in str(info.value.problems[0])
+    c = parse_config(b'<OpcUaServer address="0.0.0.0"/>', "X.XML")
+    assert len(c.warnings) == 1 and c.warnings[0].startswith("X.XML:1: listening on 0.0.0.0")
+
+
+def test_a_missing_file_says_what_it_holds(tmp_path):
+    with pytest.raises(ModuleError) as info:
+        load_config(tmp_path)
+    assert "OPCUAS.XML" in str(info.value) and "docs/opcuas.md" in str(info.value)
+
+
+def test_softplc_check_reports_the_file_located(tmp_path, monkeypatch):
+    register(tmp_path, monkeypatch)
+    app = make_app(tmp_path / "app", "XIC B3:0/0 OTE O:0/0\n", MODULES_LST="OPCUAS\n",
+                   OPCUAS_XML='<OpcUaServer port="x"\n  maxMonitoredItems="0"/>\n')
+    result = softplc_here("check", str(app))
+    assert result.returncode != 0
+    assert f"{app / 'OPCUAS.XML'}:1:14: port='x'" in result.stderr
+    assert f"{app / 'OPCUAS.XML'}:2:3: maxMonitoredItems='0'" in result.stderr
+    assert "Traceback" not in result.stderr
+    (app / "OPCUAS.XML").write_text('<OpcUaServer status="N40:0"/>\n')
+    ok = softplc_here("check", str(app))
+    assert ok.returncode == 0 and "module OPCUAS" in ok.stdout
