@@ -47,7 +47,7 @@ def test_softplc_alone_prints_usage_and_exits_2():
     p = softplc_here()
     assert p.returncode == 2 and p.stdout == ""
     assert p.stderr.startswith("usage: softplc ")
-    assert "a COMMAND is needed: run, watch, check, test, fmt, address or datatable" in p.stderr
+    assert "a COMMAND is needed: run, watch, check, test, fmt, address, datatable, opcua-cert or opcua-user" in p.stderr
 
 
 def test_version():

@@ -1,0 +1,74 @@
+"""A plain asyncua Server secured by softplc_lite.tlm.opcuas.security, and
+asyncua Clients for it, for the security tests (tests/test_opcuas_security.py).
+
+``secured_server(app_dir, settings, users)`` serves one writable Int16
+variable on 127.0.0.1 at a port the system picks; it yields a ``Served``
+(url, the variable's node id, the UserManager apply_security returned and
+the users the server saw read, each as asyncua's User). ``client_cert``
+makes a client application certificate in a test's directory."""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import AsyncIterator
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from asyncua import Client, Server, ua
+from asyncua.common.callback import CallbackType
+
+from softplc_lite.tlm.opcuas.security import CertPaths, SecuritySettings, UserManager, apply_security, \
+    create_certificate
+from softplc_lite.tlm.opcuas.users import Users
+
+CLIENT_URI = "urn:example:softplc-test-client"
+
+
+@dataclass
+class Served:
+    url: str
+    node: ua.NodeId
+    manager: UserManager
+    readers: list = field(default_factory=list)  # asyncua User of each read, in order
+
+
+@contextlib.asynccontextmanager
+async def secured_server(app_dir: Path, settings: SecuritySettings = SecuritySettings(),
+                         users: Users | None = None) -> AsyncIterator[Served]:
+    server = Server()
+    await server.init()
+    server.set_endpoint("opc.tcp://127.0.0.1:0/")
+    manager = await apply_security(server, settings, users or Users(), CertPaths.for_app(app_dir))
+    idx = await server.register_namespace("urn:example:test")
+    var = await server.nodes.objects.add_variable(idx, "Level", ua.Variant(7, ua.VariantType.Int16))
+    await var.set_writable()
+    served = Served("", var.nodeid, manager)
+
+    async def seen(event, _dispatcher) -> None:
+        if event.is_external:
+            served.readers.append(event.user)
+    server.subscribe_server_callback(CallbackType.PreRead, seen)
+    async with server:
+        served.url = f"opc.tcp://127.0.0.1:{server.bserver.port}/"
+        yield served
+
+
+def client_cert(directory: Path, name: str = "client") -> tuple[Path, Path]:
+    """(certificate, key) of a new client application certificate for CLIENT_URI."""
+    cert, key = directory / f"{name}_cert.der", directory / f"{name}_key.pem"
+    create_certificate(cert, key, CLIENT_URI, name, "localhost", days=2, client=True)
+    return cert, key
+
+
+async def secure_client(url: str, cert: Path, key: Path, policy=None,
+                        mode: ua.MessageSecurityMode = ua.MessageSecurityMode.SignAndEncrypt,
+                        user: str | None = None, password: str | None = None) -> Client:
+    """A Client (not yet connected) on an encrypted channel with ``cert``."""
+    from asyncua.crypto.security_policies import SecurityPolicyBasic256Sha256
+    client = Client(url, timeout=10)
+    client.application_uri = CLIENT_URI
+    if user is not None:
+        client.set_user(user)
+        client.set_password(password or "")
+    await client.set_security(policy or SecurityPolicyBasic256Sha256, str(cert), str(key), mode=mode)
+    return client

@@ -1,0 +1,205 @@
+"""The OPC UA server's security policy (softplc_lite/tlm/opcuas/security.py)
+on a plain asyncua Server, with asyncua's Client on real sockets: which
+channels and identities are let in, and what each may do."""
+
+from __future__ import annotations
+
+import asyncio
+import stat
+
+import pytest
+from asyncua import Client, ua
+from asyncua.crypto.security_policies import SecurityPolicyAes128Sha256RsaOaep, SecurityPolicyAes256Sha256RsaPss
+from asyncua.ua.uaerrors import BadUserAccessDenied, UaError, UaStatusCodeError
+from cryptography import x509
+
+from helpers.cli import softplc_here
+from helpers.opcuas_security import client_cert, secure_client, secured_server
+from softplc_lite.tlm.opcuas.security import CertPaths, SecurityError, SecuritySettings, certificate_uri, role_of, \
+    user_can_write
+from softplc_lite.tlm.opcuas.users import Users
+
+PASSWORD = "correct horse battery"
+
+
+@pytest.fixture
+def app(tmp_path):
+    """An app directory with a server certificate made by the command."""
+    app = tmp_path / "tank"
+    app.mkdir()
+    proc = softplc_here("opcua-cert", str(app), "--uri", "urn:example:tank")
+    assert proc.returncode == 0, proc.stderr
+    return app
+
+
+@pytest.fixture
+def users():
+    u = Users()
+    u.set("operator", PASSWORD, can_write=True)
+    u.set("viewer", PASSWORD, can_write=False)
+    return u
+
+
+async def _write(client: Client, node: ua.NodeId, value: int) -> None:
+    await client.get_node(node).write_value(ua.DataValue(ua.Variant(value, ua.VariantType.Int16)))
+
+
+def test_the_cert_command_makes_a_certificate_asyncua_serves(app):
+    paths = CertPaths.for_app(app)
+    cert = x509.load_der_x509_certificate(paths.cert.read_bytes())
+    assert certificate_uri(cert) == "urn:example:tank"
+    assert stat.S_IMODE(paths.key.stat().st_mode) == 0o600
+    assert paths.trusted.is_dir()
+
+    async def endpoints():
+        async with secured_server(app) as served:
+            return await Client(served.url).connect_and_get_server_endpoints()
+    found = asyncio.run(endpoints())
+    assert {(e.SecurityPolicyUri.rsplit("#")[-1], e.SecurityMode) for e in found} == {
+        (p, ua.MessageSecurityMode.SignAndEncrypt) for p in ("Basic256Sha256", "Aes128_Sha256_RsaOaep",
+                                                             "Aes256_Sha256_RsaPss")}
+    assert all(e.ServerCertificate == paths.cert.read_bytes() for e in found)
+    assert {e.Server.ApplicationUri for e in found} == {"urn:example:tank"}
+
+
+def test_the_cert_command_keeps_a_certificate_unless_forced(app):
+    before = CertPaths.for_app(app).cert.read_bytes()
+    again = softplc_here("opcua-cert", str(app))
+    assert again.returncode == 1 and "--force" in again.stderr
+    assert CertPaths.for_app(app).cert.read_bytes() == before
+    assert softplc_here("opcua-cert", str(app), "--force").returncode == 0
+    assert CertPaths.for_app(app).cert.read_bytes() != before
+
+
+@pytest.mark.parametrize("policy", [None, SecurityPolicyAes128Sha256RsaOaep, SecurityPolicyAes256Sha256RsaPss],
+                         ids=["Basic256Sha256", "Aes128_Sha256_RsaOaep", "Aes256_Sha256_RsaPss"])
+def test_an_encrypted_anonymous_session_reads_and_is_refused_writes(app, tmp_path, policy):
+    cert, key = client_cert(tmp_path)
+
+    async def session():
+        async with secured_server(app) as served:
+            async with await secure_client(served.url, cert, key, policy) as client:
+                value = await client.get_node(served.node).read_value()
+                with pytest.raises(BadUserAccessDenied):
+                    await _write(client, served.node, 9)
+                return value, await client.get_node(served.node).read_value(), served.readers[-1]
+    before, after, user = asyncio.run(session())
+    assert (before, after) == (7, 7)
+    assert role_of(user) == "anonymous" and not user_can_write(user)
+
+
+def test_a_write_user_writes_and_a_read_user_reads(app, tmp_path, users):
+    cert, key = client_cert(tmp_path)
+
+    async def sessions():
+        async with secured_server(app, users=users) as served:
+            async with await secure_client(served.url, cert, key, user="operator", password=PASSWORD) as client:
+                await _write(client, served.node, 42)
+                wrote = await client.get_node(served.node).read_value()
+            async with await secure_client(served.url, cert, key, user="viewer", password=PASSWORD) as client:
+                with pytest.raises(BadUserAccessDenied):
+                    await _write(client, served.node, 1)
+                read = await client.get_node(served.node).read_value()
+            return wrote, read, [role_of(u) for u in served.readers]
+    wrote, read, roles = asyncio.run(sessions())
+    assert (wrote, read) == (42, 42)
+    assert roles == ["write", "read"]
+
+
+@pytest.mark.parametrize("name,password", [("operator", "wrong password"), ("nobody", PASSWORD)])
+def test_a_wrong_password_or_an_unknown_user_is_refused(app, tmp_path, users, name, password):
+    cert, key = client_cert(tmp_path)
+
+    async def session():
+        async with secured_server(app, users=users) as served:
+            client = await secure_client(served.url, cert, key, user=name, password=password)
+            with pytest.raises(BadUserAccessDenied):
+                await client.connect()
+            client.disconnect_socket()
+            return served.manager.refused["password"]
+    assert asyncio.run(session()) == 1
+
+
+def test_security_none_is_refused_unless_the_settings_allow_it(app):
+    async def plain(settings):
+        async with secured_server(app, settings) as served:
+            client = Client(served.url, timeout=10)
+            try:
+                async with client:
+                    return await client.get_node(served.node).read_value()
+            except UaError as e:  # asyncua finds no None endpoint to match
+                return e
+    refused = asyncio.run(plain(SecuritySettings()))
+    assert isinstance(refused, UaError) and "No matching endpoints" in str(refused)
+    assert asyncio.run(plain(SecuritySettings(allow_none=True))) == 7
+
+
+def test_sign_only_is_offered_only_when_allowed(app):
+    async def modes(settings):
+        async with secured_server(app, settings) as served:
+            return {e.SecurityMode for e in await Client(served.url).connect_and_get_server_endpoints()}
+    assert asyncio.run(modes(SecuritySettings())) == {ua.MessageSecurityMode.SignAndEncrypt}
+    assert asyncio.run(modes(SecuritySettings(allow_sign=True))) == {ua.MessageSecurityMode.SignAndEncrypt,
+                                                                     ua.MessageSecurityMode.Sign}
+
+
+def test_a_trusted_client_certificate_writes(app, tmp_path):
+    cert, key = client_cert(tmp_path)
+    (CertPaths.for_app(app).trusted / "scada.der").write_bytes(cert.read_bytes())
+
+    async def session():
+        async with secured_server(app) as served:
+            async with await secure_client(served.url, cert, key) as client:
+                await _write(client, served.node, 5)
+                return await client.get_node(served.node).read_value(), served.readers[-1]
+    value, user = asyncio.run(session())
+    assert value == 5 and role_of(user) == "write" and user.name == "certificate client"
+
+
+def test_only_trusted_clients_when_configured(app, tmp_path):
+    cert, key = client_cert(tmp_path)
+
+    async def session():
+        async with secured_server(app, SecuritySettings(trusted_clients_only=True)) as served:
+            client = await secure_client(served.url, cert, key)
+            with pytest.raises(UaStatusCodeError) as refused:
+                await client.connect()
+            client.disconnect_socket()
+            return refused.value.code
+    assert asyncio.run(session()) == ua.StatusCodes.BadCertificateUntrusted
+
+
+def test_no_anonymous_when_configured(app, tmp_path):
+    cert, key = client_cert(tmp_path)
+
+    async def session():
+        async with secured_server(app, SecuritySettings(anonymous=False)) as served:
+            client = await secure_client(served.url, cert, key)
+            with pytest.raises(UaStatusCodeError) as refused:
+                await client.connect()
+            client.disconnect_socket()
+            return refused.value.code
+    assert asyncio.run(session()) == ua.StatusCodes.BadIdentityTokenRejected
+
+
+def test_no_certificate_is_a_located_error_unless_none_is_allowed(tmp_path):
+    async def start(settings):
+        async with secured_server(tmp_path, settings) as served:
+            return {e.SecurityPolicyUri.rsplit("#")[-1] for e in await Client(served.url).connect_and_get_server_endpoints()}
+    with pytest.raises(SecurityError) as missing:
+        asyncio.run(start(SecuritySettings()))
+    assert "softplc opcua-cert" in missing.value.report() and "OPCUAS.PKI" in missing.value.report()
+    assert asyncio.run(start(SecuritySettings(allow_none=True))) == {"None"}
+
+
+def test_a_trusted_file_that_is_no_certificate_is_named(app):
+    bad = CertPaths.for_app(app).trusted / "notes.txt"
+    bad.write_text("not a certificate\n")
+    with pytest.raises(SecurityError) as error:
+        asyncio.run(start_only(app))
+    assert error.value.report() == f"{bad}: expected an X.509 certificate in DER or PEM form"
+
+
+async def start_only(app):
+    async with secured_server(app):
+        pass
