@@ -88,6 +88,21 @@ def test_an_encrypted_anonymous_session_reads_and_is_refused_writes(app, tmp_pat
     assert role_of(user) == "anonymous" and not user_can_write(user)
 
 
+def test_writes_can_be_left_to_the_servers_own_write_handler(app, tmp_path):
+    """refuse_writes=False: the ruleset lets an anonymous Write through to
+    the server's handler (here asyncua's own, which writes), which must then
+    ask user_can_write itself."""
+    cert, key = client_cert(tmp_path)
+
+    async def session():
+        async with secured_server(app, refuse_writes=False) as served:
+            async with await secure_client(served.url, cert, key) as client:
+                await _write(client, served.node, 3)
+                return await client.get_node(served.node).read_value(), served.readers[-1]
+    value, user = asyncio.run(session())
+    assert value == 3 and not user_can_write(user)
+
+
 def test_a_write_user_writes_and_a_read_user_reads(app, tmp_path, users):
     cert, key = client_cert(tmp_path)
 

@@ -34,11 +34,12 @@ class Served:
 
 @contextlib.asynccontextmanager
 async def secured_server(app_dir: Path, settings: SecuritySettings = SecuritySettings(),
-                         users: Users | None = None) -> AsyncIterator[Served]:
+                         users: Users | None = None, refuse_writes: bool = True) -> AsyncIterator[Served]:
     server = Server()
     await server.init()
     server.set_endpoint("opc.tcp://127.0.0.1:0/")
-    manager = await apply_security(server, settings, users or Users(), CertPaths.for_app(app_dir))
+    manager = await apply_security(server, settings, users or Users(), CertPaths.for_app(app_dir),
+                                   refuse_writes=refuse_writes)
     idx = await server.register_namespace("urn:example:test")
     var = await server.nodes.objects.add_variable(idx, "Level", ua.Variant(7, ua.VariantType.Int16))
     await var.set_writable()

@@ -222,15 +222,17 @@ def _common_name(der: bytes) -> str:
     return str(names[0].value) if names else "(no common name)"
 
 
-def _ruleset():
+def _ruleset(refuse_writes: bool):
     """asyncua's SimpleRoleRuleset with anonymous and ``read`` sessions
-    (UserRole.Anonymous) allowed every user request but Write, and no
-    session the Admin requests (adding or deleting nodes)."""
+    (UserRole.Anonymous) allowed every user request but Write (unless the
+    caller refuses those writes itself), and no session the Admin requests
+    (adding or deleting nodes)."""
     from asyncua import ua
     from asyncua.crypto.permission_rules import USER_TYPES, PermissionRuleset, UserRole
 
     allowed = {ua.NodeId(t) for t in USER_TYPES}
-    reading = allowed - {ua.NodeId(ua.ObjectIds.WriteRequest_Encoding_DefaultBinary)}
+    write = ua.NodeId(ua.ObjectIds.WriteRequest_Encoding_DefaultBinary)
+    reading = allowed - {write} if refuse_writes else allowed
 
     class ReadOnlyAnonymous(PermissionRuleset):
         def check_validity(self, user, action_type_id, body):
@@ -269,11 +271,20 @@ def policy_types(settings: SecuritySettings, have_certificate: bool) -> list:
     return types
 
 
-async def apply_security(server, settings: SecuritySettings, users: Users, paths: CertPaths) -> UserManager:
+async def apply_security(server, settings: SecuritySettings, users: Users, paths: CertPaths,
+                         refuse_writes: bool = True) -> UserManager:
     """Give an asyncua Server (after ``await server.init()``, before
     ``start()``) this module's policy: its certificate and key, its
     ApplicationUri the certificate's, the endpoints, identities and
-    permissions above. The UserManager returned counts refused identities.
+    permissions above. The UserManager returned counts refused identities
+    (``refused``).
+
+    ``refuse_writes``: a Write request of a session that may not write is
+    refused whole here (a ServiceFault BadUserAccessDenied). False leaves
+    it to the caller's write handler, which then asks :func:`user_can_write`
+    of the session's user and answers BadUserAccessDenied per item (and can
+    count each refusal).
+
     SecurityError when there is no certificate and None is not allowed, or
     a trusted file is not a certificate."""
     from asyncua import ua
@@ -299,7 +310,7 @@ async def apply_security(server, settings: SecuritySettings, users: Users, paths
             raise SecurityError("expected a private key in PEM or DER form", str(paths.key)) from None
         await server.set_application_uri(uri)
     trusted = trusted_certificates(paths.trusted)
-    server.set_security_policy(policy_types(settings, have), permission_ruleset=_ruleset())
+    server.set_security_policy(policy_types(settings, have), permission_ruleset=_ruleset(refuse_writes))
     tokens = [ua.AnonymousIdentityToken] if settings.anonymous else []
     if have:  # a password or a certificate identity only where it is not sent in clear
         tokens += [ua.UserNameIdentityToken, ua.X509IdentityToken]
