@@ -108,3 +108,16 @@ def test_the_command_reports_a_bad_file_located(tmp_path):
     assert f"{tmp_path / FILE_NAME}:1:10: expected rights read or write, not 'sudo'" in proc.stderr
     assert f"{tmp_path / FILE_NAME}:1:15: expected a password hash" in proc.stderr
     assert (tmp_path / FILE_NAME).read_text() == "operator sudo x\n"
+
+
+def test_an_unknown_name_costs_a_derivation_as_a_known_one_does(monkeypatch):
+    from softplc_lite.tlm.opcuas import users as module
+    derived = []
+    real = module._derive
+    monkeypatch.setattr(module, "_derive", lambda *a: derived.append(a[2:]) or real(*a))
+    users = Users()
+    users.set("operator", "first password", can_write=True)
+    derived.clear()
+    users.check("operator", "wrong password")
+    users.check("nobody", "wrong password")
+    assert derived == [module.COST, module.COST]
