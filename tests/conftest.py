@@ -17,9 +17,11 @@ from softplc_lite.datatable.filetypes import FILE_TYPES
 from helpers.clocks import Clock
 from helpers.isolation import bytecode_setup, hypothesis_setup, signals_setup, pytest_sessionfinish, pytest_sessionstart, pytest_terminal_summary  # noqa: F401
 from helpers.tmux_helpers import tmux  # noqa: F401  (the fixture of the terminal tests)
+from helpers.opcua_apps import register as register_opcuas
 
 bytecode_setup()  # one bytecode cache for the run, outside the repository (tests/helpers/isolation.py)
 hypothesis_setup()  # nothing of hypothesis's in the repository, no deadline (tests/helpers/isolation.py)
+register_opcuas()  # OPCUAS's entry point where the installed metadata predates it (tests/helpers/opcua_apps.py)
 signals_setup()  # Ctrl-C heard by the processes tests start, however the run was started (tests/helpers/isolation.py)
 
 

@@ -10,7 +10,6 @@ from softplc_lite.tlm.opcuas.config import load_config, parse_config
 
 from helpers.apps import make_app
 from helpers.cli import softplc_here
-from helpers.opcua_apps import register
 
 
 def test_an_empty_root_takes_the_defaults():
@@ -54,8 +53,7 @@ def test_a_missing_file_says_what_it_holds(tmp_path):
     assert "OPCUAS.XML" in str(info.value) and "docs/opcuas.md" in str(info.value)
 
 
-def test_softplc_check_reports_the_file_located(tmp_path, monkeypatch):
-    register(tmp_path, monkeypatch)
+def test_softplc_check_reports_the_file_located(tmp_path):
     app = make_app(tmp_path / "app", "XIC B3:0/0 OTE O:0/0\n", MODULES_LST="OPCUAS\n",
                    OPCUAS_XML='<OpcUaServer port="x"\n  maxMonitoredItems="0"/>\n')
     result = softplc_here("check", str(app))

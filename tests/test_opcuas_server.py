@@ -12,7 +12,7 @@ import time
 import pytest
 
 from helpers.modbtcps_apps import LIMIT_S
-from helpers.opcua_apps import OpcUaApps, client_run, register
+from helpers.opcua_apps import OpcUaApps, client_run
 
 asyncua = pytest.importorskip("asyncua")
 from asyncua import ua  # noqa: E402
@@ -21,8 +21,7 @@ NS = "urn:softplc-lite:opcuas"
 
 
 @pytest.fixture
-def apps(tmp_path, monkeypatch):
-    register(tmp_path, monkeypatch)
+def apps(tmp_path):
     a = OpcUaApps(tmp_path)
     yield a
     a.close()

@@ -6,12 +6,17 @@ to talk to it.
 ``register`` makes the OPCUAS entry point visible where the installed
 distribution's metadata predates it (an editable install made before
 pyproject.toml listed OPCUAS): a dist-info on sys.path, as test_tlm.py
-installs its DEMO module, and on PYTHONPATH for a ``softplc`` subprocess."""
+installs its DEMO module, and on PYTHONPATH for a ``softplc`` subprocess;
+once the project is installed again it does nothing."""
 
 from __future__ import annotations
 
 import asyncio
+import atexit
 import os
+import shutil
+import sys
+import tempfile
 from pathlib import Path
 
 from softplc_lite.tlm.registry import installed
@@ -35,16 +40,21 @@ MOV ST9:0.LEN N7:48
 """
 
 
-def register(tmp_path: Path, monkeypatch) -> None:
+def register() -> None:
+    """Make the OPCUAS entry point visible to this process and the
+    ``softplc`` processes it starts, where the installed distribution's
+    metadata predates it; nothing where it is installed. Called once by
+    conftest.py; the directory goes when the process ends."""
     if "OPCUAS" in installed():
         return
-    site = tmp_path / "opcuas-site"
+    site = Path(tempfile.mkdtemp(prefix="softplc-opcuas-entry-"))
+    atexit.register(shutil.rmtree, site, True)
     info = site / "softplc_opcuas_entry-1.0.dist-info"
-    info.mkdir(parents=True, exist_ok=True)
+    info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: softplc-opcuas-entry\nVersion: 1.0\n")
     (info / "entry_points.txt").write_text("[softplc_lite.tlms]\nOPCUAS = softplc_lite.tlm.opcuas:OpcUaServer\n")
-    monkeypatch.syspath_prepend(str(site))
-    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(p for p in (str(site), os.environ.get("PYTHONPATH")) if p))
+    sys.path.insert(0, str(site))
+    os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(site), os.environ.get("PYTHONPATH")) if p)
 
 
 def opcuas_xml(port: int | None = None, **root: object) -> str:
@@ -68,7 +78,9 @@ def client_run(port: int, work, timeout: float = 30.0):
     from asyncua import Client
 
     async def main():
-        async with Client(f"opc.tcp://127.0.0.1:{port}/", timeout=timeout) as client:
+        client = Client(f"opc.tcp://127.0.0.1:{port}/", timeout=timeout)
+        client.session_timeout = 600_000  # what asyncua's server grants at most: no warning that it cut it
+        async with client:
             return await work(client)
 
     return asyncio.run(main())

@@ -1,7 +1,7 @@
 """The shipped apps (programs/) as tests run them: copied into the test's
 temporary directory without their ``.softplc`` state, so nothing is written
 inside the repository, and with every network server (MODBTCPS.XML's,
-ENIPS.XML's) moved to a port found free, so a PLC already running on this
+ENIPS.XML's, OPCUAS.XML's) moved to a port found free, so a PLC already running on this
 machine (serving the shipped 127.0.0.1:5020, or 44818) does not stand in the
 way (docs/testing.md, "Isolation")."""
 
@@ -17,11 +17,11 @@ ROOT = Path(__file__).resolve().parents[2]
 PROGRAMS = ROOT / "programs"
 SHIPPED_PORT = 5020  # programs/hmi_server/MODBTCPS.XML
 # Each network server's config file, and its root element (where its port is).
-SERVER_CONFIGS = {"MODBTCPS.XML": "ModbusTcpServer", "ENIPS.XML": "EtherNetIpServer"}
+SERVER_CONFIGS = {"MODBTCPS.XML": "ModbusTcpServer", "ENIPS.XML": "EtherNetIpServer", "OPCUAS.XML": "OpcUaServer"}
 
 
 def free_server_port(app_dir: Path) -> int | None:
-    """Moves the app's network server (MODBTCPS or ENIPS) to a free port;
+    """Moves the app's network server (MODBTCPS, ENIPS or OPCUAS) to a free port;
     the port, or None for an app without one."""
     for name, root in SERVER_CONFIGS.items():
         config = app_dir / name

@@ -13,7 +13,8 @@ relies on these internals:
   (one connection a session) and ``max_subscriptions``;
 - ``iserver.attribute_service.write``, taken over: every Write service
   call comes here first (``Refuser``);
-- ``iserver.subscription_service.create_monitored_items`` and
+- ``iserver.subscription_service.create_subscription`` (to count its
+  refusals), ``subscriptions``, ``create_monitored_items`` and
   ``subscriptions[..].monitored_item_srv._monitored_items``, to hold the
   monitored items to the configured limit;
 - ``Server.bserver._server`` (the asyncio server), for the port bound, and
@@ -51,7 +52,7 @@ from .space import NAMESPACE, Space, decode  # noqa: E402
 _NEEDED = (
     (Server, ("init", "set_endpoint", "set_security_policy", "register_namespace", "start", "stop")),
     (AttributeService, ("write",)),
-    (SubscriptionService, ("create_monitored_items",)),
+    (SubscriptionService, ("create_monitored_items", "create_subscription")),
     (InternalServer, ("write_attribute_value",)),
     (NodeManagementService, ("add_nodes",)),
 )
@@ -198,7 +199,7 @@ class Listener:
         service = iserver.attribute_service
         original_write = service.write
         ns = self.ns
-        refused_write, refused_items, _ = self.counters
+        refused_write, refused_items, refused_subscriptions = self.counters
         count = self.plc_server.count
 
         async def write(params, user=User(role=UserRole.User)):
@@ -243,3 +244,11 @@ class Listener:
             return results
 
         subs.create_monitored_items = create_monitored_items
+        original_subscription = subs.create_subscription
+
+        async def create_subscription(params, callback, session_id, request_callback=None):
+            if len(subs.subscriptions) >= iserver.max_subscriptions:  # asyncua refuses it: counted here
+                count(refused_subscriptions, f"subscription over maxSubscriptions={iserver.max_subscriptions}")
+            return await original_subscription(params, callback, session_id, request_callback)
+
+        subs.create_subscription = create_subscription

@@ -23,7 +23,7 @@ W_REFUSED_SUBSCRIPTIONS = 10
 
 COPIED = COMMON_COPIED + ((W_REFUSED_WRITES, REFUSED_WRITES), (W_REFUSED_ITEMS, REFUSED_ITEMS),
                           (W_REFUSED_SUBSCRIPTIONS, REFUSED_SUBSCRIPTIONS))
-REFUSAL_NAMES = (("session limit", REFUSED_LIMIT), ("write refused", REFUSED_WRITES),
+REFUSAL_NAMES = (("write refused", REFUSED_WRITES),
                  ("monitored item limit", REFUSED_ITEMS), ("subscription limit", REFUSED_SUBSCRIPTIONS))
 
 LAYOUT = StatusWords(bits=W_BITS, rate=W_RATE, writes_applied=W_WRITES_APPLIED, refusals=W_REFUSALS,
