@@ -56,7 +56,7 @@ def test_every_problem_of_modules_lst_and_the_settings_beside_it(tmp_path):
     lst = app / "MODULES.LST"
     assert result.stderr.splitlines() == [
         f"{lst}:2: expected one module name on the line, found 'FOO BAR'",
-        f"{lst}:3: module NOSUCH is not installed (installed modules: COMGENIUS, ENIPS, MODBMAST, MODBTCPS)",
+        f"{lst}:3: module NOSUCH is not installed (installed modules: COMGENIUS, ENIPS, MODBMAST, MODBTCPS, OPCUAS)",
         f"{lst}:4: module COMGENIUS is named twice (first on line 1)",
         f"{app / 'softplc.toml'}:2: [scan] scan_ms = -1; expected an integer from 0 to 32767",
         "4 problems found",

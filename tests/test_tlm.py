@@ -250,7 +250,7 @@ def test_modules_lst_is_case_insensitive_with_comments(demo_path, tmp_path):
 def test_a_module_not_installed_is_an_error_listing_the_installed_ones(demo_path, tmp_path):
     with pytest.raises(AppError) as e:
         load_app(demo_app(tmp_path, "TWICE 1 N7:1\n", modules="demo\nMODBSLAV\n"))
-    assert "MODULES.LST:2: module MODBSLAV is not installed (installed modules: COMGENIUS, DEMO, ENIPS, MODBMAST, MODBTCPS)" \
+    assert "MODULES.LST:2: module MODBSLAV is not installed (installed modules: COMGENIUS, DEMO, ENIPS, MODBMAST, MODBTCPS, OPCUAS)" \
         in str(e.value)
 
 
