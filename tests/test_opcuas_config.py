@@ -30,13 +30,24 @@ def test_every_attribute_is_read():
 def test_every_problem_is_located_at_once():
     with pytest.raises(ModuleErrors) as info:
         parse_config(b'<OpcUaServer port="0" maxSessions="x"\n  status="F8:0" colour="red">\n'
-                     b'  <Writable address="N7:0"/>\n</OpcUaServer>', "OPCUAS.XML")
+                     b'  <Writable address="N7:0/1"/>\n  <Writable address="N40:2"/>\n</OpcUaServer>', "OPCUAS.XML")
     text = [str(p) for p in info.value.problems]
     assert any(t.startswith("OPCUAS.XML:1:14: port='0'") for t in text), text
     assert any(t.startswith("OPCUAS.XML:1:23: maxSessions='x'") for t in text), text
     assert any(t.startswith("OPCUAS.XML:2:3: status='F8:0'") for t in text), text
     assert any("OPCUAS.XML:2:17: <OpcUaServer> has no attribute 'colour'" in t for t in text), text
-    assert any(t.startswith("OPCUAS.XML:3:3:") and "Writable" in t for t in text), text
+    assert any(t.startswith("OPCUAS.XML:3:13: address='N7:0/1': expected a whole element") for t in text), text
+    assert any(t.startswith("OPCUAS.XML:2:3: status='F8:0'") for t in text), text
+
+
+def test_writable_regions_are_read_and_kept_off_the_status_words():
+    c = parse_config(b'<OpcUaServer status="N40:0">\n  <Writable address="N7:0" count="3"/>\n'
+                     b'  <Writable address="T4:1"/>\n</OpcUaServer>')
+    assert [(str(w.address), w.count, w.line) for w in c.writable] == [("N7:0", 3, 2), ("T4:1", 1, 3)]
+    with pytest.raises(ModuleErrors) as info:
+        parse_config(b'<OpcUaServer status="N40:0">\n  <Writable address="N40:10" count="10"/>\n</OpcUaServer>',
+                     "OPCUAS.XML")
+    assert str(info.value.problems[0]).startswith("OPCUAS.XML:2:13: <Writable> N40:10..N40:19 covers the status words")
 
 
 def test_exposing_nothing_is_refused_and_listening_wide_is_warned():

@@ -47,6 +47,7 @@ except ImportError as _exc:  # the server process says this line, not a tracebac
     raise ImportError(f"the installed asyncua lacks what OPCUAS uses ({_exc}): OPCUAS is written for "
                       f"asyncua {ASYNCUA_RANGE} (pip install 'asyncua{ASYNCUA_RANGE}')") from None
 
+from . import writes  # noqa: E402
 from .space import NAMESPACE, Space, decode  # noqa: E402
 
 _NEEDED = (
@@ -91,12 +92,13 @@ def _add_items(space: Space, ns: int) -> list:
                                      BrowseName=ua.QualifiedName(o.name, ns), NodeClass=ua.NodeClass.Object,
                                      ParentNodeId=parent, ReferenceTypeId=ua.NodeId(ref),
                                      TypeDefinition=obj_type, NodeAttributes=attrs))
+    read, write = ua.AccessLevel.CurrentRead.mask, ua.AccessLevel.CurrentWrite.mask
     for v in space.variables:
+        access = read | write if v.writable else read
         attrs = ua.VariableAttributes(
             DisplayName=ua.LocalizedText(v.name), Description=ua.LocalizedText(v.description),
             Value=ua.Variant(_empty(v.kind), VARIANT[v.kind]), DataType=ua.NodeId(DATA_TYPE[v.kind]),
-            ValueRank=-1, AccessLevel=ua.AccessLevel.CurrentRead.mask,
-            UserAccessLevel=ua.AccessLevel.CurrentRead.mask)
+            ValueRank=-1, AccessLevel=access, UserAccessLevel=access)
         items.append(ua.AddNodesItem(RequestedNewNodeId=ua.NodeId(v.node, ns), BrowseName=ua.QualifiedName(v.name, ns),
                                      NodeClass=ua.NodeClass.Variable, ParentNodeId=ua.NodeId(v.parent, ns),
                                      ReferenceTypeId=ua.NodeId(ua.ObjectIds.HasComponent),
@@ -123,6 +125,11 @@ class Listener:
         self.task: asyncio.Task | None = None
         self.nodes: list = []
         self.notified = 0  # values published to asyncua: one per variable per scan at most
+        self.by_node = {v.node: v for v in space.variables}
+        # who may write a writable node: every session unless the security module says otherwise
+        self.may_write = lambda user: True
+        self._last_seq, self._last_raw, self._values = None, None, [None] * len(space.variables)
+        self._by_slot: list[list[int]] | None = None
 
     async def start(self) -> int:
         for name in ("asyncua", "asyncua.server", "asyncua.uaprotocol"):
@@ -159,39 +166,63 @@ class Listener:
     async def follow(self) -> None:
         """Publish each scan's values as the image holds them, the changed
         ones only: a monitored item gets at most one change a scan."""
+        while True:
+            await self.refresh()
+            await asyncio.sleep(POLL_S)
+
+    async def refresh(self) -> None:
+        """Take the latest whole scan from the image, if it is new, and give
+        asyncua the values it changed."""
         image, space = self.plc_server.image, self.space
-        aspace = self.ua.iserver.aspace
-        by_slot: list[list[int]] = [[] for _ in space.slots]
-        for i, v in enumerate(space.variables):
-            by_slot[v.slot].append(i)
-        spans = [(0, space.image_bytes)]
-        last_seq, last_raw, values = None, None, [None] * len(space.variables)
-        value_id = ua.AttributeIds.Value
+        if self._by_slot is None:
+            self._by_slot = [[] for _ in space.slots]
+            for i, v in enumerate(space.variables):
+                self._by_slot[v.slot].append(i)
         while True:
             seq = image.sequence()
-            if seq != last_seq and not seq & 1:
-                raws = image.read(spans)
-                if raws is None:
-                    await asyncio.sleep(0)
-                    continue
-                last_seq, raw = seq, raws[0]
-                now = datetime.now(timezone.utc)
-                for k, slot in enumerate(space.slots):
-                    end = slot.offset + slot.items * slot.itemsize
-                    if last_raw is not None and raw[slot.offset:end] == last_raw[slot.offset:end]:
-                        continue
-                    for i in by_slot[k]:
-                        v = space.variables[i]
-                        value = decode(v, raw)
-                        if value != values[i] or last_raw is None:
-                            values[i] = value
-                            dv = ua.DataValue(ua.Variant(value, VARIANT[v.kind]), SourceTimestamp=now,
-                                              ServerTimestamp=now)
-                            await aspace.write_attribute_value(self.nodes[i], value_id, dv)
-                            self.notified += 1
-                last_raw = raw
-                self.plc_server.image.set(0, len(self.ua.bserver.clients))  # counters.CONNECTED
-            await asyncio.sleep(POLL_S)
+            if seq == self._last_seq:
+                return
+            raws = None if seq & 1 else image.read([(0, space.image_bytes)])
+            if raws is not None:
+                break
+            await asyncio.sleep(0)  # the scan is publishing: a few microseconds
+        raw, last_raw, values = raws[0], self._last_raw, self._values
+        aspace = self.ua.iserver.aspace
+        now = datetime.now(timezone.utc)
+        for k, slot in enumerate(space.slots):
+            end = slot.offset + slot.items * slot.itemsize
+            if last_raw is not None and raw[slot.offset:end] == last_raw[slot.offset:end]:
+                continue
+            for i in self._by_slot[k]:
+                v = space.variables[i]
+                value = decode(v, raw)
+                if value != values[i] or last_raw is None:
+                    values[i] = value
+                    dv = ua.DataValue(ua.Variant(value, VARIANT[v.kind]), SourceTimestamp=now, ServerTimestamp=now)
+                    await aspace.write_attribute_value(self.nodes[i], ua.AttributeIds.Value, dv)
+                    self.notified += 1
+        self._last_seq, self._last_raw = seq, raw
+        image.set(0, len(self.ua.bserver.clients))  # counters.CONNECTED
+
+    async def write_one(self, wv, user) -> int:
+        """The status code of one Write operation on a node of the PLC's."""
+        v = self.by_node.get(wv.NodeId.Identifier) if isinstance(wv.NodeId.Identifier, str) else None
+        if v is None or not v.writable or wv.AttributeId != ua.AttributeIds.Value:
+            return BAD_NOT_WRITABLE
+        if not self.may_write(user):
+            return ua.StatusCodes.BadUserAccessDenied
+        variant = wv.Value.Value if wv.Value is not None else None
+        if variant is None or variant.VariantType != VARIANT[v.kind] or wv.IndexRange:
+            return ua.StatusCodes.BadTypeMismatch
+        refusal, payload = writes.check(self.space, v, variant.Value)
+        if refusal is not None:
+            return getattr(ua.StatusCodes, refusal)
+        if self.plc_server.busy() is not None:
+            return ua.StatusCodes.BadTooManyOperations
+        if not await self.plc_server.through_scan(payload):
+            return ua.StatusCodes.BadOutOfRange
+        await self.refresh()  # answered once applied: a read that follows sees it
+        return ua.StatusCodes.Good
 
     # -- refusals ----------------------------------------------------------------------------
     def _take_over(self, iserver) -> None:
@@ -203,9 +234,10 @@ class Listener:
         count = self.plc_server.count
 
         async def write(params, user=User(role=UserRole.User)):
-            """Every Write: a node of the PLC's is read-only (BadNotWritable:
-            its AccessLevel has no CurrentWrite, OPC 10000-4 5.10.4); an
-            unknown node BadNodeIdUnknown; asyncua's own nodes as asyncua
+            """Every Write: a node of the PLC's that no <Writable> opens is
+            read-only (BadNotWritable: its AccessLevel has no CurrentWrite,
+            OPC 10000-4 5.10.4), one it opens goes through the scan
+            (``write_one``); an unknown node BadNodeIdUnknown; asyncua's own nodes as asyncua
             rules for a user who is not its admin. Only asyncua's own
             internal session is admin (``allow_remote_admin`` is off)."""
             if user.role == UserRole.Admin:
@@ -217,8 +249,10 @@ class Listener:
                     count(refused_write, f"write to {wv.NodeId.to_string()}: no such node")
                     results.append(ua.StatusCode(BAD_NODE_UNKNOWN))
                 elif wv.NodeId.NamespaceIndex == ns:
-                    count(refused_write, f"write to {wv.NodeId.to_string()}: read-only")
-                    results.append(ua.StatusCode(BAD_NOT_WRITABLE))
+                    code = await self.write_one(wv, user)
+                    if code != ua.StatusCodes.Good:
+                        count(refused_write, f"write to {wv.NodeId.to_string()}: {ua.StatusCode(code).name}")
+                    results.append(ua.StatusCode(code))
                 else:
                     one = ua.WriteParameters(NodesToWrite=[wv])
                     results += await original_write(one, User(role=UserRole.User))

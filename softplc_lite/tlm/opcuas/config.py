@@ -6,7 +6,8 @@ in MODBTCPS.XML's and ENIPS.XML's style and checked by the same machinery
 (tlm/xmlcheck.py, tlm/netconfig.py): every problem at once, each with file,
 line, column and what was expected; unknown elements and attributes are
 errors. It says where to listen, which parts of the PLC the address space
-exposes, the limits on sessions, subscriptions and monitored items, and the
+exposes, the elements clients may write (none unless a ``<Writable>`` names
+them), the limits on sessions, subscriptions and monitored items, and the
 status block. The result is a ``ServerConfig``.
 """
 
@@ -15,12 +16,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ...datatable import DataTableError, parse_address
 from ...datatable.address import Address
+from ...datatable.filetypes import MAX_ELEMENTS
 from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
 from ..netconfig import HOST_WHAT, LOOPBACK, check_host, check_status, ipaddress_is_loopback
-from ..xmlcheck import Attr, XmlChecker
+from ..xmlcheck import MANY, Attr, XmlChecker
 
 CONFIG_FILE = "OPCUAS.XML"
 ROOT = "OpcUaServer"
@@ -40,7 +43,28 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
            Attr("status", text=True, what=f"a word address of an N or B file, the first of {STATUS_WORDS} "
                                            "status words (N40:0)"),
            Attr("debug", 0, 2, default=0)),
+    "Writable": (Attr("address", text=True, required=True,
+                      what="the first element clients may write (N7:0, B3:0, F8:0, T4:0, ST9:0)"),
+                 Attr("count", 1, MAX_ELEMENTS, default=1)),
 }
+
+
+@dataclass(frozen=True)
+class Writable:
+    """``count`` elements from ``address`` that clients may write."""
+
+    address: Address
+    count: int
+    line: int
+    column: int
+
+    @property
+    def file(self) -> str:
+        return f"{self.address.type_letter}{self.address.file}"
+
+    @property
+    def last(self) -> int:
+        return self.address.element + self.count - 1
 
 
 @dataclass(frozen=True)
@@ -56,6 +80,7 @@ class ServerConfig:
     max_monitored_items: int = 10_000
     status: Address | None = None
     debug: int = 0
+    writable: tuple[Writable, ...] = ()  # none: every node read-only
     warnings: list[str] = field(default_factory=list)
 
     # what the network-server layer's Settings take (tlm/netmodule.settings_of); asyncua accepts the
@@ -71,12 +96,13 @@ class ServerConfig:
 
 def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
     """Check OPCUAS.XML's bytes; ModuleErrors listing every problem."""
-    c = XmlChecker(path, ATTRIBUTES, ROOT, ())
+    c = XmlChecker(path, ATTRIBUTES, ROOT, ("Writable",))
     root = c.read_root(data, "docs/opcuas.md")
     a = c.attributes(root)
     host = check_host(c, root, a)
     status = check_status(c, root, a["status"], STATUS_WORDS) if "status" in a else None
-    c.children(root, [])
+    writable_nodes, = c.children(root, [("Writable", 0, MANY)])
+    writable = [w for w in (_check_writable(c, node, status, root.line) for node in writable_nodes) if w]
     if a.get("symbols") == a.get("dataFiles") == a.get("tags") == "no":
         c.error(root, 'symbols, dataFiles and tags are all "no": the server would expose nothing of the PLC '
                       "but its mode, fault code and scan time; say yes to one", "symbols")
@@ -89,7 +115,37 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
                         data_files=a.get("dataFiles") == "yes", tags=a.get("tags") == "yes",
                         max_sessions=a.get("maxSessions", 10), max_subscriptions=a.get("maxSubscriptions", 100),
                         max_monitored_items=a.get("maxMonitoredItems", 10_000), status=status,
-                        debug=a.get("debug", 0), warnings=warnings)
+                        debug=a.get("debug", 0), writable=tuple(writable), warnings=warnings)
+
+
+def _check_writable(c: XmlChecker, node, status: Address | None, status_line: int) -> Writable | None:
+    a = c.attributes(node)
+    c.children(node, [])
+    if "address" not in a:
+        return None  # missing or refused, and said
+    text = a["address"]
+    try:
+        address = parse_address(text)
+    except DataTableError as e:
+        c.error(node, f"address={text!r}: {getattr(e, 'message', str(e))}", "address")
+        return None
+    if not address.is_direct or address.bit is not None or address.member is not None:
+        c.error(node, f"address={text!r}: expected a whole element (N7:0, T4:0, ST9:0): a client may write every "
+                      "member and bit of the elements a <Writable> names", "address")
+        return None
+    count = a.get("count", 1)
+    if address.element + count > MAX_ELEMENTS:
+        c.error(node, f"count={count}: {count} elements from {address} run past the end of a file (elements "
+                      f"0..{MAX_ELEMENTS - 1})", "count")
+        return None
+    region = Writable(address, count, node.line, node.column)
+    if status is not None and (status.type_letter, status.file) == (address.type_letter, address.file) \
+            and address.element <= status.element + STATUS_WORDS - 1 and status.element <= region.last:
+        c.error(node, f"<Writable> {address}..{address.with_element(region.last)} covers the status words "
+                      f"{status}..{status.with_element(status.element + STATUS_WORDS - 1)} (status= on line "
+                      f"{status_line}): a client must not write the server's counters", "address")
+        return None
+    return region
 
 
 def read_config(path: Path) -> ServerConfig:
@@ -110,7 +166,11 @@ def load_config(app_dir: Path) -> ServerConfig:
 
 
 def config_references(config: ServerConfig) -> list[Address]:
-    """The status block's first and last word, so that the engine creates them before the first scan."""
-    if config.status is None:
-        return []
-    return [config.status, config.status.with_element(config.status.element + STATUS_WORDS - 1)]
+    """The first and last element of every writable region and of the
+    status block, so that the engine creates them before the first scan."""
+    found: list[Address] = []
+    for w in config.writable:
+        found += [w.address, w.address.with_element(w.last)]
+    if config.status is not None:
+        found += [config.status, config.status.with_element(config.status.element + STATUS_WORDS - 1)]
+    return found

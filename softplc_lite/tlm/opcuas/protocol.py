@@ -3,15 +3,16 @@ the whole data table in the shared image (space.py lays it out), and the
 handler the server process makes, whose listener is asyncua's server
 (asyncua_glue.py). Nothing here imports asyncua: the runtime never does.
 
-Clients' writes are refused (every node is read-only), so ``apply`` has
-nothing to apply.
+A client's write of a variable a ``<Writable>`` opens reaches the scan as
+writes.py's bytes, applied at the input point.
 """
 
 from __future__ import annotations
 
-from ...netserver import IGNORED, Handler, Protocol
+from ...netserver import Handler, Protocol
 from ...netserver.image import Segments
 from . import status as S
+from . import writes
 from .config import ServerConfig
 from .space import Space
 
@@ -35,7 +36,7 @@ class OpcUaProtocol(Protocol):
         return self.space.image_bytes
 
     def apply(self, payload: bytes, table) -> str:
-        return IGNORED  # no client write reaches the scan
+        return writes.apply(self.space, payload, table)
 
     def unusable(self) -> str | None:
         """Why asyncua cannot serve, in one line; None when it can."""

@@ -58,6 +58,7 @@ class Var:
     bit: int = -1
     size: int = 2  # bytes the value takes
     description: str = ""
+    writable: bool = False  # a <Writable> covers its element
 
 
 @dataclass(frozen=True)
@@ -75,6 +76,11 @@ class Space:
     objects: list[Obj] = field(default_factory=list)  # parents before children
     variables: list[Var] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)  # symbols not exposed, and why
+    open: dict[str, list[tuple[int, int]]] = field(default_factory=dict)  # file -> [first element, end)
+
+    def opens(self, file: str, element: int) -> bool:
+        """Whether a <Writable> covers the element."""
+        return any(lo <= element < hi for lo, hi in self.open.get(file, ()))
 
     @property
     def image_bytes(self) -> int:
@@ -109,6 +115,8 @@ def build_space(table, app: str, config, symbols: dict | None = None) -> Space:
     declaration) and the data files as ``config`` exposes them, and the
     PLC's mode, fault code and scan time always."""
     space = Space(app)
+    for w in getattr(config, "writable", ()):
+        space.open.setdefault(w.file, []).append((w.address.element, w.last + 1))
     offset = 0
     for f in table.files():
         space.slots.append(Slot(f.name, f.ftype.letter, f.data.typecode, f.data.itemsize, offset, len(f.data),
@@ -150,23 +158,26 @@ def _element(space: Space, k: int, slot: Slot, ftype, element: int, node: str, n
     """The element ``element`` of a file as ``node``: a variable, or an
     object with its members and status bits."""
     first = slot.offset + element * slot.per * slot.itemsize
+    w = space.opens(slot.name, element)
     if ftype.letter in ("ST", "SL"):
-        space.variables.append(Var(node, name, parent, "String", first, k, size=slot.per * 2, description=description))
+        space.variables.append(Var(node, name, parent, "String", first, k, size=slot.per * 2, description=description,
+                                   writable=w))
         return
     if ftype.word_members:  # a timer, counter or control: an object
         space.objects.append(Obj(node, name, parent, description))
         for m in ftype.word_members:
-            space.variables.append(Var(f"{node}.{m.name}", m.name, node, "Int16", first + m.offset * 2, k))
+            space.variables.append(Var(f"{node}.{m.name}", m.name, node, "Int16", first + m.offset * 2, k, writable=w))
         for b in ftype.bit_members:
             space.variables.append(Var(f"{node}.{b.name}" if not node[0].isdigit() and ":" not in node
                                        else f"{node}/{b.name}", b.name, node, "Boolean", first + b.word * 2, k,
-                                       bit=b.bit))
+                                       bit=b.bit, writable=w))
         return
     kind = KIND_OF_STORAGE[ftype.storage]
-    space.variables.append(Var(node, name, parent, kind, first, k, size=slot.itemsize, description=description))
+    space.variables.append(Var(node, name, parent, kind, first, k, size=slot.itemsize, description=description,
+                               writable=w))
     if bits:
         for b in range(16):
-            space.variables.append(Var(f"{node}/{b}", str(b), node, "Boolean", first, k, bit=b))
+            space.variables.append(Var(f"{node}/{b}", str(b), node, "Boolean", first, k, bit=b, writable=w))
 
 
 def _add_file(space: Space, k: int, slot: Slot, ftype, named: dict[str, list[str]]) -> None:
@@ -194,16 +205,15 @@ def _add_symbol(space: Space, by_name: dict, name: str, text: str) -> str | None
     if (a.element + 1) * slot.per > slot.items:
         return f"past the end of {slot.name}"
     first = slot.offset + a.element * slot.per * slot.itemsize
-    description = f"{text}"
+    w = space.opens(slot.name, a.element)
     if a.member is not None:
         m = next(m for m in ftype.word_members if m.name == a.member)
-        kind = "String" if m.name == "LEN" and ftype.letter in ("ST", "SL") else "Int16"
-        space.variables.append(Var(name, name, APP, "Int16", first + m.offset * 2, k, description=description))
-        return None if kind == "Int16" else None
+        space.variables.append(Var(name, name, APP, "Int16", first + m.offset * 2, k, description=text, writable=w))
+        return None
     if a.bit is not None:
         if ftype.storage is not Storage.WORD:
             return "a bit of a file whose items are not words: read its element"
-        space.variables.append(Var(name, name, APP, "Boolean", first, k, bit=a.bit, description=description))
+        space.variables.append(Var(name, name, APP, "Boolean", first, k, bit=a.bit, description=text, writable=w))
         return None
-    _element(space, k, slot, ftype, a.element, name, name, APP, description)
+    _element(space, k, slot, ftype, a.element, name, name, APP, text)
     return None

@@ -1,0 +1,103 @@
+"""Writes by asyncua's Client to the variables a <Writable> opens: applied
+by the scan at its input point and answered once applied, in RUN and in
+PROGRAM mode; refused with OPC UA's status codes where the type, the range
+or the node does not allow them, each refusal counted."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from helpers.modbtcps_apps import LIMIT_S
+from helpers.opcua_apps import OpcUaApps, client_run, opcuas_xml
+
+asyncua = pytest.importorskip("asyncua")
+from asyncua import ua  # noqa: E402
+
+NS = "urn:softplc-lite:opcuas"
+WRITABLE = """  <Writable address="N7:0" count="2"/>
+  <Writable address="F8:3"/>
+  <Writable address="ST9:0"/>
+  <Writable address="T4:0"/>
+  <Writable address="B3:0"/>
+  <Writable address="L12:0" count="2"/>
+"""
+
+
+@pytest.fixture
+def apps(tmp_path):
+    a = OpcUaApps(tmp_path)
+    yield a
+    a.close()
+
+
+def xml() -> str:
+    return opcuas_xml().replace("/>\n", f">\n{WRITABLE}</OpcUaServer>\n")
+
+
+async def write(client, text, value, kind):
+    ns = await client.get_namespace_index(NS)
+    node = client.get_node(f"ns={ns};s={text}")
+    try:
+        await node.write_value(ua.DataValue(ua.Variant(value, kind)))
+    except ua.UaStatusCodeError as e:
+        return type(e).__name__
+    return await node.read_value()  # the write answered once applied: the read sees it
+
+
+def test_writes_land_through_the_scan_and_read_back(apps):
+    r = apps.start(xml())
+    V = ua.VariantType
+
+    async def work(client):
+        return [await write(client, "N7:0", 555, V.Int16), await write(client, "F8:3", -1.5, V.Float),
+                await write(client, "Note", "check seal", V.String), await write(client, "Dwell.PRE", 900, V.Int16),
+                await write(client, "Run", True, V.Boolean), await write(client, "L12:1", -70000, V.Int32)]
+
+    assert client_run(r.port, work) == [555, -1.5, "check seal", 900, True, -70000]
+    assert (r.read("N7:0"), r.read("F8:3"), r.read("ST9:0"), r.read("T4:0.PRE")) == (555, -1.5, "check seal", 900)
+    assert r.read("L12:1") == -70000 and r.read("B3:0/4") == 1
+    r.wait_for(lambda: r.read("O:0/1") == 1, "the ladder using the written bit")
+    r.wait_for(lambda: r.status(4) >= 6, "the writes applied counted in status word 4")
+
+
+def test_writes_are_refused_by_type_range_and_region(apps):
+    r = apps.start(xml())
+    V = ua.VariantType
+
+    async def work(client):
+        return [await write(client, "N7:0", 5, V.Int32), await write(client, "Note", "x" * 83, V.String),
+                await write(client, "T4:0.ACC", -1, V.Int16), await write(client, "Count", 1, V.Int16),
+                await write(client, "N7:2", 1, V.Int16), await write(client, "N7:9x", 1, V.Int16)]
+
+    assert client_run(r.port, work) == ["BadTypeMismatch", "BadOutOfRange", "BadOutOfRange", "BadNotWritable",
+                                        "BadNotWritable", "BadNodeIdUnknown"]
+    assert r.read("N7:0") == 0 and r.read("ST9:0") == ""
+    r.wait_for(lambda: r.status(8) == 6, "the refusals counted in status word 8")
+
+
+def test_writes_land_in_program_mode(apps):
+    from softplc_lite.ladder.engine import Mode
+
+    r = apps.start(xml())
+    r.runner.request_stop()
+    r.thread.join(LIMIT_S)
+    r.engine.set_mode(Mode.PROGRAM)
+    stop = threading.Event()
+
+    def scan() -> None:
+        while not stop.is_set():
+            r.engine.scan()
+
+    t = threading.Thread(target=scan, daemon=True)
+    t.start()
+    try:
+        async def work(client):
+            return await write(client, "N7:1", 77, ua.VariantType.Int16)
+
+        assert client_run(r.port, work) == 77
+        assert r.read("N7:1") == 77 and r.read("O:0/1") == 0  # outputs idle: no ladder ran
+    finally:
+        stop.set()
+        t.join(LIMIT_S)
