@@ -22,7 +22,7 @@ BENCHMARKS = (
     "bench_datatable_memory", "bench_snapshot", "bench_word_access", "bench_ladder", "bench_load_cache",
     "bench_comgenius_format",
     "bench_comgenius_ports", "bench_modbus_master", "bench_modbmast", "bench_modbus_slave", "bench_modbus_server",
-    "bench_enips_server", "bench_watch", "bench_trend_view", "bench_trends", "bench_scenarios", "bench_mutation",
+    "bench_enips_server", "bench_opcuas", "bench_watch", "bench_trend_view", "bench_trends", "bench_scenarios", "bench_mutation",
     "bench_logix", "bench_st",
 )
 
@@ -186,6 +186,16 @@ def main() -> int:
                      f"{med(table['cip K=4']['ratio_to_modbtcps']):.2f}x MODBTCPS, PCCC "
                      f"{med(table['pccc K=4']['rates']):,.0f}/s = {med(table['pccc K=4']['ratio_to_modbtcps']):.2f}x; "
                      f"under 50 busy clients {enips['busy'].get('late_scans', 0)} late scans")
+
+    opc = load("bench_opcuas")
+    if opc:
+        t, mem = opc["table"], opc["memory"]
+        late = sum(sum(row["late_scans"]) for row in t.values())
+        lines.append(f"opcuas    reads of 100 (K=4): {med(t['reads K=4']['opcuas']):,.0f}/s = "
+                     f"{med(t['reads K=4']['ratio']):.2f}x asyncua's Server; data changes "
+                     f"{med(t['notifications']['opcuas']):,.0f}/s = {med(t['notifications']['ratio']):.2f}x; "
+                     f"{mem['opcuas']['bytes_per_item']:,.0f} B a monitored item "
+                     f"(asyncua {mem['asyncua']['bytes_per_item']:,.0f}); {late} late scans under clients")
 
     logix = load("bench_logix")
     if logix:
