@@ -466,24 +466,30 @@ def _load_export_app(path: Path, state_dir: str | Path | None, program: Program 
 
 
 EXPORT_ENIPS = ".ENIPS.XML"
+EXPORT_SERVERS = (("ENIPS", EXPORT_ENIPS), ("OPCUAS", ".OPCUAS.XML"))  # a server module, its config beside an export
 
 
 def _export_modules(path: Path, made) -> tuple[list[TLM], list[str]]:
-    """ENIPS configured from ``<stem>.ENIPS.XML`` beside the export (any
-    case), or no module."""
-    config = find_file(path.parent, path.stem + EXPORT_ENIPS)
-    if config is None:
-        return [], []
-    try:
-        module = load_module("ENIPS")
-        # each program's name as spelled: its routines' files are named PROGRAM.ROUTINE
-        programs = list(dict.fromkeys(made.program.files[n].name.split(".")[0] for n in made.routine_files.values()))
-        warnings = module.configure_export(config, shown_path(path.stem), made.directory, programs)
-    except ModuleErrors as e:
-        raise AppError(list(e.problems)) from None
-    except ModuleError as e:
-        raise AppError([e]) from None
-    return [module], warnings
+    """ENIPS configured from ``<stem>.ENIPS.XML`` beside the export, and
+    OPCUAS from ``<stem>.OPCUAS.XML`` (any case); each absent, no module."""
+    modules: list[TLM] = []
+    warnings: list[str] = []
+    for name, suffix in EXPORT_SERVERS:
+        config = find_file(path.parent, path.stem + suffix)
+        if config is None:
+            continue
+        try:
+            module = load_module(name)
+            # each program's name as spelled: its routines' files are named PROGRAM.ROUTINE
+            programs = list(dict.fromkeys(made.program.files[n].name.split(".")[0]
+                                          for n in made.routine_files.values()))
+            warnings += module.configure_export(config, shown_path(path.stem), made.directory, programs)
+        except ModuleErrors as e:
+            raise AppError(list(e.problems)) from None
+        except ModuleError as e:
+            raise AppError([e]) from None
+        modules.append(module)
+    return modules, warnings
 
 
 def _settings_problems(path: Path | None) -> list:

@@ -20,7 +20,7 @@ from typing import Mapping
 
 from ..netmodule import NetServerModule
 from . import status as S
-from .config import CONFIG_FILE, ServerConfig, config_references, load_config
+from .config import CONFIG_FILE, ServerConfig, config_references, load_config, read_config
 from .protocol import OpcUaProtocol
 from .space import build_space
 
@@ -39,11 +39,21 @@ class OpcUaServer(NetServerModule):
         self.engine = None
         self.server = None
         self.space = None
+        self.directory = None  # a Studio 5000 export's tags (logix/tags.py)
 
     def configure(self, app_dir: Path | None) -> list[str]:
         if app_dir is not None:
             self.config = load_config(app_dir)
             self.app_name = Path(app_dir).resolve().name
+        return list(self.config.warnings)
+
+    def configure_export(self, config_path: Path, app_name: str, directory, programs=()) -> list[str]:
+        """A Studio 5000 export's server: ``config_path`` its OPCUAS.XML
+        (``<export stem>.OPCUAS.XML``), ``directory`` its tag directory
+        (logix/tags.py), whose tags the address space holds."""
+        self.config = read_config(Path(config_path))
+        self.app_name = app_name
+        self.directory = directory
         return list(self.config.warnings)
 
     def config_references(self) -> list:
@@ -54,8 +64,8 @@ class OpcUaServer(NetServerModule):
         table = engine.table
         self.reference_config(table)
         program = getattr(engine, "program", None)
-        symbols = program.symbols if program is not None else {}
-        self.space = build_space(table, self.app_name, self.config, symbols)
+        symbols = program.symbols if program is not None and self.directory is None else {}
+        self.space = build_space(table, self.app_name, self.config, symbols, self.directory)
         self.serve(table, OpcUaProtocol(self.config, self.space), WHERE, S.LAYOUT)
         return [f"OPCUAS: {why}: not served to clients" for why in self.space.skipped]
 

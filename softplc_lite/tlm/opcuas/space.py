@@ -31,6 +31,7 @@ BIT_FILES = ("B", "O", "I")  # files whose elements are browsable bit by bit: a 
 # OPC UA built-in types (OPC 10000-6, 5.1.2) of each storage's items
 KIND_OF_STORAGE = {Storage.WORD: "Int16", Storage.FLOAT: "Float", Storage.LONG: "Int32", Storage.BYTE: "SByte",
                    Storage.LONG64: "Int64"}
+_BITS_FORMAT = {1: "=b", 2: "=h", 4: "=i", 8: "=q"}  # a Boolean's host item, by its size
 _FORMATS = {"Boolean": "=h", "Int16": "=h", "Float": "=f", "SByte": "=b", "Int64": "=q", "Mode": "=h"}
 
 
@@ -102,18 +103,19 @@ def decode(var: Var, raw: bytes | memoryview):
         return read_string(words, 0, len(words) - 1)
     if kind == "Int32":
         return struct.unpack_from("=i", raw, var.offset)[0]
-    value = struct.unpack_from(_FORMATS[kind], raw, var.offset)[0]
     if kind == "Boolean":
-        return bool(value >> var.bit & 1)
+        return bool(struct.unpack_from(_BITS_FORMAT[var.size], raw, var.offset)[0] >> var.bit & 1)
+    value = struct.unpack_from(_FORMATS[kind], raw, var.offset)[0]
     if kind == "Mode":
         return MODES.get(value, f"mode {value}")
     return value
 
 
-def build_space(table, app: str, config, symbols: dict | None = None) -> Space:
+def build_space(table, app: str, config, symbols: dict | None = None, directory=None) -> Space:
     """The address space of ``table``: ``symbols`` (a program's, name ->
     declaration) and the data files as ``config`` exposes them, and the
-    PLC's mode, fault code and scan time always."""
+    PLC's mode, fault code and scan time always; for a Studio 5000 export,
+    its tag ``directory``'s tags in place of the symbols and the files."""
     space = Space(app)
     for w in getattr(config, "writable", ()):
         space.open.setdefault(w.file, []).append((w.address.element, w.last + 1))
@@ -133,6 +135,12 @@ def build_space(table, app: str, config, symbols: dict | None = None) -> Space:
         Var(FAULT_CODE, "FaultCode", PLC, "Int16", at(S.MAJOR_FAULT_CODE), k,
             description="The major fault code, 0 when none (S:12)"),
         Var(SCAN_TIME, "ScanTime", PLC, "Int16", at(S.LAST_SCAN_MS), k, description="The last scan's time, ms (S:8)")]
+    if directory is not None:
+        if config.tags:
+            from .logixspace import add_tags
+
+            add_tags(space, by_name, directory)
+        return space
     named: dict[str, list[str]] = {}
     if config.symbols and symbols:
         for decl in sorted(symbols.values(), key=lambda d: d.name.upper()):

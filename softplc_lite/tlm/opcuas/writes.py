@@ -54,10 +54,11 @@ def apply(space: Space, payload: bytes, table) -> str:
         return REFUSED
     data = table.file(slot.name).data
     rest = payload[_HEAD.size:]
-    if bit >= 0:
-        word = data[item] & 0xFFFF
+    if bit >= 0:  # a bit of a word (or of a Logix host item, whose width the file's items give)
+        width = 8 * slot.itemsize
+        word = data[item] & ((1 << width) - 1)
         word = word | (1 << bit) if rest[0] else word & ~(1 << bit)
-        data[item] = word - 0x10000 if word & 0x8000 else word
+        data[item] = word - (1 << width) if word >> (width - 1) else word
     elif slot.letter in ("ST", "SL"):
         store_text(data, item, rest.decode("utf-8"), slot.per - 1)
     else:
