@@ -72,7 +72,7 @@ def test_a_thousand_items_each_get_every_change_of_the_counter_once(apps):
     # the first value may differ between items (they are created within a scan or two), not what follows
     firsts = {values[0] for values in seen.values()}
     assert max(firsts) - min(firsts) <= 3, sorted(firsts)
-    assert r.runner.late_scans >= 0 and r.engine.fault is None
+    assert r.engine.fault is None
 
 
 def test_a_subscribed_client_sees_a_restart_and_reads_again(apps):
