@@ -104,6 +104,17 @@ def test_the_address_space_browses_from_the_app_down_to_bits_with_descriptions(a
     assert described == ["N7:5", "Symbol Count"]
 
 
+def test_rung_comments_describe_the_elements_their_rungs_name(apps):
+    r = apps.start(ladder="SYMBOL Count N7:5\n// Counts the scans.\nADD Count 1 Count\nMOV N7:5 N7:6\n"
+                          "// Copies the count.\nMOV N7:5 N7:7\n")
+
+    async def work(client):
+        return [(await (await _node(client, t)).read_description()).Text for t in ("Count", "N7:5", "N7:6", "N7:7")]
+
+    assert client_run(r.port, work) == ["N7:5: Counts the scans.", "Symbol Count: Counts the scans.", "",
+                                        "Copies the count."]
+
+
 def test_a_subscription_gets_every_change_of_a_counter_once_a_scan(apps):
     # the counter adds 1 each 100 ms scan of the wall clock; the values notified must run on by
     # one each, none twice, none missed; a word the ladder never changes is notified once

@@ -22,7 +22,7 @@ from ..netmodule import NetServerModule
 from . import status as S
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config, read_config
 from .protocol import OpcUaProtocol
-from .space import build_space
+from .space import build_space, rung_comments
 
 WHERE = "OPCUAS.XML address and port; docs/opcuas.md"
 
@@ -65,7 +65,8 @@ class OpcUaServer(NetServerModule):
         self.reference_config(table)
         program = getattr(engine, "program", None)
         symbols = program.symbols if program is not None and self.directory is None else {}
-        self.space = build_space(table, self.app_name, self.config, symbols, self.directory)
+        comments = rung_comments(program) if self.directory is None else {}
+        self.space = build_space(table, self.app_name, self.config, symbols, self.directory, comments)
         self.serve(table, OpcUaProtocol(self.config, self.space), WHERE, S.LAYOUT)
         return [f"OPCUAS: {why}: not served to clients" for why in self.space.skipped]
 

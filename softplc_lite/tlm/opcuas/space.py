@@ -111,11 +111,44 @@ def decode(var: Var, raw: bytes | memoryview):
     return value
 
 
-def build_space(table, app: str, config, symbols: dict | None = None, directory=None) -> Space:
+def rung_comments(program) -> dict[str, str]:
+    """Each element's rung comment: the comment of the first commented rung
+    that names it, by its address or a symbol (a choice: the rung that uses
+    a value first is the one whose comment says what it is for); keyed by
+    the element's address (``N7:5``, ``O:0``)."""
+    from ...ladder.ast import AddressRef, Instruction, SymbolRef, walk
+
+    found: dict[str, str] = {}
+    if program is None:
+        return found
+    symbols = {name.upper(): decl.address for name, decl in program.symbols.items()}
+    for f in sorted(program.files.values(), key=lambda f: f.number):
+        for rung in f.rungs:
+            if not rung.comment:
+                continue
+            for instr in walk(rung.elements):
+                if not isinstance(instr, Instruction):
+                    continue
+                for op in instr.operands:
+                    address = op.address if isinstance(op, AddressRef) else \
+                        symbols.get(op.name.upper()) if isinstance(op, SymbolRef) else None
+                    if address is not None and address.is_direct and address.element is not None:
+                        found.setdefault(_element_text(address), " ".join(rung.comment.split()))
+    return found
+
+
+def _element_text(a) -> str:
+    return f"{a.type_letter}:{a.element}" if a.type_letter in ("O", "I", "S") else f"{a.file_name()}:{a.element}"
+
+
+def build_space(table, app: str, config, symbols: dict | None = None, directory=None, comments=None) -> Space:
     """The address space of ``table``: ``symbols`` (a program's, name ->
     declaration) and the data files as ``config`` exposes them, and the
     PLC's mode, fault code and scan time always; for a Studio 5000 export,
-    its tag ``directory``'s tags in place of the symbols and the files."""
+    its tag ``directory``'s tags in place of the symbols and the files.
+    ``comments``: each element's rung comment (``rung_comments``), which
+    its nodes' Descriptions say."""
+    comments = comments or {}
     space = Space(app)
     for w in getattr(config, "writable", ()):
         space.open.setdefault(w.file, []).append((w.address.element, w.last + 1))
@@ -145,7 +178,7 @@ def build_space(table, app: str, config, symbols: dict | None = None, directory=
     if config.symbols and symbols:
         for decl in sorted(symbols.values(), key=lambda d: d.name.upper()):
             text = str(decl.address)
-            problem = _add_symbol(space, by_name, decl.name, text)
+            problem = _add_symbol(space, by_name, decl.name, text, comments)
             if problem:
                 space.skipped.append(f"symbol {decl.name} ({text}): {problem}")
             else:
@@ -153,12 +186,13 @@ def build_space(table, app: str, config, symbols: dict | None = None, directory=
     if config.data_files:
         space.objects.append(Obj(DATA_FILES, "DataFiles", APP, "The data table, by file, element and bit"))
         for k, (slot, f) in enumerate(zip(space.slots, table.files())):
-            _add_file(space, k, slot, f.ftype, named)
+            _add_file(space, k, slot, f.ftype, named, comments)
     return space
 
 
-def _described(names: list[str] | None) -> str:
-    return f"Symbol {', '.join(names)}" if names else ""
+def _described(names: list[str] | None, comment: str | None) -> str:
+    said = f"Symbol {', '.join(names)}" if names else ""
+    return f"{said}: {comment}" if said and comment else said or comment or ""
 
 
 def _element(space: Space, k: int, slot: Slot, ftype, element: int, node: str, name: str, parent: str,
@@ -188,15 +222,15 @@ def _element(space: Space, k: int, slot: Slot, ftype, element: int, node: str, n
             space.variables.append(Var(f"{node}/{b}", str(b), node, "Boolean", first, k, bit=b, writable=w))
 
 
-def _add_file(space: Space, k: int, slot: Slot, ftype, named: dict[str, list[str]]) -> None:
+def _add_file(space: Space, k: int, slot: Slot, ftype, named: dict[str, list[str]], comments: dict) -> None:
     space.objects.append(Obj(slot.name, slot.name, DATA_FILES, f"{ftype.title} file"))
     bits = ftype.letter in BIT_FILES
     for e in range(slot.items // slot.per):
         address = f"{slot.name}:{e}" if ftype.letter not in ("O", "I", "S") else f"{ftype.letter}:{e}"
-        _element(space, k, slot, ftype, e, address, address, slot.name, _described(named.get(address)), bits)
+        _element(space, k, slot, ftype, e, address, address, slot.name, _described(named.get(address), comments.get(address)), bits)
 
 
-def _add_symbol(space: Space, by_name: dict, name: str, text: str) -> str | None:
+def _add_symbol(space: Space, by_name: dict, name: str, text: str, comments: dict) -> str | None:
     """The symbol ``name`` at ``text`` as a variable or object under the
     app's; why not, or None."""
     try:
@@ -214,6 +248,8 @@ def _add_symbol(space: Space, by_name: dict, name: str, text: str) -> str | None
         return f"past the end of {slot.name}"
     first = slot.offset + a.element * slot.per * slot.itemsize
     w = space.opens(slot.name, a.element)
+    comment = comments.get(_element_text(a))
+    text = f"{text}: {comment}" if comment else text
     if a.member is not None:
         m = next(m for m in ftype.word_members if m.name == a.member)
         space.variables.append(Var(name, name, APP, "Int16", first + m.offset * 2, k, description=text, writable=w))
