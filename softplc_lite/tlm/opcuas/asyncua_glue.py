@@ -37,7 +37,7 @@ try:
     import asyncua
     from asyncua import Server, ua
     from asyncua.crypto.permission_rules import User, UserRole
-    from asyncua.server.address_space import AttributeService, NodeManagementService
+    from asyncua.server.address_space import AddressSpace, AttributeService, NodeManagementService
     from asyncua.server.internal_server import InternalServer
     from asyncua.server.subscription_service import SubscriptionService
 except ImportError as _exc:  # the server process says this line, not a traceback
@@ -54,7 +54,8 @@ _NEEDED = (
     (Server, ("init", "set_endpoint", "set_security_policy", "register_namespace", "start", "stop")),
     (AttributeService, ("write",)),
     (SubscriptionService, ("create_monitored_items", "create_subscription")),
-    (InternalServer, ("write_attribute_value",)),
+    (AddressSpace, ("write_attribute_value", "read_attribute_value")),
+    (InternalServer, ("start",)),
     (NodeManagementService, ("add_nodes",)),
 )
 POLL_S = 0.002  # how often the server looks for a new scan in the image: a choice (docs/opcuas.md)

@@ -15,16 +15,14 @@ from __future__ import annotations
 
 from itertools import product
 
-from .space import APP, KIND_OF_STORAGE, Obj, Space, Var
+from .space import APP, Obj, Space, Var
 
 KIND_OF_LETTER = {"N": "Int16", "L": "Int32", "F": "Float", "SI": "SByte", "LI": "Int64"}
-_STORAGE = {"N": 2, "L": 4, "F": 4, "SI": 1, "LI": 8, "B": 2}
 
 
 def add_tags(space: Space, by_name: dict, directory) -> None:
     """Every tag of ``directory`` under the app's object (a program's under
     its own); ``by_name``: the image's slots by file name."""
-    assert KIND_OF_STORAGE  # the data files' types, which these follow
     for scope, tags in directory.scopes.items():
         parent = APP
         if scope is not None:
