@@ -175,7 +175,7 @@ def test_programs_dir_executors_agree(path):
     def modules():  # fresh modules for each engine
         found = load_modules(app_dir)[0]
         for m in found:
-            if m.name in ("MODBTCPS", "ENIPS"):  # two engines at once: two servers, each on a port of its own
+            if m.name in ("MODBTCPS", "ENIPS", "OPCUAS"):  # two engines at once: two servers, each on a port of its own
                 m.config = dataclasses.replace(m.config, port=free_tcp_port())
         return found
     for k, compiled, reference in run_pair(app.program, {}, words, space=(), modules=modules):
