@@ -45,10 +45,13 @@ class Changes:
         self.status.append(status)
 
 
+@pytest.mark.alone  # the server must keep pace with a wall-clock scan (docs/testing.md)
 def test_a_thousand_items_each_get_every_change_of_the_counter_once(apps):
-    # 100 ms scans of the wall clock: each of the 1,000 items must be notified the counter's values
-    # one after another, none skipped, none twice, the same run of values for all
-    r = apps.start(opcuas_xml(maxMonitoredItems=ITEMS), ladder=FILL, scan_ms=100)
+    # each of the 1,000 items must be notified the counter's values one after another, none skipped,
+    # none twice, the same run of values for all. The server spends some 70 us of CPU a changed value
+    # (docs/opcuas.md, Measured): 1,000 changes a scan take it about 70 ms, so the scans are 400 ms of
+    # the wall clock; a server starved of the CPU for longer than a scan sees only the later scan
+    r = apps.start(opcuas_xml(maxMonitoredItems=ITEMS), ladder=FILL, scan_ms=400)
 
     async def work():
         async with Client(f"opc.tcp://127.0.0.1:{r.port}/", timeout=30) as client:
@@ -59,7 +62,7 @@ def test_a_thousand_items_each_get_every_change_of_the_counter_once(apps):
             handles = await sub.subscribe_data_change(nodes, queuesize=1000)
             assert all(isinstance(h, int) for h in handles), "every item created"
             deadline = time.monotonic() + 60
-            while min((len(v) for v in changes.seen.values()), default=0) < 15 or len(changes.seen) < ITEMS:
+            while min((len(v) for v in changes.seen.values()), default=0) < 10 or len(changes.seen) < ITEMS:
                 assert time.monotonic() < deadline, f"{len(changes.seen)} items notified"
                 await asyncio.sleep(0.1)
             await sub.delete()
