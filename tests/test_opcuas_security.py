@@ -5,6 +5,7 @@ channels and identities are let in, and what each may do."""
 from __future__ import annotations
 
 import asyncio
+import shutil
 import stat
 
 import pytest
@@ -22,13 +23,22 @@ from softplc_lite.tlm.opcuas.users import Users
 PASSWORD = "correct horse battery"
 
 
-@pytest.fixture
-def app(tmp_path):
-    """An app directory with a server certificate made by the command."""
-    app = tmp_path / "tank"
+@pytest.fixture(scope="module")
+def made_app(tmp_path_factory):
+    """An app directory with a server certificate made by the command, once a
+    module (a command's run and an RSA key cost a second)."""
+    app = tmp_path_factory.mktemp("pki") / "tank"
     app.mkdir()
     proc = softplc_here("opcua-cert", str(app), "--uri", "urn:example:tank")
     assert proc.returncode == 0, proc.stderr
+    return app
+
+
+@pytest.fixture
+def app(tmp_path, made_app):
+    """A test's own copy of ``made_app`` (modes kept: the key stays 0600)."""
+    app = tmp_path / "tank"
+    shutil.copytree(made_app, app)
     return app
 
 

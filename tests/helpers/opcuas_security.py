@@ -19,6 +19,7 @@ from asyncua.common.callback import CallbackType
 
 from softplc_lite.tlm.opcuas.security import CertPaths, SecuritySettings, UserManager, apply_security, \
     create_certificate
+from softplc_lite.tlm.opcuas.asyncua_glue import end_clock
 from softplc_lite.tlm.opcuas.users import Users
 
 CLIENT_URI = "urn:example:softplc-test-client"
@@ -49,9 +50,13 @@ async def secured_server(app_dir: Path, settings: SecuritySettings = SecuritySet
         if event.is_external:
             served.readers.append(event.user)
     server.subscribe_server_callback(CallbackType.PreRead, seen)
-    async with server:
+    await server.start()
+    try:
         served.url = f"opc.tcp://127.0.0.1:{server.bserver.port}/"
         yield served
+    finally:
+        await end_clock(server)  # a stop in milliseconds, not a second (asyncua_glue.end_clock)
+        await server.stop()
 
 
 def client_cert(directory: Path, name: str = "client") -> tuple[Path, Path]:

@@ -70,6 +70,23 @@ BAD_NODE_UNKNOWN = ua.StatusCodes.BadNodeIdUnknown
 BAD_TOO_MANY_ITEMS = ua.StatusCodes.BadTooManyMonitoredItems
 
 
+async def end_clock(server) -> None:
+    """Stop the task asyncua's InternalServer keeps ServerStatus.CurrentTime
+    with: it sleeps a second between updates and ``Server.stop`` awaits it,
+    so a runtime's stop (and every test's) would wait up to a second."""
+    iserver = server.iserver
+    task = getattr(iserver, "time_task", None)
+    if task is None:
+        return
+    iserver._time_task_stop = True
+    task.cancel()
+    try:
+        await task
+    except asyncio.CancelledError:
+        pass
+    iserver.time_task = None
+
+
 def missing() -> str | None:
     """What the installed asyncua lacks of what this module uses, in one
     line; None when it has everything."""
@@ -161,6 +178,7 @@ class Listener:
         if self.task is not None:
             self.task.cancel()
         if self.ua is not None:
+            await end_clock(self.ua)
             await self.ua.stop()
 
     # -- the scans ---------------------------------------------------------------------------
