@@ -16,7 +16,19 @@ def test_an_empty_root_takes_the_defaults():
     c = parse_config(b"<OpcUaServer/>")
     assert (c.host, c.port, c.symbols, c.data_files, c.tags) == ("127.0.0.1", 4840, True, True, True)
     assert (c.max_sessions, c.max_subscriptions, c.max_monitored_items, c.status) == (10, 100, 10_000, None)
+    assert (c.allow_none, c.allow_sign, c.anonymous, c.trusted_clients_only) == (False, False, True, False)
     assert c.warnings == []
+
+
+def test_the_security_attributes_are_read_and_checked():
+    c = parse_config(b'<OpcUaServer securityNone="yes" securitySign="yes" anonymous="no" trustedClientsOnly="yes"/>')
+    assert (c.allow_none, c.allow_sign, c.anonymous, c.trusted_clients_only) == (True, True, False, True)
+    with pytest.raises(ModuleErrors) as info:
+        parse_config(b'<OpcUaServer\n  securityNone="true" anonymous="read"/>', "OPCUAS.XML")
+    text = [str(p) for p in info.value.problems]
+    assert [t[:28] for t in text] == ["OPCUAS.XML:2:3: securityNone", "OPCUAS.XML:2:23: anonymous='"], text
+    wide = parse_config(b'<OpcUaServer address="0.0.0.0" securityNone="yes"/>', "X.XML")
+    assert len(wide.warnings) == 2 and "connect unencrypted" in wide.warnings[1]
 
 
 def test_every_attribute_is_read():
@@ -73,5 +85,9 @@ def test_softplc_check_reports_the_file_located(tmp_path):
     assert f"{app / 'OPCUAS.XML'}:2:3: maxMonitoredItems='0'" in result.stderr
     assert "Traceback" not in result.stderr
     (app / "OPCUAS.XML").write_text('<OpcUaServer status="N40:0"/>\n')
+    bare = softplc_here("check", str(app))  # secure by default: no certificate, no endpoint
+    assert bare.returncode != 0 and "Traceback" not in bare.stderr
+    assert f"{app / 'OPCUAS.XML'}:1:1: no server certificate" in bare.stderr and "opcua-cert" in bare.stderr
+    (app / "OPCUAS.XML").write_text('<OpcUaServer status="N40:0" securityNone="yes"/>\n')
     ok = softplc_here("check", str(app))
     assert ok.returncode == 0 and "module OPCUAS" in ok.stdout

@@ -1,7 +1,9 @@
 """Writes by asyncua's Client to the variables a <Writable> opens: applied
 by the scan at its input point and answered once applied, in RUN and in
 PROGRAM mode; refused with OPC UA's status codes where the type, the range
-or the node does not allow them, each refusal counted."""
+or the node does not allow them, each refusal counted. The client writes
+on an encrypted channel with a trusted certificate (helpers.opcua_apps
+secure=True): an anonymous session may not write."""
 
 from __future__ import annotations
 
@@ -47,7 +49,7 @@ async def write(client, text, value, kind):
 
 
 def test_writes_land_through_the_scan_and_read_back(apps):
-    r = apps.start(xml())
+    r = apps.start(xml(), secure=True)
     V = ua.VariantType
 
     async def work(client):
@@ -55,7 +57,7 @@ def test_writes_land_through_the_scan_and_read_back(apps):
                 await write(client, "Note", "check seal", V.String), await write(client, "Dwell.PRE", 900, V.Int16),
                 await write(client, "Run", True, V.Boolean), await write(client, "L12:1", -70000, V.Int32)]
 
-    assert client_run(r.port, work) == [555, -1.5, "check seal", 900, True, -70000]
+    assert client_run(r.port, work, secure=True) == [555, -1.5, "check seal", 900, True, -70000]
     assert (r.read("N7:0"), r.read("F8:3"), r.read("ST9:0"), r.read("T4:0.PRE")) == (555, -1.5, "check seal", 900)
     assert r.read("L12:1") == -70000 and r.read("B3:0/4") == 1
     r.wait_for(lambda: r.read("O:0/1") == 1, "the ladder using the written bit")
@@ -63,7 +65,7 @@ def test_writes_land_through_the_scan_and_read_back(apps):
 
 
 def test_writes_are_refused_by_type_range_and_region(apps):
-    r = apps.start(xml())
+    r = apps.start(xml(), secure=True)
     V = ua.VariantType
 
     async def work(client):
@@ -71,8 +73,8 @@ def test_writes_are_refused_by_type_range_and_region(apps):
                 await write(client, "T4:0.ACC", -1, V.Int16), await write(client, "Count", 1, V.Int16),
                 await write(client, "N7:2", 1, V.Int16), await write(client, "N7:9x", 1, V.Int16)]
 
-    assert client_run(r.port, work) == ["BadTypeMismatch", "BadOutOfRange", "BadOutOfRange", "BadNotWritable",
-                                        "BadNotWritable", "BadNodeIdUnknown"]
+    assert client_run(r.port, work, secure=True) == ["BadTypeMismatch", "BadOutOfRange", "BadOutOfRange",
+                                                     "BadNotWritable", "BadNotWritable", "BadNodeIdUnknown"]
     assert r.read("N7:0") == 0 and r.read("ST9:0") == ""
     r.wait_for(lambda: r.status(8) == 6, "the refusals counted in status word 8")
 
@@ -80,7 +82,7 @@ def test_writes_are_refused_by_type_range_and_region(apps):
 def test_writes_land_in_program_mode(apps):
     from softplc_lite.ladder.engine import Mode
 
-    r = apps.start(xml())
+    r = apps.start(xml(), secure=True)
     r.runner.request_stop()
     r.thread.join(LIMIT_S)
     r.engine.set_mode(Mode.PROGRAM)
@@ -96,7 +98,7 @@ def test_writes_land_in_program_mode(apps):
         async def work(client):
             return await write(client, "N7:1", 77, ua.VariantType.Int16)
 
-        assert client_run(r.port, work) == 77
+        assert client_run(r.port, work, secure=True) == 77
         assert r.read("N7:1") == 77 and r.read("O:0/1") == 0  # outputs idle: no ladder ran
     finally:
         stop.set()

@@ -58,7 +58,9 @@ def register() -> None:
 
 
 def opcuas_xml(port: int | None = None, **root: object) -> str:
-    attrs = {"port": port or free_tcp_port(), "status": "N40:0", **root}
+    """An OPCUAS.XML for a test: SecurityPolicy None allowed (the tests that
+    are not about security read anonymously, without certificates)."""
+    attrs = {"port": port or free_tcp_port(), "status": "N40:0", "securityNone": "yes", **root}
     text = " ".join(f'{k}="{v}"' for k, v in attrs.items())
     return f'<?xml version="1.0"?>\n<OpcUaServer {text}/>\n'
 
@@ -66,18 +68,64 @@ def opcuas_xml(port: int | None = None, **root: object) -> str:
 class OpcUaApps(Apps):
     """OPCUAS apps started by a test, each stopped after it."""
 
-    def write(self, directory: Path, xml: str | None, ladder: str) -> Path:
-        return make_app(directory, ladder, MODULES_LST="OPCUAS\n", OPCUAS_XML=xml or opcuas_xml())
+    secure = False  # the next app gets the server certificate and trusts the test client's (secure_app)
 
-    def start(self, xml: str | None = None, ladder: str = LADDER, **kw) -> Running:
+    def write(self, directory: Path, xml: str | None, ladder: str) -> Path:
+        app = make_app(directory, ladder, MODULES_LST="OPCUAS\n", OPCUAS_XML=xml or opcuas_xml())
+        if self.secure:
+            secure_app(app)
+        return app
+
+    def start(self, xml: str | None = None, ladder: str = LADDER, secure: bool = False, **kw) -> Running:
+        self.secure = secure
         return super().start(xml, ladder, module="OPCUAS", **kw)
 
 
-def client_run(port: int, work, timeout: float = 30.0):
-    """``await work(client)`` with an asyncua Client connected to the server on ``port``."""
+_CERTS: list[Path] = []  # a directory holding a server's and a client's certificates, made once a process
+
+
+def certificates() -> Path:
+    """A directory with a server certificate (OPCUAS.PKI/) and a client
+    certificate, made once a process (an RSA key costs a fraction of a second)."""
+    if not _CERTS:
+        from softplc_lite.tlm.opcuas.security import CertPaths, create_certificate
+
+        from helpers.opcuas_security import client_cert
+        base = Path(tempfile.mkdtemp(prefix="softplc-opcuas-certs-"))
+        atexit.register(shutil.rmtree, base, True)
+        paths = CertPaths.for_app(base)
+        create_certificate(paths.cert, paths.key, "urn:example:softplc-test-server", "test server", "localhost", 2)
+        client_cert(base)
+        _CERTS.append(base)
+    return _CERTS[0]
+
+
+def secure_app(app_dir: Path, trust_client: bool = True) -> None:
+    """Give an app the server certificate; ``trust_client``: and the test
+    client's certificate in OPCUAS.PKI/trusted/ (so its sessions may write)."""
+    base = certificates()
+    shutil.copytree(base / "OPCUAS.PKI", app_dir / "OPCUAS.PKI", dirs_exist_ok=True)
+    if trust_client:
+        (app_dir / "OPCUAS.PKI" / "trusted").mkdir(exist_ok=True)
+        shutil.copy(base / "client_cert.der", app_dir / "OPCUAS.PKI" / "trusted" / "client_cert.der")
+
+
+def client_run(port: int, work, timeout: float = 30.0, secure: bool = False, user: str | None = None,
+               password: str | None = None):
+    """``await work(client)`` with an asyncua Client connected to the server on
+    ``port``; ``secure``: on a Basic256Sha256 SignAndEncrypt channel with the
+    test client's certificate (``secure_app`` trusts it), as ``user`` if named."""
     from asyncua import Client
 
     async def main():
+        if secure:
+            from helpers.opcuas_security import secure_client
+            base = certificates()
+            client = await secure_client(f"opc.tcp://127.0.0.1:{port}/", base / "client_cert.der",
+                                         base / "client_key.pem", user=user, password=password)
+            client.session_timeout = 600_000
+            async with client:
+                return await work(client)
         client = Client(f"opc.tcp://127.0.0.1:{port}/", timeout=timeout)
         client.session_timeout = 600_000  # what asyncua's server grants at most: no warning that it cut it
         async with client:

@@ -47,7 +47,11 @@ except ImportError as _exc:  # the server process says this line, not a tracebac
     raise ImportError(f"the installed asyncua lacks what OPCUAS uses ({_exc}): OPCUAS is written for "
                       f"asyncua {ASYNCUA_RANGE} (pip install 'asyncua{ASYNCUA_RANGE}')") from None
 
+from pathlib import Path  # noqa: E402
+
 from . import writes  # noqa: E402
+from .security import CertPaths, SecuritySettings, apply_security, role_of, user_can_write  # noqa: E402
+from .users import FILE_NAME as USERS_FILE, Users  # noqa: E402
 from .space import NAMESPACE, Space, decode  # noqa: E402
 
 _NEEDED = (
@@ -137,15 +141,15 @@ class Listener:
         self.plc_server = server
         self.space = space
         self.config = config
-        self.counters = counters  # (refused writes, refused monitored items, refused subscriptions)
+        self.counters = counters  # (refused writes, monitored items, subscriptions, identities)
         self.ua: Server | None = None
         self.ns = 2
         self.task: asyncio.Task | None = None
         self.nodes: list = []
         self.notified = 0  # values published to asyncua: one per variable per scan at most
         self.by_node = {v.node: v for v in space.variables}
-        # who may write a writable node: every session unless the security module says otherwise
-        self.may_write = lambda user: True
+        self.may_write = user_can_write  # a write user or a trusted certificate (security.py)
+        self.manager = None  # security.py's UserManager: the identities it refused
         self._last_seq, self._last_raw, self._values = None, None, [None] * len(space.variables)
         self._by_slot: list[list[int]] | None = None
 
@@ -158,7 +162,7 @@ class Listener:
         host = f"[{s.host}]" if ":" in s.host else s.host
         server.set_endpoint(f"opc.tcp://{host}:{s.port}/")
         server.set_server_name(f"softplc_lite {self.space.app}")
-        server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+        await self._secure(server)
         self.ns = await server.register_namespace(NAMESPACE)
         iserver = server.iserver
         iserver.max_connections = self.config.max_sessions
@@ -173,6 +177,26 @@ class Listener:
         await server.start()
         self.task = asyncio.get_running_loop().create_task(self.follow())
         return server.bserver._server.sockets[0].getsockname()[1]
+
+    async def _secure(self, server) -> None:
+        """security.py's policy, from the config and the files beside it
+        (OPCUAS.PKI/, OPCUAS.USERS); a refused identity counted. Writes are
+        refused per item by ``write_one`` (BadUserAccessDenied, counted), not
+        by the ruleset as a whole request."""
+        c = self.config
+        app_dir = Path(c.path).parent
+        settings = SecuritySettings(allow_none=c.allow_none, allow_sign=c.allow_sign, anonymous=c.anonymous,
+                                    trusted_clients_only=c.trusted_clients_only)
+        manager = self.manager = await apply_security(server, settings, Users.load(app_dir / USERS_FILE),
+                                                      CertPaths.for_app(app_dir), refuse_writes=False)
+        get_user, counter, count = manager.get_user, self.counters[3], self.plc_server.count
+
+        def checked(iserver, username=None, password=None, certificate=None):
+            user = get_user(iserver, username=username, password=password, certificate=certificate)
+            if user is None:
+                count(counter, f"session refused: {'user ' + repr(username) if username is not None else 'identity'}")
+            return user
+        manager.get_user = checked
 
     async def stop(self) -> None:
         if self.task is not None:
@@ -228,7 +252,7 @@ class Listener:
         v = self.by_node.get(wv.NodeId.Identifier) if isinstance(wv.NodeId.Identifier, str) else None
         if v is None or not v.writable or wv.AttributeId != ua.AttributeIds.Value:
             return BAD_NOT_WRITABLE
-        if not self.may_write(user):
+        if not self.may_write(user):  # a refusal the caller counts, with whose it was
             return ua.StatusCodes.BadUserAccessDenied
         variant = wv.Value.Value if wv.Value is not None else None
         if variant is None or variant.VariantType != VARIANT[v.kind] or wv.IndexRange:
@@ -249,7 +273,7 @@ class Listener:
         service = iserver.attribute_service
         original_write = service.write
         ns = self.ns
-        refused_write, refused_items, refused_subscriptions = self.counters
+        refused_write, refused_items, refused_subscriptions = self.counters[:3]
         count = self.plc_server.count
 
         async def write(params, user=User(role=UserRole.User)):
@@ -270,7 +294,8 @@ class Listener:
                 elif wv.NodeId.NamespaceIndex == ns:
                     code = await self.write_one(wv, user)
                     if code != ua.StatusCodes.Good:
-                        count(refused_write, f"write to {wv.NodeId.to_string()}: {ua.StatusCode(code).name}")
+                        count(refused_write, f"write to {wv.NodeId.to_string()} by {role_of(user)}: "
+                                             f"{ua.StatusCode(code).name}")
                     results.append(ua.StatusCode(code))
                 else:
                     one = ua.WriteParameters(NodesToWrite=[wv])

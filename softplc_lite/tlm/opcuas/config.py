@@ -42,7 +42,11 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
            Attr("maxMonitoredItems", 1, 1_000_000, default=10_000),
            Attr("status", text=True, what=f"a word address of an N or B file, the first of {STATUS_WORDS} "
                                            "status words (N40:0)"),
-           Attr("debug", 0, 2, default=0)),
+           Attr("debug", 0, 2, default=0),
+           Attr("securityNone", choices=YES_NO, default="no"),
+           Attr("securitySign", choices=YES_NO, default="no"),
+           Attr("anonymous", choices=YES_NO, default="yes"),
+           Attr("trustedClientsOnly", choices=YES_NO, default="no")),
     "Writable": (Attr("address", text=True, required=True,
                       what="the first element clients may write (N7:0, B3:0, F8:0, T4:0, ST9:0)"),
                  Attr("count", 1, MAX_ELEMENTS, default=1)),
@@ -81,6 +85,12 @@ class ServerConfig:
     status: Address | None = None
     debug: int = 0
     writable: tuple[Writable, ...] = ()  # none: every node read-only
+    # security (security.py): the defaults are the secure ones; each "yes" but anonymous loosens it
+    allow_none: bool = False  # an endpoint with SecurityPolicy None beside the encrypted ones
+    allow_sign: bool = False  # Sign-only endpoints beside SignAndEncrypt
+    anonymous: bool = True  # anonymous sessions, read only
+    trusted_clients_only: bool = False  # a channel's certificate must be one of OPCUAS.PKI/trusted/
+    line: int = 0  # the root element's, where a security problem is located
     warnings: list[str] = field(default_factory=list)
 
     # what the network-server layer's Settings take (tlm/netmodule.settings_of); asyncua accepts the
@@ -111,11 +121,17 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
     warnings = [] if ipaddress_is_loopback(host) else [
         f"{path}:{root.line}: listening on {host}: OPC UA clients beyond this machine can read the PLC "
         "(anonymous sessions read only; docs/opcuas.md)"]
+    if a.get("securityNone") == "yes" and not ipaddress_is_loopback(host):
+        warnings.append(f"{path}:{root.line}: securityNone=\"yes\" on {host}: clients beyond this machine may "
+                        "connect unencrypted, unsigned (docs/opcuas.md, Security)")
     return ServerConfig(path=path, host=host, port=a.get("port", PORT), symbols=a.get("symbols") == "yes",
                         data_files=a.get("dataFiles") == "yes", tags=a.get("tags") == "yes",
                         max_sessions=a.get("maxSessions", 10), max_subscriptions=a.get("maxSubscriptions", 100),
                         max_monitored_items=a.get("maxMonitoredItems", 10_000), status=status,
-                        debug=a.get("debug", 0), writable=tuple(writable), warnings=warnings)
+                        debug=a.get("debug", 0), writable=tuple(writable), warnings=warnings,
+                        allow_none=a.get("securityNone") == "yes", allow_sign=a.get("securitySign") == "yes",
+                        anonymous=a.get("anonymous", "yes") == "yes",
+                        trusted_clients_only=a.get("trustedClientsOnly") == "yes", line=root.line)
 
 
 def _check_writable(c: XmlChecker, node, status: Address | None, status_line: int) -> Writable | None:

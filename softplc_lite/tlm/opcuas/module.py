@@ -18,10 +18,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
+from ..errors import ModuleError
 from ..netmodule import NetServerModule
 from . import status as S
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config, read_config
 from .protocol import OpcUaProtocol
+from .security import CertPaths
 from .space import build_space, rung_comments
 
 WHERE = "OPCUAS.XML address and port; docs/opcuas.md"
@@ -45,6 +47,7 @@ class OpcUaServer(NetServerModule):
         if app_dir is not None:
             self.config = load_config(app_dir)
             self.app_name = Path(app_dir).resolve().name
+            check_certificate(self.config)
         return list(self.config.warnings)
 
     def configure_export(self, config_path: Path, app_name: str, directory, programs=()) -> list[str]:
@@ -54,6 +57,7 @@ class OpcUaServer(NetServerModule):
         self.config = read_config(Path(config_path))
         self.app_name = app_name
         self.directory = directory
+        check_certificate(self.config)
         return list(self.config.warnings)
 
     def config_references(self) -> list:
@@ -70,3 +74,15 @@ class OpcUaServer(NetServerModule):
         self.serve(table, OpcUaProtocol(self.config, self.space), WHERE, S.LAYOUT)
         return [f"OPCUAS: {why}: not served to clients" for why in self.space.skipped]
 
+
+
+def check_certificate(config: ServerConfig) -> None:
+    """A ModuleError at the config's root when the server could offer no
+    endpoint: no certificate (so no encrypted endpoint) and None not allowed.
+    Said by ``softplc check`` and before a run, not by the server process."""
+    paths = CertPaths.for_app(Path(config.path).parent)
+    if config.allow_none or (paths.cert.exists() and paths.key.exists()):
+        return
+    raise ModuleError(f"no server certificate {paths.cert} and key {paths.key.name}: the server offers only "
+                      "encrypted endpoints (securityNone=\"no\"); `softplc opcua-cert APP` makes them "
+                      "(docs/opcuas.md, Security)", config.path, config.line, 1)

@@ -65,7 +65,7 @@ class OpcUaHandler(Handler):
         from .asyncua_glue import Listener
 
         return Listener(self.server, self.protocol.space, self.protocol.config,
-                        (S.REFUSED_WRITES, S.REFUSED_ITEMS, S.REFUSED_SUBSCRIPTIONS))
+                        (S.REFUSED_WRITES, S.REFUSED_ITEMS, S.REFUSED_SUBSCRIPTIONS, S.REFUSED_IDENTITIES))
 
     def frame_length(self, data, at):  # pragma: no cover - asyncua frames
         raise NotImplementedError

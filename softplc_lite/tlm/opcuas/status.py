@@ -16,15 +16,18 @@ from ...netserver.counters import (  # noqa: F401 - the counters and words by na
 REFUSED_WRITES = OWN  # Write operations refused: a read-only node (BadNotWritable), an unknown one (BadNodeIdUnknown)
 REFUSED_ITEMS = OWN + 1  # monitored items over maxMonitoredItems (BadTooManyMonitoredItems)
 REFUSED_SUBSCRIPTIONS = OWN + 2  # subscriptions over maxSubscriptions (BadTooManySubscriptions)
+REFUSED_IDENTITIES = OWN + 3  # sessions refused: a wrong password, an untrusted certificate, anonymous where not allowed
 
 W_REFUSED_WRITES = 8
 W_REFUSED_ITEMS = 9
 W_REFUSED_SUBSCRIPTIONS = 10
+W_REFUSED_IDENTITIES = 11
 
 COPIED = COMMON_COPIED + ((W_REFUSED_WRITES, REFUSED_WRITES), (W_REFUSED_ITEMS, REFUSED_ITEMS),
-                          (W_REFUSED_SUBSCRIPTIONS, REFUSED_SUBSCRIPTIONS))
+                          (W_REFUSED_SUBSCRIPTIONS, REFUSED_SUBSCRIPTIONS), (W_REFUSED_IDENTITIES, REFUSED_IDENTITIES))
 REFUSAL_NAMES = (("write refused", REFUSED_WRITES),
-                 ("monitored item limit", REFUSED_ITEMS), ("subscription limit", REFUSED_SUBSCRIPTIONS))
+                 ("monitored item limit", REFUSED_ITEMS), ("subscription limit", REFUSED_SUBSCRIPTIONS),
+                 ("identity refused", REFUSED_IDENTITIES))
 
 LAYOUT = StatusWords(bits=W_BITS, rate=W_RATE, writes_applied=W_WRITES_APPLIED, refusals=W_REFUSALS,
                      copied=COPIED, refusal_names=REFUSAL_NAMES, words=STATUS_WORDS)
