@@ -18,7 +18,13 @@ relies on these internals:
   ``subscriptions[..].monitored_item_srv._monitored_items``, to hold the
   monitored items to the configured limit;
 - ``Server.bserver._server`` (the asyncio server), for the port bound, and
-  ``bserver.clients``, the connections open.
+  ``bserver.clients``, the connections open;
+- ``UaProcessor._process_message`` and its ``_connection`` (its
+  ``security_policy`` and ``_policies``): asyncua opens a channel with
+  SecurityPolicy None even where no endpoint offers None (GetEndpoints must
+  work on one, OPC 10000-4 5.4.4), and then creates and activates a session
+  on it; ``refuse_unoffered`` refuses CreateSession and ActivateSession on a
+  channel whose policy and mode no endpoint offers (BadSecurityPolicyRejected).
 
 Nothing else in OPCUAS imports asyncua. ``missing()`` says, in one line,
 what an installed asyncua lacks of this; the server process reports it
@@ -36,6 +42,7 @@ ASYNCUA_RANGE = ">=2.1,<2.2"
 try:
     import asyncua
     from asyncua import Server, ua
+    from asyncua.server.uaprocessor import UaProcessor
     from asyncua.crypto.permission_rules import User, UserRole
     from asyncua.server.address_space import AddressSpace, AttributeService, NodeManagementService
     from asyncua.server.internal_server import InternalServer
@@ -60,6 +67,7 @@ _NEEDED = (
     (SubscriptionService, ("create_monitored_items", "create_subscription")),
     (AddressSpace, ("write_attribute_value", "read_attribute_value")),
     (InternalServer, ("start",)),
+    (UaProcessor, ("_process_message",)),
     (NodeManagementService, ("add_nodes",)),
 )
 POLL_S = 0.002  # how often the server looks for a new scan in the image: a choice (docs/opcuas.md)
@@ -92,6 +100,34 @@ async def end_clock(server) -> None:
     except asyncio.CancelledError:
         pass
     iserver.time_task = None
+
+
+_REFUSED_CHANNEL: list = []  # the Listener's count of a refused channel (one server a process)
+
+
+_SESSION_REQUESTS = frozenset((ua.ObjectIds.CreateSessionRequest_Encoding_DefaultBinary,
+                               ua.ObjectIds.ActivateSessionRequest_Encoding_DefaultBinary))  # namespace 0
+
+
+def refuse_unoffered() -> None:
+    """Make asyncua refuse a session (BadSecurityPolicyRejected) on a channel
+    whose policy and mode no endpoint offers: a None channel serves
+    discovery only, unless the config allows None."""
+    original = UaProcessor._process_message
+    if getattr(original, "refuses_unoffered", False):
+        return
+
+    async def _process_message(self, typeid, requesthdr, seqhdr, body):
+        if typeid.Identifier in _SESSION_REQUESTS and typeid.NamespaceIndex == 0:  # every request passes here
+            conn = self._connection
+            policy, offered = conn.security_policy, getattr(conn, "_policies", None) or []
+            if not any(p.matches(policy.URI, policy.Mode) for p in offered):
+                for count in _REFUSED_CHANNEL:
+                    count(f"session refused: {policy.URI.rsplit('#', 1)[-1]} is not offered")
+                raise ua.UaStatusCodeError(ua.StatusCodes.BadSecurityPolicyRejected)
+        return await original(self, typeid, requesthdr, seqhdr, body)
+    _process_message.refuses_unoffered = True
+    UaProcessor._process_message = _process_message
 
 
 def missing() -> str | None:
@@ -204,6 +240,8 @@ class Listener:
                 count(counter, f"session refused: {'user ' + repr(username) if username is not None else 'identity'}")
             return user
         manager.get_user = checked
+        _REFUSED_CHANNEL[:] = [lambda message: count(counter, message)]
+        refuse_unoffered()
 
     async def stop(self) -> None:
         if self.task is not None:
