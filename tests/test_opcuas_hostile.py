@@ -62,7 +62,7 @@ async def garbage():
         w.write(frame)
         await w.drain()
         try:
-            reply = await asyncio.wait_for(r.read(256), 1)
+            reply = await asyncio.wait_for(r.read(256), 0.3)
             out["garbage"].append("closed" if not reply else "answered " + reply[:3].decode("latin-1"))
         except asyncio.TimeoutError:
             out["garbage"].append("held")
@@ -73,7 +73,7 @@ async def garbage():
 async def session_flood():
     held = []
     for _ in range(sessions):
-        c = Client(url, timeout=2)
+        c = Client(url, timeout=1)
         try:
             await c.connect()
             held.append(c)
