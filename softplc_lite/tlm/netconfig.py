@@ -136,3 +136,34 @@ def check_status(c: XmlChecker, root: XmlNode, text: str, words: int) -> Address
         c.error(root, f"status={text!r}: {problem}", "status")
         return None
     return address
+
+
+def check_writable_elements(c: XmlChecker, node: XmlNode, a: dict, status: Address | None, status_line: int,
+                            status_words: int, parts: str) -> tuple[Address, int] | None:
+    """A ``<Writable address=... count=...>``'s first element and count, or
+    None (the problem recorded): whole elements (a client may write every one
+    of their ``parts``), inside one file, and none of the server's status
+    words (the block ``status=`` on line ``status_line`` names)."""
+    text = a["address"]
+    try:
+        address = parse_address(text)
+    except DataTableError as e:
+        c.error(node, f"address={text!r}: {getattr(e, 'message', str(e))}", "address")
+        return None
+    if not address.is_direct or address.bit is not None or address.member is not None:
+        c.error(node, f"address={text!r}: expected a whole element (N7:0, T4:0, ST9:0): a client may write every "
+                      f"{parts} of the elements a <Writable> names", "address")
+        return None
+    count = a.get("count", 1)
+    if address.element + count > MAX_ELEMENTS:
+        c.error(node, f"count={count}: {count} elements from {address} run past the end of a file (elements "
+                      f"0..{MAX_ELEMENTS - 1})", "count")
+        return None
+    last = address.element + count - 1
+    if status is not None and (status.type_letter, status.file) == (address.type_letter, address.file) \
+            and address.element <= status.element + status_words - 1 and status.element <= last:
+        c.error(node, f"<Writable> {address}..{address.with_element(last)} covers the status words "
+                      f"{status}..{status.with_element(status.element + status_words - 1)} (status= on line "
+                      f"{status_line}): a client must not write the server's counters", "address")
+        return None
+    return address, count

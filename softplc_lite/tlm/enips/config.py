@@ -16,13 +16,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ...datatable import DataTableError, parse_address
 from ...datatable.address import Address
 from ...datatable.filetypes import MAX_ELEMENTS
 from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
-from ..netconfig import ALLOW, check_allow, check_host, check_status, listen_attributes, listen_warning
+from ..netconfig import check_writable_elements, ALLOW, check_allow, check_host, check_status, listen_attributes, listen_warning
 from ..xmlcheck import MANY, Attr, XmlChecker
 
 CONFIG_FILE = "ENIPS.XML"
@@ -96,29 +95,8 @@ def _check_writable(c: XmlChecker, node, status: Address | None, status_line: in
             c.error(node, "<Writable tag=...> takes no count: the tag path names what clients may write", "count")
             return None
         return Writable(None, 1, node.line, node.column, tag=a["tag"])
-    text = a["address"]
-    try:
-        address = parse_address(text)
-    except DataTableError as e:
-        c.error(node, f"address={text!r}: {getattr(e, 'message', str(e))}", "address")
-        return None
-    if not address.is_direct or address.bit is not None or address.member is not None:
-        c.error(node, f"address={text!r}: expected a whole element (N7:0, T4:0, ST9:0): a client may write every "
-                      "word and bit of the elements a <Writable> names", "address")
-        return None
-    count = a.get("count", 1)
-    if address.element + count > MAX_ELEMENTS:
-        c.error(node, f"count={count}: {count} elements from {address} run past the end of a file (elements "
-                      f"0..{MAX_ELEMENTS - 1})", "count")
-        return None
-    region = Writable(address, count, node.line, node.column)
-    if status is not None and (status.type_letter, status.file) == (address.type_letter, address.file) \
-            and address.element <= status.element + STATUS_WORDS - 1 and status.element <= region.last:
-        c.error(node, f"<Writable> {address}..{address.with_element(region.last)} covers the status words "
-                      f"{status}..{status.with_element(status.element + STATUS_WORDS - 1)} (status= on line "
-                      f"{status_line}): a client must not write the server's counters", "address")
-        return None
-    return region
+    found = check_writable_elements(c, node, a, status, status_line, STATUS_WORDS, "word and bit")
+    return None if found is None else Writable(found[0], found[1], node.line, node.column)
 
 
 def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
