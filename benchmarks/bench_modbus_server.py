@@ -146,34 +146,54 @@ def write_app(directory: Path) -> Path:
 
 
 class Child:
-    """A process that prints "ready ..." and runs until its standard input closes."""
+    """A process that prints "ready ..." and runs until its standard input
+    closes. ``wait=False``: started only; ``ready()`` waits for its line (so
+    that two children start side by side)."""
 
-    def __init__(self, args: list[str], what: str) -> None:
+    def __init__(self, args: list[str], what: str, wait: bool = True) -> None:
         self.what = what
+        self.fields: list[int] = []
         self.proc = subprocess.Popen([sys.executable, *args], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                      text=True)
+        if wait:
+            self.ready()
+
+    def ready(self) -> None:
         line = self._ready_line()
         if not line.startswith("ready "):
             self.stop()
-            raise CheckFailed(f"{what} did not start (exit status {self.proc.returncode})")
+            raise CheckFailed(f"{self.what} did not start (exit status {self.proc.returncode})")
         self.fields = [int(x) for x in line.split()[1:]]
 
     def _ready_line(self) -> str:
         ready, _, _ = select.select([self.proc.stdout], [], [], START_LIMIT_S)
         return self.proc.stdout.readline().strip() if ready else ""
 
-    def stop(self) -> None:
+    def close_input(self) -> None:
+        """Tell the child to stop (``stop`` waits for it)."""
         if self.proc.poll() is None:
             try:
                 self.proc.stdin.close()
             except OSError:
                 pass
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.close_input()
             try:
                 self.proc.wait(20)
             except subprocess.TimeoutExpired:
                 self.proc.kill()
                 self.proc.wait(10)
         self.proc.stdout.close()
+
+
+def stop_all(children: list[Child]) -> None:
+    """Stop children side by side: each is told first, then each awaited."""
+    for child in children:
+        child.close_input()
+    for child in children:
+        child.stop()
 
 
 def client_results(procs: list[subprocess.Popen], timeout_s: float) -> list[dict]:

@@ -60,7 +60,7 @@ from pathlib import Path
 
 import _common as C
 import opcuas_load as L
-from bench_modbus_server import RUNTIME, CheckFailed, Child, ladder, scans_in, span
+from bench_modbus_server import RUNTIME, CheckFailed, Child, ladder, scans_in, span, stop_all
 
 from helpers.modbus_peer import free_tcp_port
 
@@ -113,16 +113,24 @@ def register_entry_point(work: Path) -> None:
 def space_of(app: Path) -> tuple[int, list[int]]:
     """How many variables OPCUAS's address space holds for the app (the
     baseline holds as many), and the words of N10 the ladder changes every
-    scan (the ones subscribed to: the baseline changes as many every 10 ms)."""
+    scan (the ones subscribed to: the baseline changes as many every 10 ms).
+    The space is laid out as the module lays it out, on an engine without
+    the module: no server process is started for a count."""
     from softplc_lite.app import load_app
+    from softplc_lite.datatable import DataTable
     from softplc_lite.ladder.engine import Mode
-    from softplc_lite.runner import RunOptions, Runner
+    from softplc_lite.runner import module_engine
+    from softplc_lite.tlm.opcuas.space import build_space, rung_comments
 
-    runner = Runner(load_app(app), RunOptions(realtime=False, fresh=True, save_state=False))
+    loaded = load_app(app, use_cache=False)
+    module = next(m for m in loaded.modules if m.name == "OPCUAS")
+    table = DataTable()
+    engine = module_engine(loaded.program, table, loaded.settings)
     try:
-        module = next(m for m in runner.engine.modules if m.name == "OPCUAS")
-        engine, table = runner.engine, runner.engine.table
-        engine.set_mode(Mode.RUN)  # as Runner.run does first
+        module.reference_config(table)  # as attach does: the status words are variables too
+        space = build_space(table, module.app_name, module.config, loaded.program.symbols, None,
+                            rung_comments(loaded.program))
+        engine.set_mode(Mode.RUN)
         seen = []
         for _ in range(4):
             engine.scan()
@@ -130,9 +138,9 @@ def space_of(app: Path) -> tuple[int, list[int]]:
         changing = [k for k in range(WORDS) if all(a[k] != b[k] for a, b in zip(seen, seen[1:]))]
         if not changing:
             raise CheckFailed("the ladder changes no word of N10 every scan: nothing to subscribe to")
-        return len(module.space.variables), changing
+        return len(space.variables), changing
     finally:
-        runner.close()
+        engine.close()
 
 
 def run(cfg: dict, work: Path) -> dict:
@@ -140,11 +148,14 @@ def run(cfg: dict, work: Path) -> dict:
     app = write_app(work / "app")
     variables, changing = space_of(app)
     records_path = work / "scans.json"
-    runtime = Child([RUNTIME, str(app), str(records_path), "0", "OPCUAS"], "the runtime (OPCUAS)")
+    runtime = Child([RUNTIME, str(app), str(records_path), "0", "OPCUAS"], "the runtime (OPCUAS)", wait=False)
+    baseline = Child([BASELINE, "serve", str(variables), str(len(changing)), str(SCAN_MS)],
+                     "asyncua's plain Server", wait=False)
     try:
-        baseline = Child([BASELINE, "serve", str(variables), str(len(changing)), str(SCAN_MS)], "asyncua's plain Server")
+        runtime.ready()
+        baseline.ready()
     except CheckFailed:
-        runtime.stop()
+        stop_all([baseline, runtime])
         raise
     opc_port, opc_pid, runtime_pid = runtime.fields
     base_port, base_pid = baseline.fields
@@ -187,8 +198,7 @@ def run(cfg: dict, work: Path) -> dict:
             memory[name] = asyncio.run(L.item_memory(port, pid, items[name], cfg["settle_s"]))
             print(f"  memory {name:<8} {memory[name]['bytes_per_item']:8.0f} bytes an item", flush=True)
     finally:
-        baseline.stop()
-        runtime.stop()
+        stop_all([baseline, runtime])
     if not records_path.exists():
         raise CheckFailed("the runtime wrote no records (it did not stop cleanly)")
     result = json.loads(records_path.read_text(encoding="utf-8"))
