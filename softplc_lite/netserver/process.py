@@ -129,5 +129,20 @@ def main() -> int:
     return 0
 
 
+def run_and_exit() -> None:
+    """``main``, then the process ends at once. Python's own teardown would
+    free the protocol library's objects one by one (asyncua's address space:
+    over a second) while the runtime waits for this process to end; there is
+    nothing left to finalize: the image is the runtime's, the pipe is
+    written, standard error is flushed here."""
+    code = main()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(code)
+
+
 if __name__ == "__main__":
-    sys.exit(main())
+    run_and_exit()

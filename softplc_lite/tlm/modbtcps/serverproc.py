@@ -3,9 +3,7 @@ OUT_FD IMAGE_FD``): the network-server layer's process (netserver/process.py),
 under a name that says whose it is. pymodbus does the Modbus framing, through
 pymodbus_glue.py; handler.py serves the requests."""
 
-import sys
-
-from ...netserver.process import main
+from ...netserver.process import run_and_exit
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run_and_exit()

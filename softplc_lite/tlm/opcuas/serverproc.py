@@ -3,9 +3,7 @@ OUT_FD IMAGE_FD``): the network-server layer's process (netserver/process.py),
 under a name that says whose it is. asyncua serves OPC UA, through
 asyncua_glue.py."""
 
-import sys
-
-from ...netserver.process import main
+from ...netserver.process import run_and_exit
 
 if __name__ == "__main__":
-    sys.exit(main())
+    run_and_exit()
