@@ -12,12 +12,28 @@ import time
 import pytest
 
 from helpers.modbtcps_apps import LIMIT_S
-from helpers.opcua_apps import OpcUaApps, client_run
+from helpers.opcua_apps import LADDER, OpcUaApps, client_run
 
 asyncua = pytest.importorskip("asyncua")
 from asyncua import ua  # noqa: E402
 
 NS = "urn:softplc-lite:opcuas"
+
+
+# The checks that only read share one running app: a server start costs seconds of CPU (asyncua
+# builds its standard address space), and the suite has a budget. Its ladder is the helpers' LADDER
+# with two commented rungs on N7:20..22, scanned every 100 ms of the wall clock (the subscription
+# test sees every count). Tests that stop or change the engine start their own.
+pytestmark = pytest.mark.xdist_group("opcuas_server")
+SHARED_LADDER = LADDER + "SYMBOL Checks N7:20\n// Counts the checks.\nADD Checks 1 Checks\nMOV N7:20 N7:21\n" \
+                         "// Copies the check.\nMOV N7:20 N7:22\n"
+
+
+@pytest.fixture(scope="module")
+def shared(tmp_path_factory):
+    a = OpcUaApps(tmp_path_factory.mktemp("opcuas_server"))
+    yield a.start(ladder=SHARED_LADDER, scan_ms=100)
+    a.close()
 
 
 @pytest.fixture
@@ -32,8 +48,8 @@ async def _node(client, text):
     return client.get_node(f"ns={ns};s={text}")
 
 
-def test_every_kind_of_variable_reads_as_its_opc_ua_type(apps):
-    r = apps.start()
+def test_every_kind_of_variable_reads_as_its_opc_ua_type(shared):
+    r = shared
     r.wait_for(lambda: r.read("N7:5") > 3, "a few scans")
 
     async def work(client):
@@ -58,8 +74,9 @@ def test_every_kind_of_variable_reads_as_its_opc_ua_type(apps):
     assert got["$PLC.ScanTime"][1] == ua.VariantType.Int16
 
 
-def test_writes_are_refused_with_their_status_codes(apps):
-    r = apps.start()
+def test_writes_are_refused_with_their_status_codes(shared):
+    r = shared
+    refused_before = r.status(8)
 
     async def work(client):
         codes = {}
@@ -75,11 +92,11 @@ def test_writes_are_refused_with_their_status_codes(apps):
     codes = client_run(r.port, work)
     assert codes == {"Count": "BadNotWritable", "N7:5": "BadNotWritable", "$PLC.Mode": "BadNotWritable",
                      "N7:9999x": "BadNodeIdUnknown"}
-    r.wait_for(lambda: r.status(8) == 4, "the refusals counted in status word 8")
+    r.wait_for(lambda: r.status(8) - refused_before == 4, "the refusals counted in status word 8")
 
 
-def test_the_address_space_browses_from_the_app_down_to_bits_with_descriptions(apps):
-    r = apps.start()
+def test_the_address_space_browses_from_the_app_down_to_bits_with_descriptions(shared):
+    r = shared
 
     async def work(client):
         ns = await client.get_namespace_index(NS)
@@ -95,7 +112,7 @@ def test_the_address_space_browses_from_the_app_down_to_bits_with_descriptions(a
         return top, (await app.read_browse_name()).Name, under_app, files, n7, bits, timer, described
 
     top, app_name, under_app, files, n7, bits, timer, described = client_run(r.port, work)
-    assert app_name == "app1" and "app1" in top
+    assert app_name == r.app_dir.name and r.app_dir.name in top
     assert {"DataFiles", "PLC", "Count", "Speed", "Note", "Run", "Dwell", "Total"} <= under_app
     assert {"O0", "I1", "S2", "B3", "T4", "N7", "F8", "ST9", "L12", "N40"} <= files
     assert n7[:6] == ["N7:0", "N7:1", "N7:2", "N7:3", "N7:4", "N7:5"]
@@ -104,21 +121,18 @@ def test_the_address_space_browses_from_the_app_down_to_bits_with_descriptions(a
     assert described == ["N7:5", "Symbol Count"]
 
 
-def test_rung_comments_describe_the_elements_their_rungs_name(apps):
-    r = apps.start(ladder="SYMBOL Count N7:5\n// Counts the scans.\nADD Count 1 Count\nMOV N7:5 N7:6\n"
-                          "// Copies the count.\nMOV N7:5 N7:7\n")
-
+def test_rung_comments_describe_the_elements_their_rungs_name(shared):
     async def work(client):
-        return [(await (await _node(client, t)).read_description()).Text for t in ("Count", "N7:5", "N7:6", "N7:7")]
+        return [(await (await _node(client, t)).read_description()).Text for t in ("Checks", "N7:20", "N7:21", "N7:22")]
 
-    assert client_run(r.port, work) == ["N7:5: Counts the scans.", "Symbol Count: Counts the scans.", "",
-                                        "Copies the count."]
+    assert client_run(shared.port, work) == ["N7:20: Counts the checks.", "Symbol Checks: Counts the checks.", "",
+                                             "Copies the check."]
 
 
-def test_a_subscription_gets_every_change_of_a_counter_once_a_scan(apps):
+def test_a_subscription_gets_every_change_of_a_counter_once_a_scan(shared):
     # the counter adds 1 each 100 ms scan of the wall clock; the values notified must run on by
     # one each, none twice, none missed; a word the ladder never changes is notified once
-    r = apps.start(scan_ms=100)
+    r = shared
 
     class Handler:
         def __init__(self):
@@ -145,15 +159,12 @@ def test_a_subscription_gets_every_change_of_a_counter_once_a_scan(apps):
     assert seen["N7:0"] == [0]
 
 
-@pytest.mark.parametrize("mode", ["PROGRAM", "TEST"])
-def test_the_mode_variable_follows_the_engine(apps, mode):
+def test_the_mode_variable_follows_the_engine(apps):
     from softplc_lite.ladder.engine import Mode
 
     r = apps.start()
     r.runner.request_stop()
     r.thread.join(LIMIT_S)
-    r.engine.set_mode(Mode.PROGRAM)
-    r.engine.set_mode(Mode[mode])
     stop = threading.Event()
 
     def scan() -> None:
@@ -161,10 +172,7 @@ def test_the_mode_variable_follows_the_engine(apps, mode):
             r.engine.scan()
             time.sleep(0.005)
 
-    t = threading.Thread(target=scan, daemon=True)
-    t.start()
-
-    async def work(client):
+    async def work(client, mode):
         node = await _node(client, "$PLC.Mode")
         for _ in range(200):
             if await node.read_value() == mode:
@@ -172,8 +180,16 @@ def test_the_mode_variable_follows_the_engine(apps, mode):
             await asyncio.sleep(0.02)
         return await node.read_value(), await (await _node(client, "$PLC.FaultCode")).read_value()
 
-    try:
-        assert client_run(r.port, work) == (mode, 0)
-    finally:
-        stop.set()
-        t.join(LIMIT_S)
+    seen = []
+    for mode in ("PROGRAM", "TEST"):
+        r.engine.set_mode(Mode.PROGRAM)
+        r.engine.set_mode(Mode[mode])
+        stop.clear()
+        t = threading.Thread(target=scan, daemon=True)
+        t.start()
+        try:
+            seen.append(client_run(r.port, lambda client: work(client, mode)))
+        finally:
+            stop.set()
+            t.join(LIMIT_S)
+    assert seen == [("PROGRAM", 0), ("TEST", 0)]

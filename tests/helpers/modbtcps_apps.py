@@ -66,6 +66,7 @@ class Running:
 
     def __init__(self, app_dir: Path, realtime: bool = True, scan_ms: int | None = None,
                  module: str = "MODBTCPS") -> None:
+        self.app_dir = Path(app_dir)
         app = load_app(app_dir)
         if scan_ms is not None:
             app.settings.scan_ms = scan_ms

@@ -9,7 +9,9 @@ makes a client application certificate in a test's directory."""
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
+import threading
 from collections.abc import AsyncIterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -57,6 +59,41 @@ async def secured_server(app_dir: Path, settings: SecuritySettings = SecuritySet
     finally:
         await end_clock(server)  # a stop in milliseconds, not a second (asyncua_glue.end_clock)
         await server.stop()
+
+
+class ServedInThread:
+    """``secured_server`` kept running in a thread of its own (its own event
+    loop), so that several tests, each with ``asyncio.run`` of its own
+    clients, share one server: a server start costs a second of CPU."""
+
+    def __init__(self, app_dir: Path, settings: SecuritySettings = SecuritySettings(),
+                 users: Users | None = None) -> None:
+        self.served: Served | None = None
+        self.error: BaseException | None = None
+        self._ready = threading.Event()
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._stop: asyncio.Event | None = None
+        self._thread = threading.Thread(target=asyncio.run, args=(self._serve(app_dir, settings, users),),
+                                        name="secured-server", daemon=True)
+        self._thread.start()
+        if not self._ready.wait(30) or self.served is None:
+            raise RuntimeError(f"the secured server did not start: {self.error!r}")
+
+    async def _serve(self, app_dir, settings, users) -> None:
+        self._loop, self._stop = asyncio.get_running_loop(), asyncio.Event()
+        try:
+            async with secured_server(app_dir, settings, users) as served:
+                self.served = served
+                self._ready.set()
+                await self._stop.wait()
+        except BaseException as e:  # the fixture's caller sees it
+            self.error = e
+            self._ready.set()
+
+    def close(self) -> None:
+        if self._loop is not None and self._stop is not None:
+            self._loop.call_soon_threadsafe(self._stop.set)
+        self._thread.join(30)
 
 
 def client_cert(directory: Path, name: str = "client") -> tuple[Path, Path]:
