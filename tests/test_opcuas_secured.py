@@ -79,3 +79,48 @@ def test_a_write_user_writes_anonymous_reads_and_none_is_refused(tmp_path):
         r.wait_for(lambda: r.status(14) >= 2, "every refusal summed in status word 14")
     finally:
         apps.close()
+
+
+def test_sign_and_trusted_clients_only_as_the_config_says(tmp_path):
+    """securitySign="yes" offers Sign beside SignAndEncrypt, and a trusted
+    client writes on a Sign channel; trustedClientsOnly="yes" refuses a
+    client whose certificate is not in OPCUAS.PKI/trusted/ at its session
+    (BadCertificateUntrusted), counted in status word 11."""
+    from helpers.opcua_apps import certificates
+    from helpers.opcuas_security import client_cert, secure_client
+
+    apps = OpcUaApps(tmp_path)
+    xml = opcuas_xml(securityNone="no", securitySign="yes", trustedClientsOnly="yes").replace(
+        "/>\n", '>\n  <Writable address="N7:0"/>\n</OpcUaServer>\n')
+    r = apps.start(xml, ladder="ADD N7:5 1 N7:5\n", secure=True)
+    url = f"opc.tcp://127.0.0.1:{r.port}/"
+    base = certificates()
+    stranger = client_cert(tmp_path, "stranger")
+
+    async def work():
+        modes = {e.SecurityMode for e in await Client(url).connect_and_get_server_endpoints()}
+        client = await secure_client(url, base / "client_cert.der", base / "client_key.pem",
+                                     mode=ua.MessageSecurityMode.Sign)
+        async with client:
+            ns = await client.get_namespace_index(NS)
+            node = client.get_node(f"ns={ns};s=N7:0")
+            await node.write_value(ua.DataValue(ua.Variant(44, ua.VariantType.Int16)))
+            written = await node.read_value()
+        untrusted = await secure_client(url, *stranger)
+        try:
+            await untrusted.connect()
+            refused = "connected"
+        except ua.UaStatusCodeError as e:
+            refused = type(e).__name__
+        finally:
+            untrusted.disconnect_socket()
+        return modes, written, refused
+
+    try:
+        modes, written, refused = asyncio.run(work())
+        assert modes == {ua.MessageSecurityMode.Sign, ua.MessageSecurityMode.SignAndEncrypt}
+        assert written == 44 and r.read("N7:0") == 44
+        assert refused == "BadCertificateUntrusted"
+        r.wait_for(lambda: r.status(11) == 1, "the untrusted client counted in status word 11")
+    finally:
+        apps.close()

@@ -6,7 +6,8 @@ API (``Server``: ``init``, ``set_endpoint``, ``set_security_policy``,
 ``register_namespace``, ``start``, ``stop``; the ``ua`` types), OPCUAS
 relies on these internals:
 
-- ``Server.iserver`` (the ``InternalServer``): ``node_mgt_service.add_nodes``, to
+- ``Server.iserver`` (the ``InternalServer``): ``certificate_validator``, the
+  one security.py set, wrapped to count its refusals; ``node_mgt_service.add_nodes``, to
   make the address space in one call; ``aspace.write_attribute_value``
   and ``aspace.read_attribute_value``, to publish a scan's values and to
   tell a known node from an unknown one; its limits ``max_connections``
@@ -240,6 +241,15 @@ class Listener:
                 count(counter, f"session refused: {'user ' + repr(username) if username is not None else 'identity'}")
             return user
         manager.get_user = checked
+        validate = server.iserver.certificate_validator
+
+        async def counted(cert, app_description) -> None:  # an untrusted or invalid client certificate
+            try:
+                await validate(cert, app_description)
+            except ua.UaStatusCodeError as e:
+                count(counter, f"session refused: client certificate {type(e).__name__}")
+                raise
+        server.set_certificate_validator(counted)
         _REFUSED_CHANNEL[:] = [lambda message: count(counter, message)]
         refuse_unoffered()
 
