@@ -117,3 +117,24 @@ def test_writes_land_in_program_mode(apps):
     finally:
         stop.set()
         t.join(LIMIT_S)
+
+
+def test_a_write_to_a_forced_bit_follows_the_force(shared):
+    """A write lands before the forces at the input point (docs/opcuas.md,
+    Writes): a forced bit stays forced, and the client reads the forced value."""
+    from softplc_lite.watch.forces import Forces, parse_force
+
+    r = shared
+    forces = Forces(r.engine)
+    r.runner.between_scans.append(lambda runner: None)  # forces hook themselves into the scan
+    forces.set(parse_force("B3/12=1"))
+    try:
+        r.wait_for(lambda: r.read("B3/12") == 1, "the force applied")
+
+        async def work(client):
+            return await write(client, "B3:0/12", False, ua.VariantType.Boolean)
+
+        assert client_run(r.port, work, secure=True) is True
+        assert r.read("B3/12") == 1
+    finally:
+        forces.clear()
