@@ -159,6 +159,36 @@ def test_a_subscription_gets_every_change_of_a_counter_once_a_scan(shared):
     assert seen["N7:0"] == [0]
 
 
+def test_an_item_is_sampled_at_its_sampling_interval(shared):
+    # Count and Checks both add 1 each 100 ms scan. Count sampled every 500 ms is notified at most
+    # once each 500 ms, with the value then (steps of about five); Checks sampled at 0 (the
+    # fastest: every scan) gets every change. OPC 10000-4 5.12.1.2.
+    class Handler:
+        def __init__(self):
+            self.seen: dict[str, list] = {"Count": [], "N7:20": []}
+
+        def datachange_notification(self, node, value, data):
+            self.seen[node.nodeid.Identifier].append(value)
+
+    async def work(client):
+        handler = Handler()
+        sub = await client.create_subscription(50, handler)
+        count = await sub.subscribe_data_change(await _node(client, "Count"), queuesize=100, sampling_interval=0.0)
+        await sub.subscribe_data_change(await _node(client, "N7:20"), queuesize=100, sampling_interval=0.0)
+        revised = (await sub.modify_monitored_item(count, 500.0, 100))[0].RevisedSamplingInterval
+        handler.seen["Count"].clear()
+        await asyncio.sleep(2.6)
+        await sub.delete()
+        return revised, handler.seen
+
+    revised, seen = client_run(shared.port, work)
+    assert revised == 500.0
+    checks, counts = seen["N7:20"], seen["Count"]
+    assert len(checks) >= 15 and checks == list(range(checks[0], checks[0] + len(checks))), checks
+    steps = [b - a for a, b in zip(counts[1:], counts[2:])]  # the first after the change: any time
+    assert 3 <= len(counts) <= 8 and steps and min(steps) >= 3, counts
+
+
 def test_the_mode_variable_follows_the_engine(apps):
     from softplc_lite.ladder.engine import Mode
 

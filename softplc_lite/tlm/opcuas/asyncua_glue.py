@@ -15,9 +15,15 @@ relies on these internals:
 - ``iserver.attribute_service.write``, taken over: every Write service
   call comes here first (``Refuser``);
 - ``iserver.subscription_service.create_subscription`` (to count its
-  refusals), ``subscriptions``, ``create_monitored_items`` and
+  refusals), ``subscriptions``, ``create_monitored_items``,
+  ``modify_monitored_items`` and
   ``subscriptions[..].monitored_item_srv._monitored_items``, to hold the
-  monitored items to the configured limit;
+  monitored items to the configured limit and keep each one's sampling
+  interval;
+- ``MonitoredItemService.datachange_callback`` (and its
+  ``_monitored_datachange``, ``_monitored_items``), taken over by
+  ``sample_items``: asyncua queues every change of a value whatever the
+  item's sampling interval, where OPC 10000-4 5.12.1.2 samples at it;
 - ``Server.bserver._server`` (the asyncio server), for the port bound, and
   ``bserver.clients``, the connections open;
 - ``UaProcessor._process_message`` and its ``_connection`` (its
@@ -47,6 +53,7 @@ try:
     from asyncua.crypto.permission_rules import User, UserRole
     from asyncua.server.address_space import AddressSpace, AttributeService, NodeManagementService
     from asyncua.server.internal_server import InternalServer
+    from asyncua.server.monitored_item_service import MonitoredItemService
     from asyncua.server.subscription_service import SubscriptionService
 except ImportError as _exc:  # the server process says this line, not a traceback
     if isinstance(_exc, ModuleNotFoundError) and _exc.name == "asyncua":
@@ -65,7 +72,8 @@ from .space import NAMESPACE, Space, decode  # noqa: E402
 _NEEDED = (
     (Server, ("init", "set_endpoint", "set_security_policy", "register_namespace", "start", "stop")),
     (AttributeService, ("write",)),
-    (SubscriptionService, ("create_monitored_items", "create_subscription")),
+    (SubscriptionService, ("create_monitored_items", "create_subscription", "modify_monitored_items")),
+    (MonitoredItemService, ("datachange_callback",)),
     (AddressSpace, ("write_attribute_value", "read_attribute_value")),
     (InternalServer, ("start",)),
     (UaProcessor, ("_process_message",)),
@@ -129,6 +137,67 @@ def refuse_unoffered() -> None:
         return await original(self, typeid, requesthdr, seqhdr, body)
     _process_message.refuses_unoffered = True
     UaProcessor._process_message = _process_message
+
+
+def sampling_s(requested_ms: float, publishing_ms: float) -> float:
+    """The seconds between an item's samples, as OPC 10000-4 5.12.1.2 has a
+    requested SamplingInterval revised: -1 is the subscription's publishing
+    interval; 0, or less than the server looks for a new scan (POLL_S), is
+    every scan (the fastest the values change). 0.0: every scan."""
+    ms = publishing_ms if requested_ms < 0 else requested_ms
+    return ms / 1000.0 if ms / 1000.0 > POLL_S else 0.0
+
+
+def sample_items() -> None:
+    """Make asyncua's monitored items sample at their sampling interval: a
+    change that comes sooner than an interval after the last one sampled is
+    held, and the newest held is sampled when the interval is up (one
+    notification an interval at most, the value current then). Items
+    without an interval (``sampling`` unset or 0) get every scan's change."""
+    original = MonitoredItemService.datachange_callback
+    if getattr(original, "samples", False):
+        return
+
+    async def datachange_callback(self, handle, value, error=None):
+        if error is None:
+            mdata = self._monitored_items.get(self._monitored_datachange.get(handle))
+            interval = getattr(mdata, "sampling", 0.0)
+            if interval:
+                loop = asyncio.get_running_loop()
+                now, due = loop.time(), getattr(mdata, "next_sample", 0.0)
+                if now < due:
+                    if getattr(mdata, "held", None) is None:
+                        loop.call_at(due, lambda: loop.create_task(release(self, handle, mdata)))
+                    mdata.held = value
+                    return
+                mdata.next_sample = now + interval
+        await original(self, handle, value, error)
+
+    async def release(service, handle, mdata) -> None:
+        value, mdata.held = mdata.held, None
+        if value is not None and handle in service._monitored_datachange:  # not deleted since
+            mdata.next_sample = asyncio.get_running_loop().time() + mdata.sampling
+            await original(service, handle, value)
+    datachange_callback.samples = True
+    MonitoredItemService.datachange_callback = datachange_callback
+
+
+def _keep_sampling(subs, subscription_id: int, items, created: bool = True) -> None:
+    """Give each item created or modified its sampling interval, revised as
+    ``sampling_s`` says, and say it in its result. ``items``: (monitored
+    item id, its requested parameters, its result). A created item's first
+    sample is the value asyncua sent it on creation."""
+    sub = subs.subscriptions.get(subscription_id)
+    if sub is None:
+        return
+    for item_id, requested, result in items:
+        mdata = sub.monitored_item_srv._monitored_items.get(item_id)
+        if mdata is None or not result.StatusCode.is_good():
+            continue
+        mdata.sampling = sampling_s(requested.SamplingInterval, sub.data.RevisedPublishingInterval)
+        result.RevisedSamplingInterval = 1000.0 * (mdata.sampling or POLL_S)
+        if created and mdata.sampling:
+            mdata.next_sample = asyncio.get_running_loop().time() + mdata.sampling
 
 
 def missing() -> str | None:
@@ -367,16 +436,31 @@ class Listener:
             room = max(0, limit - held)
             asked = list(params.ItemsToCreate)
             if len(asked) <= room:
-                return await original_items(params)
+                results = await original_items(params)
+                _keep_sampling(subs, params.SubscriptionId,
+                               [(r.MonitoredItemId, a.RequestedParameters, r) for a, r in zip(asked, results)])
+                return results
             taken = params.__class__(SubscriptionId=params.SubscriptionId,
                                      TimestampsToReturn=params.TimestampsToReturn, ItemsToCreate=asked[:room])
             results = await original_items(taken) if room else []
+            _keep_sampling(subs, params.SubscriptionId,
+                           [(r.MonitoredItemId, a.RequestedParameters, r) for a, r in zip(asked, results)])
             for _ in asked[room:]:
                 count(refused_items, f"monitored item over maxMonitoredItems={limit}")
                 results.append(ua.MonitoredItemCreateResult(StatusCode=ua.StatusCode(BAD_TOO_MANY_ITEMS)))
             return results
 
         subs.create_monitored_items = create_monitored_items
+        original_modify = subs.modify_monitored_items
+
+        def modify_monitored_items(params):
+            results = original_modify(params)
+            _keep_sampling(subs, params.SubscriptionId, [(m.MonitoredItemId, m.RequestedParameters, r)
+                                                         for m, r in zip(params.ItemsToModify, results)], False)
+            return results
+
+        subs.modify_monitored_items = modify_monitored_items
+        sample_items()
         original_subscription = subs.create_subscription
 
         async def create_subscription(params, callback, session_id, request_callback=None):
