@@ -35,7 +35,7 @@ from __future__ import annotations
 from ..errors import Pos
 from ..ladder.ast import AddressRef, Arm, Branch, Const, Instruction, Listing, Rung, BinOp
 from ..st import ast as A
-from ..st.parser import parse_routine
+from ..st.parser import SourceLines, parse_routine
 from . import model
 from .neutral import NInstruction
 from .rungs import NOT_RUN_REASON, PLAN, _instruction
@@ -72,15 +72,13 @@ class StRoutine:
     # -- output ----------------------------------------------------------------------------
     def translate(self) -> tuple[list[Rung], Listing]:
         lines = self.routine.lines
-        for k, line in enumerate(lines):
-            pos = line.pos if line.pos.line else Pos(self.ctx.source, k + 1, 1)
-            for j, part in enumerate(line.text.split("\n")):
-                where = pos if j == 0 else Pos(pos.source, pos.line + j, 1)
-                self.line_of.setdefault(where.line, len(self.lines))
-                self.lines.append((where, part))
-        errors = []
         first = lines[0].pos.line if lines and lines[0].pos.line else 1
-        statements = parse_routine(lines, self.ctx.source, first, errors)
+        where = SourceLines(lines, self.ctx.source, first)
+        for pos, part in zip(where.starts, where.texts):
+            self.line_of.setdefault(pos.line, len(self.lines))
+            self.lines.append((pos, part))
+        errors = []
+        statements = parse_routine(where, self.ctx.source, first, errors)
         for e in errors:
             self.ctx.problem(e.pos, f"{e.message}")
         self.block(statements)

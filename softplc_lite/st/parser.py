@@ -92,8 +92,11 @@ def _expected(names) -> str:
     return shown[0] if shown else "nothing"
 
 
-class _Lines:
-    """Where a (line, column) of the joined routine text is in the export."""
+class SourceLines:
+    """A routine's text as lines, each with where it starts in the export
+    (``starts``, ``texts``): the parser reads their joined text and places
+    a (line, column) of it back (``pos``); the ST translation lists the
+    same lines for the tools (logix/st_routine.py)."""
 
     def __init__(self, lines, source: str, first_line: int) -> None:
         self.texts: list[str] = []
@@ -133,9 +136,9 @@ class _Lines:
         return f"{text}\n{' ' * (column - 1)}^"
 
 
-def parse_routine(lines: Sequence | str, source: str = "<st>", first_line: int = 1,
+def parse_routine(lines: Sequence | str | SourceLines, source: str = "<st>", first_line: int = 1,
                   errors: list[StError] | None = None) -> list[A.Statement]:
-    where = _Lines(lines, source, first_line)
+    where = lines if isinstance(lines, SourceLines) else SourceLines(lines, source, first_line)
     found: list[StError] = []
     tree = _parse_tree(where, found)
     try:
@@ -157,11 +160,11 @@ def parse_routine(lines: Sequence | str, source: str = "<st>", first_line: int =
     return statements
 
 
-def _error(where: _Lines, line: int, column: int, message: str) -> StError:
+def _error(where: SourceLines, line: int, column: int, message: str) -> StError:
     return StError(where.pos(line, column), message, where.context(line, column))
 
 
-def _tokens(where: _Lines, text: str, found: list[StError], blanked: list[int]) -> list[Token]:
+def _tokens(where: SourceLines, text: str, found: list[StError], blanked: list[int]) -> list[Token]:
     parser = _parser()
     while True:
         try:
@@ -181,7 +184,7 @@ def _tokens(where: _Lines, text: str, found: list[StError], blanked: list[int]) 
             text = text[:e.pos_in_stream] + " " + text[e.pos_in_stream + 1:]
 
 
-def _parse_tree(where: _Lines, found: list[StError]):
+def _parse_tree(where: SourceLines, found: list[StError]):
     blanked: list[int] = []
     tokens = _tokens(where, where.text, found, blanked)
     ip = _parser().parse_interactive("")
@@ -269,7 +272,7 @@ def _accepted(checkpoint, fed: list[Token]) -> set[str]:
     return ip.accepts()
 
 
-def _token_error(where: _Lines, e: UnexpectedToken, tokens: list[Token], accepted: set[str]) -> StError:
+def _token_error(where: SourceLines, e: UnexpectedToken, tokens: list[Token], accepted: set[str]) -> StError:
     tok = e.token
     if tok.type == "$END":
         last = tokens[-1] if tokens else None
@@ -287,7 +290,7 @@ _SPACE = re.compile(r"\s+|\(\*[\s\S]*?\*\)|/\*[\s\S]*?\*/|//[^\n]*")
 class _Build(Transformer):
     """The lark tree to the typed tree, every node at its place in the export."""
 
-    def __init__(self, where: _Lines) -> None:
+    def __init__(self, where: SourceLines) -> None:
         super().__init__()
         self.where = where
         self.text = where.text
