@@ -74,6 +74,8 @@ def test_the_goldens_show_text_values_and_the_lines_that_ran():
         marked = _marked(lines)
         assert [n for n, on in sorted(marked.items()) if on] == [2, 3, 7, 9, 11, 14]
         assert len(marked) == 15
+        assert "↑↓ rung" not in lines[-1]  # the arrows move by line here
+    assert "↑↓ line" in (GOLDENS / "st_tank-120x40.txt").read_text(encoding="utf-8").splitlines()[-1]
 
 
 @pytest.mark.parametrize("executor", EXECUTORS)

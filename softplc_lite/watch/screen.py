@@ -263,6 +263,8 @@ class WatchScreen:
             bottom = Text(f" {self.prompt}", style="bold reverse")
         else:
             keys = next((k for k in KEY_LINES if cell_len(k) < width), KEY_LINES[-1])
+            if self.session.listing is not None:  # a Structured Text file: the arrows move by line
+                keys = keys.replace("↑↓ rung", "↑↓ line")
             bottom = Text(f" {keys}", style="dim", no_wrap=True, overflow="ellipsis")
         root.split_column(Layout(self.status, size=2), Layout(name="body"), Layout(bottom, size=1))
         body = root["body"]
