@@ -4,6 +4,8 @@ paths, a failure drawn by tag path and routine, coverage and mutation."""
 
 from __future__ import annotations
 
+import re
+
 import shutil
 from pathlib import Path
 
@@ -101,6 +103,10 @@ def test_mutation_judges_the_exports_rungs(tmp_path):
     assert report.count(KILLED) >= 30 and report.count(SURVIVED) == 0
     # every mutant is killed by a failed expectation, never by an error of the runner
     assert all("Error:" not in o.detail for _, o in report.with_status(KILLED))
+    # described as Studio 5000 shows the rungs: neutral text, tag paths, no data table address
+    described = [m.description for m, _ in report.with_status(KILLED)]
+    assert "XIC(Start) -> XIO(Start)" in described, described[:10]
+    assert not any(re.search(r"\b[BNFTCRL]\d+[:/]\d", d) for d in described), described
 
 
 def test_coverage_annotates_the_export_itself(tmp_path):

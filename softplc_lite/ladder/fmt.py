@@ -90,14 +90,16 @@ def format_expression(node, name_of=None, operators=None) -> str:
     return f"{left} {operators.get(node.op, node.op) if operators else node.op} {right}"
 
 
-def format_operand(op, style: str, file_operand: bool = False) -> str:
+def format_operand(op, style: str, file_operand: bool = False, name_of=None, operators=None) -> str:
+    """``name_of`` and ``operators`` as for format_expression: a view's
+    names for addresses (a Logix app's tag paths) and operators."""
     if isinstance(op, (BinOp, UnaryOp, Call)):
-        text = format_expression(op)
+        text = format_expression(op, name_of, operators)
         return f'"{text}"' if style == "mnemonic" else text
     if isinstance(op, Const):
         return _constant(op)
     if isinstance(op, AddressRef):
-        return str(op.address)
+        return (name_of(op.address) if name_of is not None else None) or str(op.address)
     if isinstance(op, SymbolRef):
         return op.name
     if isinstance(op, Text):
@@ -106,24 +108,28 @@ def format_operand(op, style: str, file_operand: bool = False) -> str:
     raise TypeError(f"cannot print operand {op!r}")
 
 
-def format_instruction(ins: Instruction, style: str = "mnemonic") -> str:
-    operands = [format_operand(o, style) for o in ins.operands]
+def format_instruction(ins: Instruction, style: str = "mnemonic", name_of=None, operators=None,
+                       mnemonic_of=None) -> str:
+    """``mnemonic_of``: the name a view gives the instruction (Logix's)."""
+    operands = [format_operand(o, style, name_of=name_of, operators=operators) for o in ins.operands]
+    mnemonic = mnemonic_of(ins.mnemonic) if mnemonic_of is not None else ins.mnemonic
     if style == "neutral":
-        return f"{ins.mnemonic}({','.join(operands)})"
-    return " ".join([ins.mnemonic, *operands])
+        return f"{mnemonic}({','.join(operands)})"
+    return " ".join([mnemonic, *operands])
 
 
-def format_series(elements: list[Element], style: str) -> str:
+def format_series(elements: list[Element], style: str, **names) -> str:
+    """``names``: format_instruction's ``name_of``, ``operators`` and ``mnemonic_of``."""
     parts = []
     for el in elements:
         if isinstance(el, Branch):
-            legs = [format_series(leg, style) for leg in el.legs]
+            legs = [format_series(leg, style, **names) for leg in el.legs]
             if style == "neutral":
                 parts.append("[" + ",".join(legs) + "]")
             else:
                 parts.append("BST " + " NXB ".join(legs) + " BND")
         else:
-            parts.append(format_instruction(el, style))
+            parts.append(format_instruction(el, style, **names))
     return ("" if style == "neutral" else " ").join(parts)
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Iterator
+from typing import Callable, Iterator
 
 from ..ladder.ast import BinOp, Branch, Call, Const, Instruction, Placeholder, Pos, Program, Rung, UnaryOp
 from ..ladder.fmt import format_instruction, format_series
@@ -43,6 +43,29 @@ _EXPRESSION_NEIGHBOURS = {"=": "<>", "<>": "=", ">": ">=", ">=": ">", "<": "<=",
 # accumulator a timer or counter starts from.
 _FIXED_KINDS = {K.LABEL, K.PROGRAM_FILE, K.PARAM_COUNT, K.TIMEBASE}
 _FIXED_NAMES = {"accum"}
+
+
+@dataclass(frozen=True)
+class Spelling:
+    """How mutant descriptions write a program file's instructions: as its
+    source does (mnemonic text, addresses and symbols), or a Logix app's
+    way (neutral text, tag paths, Logix's instruction names), as the watch
+    view names them (watch/naming.py)."""
+
+    style: str = "mnemonic"
+    name_of: Callable | None = None
+    operators: dict | None = None
+    mnemonic_of: Callable | None = None
+
+    def instruction(self, ins: Instruction) -> str:
+        return format_instruction(ins, self.style, self.name_of, self.operators, self.mnemonic_of)
+
+    def series(self, elements) -> str:
+        return format_series(elements, self.style, name_of=self.name_of, operators=self.operators,
+                             mnemonic_of=self.mnemonic_of)
+
+
+AS_WRITTEN = Spelling()
 
 
 @dataclass(frozen=True)
@@ -72,23 +95,29 @@ class Mutant:
         return Program(files, program.data, program.symbols)
 
 
-def mutants(program: Program, instructions: InstructionSet = BUILTIN) -> list[Mutant]:
-    """Every mutant of a parsed program, in file, rung and element order."""
+def mutants(program: Program, instructions: InstructionSet = BUILTIN,
+            spelling: Callable[[int], Spelling | None] | None = None) -> list[Mutant]:
+    """Every mutant of a parsed program, in file, rung and element order;
+    ``spelling(file number)``: how its descriptions write the file's
+    instructions (as written when None), None for a file to leave alone."""
     found: list[Mutant] = []
     for number in sorted(program.files):
         pfile = program.files[number]
+        spell = spelling(number) if spelling is not None else AS_WRITTEN
+        if spell is None:  # a file the program made itself: nothing its author wrote, or could change
+            continue
         if pfile.listing is not None:  # Structured Text: its operators and constants, as the text shows them
             for index, m in st_mutants(pfile, instructions):
                 found.append(Mutant(len(found), m.operator, (number, index), m.pos, m.description, m.rung))
             continue
         rungs = pfile.rungs
         for index, rung in enumerate(rungs):
-            for operator, description, pos, elements in _series(rung.elements, instructions):
+            for operator, description, pos, elements in _series(rung.elements, instructions, spell):
                 found.append(Mutant(len(found), operator, (number, index), pos, description,
                                     Rung(elements, rung.comment, rung.pos)))
             if rung.elements and not _deletion_changes_nothing(rungs, index):
                 found.append(Mutant(len(found), RUNG, (number, index), rung.pos,
-                                    f"rung deleted: {format_series(rung.elements, 'mnemonic')}", None))
+                                    f"rung deleted: {spell.series(rung.elements)}", None))
     return found
 
 
@@ -103,7 +132,7 @@ def _deletion_changes_nothing(rungs, index: int) -> bool:
     return elements[0].mnemonic == "SBR" or (elements[0].mnemonic == "RET" and index == len(rungs) - 1)
 
 
-def _series(elements, instructions) -> Iterator[tuple[str, str, Pos, list]]:
+def _series(elements, instructions, spell: Spelling = AS_WRITTEN) -> Iterator[tuple[str, str, Pos, list]]:
     """(operator, description, position, the series changed) for each
     single change of a series, branches included."""
     elements = list(elements)
@@ -117,19 +146,19 @@ def _series(elements, instructions) -> Iterator[tuple[str, str, Pos, list]]:
                     # a branch of one leg is that leg in series
                     middle = [Branch(rest, el.pos)] if len(rest) > 1 else rest[0]
                     pos = leg[0].pos if leg else el.pos
-                    text = format_series(leg, "mnemonic") or "(empty)"
+                    text = spell.series(leg) or "(empty)"
                     yield LEG, f"branch leg {j + 1} of {len(legs)} removed: {text}", pos, before + middle + after
             for j, leg in enumerate(legs):
-                for operator, description, pos, changed in _series(leg, instructions):
+                for operator, description, pos, changed in _series(leg, instructions, spell):
                     new_legs = legs[:j] + [changed] + legs[j + 1:]
                     yield operator, description, pos, before + [Branch(new_legs, el.pos)] + after
         else:
             for operator, new in _instruction(el, instructions):
-                old = format_instruction(el)
+                old = spell.instruction(el)
                 if new is None:
                     yield operator, f"{old} removed", el.pos, before + after
                 else:
-                    yield operator, f"{old} -> {format_instruction(new)}", el.pos, before + [new] + after
+                    yield operator, f"{old} -> {spell.instruction(new)}", el.pos, before + [new] + after
 
 
 def _instruction(ins: Instruction, instructions) -> Iterator[tuple[str, Instruction | None]]:

@@ -33,7 +33,8 @@ from typing import Callable
 from ..app import AppError, load_app
 from ..ladder.ast import Program
 from .coverage import Coverage
-from .mutants import Mutant, RungKey, mutants
+from ..watch.naming import LOGIX_OPERATORS, names_in_file, routines_of
+from .mutants import AS_WRITTEN, Mutant, RungKey, Spelling, mutants
 from .runner import run_scenario, scenario_files
 from .scenario import ScenarioFile, load_scenarios
 
@@ -205,6 +206,25 @@ def baseline(app: str | Path, files: list[ScenarioFile],
     return seconds, cov.executed
 
 
+def spelling_of(program: Program) -> Callable[[int], Spelling | None]:
+    """How mutant descriptions write each program file: a Logix app's by
+    tag path in neutral text with Logix's instruction names, as Studio 5000
+    and the watch view show its rungs; another app's as its files are
+    written. A Logix app's file that is none of its routines (the rungs a
+    task calls its programs with, made at load) gets no mutants (None):
+    its author wrote nothing there (a choice, docs/testing.md)."""
+    routines = dict(routines_of(program))
+    if not routines:
+        return lambda number: AS_WRITTEN
+
+    def spelling(number: int) -> Spelling | None:
+        if number not in routines:
+            return None
+        names, _ = names_in_file(program.symbols, tuple(routines.items()), number)
+        return Spelling("neutral", names.name, LOGIX_OPERATORS, names.mnemonic)
+    return spelling
+
+
 def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DEFAULT_BUDGET_S,
                  limit: float | None = None, covered: Callable[[RungKey], bool] | None = None,
                  coverage_factory: Callable[[], Coverage] | None = Coverage,
@@ -228,7 +248,8 @@ def run_mutation(app: str | Path, *, jobs: int | None = None, budget: float = DE
     covered = covered or measured
     if limit is None:
         limit = max(MIN_LIMIT_S, LIMIT_FACTOR * seconds)
-    found = [m for m in mutants(source, loaded.instructions) if select is None or select(m)]
+    found = [m for m in mutants(source, loaded.instructions, spelling_of(loaded.program))
+             if select is None or select(m)]
     outcomes: dict[int, Outcome] = {m.index: Outcome(m.index, NOT_COVERED) for m in found if not covered(m.key)}
     todo = [m for m in found if m.index not in outcomes]
     jobs = max(1, min(jobs or os.cpu_count() or 1, len(todo) or 1))
