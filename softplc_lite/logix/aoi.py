@@ -194,7 +194,7 @@ class _Names:
         m = _NAME.match(text)
         h = self.hidden.get(m.group(1).upper()) if m else None
         if isinstance(h, Declared):
-            return self.directory._walk(text, m.end(), h, h.type, h.dims, (), 0, index_of, None, var=None)
+            return self.directory.walk(text, m.end(), h, h.type, h.dims, (), 0, index_of, None, var=None)
         return self.directory.resolve(text, scope, index_of)
 
     def head(self, text: str) -> str:
@@ -519,7 +519,7 @@ class AoiCalls:
         for size in dims:
             count *= size
         try:
-            self.directory._lay_out(d, t, (), count)
+            self.directory.lay_out(d, t, (), count)
         except PathError:
             return None
         key = HIDDEN.format(len(self.hidden))

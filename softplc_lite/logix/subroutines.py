@@ -140,7 +140,7 @@ class Subroutines:
         count = 1
         for n in like.dims:
             count *= n
-        self.directory._lay_out(d, like.type, (), count)
+        self.directory.lay_out(d, like.type, (), count)
         address = None
         if not like.dims and like.type.kind == "string":
             leaf = d.leaves[()]

@@ -189,7 +189,7 @@ class TagDirectory:
             return None
         d = Declared(tag, t, tuple(tag.dims), scope)
         try:
-            self._lay_out(d, t, (), _count(d.dims))
+            self.lay_out(d, t, (), _count(d.dims))
         except PathError as e:  # larger than the table holds: a limit of softplc_lite's, not a mistake
             reason = str(e)
             self.warnings.append(Problem(tag.pos, f"tag {tag.name}: {reason}; rungs that use it are not run"))
@@ -198,7 +198,10 @@ class TagDirectory:
         names[key] = d
         return d
 
-    def _lay_out(self, d: Declared, t: LogixType, path: tuple[str, ...], count: int) -> None:
+    def lay_out(self, d: Declared, t: LogixType, path: tuple[str, ...], count: int) -> None:
+        """Give each atomic leaf of ``d`` (of type ``t``, ``count`` of it) its
+        data-table words: the tags' own layout, and an Add-On Instruction's or
+        a subroutine's parameters laid out like a tag (aoi.py, subroutines.py)."""
         if t.kind == "atomic":
             d.leaves[path] = self.alloc.one(t.letter) if count == 1 else self.alloc.many(t.letter, count)
             return
@@ -209,7 +212,7 @@ class TagDirectory:
         for m in t.members:
             if m.host is not None:
                 continue  # a bit of its host's leaf
-            self._lay_out(d, m.type, path + (m.name.upper(),), count * max(m.dim, 1))
+            self.lay_out(d, m.type, path + (m.name.upper(),), count * max(m.dim, 1))
 
     def hidden_index(self) -> Address:
         """A DINT of its own for an index made at run time (LIDX writes it)."""
@@ -261,13 +264,13 @@ class TagDirectory:
             if not rest.strip():
                 return Resolved(text, target.type, target.dims, target.address, target.declared, target.path,
                                 target.flat, target.bit)
-            return self._walk(text, m.end(), target.declared, target.type, target.dims, target.path,
+            return self.walk(text, m.end(), target.declared, target.type, target.dims, target.path,
                               target.flat, index_of, target.bit, var=target.terms)
-        return self._walk(text, m.end(), d, d.type, d.dims, (), 0, index_of, None, var=None)
+        return self.walk(text, m.end(), d, d.type, d.dims, (), 0, index_of, None, var=None)
 
-    def _walk(self, text, at, d, t, dims, path, flat, index_of, bit, var):
+    def walk(self, text, at, d, t, dims, path, flat, index_of, bit, var):
         """Follow ``[..]``, ``.member``, ``.bit`` and ``.[bit]`` steps from
-        ``at``. An index that is not a constant is a term of the flat index
+        ``at`` (a tag path's, or an Add-On Instruction parameter's, aoi.py). An index that is not a constant is a term of the flat index
         (its text, its dimension, its stride), made at run time (``_finish``)."""
         terms: list[list] = list(var or [])
         bit_term = None
