@@ -40,12 +40,11 @@ import json
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import _common as C
-from bench_modbus_server import (RUNTIME, START_LIMIT_S, CheckFailed, Child, client_results, ladder, scans_in,
+from bench_modbus_server import (RUNTIME, START_LIMIT_S, CheckFailed, Child, client_results, finish, ladder, scans_in,
                                  server_xml, span)
 
 from helpers.modbus_peer import free_tcp_port
@@ -218,24 +217,7 @@ def main() -> int:
     ap.add_argument("--json", type=Path)
     args = ap.parse_args()
     cfg = QUICK if args.quick else FULL
-    started = time.monotonic()
-    with tempfile.TemporaryDirectory(prefix="bench_enips_") as tmp:
-        try:
-            raw = run(cfg, Path(tmp))
-        except CheckFailed as e:
-            print(f"FAIL: {e}")
-            return 1
-    fig = figures_of(raw)
-    failures = report(fig)
-    for f in failures:
-        print(f"FAIL: {f}")
-    print(f"\nwall time {time.monotonic() - started:.0f} s")
-    out = args.json or (None if args.quick else C.RESULTS / "bench_enips_server.json")
-    if out is not None:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        fig = {**fig, "config": cfg, "machine": C.machine() if hasattr(C, "machine") else None}
-        out.write_text(json.dumps(fig, indent=1, default=str), encoding="utf-8")
-    return 1 if failures else 0
+    return finish("bench_enips_server", cfg, args.quick, args.json, run, figures_of, report)
 
 
 if __name__ == "__main__":

@@ -503,6 +503,28 @@ def report(f: dict) -> list[str]:
     return failed
 
 
+def finish(name: str, cfg: dict, quick: bool, json_path, run, figures_of, report) -> int:
+    """The end every server benchmark shares (this one, bench_enips_server,
+    bench_opcuas): ``run(cfg, directory)`` in a temporary directory, its
+    figures (``figures_of(raw)``), their report (``report(figures)``: the
+    failed checks), the wall time, the figures saved; 1 when a check failed."""
+    started = time.monotonic()
+    with tempfile.TemporaryDirectory(prefix=f"{name}-") as tmp:
+        try:
+            raw = run(cfg, Path(tmp))
+        except CheckFailed as e:
+            print(f"FAILED: {e}")
+            return 1
+    figures = figures_of(raw)
+    failed = report(figures)
+    figures["wall_s"] = time.monotonic() - started
+    print(f"\nwall time {figures['wall_s']:.0f} s")
+    C.save_figures(name, {**figures, "config": cfg, "failures": failed}, quick, str(json_path) if json_path else None)
+    for problem in failed:
+        print(f"FAILED: {problem}")
+    return 1 if failed else 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--quick", action="store_true", help="a smoke run of about 35 s (results not written)")
@@ -511,23 +533,9 @@ def main() -> int:
                         help="run the runtime at nice N (e.g. -10: before the clients; needs the privilege)")
     args = parser.parse_args()
     cfg = dict(QUICK if args.quick else FULL, runtime_nice=args.runtime_nice)
-    t0 = time.perf_counter()
     print(f"MODBTCPS against pymodbus's ModbusTcpServer: {cfg['rounds']} round(s) of {cfg['window_s']} s windows, "
           f"{BUSY_CLIENTS} busy clients for {cfg['busy_s']} s; the runtime at nice {cfg['runtime_nice']}")
-    with tempfile.TemporaryDirectory(prefix="bench-modbtcps-") as tmp:
-        try:
-            raw = run(cfg, Path(tmp))
-        except CheckFailed as e:
-            print(f"FAILED: {e}")
-            return 1
-    figures = figures_of(raw, cfg)
-    failed = report(figures)
-    figures["wall_s"] = time.perf_counter() - t0
-    print(f"\nwall time {figures['wall_s']:.0f} s")
-    C.save_figures("bench_modbus_server", figures, args.quick, args.json)
-    for problem in failed:
-        print(f"FAILED: {problem}")
-    return 1 if failed else 0
+    return finish("bench_modbus_server", cfg, args.quick, args.json, run, lambda raw: figures_of(raw, cfg), report)
 
 
 if __name__ == "__main__":

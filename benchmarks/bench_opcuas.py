@@ -54,13 +54,12 @@ import json
 import os
 import statistics
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import _common as C
 import opcuas_load as L
-from bench_modbus_server import RUNTIME, CheckFailed, Child, ladder, scans_in, span, stop_all
+from bench_modbus_server import RUNTIME, CheckFailed, Child, finish, ladder, scans_in, span, stop_all
 
 from helpers.modbus_peer import free_tcp_port
 
@@ -271,21 +270,7 @@ def main() -> int:
     ap.add_argument("--json", type=Path)
     args = ap.parse_args()
     cfg = TINY if args.tiny else QUICK if args.quick else FULL
-    started = time.monotonic()
-    with tempfile.TemporaryDirectory(prefix="bench_opcuas_") as tmp:
-        try:
-            raw = run(cfg, Path(tmp))
-        except CheckFailed as e:
-            print(f"FAIL: {e}")
-            return 1
-    fig = figures_of(raw)
-    failures = report(fig)
-    for f in failures:
-        print(f"FAIL: {f}")
-    print(f"\nwall time {time.monotonic() - started:.0f} s")
-    C.save_figures("bench_opcuas", {**fig, "config": cfg, "failures": failures}, args.quick or args.tiny,
-                   str(args.json) if args.json else None)
-    return 1 if failures else 0
+    return finish("bench_opcuas", cfg, args.quick or args.tiny, args.json, run, figures_of, report)
 
 
 if __name__ == "__main__":
