@@ -16,6 +16,7 @@ import argparse
 import signal
 import sys
 import threading
+from pathlib import Path
 
 from ..datatable import DataTable, DataTableError
 from ..datatable.display import format_read
@@ -43,6 +44,16 @@ def int_in(valid: range, what: str):
         return value
     parse.__name__ = what  # argparse names the type in its messages
     return parse
+
+
+def app_directory(text: str) -> Path | None:
+    """An APP argument that must be an app's directory (a command that
+    writes files into it); None, said on standard error, when it is not."""
+    app = Path(text)
+    if not app.is_dir():
+        print(f"error: {text}: expected an app's directory", file=sys.stderr)
+        return None
+    return app
 
 
 def print_warnings(warnings: list[str]) -> None:

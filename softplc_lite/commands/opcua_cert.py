@@ -5,10 +5,9 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from ..tlm.opcuas.security import DAYS, CertPaths, application_uri, create_certificate
-from .common import EXIT_ERROR, EXIT_OK, int_in
+from .common import EXIT_ERROR, EXIT_OK, app_directory, int_in
 
 NAME = "opcua-cert"
 
@@ -30,9 +29,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    app = Path(args.app)
-    if not app.is_dir():
-        print(f"error: {args.app}: expected an app's directory", file=sys.stderr)
+    app = app_directory(args.app)
+    if app is None:
         return EXIT_ERROR
     paths = CertPaths.for_app(app)
     if (paths.cert.exists() or paths.key.exists()) and not args.force:

@@ -6,10 +6,9 @@ from __future__ import annotations
 import argparse
 import getpass
 import sys
-from pathlib import Path
 
 from ..tlm.opcuas.users import FILE_NAME, NAME as USER_NAME, Users
-from .common import EXIT_ERROR, EXIT_OK
+from .common import EXIT_ERROR, EXIT_OK, app_directory
 
 NAME = "opcua-user"
 MIN_PASSWORD = 8  # a choice: NIST SP 800-63B's least length for a chosen secret
@@ -31,9 +30,8 @@ def add_parser(sub) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    app = Path(args.app)
-    if not app.is_dir():
-        print(f"error: {args.app}: expected an app's directory", file=sys.stderr)
+    app = app_directory(args.app)
+    if app is None:
         return EXIT_ERROR
     if not USER_NAME.fullmatch(args.name):
         print(f"error: expected a user name of 1 to 64 letters, digits, _ . @ or -, not {args.name[:70]!r}",
