@@ -1,8 +1,10 @@
 """OPCUAS against hostile clients while the ladder runs on the wall clock:
 garbage bytes on the socket, a flood of sessions past maxSessions, a flood
-of subscriptions past maxSubscriptions. Each refusal is answered as OPC UA
-says (the connection refused, BadTooManySubscriptions) and the
-subscription refusals are counted in their status word; a good client
+of subscriptions past maxSubscriptions, a connection that never says a whole
+message. Each refusal is answered as OPC UA says (garbage with an Error
+message and the end of the connection, OPC 10000-6 7.1.5; the connection
+refused; BadTooManySubscriptions; the silent connection closed) and each is
+counted in its status word, exactly as often as the client did it; a good client
 goes on reading all the while, and no scan is late: the server is a process
 of its own and the scan never waits for it.
 
@@ -38,7 +40,8 @@ for name in ("asyncua", "asyncua.client", "asyncua.common", "asyncua.uaprotocol"
 port, sessions, subscriptions = int(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
 url = f"opc.tcp://127.0.0.1:{port}/"
 out = {"good_reads": 0, "good_values": [], "good_errors": [], "garbage": [], "sessions_ok": 0,
-       "sessions_refused": 0, "subscriptions_ok": 0, "subscriptions_refused": 0, "other": []}
+       "sessions_refused": 0, "subscriptions_ok": 0, "subscriptions_refused": 0, "other": [],
+       "idle": None}
 
 async def good(stop):
     async with Client(url, timeout=10) as c:
@@ -55,20 +58,40 @@ async def good(stop):
 async def garbage():
     frames = [os.urandom(64), os.urandom(4096),
               b"XYZF" + struct.pack("<I", 16) + os.urandom(8),               # an unknown message type, whole
+              b"HELX" + struct.pack("<I", 16) + os.urandom(8),               # an unknown chunk type
               b"HELF" + struct.pack("<I", 12) + b"\xff\xff\xff\xff",          # a Hello cut short
-              b"MSGF" + struct.pack("<I", 32) + os.urandom(24)]               # a message with no channel
+              b"MSGF" + struct.pack("<I", 32) + os.urandom(24),              # a message with no channel
+              b"MSGF" + struct.pack("<I", 1 << 20) + os.urandom(24)]         # a chunk over the receive buffer
     for frame in frames:
         r, w = await asyncio.open_connection("127.0.0.1", port)
         w.write(frame)
         await w.drain()
         try:
-            reply = await asyncio.wait_for(r.read(256), 0.3)
-            out["garbage"].append("closed" if not reply else "answered " + reply[:3].decode("latin-1"))
+            reply = await asyncio.wait_for(r.read(), 2.0)  # to the end: the server closes
+            if reply[:4] == b"ERRF" and len(reply) >= 12:  # an Error message: its status code, then the end
+                code = struct.unpack_from("<I", reply, 8)[0]
+                out["garbage"].append("ERR " + ua.StatusCode(code).name)
+            else:
+                out["garbage"].append("closed" if not reply else "answered " + reply[:4].decode("latin-1"))
         except asyncio.TimeoutError:
             out["garbage"].append("held")
         except OSError:
             out["garbage"].append("reset")
         w.close()
+
+async def idle():
+    # a connection that says half a header and no more: closed by the server, idle
+    loop = asyncio.get_running_loop()
+    r, w = await asyncio.open_connection("127.0.0.1", port)
+    w.write(b"HEL")
+    await w.drain()
+    start = loop.time()
+    try:
+        reply = await asyncio.wait_for(r.read(), 10.0)
+        out["idle"] = ["closed" if not reply else "answered", round(loop.time() - start, 1)]
+    except (asyncio.TimeoutError, OSError) as e:
+        out["idle"] = [repr(e), 0]
+    w.close()
 
 async def session_flood():
     held = []
@@ -107,7 +130,9 @@ async def main():
     await asyncio.sleep(0.5)
     await garbage()
     await session_flood()
+    idler = asyncio.create_task(idle())  # beside the subscription flood: a slot of maxSessions each
     await subscription_flood()
+    await idler
     await asyncio.sleep(0.5)
     stop.set()
     await reader
@@ -129,7 +154,9 @@ def test_garbage_and_floods_are_refused_and_a_good_client_is_served_with_no_late
     xml = opcuas_xml(maxSessions=SESSIONS, maxSubscriptions=SUBSCRIPTIONS)
     r = apps.start(xml, ladder="SYMBOL Count N7:5\nADD N7:5 1 N7:5\nMOV N7:5 N7:6\n", scan_ms=10)
     r.wait_for(lambda: r.engine.scans > 20, "scans running")
-    late_before, refused_before = r.runner.late_scans, r.status(S.W_REFUSED_SUBSCRIPTIONS)
+    late_before = r.runner.late_scans
+    words = (S.W_REFUSED_LIMIT, S.W_MALFORMED, S.W_IDLE, S.W_REFUSED_SUBSCRIPTIONS, S.W_REFUSALS)
+    before = {w: r.status(w) for w in words}
     run = subprocess.run([sys.executable, "-c", HOSTILE, str(r.port), str(FLOOD_SESSIONS), str(FLOOD_SUBSCRIPTIONS)],
                          capture_output=True, text=True, timeout=150, check=False)
     assert run.returncode == 0, run.stderr[-3000:]
@@ -143,9 +170,15 @@ def test_garbage_and_floods_are_refused_and_a_good_client_is_served_with_no_late
     assert out["sessions_ok"] == SESSIONS - 1 and out["sessions_refused"] == FLOOD_SESSIONS - SESSIONS + 1
     assert out["subscriptions_ok"] == SUBSCRIPTIONS
     assert out["subscriptions_refused"] == FLOOD_SUBSCRIPTIONS - SUBSCRIPTIONS
-    r.wait_for(lambda: r.status(S.W_REFUSED_SUBSCRIPTIONS) - refused_before == out["subscriptions_refused"],
-               "the subscription refusals counted in their status word")
-    assert "answered" not in " ".join(out["garbage"]), "garbage is never answered as if it were a request"
+    # garbage is never answered as if it were a request: an Error message, then the end of the connection
+    assert out["garbage"] == ["ERR BadTcpMessageTypeInvalid"] * 4 + [
+        "ERR BadDecodingError", "ERR BadTcpSecureChannelUnknown", "ERR BadTcpMessageTooLarge"], out["garbage"]
+    assert out["idle"][0] == "closed" and out["idle"][1] >= 4.5, out["idle"]  # PENDING_SESSION_S
+    expected = {S.W_REFUSED_LIMIT: out["sessions_refused"], S.W_MALFORMED: len(out["garbage"]), S.W_IDLE: 1,
+                S.W_REFUSED_SUBSCRIPTIONS: out["subscriptions_refused"]}
+    expected[S.W_REFUSALS] = sum(expected.values())
+    r.wait_for(lambda: {w: r.status(w) - before[w] for w in words} == expected,
+               f"each refusal counted in its status word: {expected}")
     values = out["good_values"]
     assert out["good_reads"] >= 20 and values == sorted(values) and values[-1] > values[0], values[-5:]
     assert late == 0, f"{late} late scans under hostile clients"

@@ -65,6 +65,7 @@ class StatusWords:
     copied: tuple[tuple[int, int], ...]  # (status word, counter)
     refusal_names: tuple[tuple[str, int], ...]  # every refusal counter, by the name the watch view gives it
     words: int = 16
+    noted_names: tuple[tuple[str, int], ...] = ()  # counters the watch view shows that are not refusals
 
     @property
     def refusal_counters(self) -> tuple[int, ...]:
@@ -89,4 +90,5 @@ class ServerStatus:
     writes: int = 0
     refusals: int = 0
     refused: dict[str, int] | None = None  # by kind, only those not zero
+    noted: dict[str, int] | None = None  # counts that are not refusals (scans skipped), only those not zero
     pending: bool = False  # not started yet, or starting: neither up nor failed

@@ -278,10 +278,12 @@ class ServerHandle:
         counters = self.image.counters() if self.image is not None else ZERO_COUNTERS
         names = self.words.refusal_names if self.words is not None else ()
         refused = {name: counters[c] for name, c in names if counters[c]}
+        noted = {name: counters[c] for name, c in (self.words.noted_names if self.words is not None else ())
+                 if counters[c]}
         bound = self.failed is None and self._bound_port() is not None
         return C.ServerStatus(self.failed or self.listening, bound, counters[C.CONNECTED],
                               self.rate, counters[C.REQUESTS], self.writes_applied, sum(refused.values()),
-                              refused, pending=self.failed is None and not bound)
+                              refused, noted or None, pending=self.failed is None and not bound)
 
     # -- the end -----------------------------------------------------------------------------
     def close(self) -> None:

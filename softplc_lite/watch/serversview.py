@@ -24,9 +24,12 @@ def servers_of(engine) -> list[tuple[str, object]]:
 
 
 def refusals_text(server) -> str:
-    """``3 (not allowed 2, exception 02 1)``: the total, then each kind that is not zero."""
+    """``3 (not allowed 2, exception 02 1)``: the total, then each kind that
+    is not zero; then the counts that are not refusals (``; scans skipped 4``)."""
     kinds = ", ".join(f"{kind} {n}" for kind, n in (server.refused or {}).items() if n)
-    return f"{server.refusals} ({kinds})" if kinds else str(server.refusals)
+    text = f"{server.refusals} ({kinds})" if kinds else str(server.refusals)
+    noted = "; ".join(f"{name} {n}" for name, n in (getattr(server, "noted", None) or {}).items() if n)
+    return f"{text}; {noted}" if noted else text
 
 
 def _where(name: str, server) -> Text:
