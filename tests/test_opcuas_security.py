@@ -246,3 +246,35 @@ def test_a_trusted_file_that_is_no_certificate_is_named(app):
 async def start_only(app):
     async with secured_server(app):
         pass
+
+
+def test_a_password_checked_aside_is_checked_in_another_thread_once():
+    # asyncua asks get_user on its event loop; check_aside runs scrypt in a thread before, and
+    # get_user takes its result: one derivation, none of it on the loop's thread
+    import threading
+
+    from softplc_lite.tlm.opcuas.security import UserManager
+
+    class Counted(Users):
+        def check(self, name, password):
+            threads.append(threading.get_ident())
+            return super().check(name, password)
+
+    threads: list[int] = []
+    users = Counted()
+    users.set("operator", "a long passphrase", can_write=True)
+    manager = UserManager(users, set(), SecuritySettings())
+
+    async def activate(password):
+        key = await manager.check_aside("operator", password)
+        try:
+            return manager.get_user(None, username="operator", password=password), threading.get_ident()
+        finally:
+            manager.forget(key)
+
+    user, loop_thread = asyncio.run(activate("a long passphrase"))
+    assert user is not None and user.name == "operator"
+    refused, _ = asyncio.run(activate("a guess"))
+    assert refused is None and manager.refused["password"] == 1
+    assert len(threads) == 2 and loop_thread not in threads
+    assert manager.checked == {}, "no password kept once the session is answered"

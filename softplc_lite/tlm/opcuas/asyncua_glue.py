@@ -32,6 +32,12 @@ relies on these internals:
   work on one, OPC 10000-4 5.4.4), and then creates and activates a session
   on it; ``refuse_unoffered`` refuses CreateSession and ActivateSession on a
   channel whose policy and mode no endpoint offers (BadSecurityPolicyRejected);
+  ``check_passwords_aside`` reads an ActivateSession's identity token
+  (``struct_from_binary`` of the request body, ``Buffer.copy``) and
+  decrypts it (``iserver.decrypt_user_token``, the processor's ``session``)
+  to check its password in a thread before asyncua's synchronous
+  ``activate_session`` asks the user manager (asyncua 2.1 cannot await a
+  coroutine ``get_user``);
 - ``OPCUAProtocol`` (binary_server_asyncio.py), one connection:
   ``connection_made`` (it closes a connection at ``max_connections``:
   counted first), ``data_received`` and its ``_buffer``, ``transport`` and
@@ -63,7 +69,7 @@ try:
     from asyncua.server.uaprocessor import UaProcessor
     from asyncua.crypto.permission_rules import User, UserRole
     from asyncua.server.binary_server_asyncio import OPCUAProtocol
-    from asyncua.ua.ua_binary import uatcp_to_binary
+    from asyncua.ua.ua_binary import struct_from_binary, uatcp_to_binary
     from asyncua.server.address_space import AddressSpace, AttributeService, NodeManagementService
     from asyncua.server.internal_server import InternalServer
     from asyncua.server.monitored_item_service import MonitoredItemService
@@ -263,6 +269,43 @@ def check_transport() -> None:
     OPCUAProtocol.data_received = data_received
     OPCUAProtocol._process_one_msg = _process_one_msg
     OPCUAProtocol._activation_watchdog = _activation_watchdog
+
+
+_ASIDE: dict = {}  # "manager": the Listener's UserManager, whose password checks run in a thread
+_INSTALLED: set = set()  # the patches installed in this process, by name
+_ACTIVATE = ua.ObjectIds.ActivateSessionRequest_Encoding_DefaultBinary
+
+
+def check_passwords_aside() -> None:
+    """Make an ActivateSession with a user name and password check the
+    password in a thread before asyncua handles it: asyncua calls the user
+    manager's ``get_user`` synchronously, on its event loop, and a password
+    costs scrypt's 50 ms of CPU there (20 wrong passwords at once stopped a
+    subscriber's notifications for half a second, docs/opcuas.md). The
+    token is read and decrypted as asyncua will read it; a token that fails
+    to is left to asyncua to refuse."""
+    if "aside" in _INSTALLED:
+        return
+    _INSTALLED.add("aside")
+    original = UaProcessor._process_message
+
+    async def _process_message(self, typeid, requesthdr, seqhdr, body):
+        manager = _ASIDE.get("manager")
+        if manager is None or typeid.Identifier != _ACTIVATE or typeid.NamespaceIndex != 0 or self.session is None:
+            return await original(self, typeid, requesthdr, seqhdr, body)
+        try:
+            token = struct_from_binary(ua.ActivateSessionParameters, body.copy()).UserIdentityToken
+            if not isinstance(token, ua.UserNameIdentityToken):
+                return await original(self, typeid, requesthdr, seqhdr, body)
+            username, password = self.iserver.decrypt_user_token(self.session, token)
+        except Exception:  # asyncua refuses it, as it would
+            return await original(self, typeid, requesthdr, seqhdr, body)
+        key = await manager.check_aside(username, password)
+        try:
+            return await original(self, typeid, requesthdr, seqhdr, body)  # asyncua's get_user takes the result
+        finally:
+            manager.forget(key)
+    UaProcessor._process_message = _process_message
 
 
 def sampling_s(requested_ms: float, publishing_ms: float) -> float:
@@ -466,7 +509,9 @@ class Listener:
                 raise
         server.set_certificate_validator(counted)
         _COUNT["channel"] = lambda message: count(counter, message)
-        refuse_unoffered()
+        _ASIDE["manager"] = manager
+        check_passwords_aside()
+        refuse_unoffered()  # after: a session on a channel not offered is refused before its password is checked
 
     async def stop(self) -> None:
         if self.task is not None:

@@ -36,6 +36,7 @@ request type lists ``USER_TYPES``) with its ``User``/``UserRole``.
 
 from __future__ import annotations
 
+import asyncio
 import os
 import socket
 from dataclasses import dataclass, field
@@ -190,11 +191,25 @@ class UserManager:
     trusted: set[bytes]
     settings: SecuritySettings
     refused: dict[str, int] = field(default_factory=lambda: {"password": 0, "anonymous": 0, "certificate": 0})
+    checked: dict = field(default_factory=dict)  # (name, password): the entry a check aside found, until taken
+
+    async def check_aside(self, username: str, password: str) -> tuple[str, str]:
+        """Check a password in a thread (scrypt: some 50 ms of CPU that
+        ``get_user``, which asyncua calls on its event loop, would take
+        there, stopping every client's service meanwhile); ``get_user`` takes
+        the result. The key to ``forget`` it by once the session is answered."""
+        key = (username, password)
+        self.checked[key] = await asyncio.to_thread(self.users.check, username, password)
+        return key
+
+    def forget(self, key: tuple[str, str]) -> None:
+        self.checked.pop(key, None)
 
     def get_user(self, iserver, username=None, password=None, certificate=None):
         from asyncua.crypto.permission_rules import User, UserRole
         if username is not None:
-            entry = self.users.check(username, password)
+            key = (username, password)
+            entry = self.checked.pop(key) if key in self.checked else self.users.check(username, password)
             if entry is None:
                 self.refused["password"] += 1
                 return None
