@@ -186,8 +186,9 @@ def check_passwords_aside() -> None:
     """Make an ActivateSession with a user name and password check the
     password in a thread before asyncua handles it: asyncua calls the user
     manager's ``get_user`` synchronously, on its event loop, and a password
-    costs scrypt's 50 ms of CPU there (20 wrong passwords at once stopped a
-    subscriber's notifications for half a second, docs/opcuas.md). The
+    costs scrypt's 50 ms of CPU there (20 wrong passwords at once, checked
+    there, stop a subscriber's notifications for half a second,
+    docs/opcuas.md). The
     token is read and decrypted as asyncua will read it; a token that fails
     to is left to asyncua to refuse."""
     if "aside" in _INSTALLED:
