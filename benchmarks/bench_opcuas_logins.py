@@ -4,7 +4,7 @@ password at once. A password is checked with scrypt (about 50 ms of CPU,
 users.py); checked on the server's event loop, it stops everything that
 loop serves for as long.
 
-    python benchmarks/bench_opcuas_logins.py          # about 20 s; needs asyncua
+    python benchmarks/bench_opcuas_logins.py          # about 15 s; needs asyncua
     python benchmarks/bench_opcuas_logins.py --rounds 1
 
 Processes: the runtime (modbus_server_runtime.py) with an app whose ladder
