@@ -91,3 +91,42 @@ def test_softplc_check_reports_the_file_located(tmp_path):
     (app / "OPCUAS.XML").write_text('<OpcUaServer status="N40:0" securityNone="yes"/>\n')
     ok = softplc_here("check", str(app))
     assert ok.returncode == 0 and "module OPCUAS" in ok.stdout
+
+
+def test_writable_tags_are_read_and_their_form_checked():
+    c = parse_config(b'<OpcUaServer>\n  <Writable tag="Tanks[1].Level"/>\n  <Writable address="N7:0"/>\n</OpcUaServer>')
+    assert [(w.tag, str(w.address), w.line) for w in c.writable] == [("Tanks[1].Level", "None", 2), (None, "N7:0", 3)]
+    with pytest.raises(ModuleErrors) as info:
+        parse_config(b'<OpcUaServer>\n  <Writable tag="Tanks" count="2"/>\n  <Writable tag="A" address="N7:0"/>\n'
+                     b'  <Writable/>\n</OpcUaServer>', "OPCUAS.XML")
+    text = [str(p) for p in info.value.problems]
+    assert text[0].startswith("OPCUAS.XML:2:25: <Writable tag=...> takes no count"), text
+    assert text[1].startswith("OPCUAS.XML:3:3: <Writable> needs the attribute address") and "one of them" in text[1]
+    assert text[2].startswith("OPCUAS.XML:4:3: <Writable> needs the attribute address"), text
+
+
+def test_softplc_check_locates_every_tag_the_export_does_not_open(tmp_path):
+    from helpers.shipped_apps import PROGRAMS
+
+    export = tmp_path / "tank_line.L5X"
+    export.write_bytes((PROGRAMS / "logix" / "tank_line.L5X").read_bytes())
+    config = tmp_path / "tank_line.OPCUAS.XML"
+    config.write_text('<OpcUaServer securityNone="yes">\n  <Writable tag="Running"/>\n'
+                      '  <Writable tag="Tanks[0].Fills"/>\n  <Writable tag="Nowhere"/>\n  <Writable tag="Tanks[5]"/>\n'
+                      '  <Writable tag="Tanks[1]"/>\n</OpcUaServer>\n')
+    result = softplc_here("check", str(export))
+    assert result.returncode != 0 and "Traceback" not in result.stderr
+    assert f"{config}:2:3: <Writable tag='Running'>: the export makes it Read Only" in result.stderr
+    assert f"{config}:3:3: <Writable tag='Tanks[0].Fills'>: the export makes it Read Only" in result.stderr
+    assert f"{config}:4:3: <Writable tag='Nowhere'>: no tag named 'Nowhere'" in result.stderr
+    assert f"{config}:5:3: <Writable tag='Tanks[5]'>: Tanks: index 5 is past its end (2)" in result.stderr
+    assert ":6:3:" not in result.stderr and "4 problems found" in result.stderr
+
+
+def test_a_tag_in_an_app_directory_is_located(tmp_path):
+    app = make_app(tmp_path / "app", "XIC B3:0/0 OTE O:0/0\n", MODULES_LST="OPCUAS\n",
+                   OPCUAS_XML='<OpcUaServer securityNone="yes">\n  <Writable tag="Tanks"/>\n</OpcUaServer>\n')
+    result = softplc_here("check", str(app))
+    assert result.returncode != 0 and "Traceback" not in result.stderr
+    assert f"{app / 'OPCUAS.XML'}:2:3: <Writable tag='Tanks'>: tag= names a tag of a Studio 5000 export's app" \
+        in result.stderr

@@ -1,7 +1,9 @@
 """What every network server module's XML configuration says the same way
-(MODBTCPS.XML, ENIPS.XML): where to listen, who may connect, the limits,
-the status block, and how each is checked (docs/modbtcps.md, "Safe by
-default"; docs/enips.md, "The configuration file").
+(MODBTCPS.XML, ENIPS.XML, OPCUAS.XML): where to listen, who may connect,
+the limits, the status block, what clients may write (``<Writable>``: data
+table elements, or a Studio 5000 export's tags) and how each is checked
+(docs/modbtcps.md, "Safe by default"; docs/enips.md, "The configuration
+file" and "Logix tags").
 
 The rules are softplc_lite's own choices, one set for every server so that
 an engineer who has configured one has configured them all: listen on
@@ -14,10 +16,12 @@ from __future__ import annotations
 
 import ipaddress
 import re
+from dataclasses import dataclass
 
 from ..datatable import DataTableError, parse_address
 from ..datatable.address import Address
 from ..datatable.filetypes import MAX_ELEMENTS
+from .errors import ModuleError, ModuleErrors
 from .xmlcheck import Attr, XmlChecker
 from .xmlreader import XmlNode
 
@@ -167,3 +171,64 @@ def check_writable_elements(c: XmlChecker, node: XmlNode, a: dict, status: Addre
                       f"{status_line}): a client must not write the server's counters", "address")
         return None
     return address, count
+
+
+@dataclass(frozen=True)
+class Writable:
+    """``count`` elements from ``address`` that clients may write; or, in a
+    Logix app's configuration, the tag path ``tag`` (enips/logixconfig.py
+    checks it against the export's tags)."""
+
+    address: Address | None  # an element of a file (N7:0, T4:0, ST9:0); None with ``tag``
+    count: int
+    line: int
+    column: int
+    tag: str | None = None  # a Logix tag path (Tanks, Tanks[1].Setpoint, SettleTimer.PRE)
+
+    @property
+    def file(self) -> str:
+        return f"{self.address.type_letter}{self.address.file}"
+
+    @property
+    def last(self) -> int:
+        return self.address.element + self.count - 1 if self.address is not None else 0
+
+
+def writable_attributes(elements: str) -> tuple[Attr, ...]:
+    """``<Writable>``'s attributes; ``elements``: examples of the first element."""
+    return (Attr("address", text=True, what=f"the first element clients may write ({elements})"),
+            Attr("tag", text=True, extension=True,
+                 what="a Logix app's tag clients may write (Tanks, Tanks[1].Setpoint, SettleTimer.PRE)"),
+            Attr("count", 1, MAX_ELEMENTS, default=1))
+
+
+def check_writable(c: XmlChecker, node: XmlNode, status: Address | None, status_line: int, status_words: int,
+                   parts: str) -> Writable | None:
+    """One ``<Writable>``: ``address=`` (and ``count=``, checked by
+    ``check_writable_elements``) or ``tag=``, one of them; None if refused
+    (the problem recorded)."""
+    a = c.attributes(node)
+    c.children(node, [])
+    if ("address" in node.attrs) == ("tag" in node.attrs):
+        c.error(node, "<Writable> needs the attribute address (a data table element: N7:0) or, in a Logix "
+                      "app's configuration, tag (a tag path: Tanks[1].Setpoint), one of them")
+        return None
+    if "address" not in a and "tag" not in a:
+        return None  # its value was refused, and said
+    if "tag" in a:
+        if "count" in node.attrs:
+            c.error(node, "<Writable tag=...> takes no count: the tag path names what clients may write", "count")
+            return None
+        return Writable(None, 1, node.line, node.column, tag=a["tag"])
+    found = check_writable_elements(c, node, a, status, status_line, status_words, parts)
+    return None if found is None else Writable(found[0], found[1], node.line, node.column)
+
+
+def refuse_tags(config) -> None:
+    """ModuleErrors for each ``<Writable tag=...>`` of an app directory's
+    configuration: its data table has no tags."""
+    tagged = [ModuleError(f"<Writable tag={w.tag!r}>: tag= names a tag of a Studio 5000 export's app; "
+                          "this app's data table elements are named by address=", config.path, w.line, w.column)
+              for w in config.writable if w.tag is not None]
+    if tagged:
+        raise ModuleErrors(tagged)

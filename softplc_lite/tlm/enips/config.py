@@ -17,11 +17,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...datatable.address import Address
-from ...datatable.filetypes import MAX_ELEMENTS
 from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
-from ..netconfig import check_writable_elements, ALLOW, check_allow, check_host, check_status, listen_attributes, listen_warning
+from ..netconfig import (ALLOW, Writable, check_allow, check_host, check_status, check_writable, listen_attributes,
+                         listen_warning, writable_attributes)
 from ..xmlcheck import MANY, Attr, XmlChecker
 
 CONFIG_FILE = "ENIPS.XML"
@@ -29,26 +29,6 @@ ROOT = "EtherNetIpServer"
 PORT = 44818  # EtherNet/IP's registered port (CIP Volume 2, 2-2), TCP and UDP
 STATUS_WORDS = 16
 MAX_CIP_CONNECTIONS = 32  # a ControlLogix L6x's class-3 connection count: a choice
-
-
-@dataclass(frozen=True)
-class Writable:
-    """``count`` elements from ``address`` that clients may write; or, in a
-    Logix app's configuration, the tag path ``tag`` (logixconfig.py)."""
-
-    address: Address | None  # an element of a file (N7:0, T4:0, ST9:0); None with ``tag``
-    count: int
-    line: int
-    column: int
-    tag: str | None = None  # a Logix tag path (Tanks, Tanks[1].Setpoint, SettleTimer.PRE)
-
-    @property
-    def file(self) -> str:
-        return f"{self.address.type_letter}{self.address.file}"
-
-    @property
-    def last(self) -> int:
-        return self.address.element + self.count - 1 if self.address is not None else 0
 
 
 @dataclass(frozen=True)
@@ -73,30 +53,8 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
            Attr("maxCipConnections", 1, 1000, default=MAX_CIP_CONNECTIONS),
            Attr("udpListIdentity", choices=("yes", "no"), default="yes")),
     "Allow": ALLOW,
-    "Writable": (Attr("address", text=True,
-                      what="the first element clients may write (N7:0, B3:2, F8:0, T4:0, ST9:0)"),
-                 Attr("tag", text=True, extension=True,
-                      what="a Logix app's tag clients may write (Tanks, Tanks[1].Setpoint, SettleTimer.PRE)"),
-                 Attr("count", 1, MAX_ELEMENTS, default=1)),
+    "Writable": writable_attributes("N7:0, B3:2, F8:0, T4:0, ST9:0"),
 }
-
-
-def _check_writable(c: XmlChecker, node, status: Address | None, status_line: int) -> Writable | None:
-    a = c.attributes(node)
-    c.children(node, [])
-    if ("address" in node.attrs) == ("tag" in node.attrs):
-        c.error(node, "<Writable> needs the attribute address (a data table element: N7:0) or, in a Logix "
-                      "app's configuration, tag (a tag path: Tanks[1].Setpoint), one of them")
-        return None
-    if "address" not in a and "tag" not in a:
-        return None  # its value was refused, and said
-    if "tag" in a:
-        if "count" in node.attrs:
-            c.error(node, "<Writable tag=...> takes no count: the tag path names what clients may write", "count")
-            return None
-        return Writable(None, 1, node.line, node.column, tag=a["tag"])
-    found = check_writable_elements(c, node, a, status, status_line, STATUS_WORDS, "word and bit")
-    return None if found is None else Writable(found[0], found[1], node.line, node.column)
 
 
 def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
@@ -108,7 +66,7 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
     status = check_status(c, root, a["status"], STATUS_WORDS) if "status" in a else None
     allow_nodes, writable_nodes = c.children(root, [("Allow", 0, MANY), ("Writable", 0, MANY)])
     allow = check_allow(c, allow_nodes)
-    writable = [w for w in (_check_writable(c, node, status, root.line) for node in writable_nodes) if w]
+    writable = [w for w in (check_writable(c, node, status, root.line, STATUS_WORDS, "word and bit") for node in writable_nodes) if w]
     if c.problems:
         raise ModuleErrors(c.found())
     return ServerConfig(path=path, host=host, port=a.get("port", PORT), allow=allow,

@@ -1,12 +1,14 @@
-"""ENIPS.XML for a Logix app (docs/enips.md, "Logix tags"): the export's
+"""ENIPS.XML and OPCUAS.XML for a Logix app (docs/enips.md, "Logix tags";
+docs/opcuas.md, "Logix tags"): the export's
 tags made writable by ``<Writable tag="..."/>``, and the storage of every
 tag or member the export makes Read Only or None kept closed to clients
 whatever ``<Writable>`` opens (1756-PM004, "Data access control": external
 applications cannot change such a value).
 
-The result is item ranges per data table file, which the image's slots take
-(protocol.build_slots): a client's write is checked against them in the
-server process and again by the scan.
+The result is item ranges per data table file, which ENIPS's image slots
+(protocol.build_slots) and OPCUAS's address space (opcuas/space.py) take: a
+client's write is checked against them in the server process and again by
+the scan.
 """
 
 from __future__ import annotations

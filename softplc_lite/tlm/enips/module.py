@@ -23,6 +23,7 @@ from typing import Mapping
 
 from ...textfile import read_bytes
 from ..errors import ModuleError, ModuleErrors
+from ..netconfig import refuse_tags
 from ..netmodule import NetServerModule
 from . import status as S
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config, parse_config
@@ -54,11 +55,7 @@ class EnipServer(NetServerModule):
         if app_dir is not None:
             self.config = load_config(app_dir)
             self.app_name = Path(app_dir).resolve().name
-            tagged = [ModuleError(f"<Writable tag={w.tag!r}>: tag= names a tag of a Studio 5000 export's app; "
-                                  "this app's data table elements are named by address=", self.config.path,
-                                  w.line, w.column) for w in self.config.writable if w.tag is not None]
-            if tagged:
-                raise ModuleErrors(tagged)
+            refuse_tags(self.config)
         return list(self.config.warnings)
 
     def configure_export(self, config_path: Path, app_name: str, directory, programs=()) -> list[str]:

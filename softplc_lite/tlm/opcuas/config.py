@@ -6,8 +6,8 @@ in MODBTCPS.XML's and ENIPS.XML's style and checked by the same machinery
 (tlm/xmlcheck.py, tlm/netconfig.py): every problem at once, each with file,
 line, column and what was expected; unknown elements and attributes are
 errors. It says where to listen, which parts of the PLC the address space
-exposes, the elements clients may write (none unless a ``<Writable>`` names
-them), the limits on sessions, subscriptions and monitored items, and the
+exposes, what clients may write (none unless a ``<Writable>`` names it: data
+table elements, or a Studio 5000 export's tags, checked as ENIPS.XML's are), the limits on sessions, subscriptions and monitored items, and the
 status block. The result is a ``ServerConfig``.
 """
 
@@ -17,11 +17,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ...datatable.address import Address
-from ...datatable.filetypes import MAX_ELEMENTS
 from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
-from ..netconfig import check_writable_elements, HOST_WHAT, LOOPBACK, check_host, check_status, ipaddress_is_loopback
+from ..netconfig import (HOST_WHAT, LOOPBACK, Writable, check_host, check_status, check_writable, ipaddress_is_loopback,
+                         writable_attributes)
 from ..xmlcheck import MANY, Attr, XmlChecker
 
 CONFIG_FILE = "OPCUAS.XML"
@@ -46,28 +46,8 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
            Attr("securitySign", choices=YES_NO, default="no"),
            Attr("anonymous", choices=YES_NO, default="yes"),
            Attr("trustedClientsOnly", choices=YES_NO, default="no")),
-    "Writable": (Attr("address", text=True, required=True,
-                      what="the first element clients may write (N7:0, B3:0, F8:0, T4:0, ST9:0)"),
-                 Attr("count", 1, MAX_ELEMENTS, default=1)),
+    "Writable": writable_attributes("N7:0, B3:0, F8:0, T4:0, ST9:0"),
 }
-
-
-@dataclass(frozen=True)
-class Writable:
-    """``count`` elements from ``address`` that clients may write."""
-
-    address: Address
-    count: int
-    line: int
-    column: int
-
-    @property
-    def file(self) -> str:
-        return f"{self.address.type_letter}{self.address.file}"
-
-    @property
-    def last(self) -> int:
-        return self.address.element + self.count - 1
 
 
 @dataclass(frozen=True)
@@ -111,7 +91,8 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
     host = check_host(c, root, a)
     status = check_status(c, root, a["status"], STATUS_WORDS) if "status" in a else None
     writable_nodes, = c.children(root, [("Writable", 0, MANY)])
-    writable = [w for w in (_check_writable(c, node, status, root.line) for node in writable_nodes) if w]
+    writable = [w for w in (check_writable(c, node, status, root.line, STATUS_WORDS, "member and bit")
+                            for node in writable_nodes) if w]
     if a.get("symbols") == a.get("dataFiles") == a.get("tags") == "no":
         c.error(root, 'symbols, dataFiles and tags are all "no": the server would expose nothing of the PLC '
                       "but its mode, fault code and scan time; say yes to one", "symbols")
@@ -131,15 +112,6 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
                         allow_none=a.get("securityNone") == "yes", allow_sign=a.get("securitySign") == "yes",
                         anonymous=a.get("anonymous", "yes") == "yes",
                         trusted_clients_only=a.get("trustedClientsOnly") == "yes", line=root.line)
-
-
-def _check_writable(c: XmlChecker, node, status: Address | None, status_line: int) -> Writable | None:
-    a = c.attributes(node)
-    c.children(node, [])
-    if "address" not in a:
-        return None  # missing or refused, and said
-    found = check_writable_elements(c, node, a, status, status_line, STATUS_WORDS, "member and bit")
-    return None if found is None else Writable(found[0], found[1], node.line, node.column)
 
 
 def read_config(path: Path) -> ServerConfig:
@@ -164,7 +136,8 @@ def config_references(config: ServerConfig) -> list[Address]:
     status block, so that the engine creates them before the first scan."""
     found: list[Address] = []
     for w in config.writable:
-        found += [w.address, w.address.with_element(w.last)]
+        if w.address is not None:
+            found += [w.address, w.address.with_element(w.last)]
     if config.status is not None:
         found += [config.status, config.status.with_element(config.status.element + STATUS_WORDS - 1)]
     return found

@@ -7,8 +7,10 @@ value a variable of its OPC UA type: BOOL Boolean, SINT SByte, INT Int16,
 DINT Int32, LINT Int64, REAL Float, a string String. A BOOL member kept in a
 bit of a hidden host is a variable over that bit; hidden members are not
 shown. A tag's External Access None keeps it out; program tags are under an
-object ``Program:NAME``. Every tag is read-only: ``<Writable>`` opens a
-data table's elements, and a Logix app's table is its tags' storage.
+object ``Program:NAME``. A variable is writable where a ``<Writable tag>``
+opens its storage and the export's External Access leaves it Read/Write
+(``Space.may_write``, the ranges ENIPS's checks give: enips/logixconfig.py);
+every other is read-only.
 """
 
 from __future__ import annotations
@@ -78,23 +80,26 @@ def _atomic(space, by_name, leaf, flat, node, shown, parent, description, bit=No
         return
     k, slot, _ = found
     if string:
-        first = slot.offset + (leaf.first + flat) * slot.per * slot.itemsize
-        space.variables.append(Var(node, shown, parent, "String", first, k, size=slot.per * 2,
-                                   description=description))
+        item = (leaf.first + flat) * slot.per
+        space.variables.append(Var(node, shown, parent, "String", slot.offset + item * slot.itemsize, k,
+                                   size=slot.per * 2, description=description, writable=space.may_write(slot, item)))
         return
     if leaf.letter == "B":  # a BOOL tag: a bit of a B file, whose leaves count bits
         word, b = divmod(leaf.first + flat, 16)
         space.variables.append(Var(node, shown, parent, "Boolean", slot.offset + word * 2, k, bit=b,
-                                   description=description))
+                                   description=description, writable=space.may_write(slot, word, b)))
         return
-    offset = slot.offset + (leaf.first + flat) * slot.itemsize
+    item = leaf.first + flat
+    offset = slot.offset + item * slot.itemsize
+    w = space.may_write(slot, item)
     if bit is not None:
         space.variables.append(Var(node, shown, parent, "Boolean", offset, k, bit=bit, size=slot.itemsize,
-                                   description=description))
+                                   description=description, writable=w))
         return
     kind = KIND_OF_LETTER.get(leaf.letter)
     if kind is not None:
-        space.variables.append(Var(node, shown, parent, kind, offset, k, size=slot.itemsize, description=description))
+        space.variables.append(Var(node, shown, parent, kind, offset, k, size=slot.itemsize, description=description,
+                                   writable=w))
 
 
 def _count(dims) -> int:

@@ -18,7 +18,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-from ..errors import ModuleError
+from ..enips.logixconfig import closed_ranges, tag_ranges
+from ..enips.logixview import build_view
+from ..errors import ModuleError, ModuleErrors
+from ..netconfig import refuse_tags
 from ..netmodule import NetServerModule
 from . import status as S
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config, read_config
@@ -42,21 +45,30 @@ class OpcUaServer(NetServerModule):
         self.server = None
         self.space = None
         self.directory = None  # a Studio 5000 export's tags (logix/tags.py)
+        self.tag_ranges = None  # its storage <Writable tag>s open, and what its External Access closes
 
     def configure(self, app_dir: Path | None) -> list[str]:
         if app_dir is not None:
             self.config = load_config(app_dir)
             self.app_name = Path(app_dir).resolve().name
+            refuse_tags(self.config)
             check_certificate(self.config)
         return list(self.config.warnings)
 
     def configure_export(self, config_path: Path, app_name: str, directory, programs=()) -> list[str]:
         """A Studio 5000 export's server: ``config_path`` its OPCUAS.XML
         (``<export stem>.OPCUAS.XML``), ``directory`` its tag directory
-        (logix/tags.py), whose tags the address space holds."""
+        (logix/tags.py), whose tags the address space holds; ``<Writable
+        tag>``s are checked against them as ENIPS checks its own (every
+        problem at once, located in the file)."""
         self.config = read_config(Path(config_path))
         self.app_name = app_name
         self.directory = directory
+        view = build_view(directory, programs)
+        opened, problems = tag_ranges(view, self.config)
+        if problems:
+            raise ModuleErrors(problems)
+        self.tag_ranges = (opened, closed_ranges(view))
         check_certificate(self.config)
         return list(self.config.warnings)
 
@@ -70,7 +82,8 @@ class OpcUaServer(NetServerModule):
         program = getattr(engine, "program", None)
         symbols = program.symbols if program is not None and self.directory is None else {}
         comments = rung_comments(program) if self.directory is None else {}
-        self.space = build_space(table, self.app_name, self.config, symbols, self.directory, comments)
+        self.space = build_space(table, self.app_name, self.config, symbols, self.directory, comments,
+                                 self.tag_ranges)
         self.serve(table, OpcUaProtocol(self.config, self.space), WHERE, S.LAYOUT)
         return [f"OPCUAS: {why}: not served to clients" for why in self.space.skipped]
 

@@ -78,10 +78,23 @@ class Space:
     variables: list[Var] = field(default_factory=list)
     skipped: list[str] = field(default_factory=list)  # symbols not exposed, and why
     open: dict[str, list[tuple[int, int]]] = field(default_factory=dict)  # file -> [first element, end)
+    # a Studio 5000 export's: what its <Writable tag>s open and what its External Access keeps closed
+    # (enips/logixconfig.py), file -> [first item, end), bits in a B file
+    tags_open: dict[str, list[tuple[int, int]]] | None = None
+    tags_closed: dict[str, list[tuple[int, int]]] = field(default_factory=dict)
 
     def opens(self, file: str, element: int) -> bool:
         """Whether a <Writable> covers the element."""
         return any(lo <= element < hi for lo, hi in self.open.get(file, ()))
+
+    def may_write(self, slot: Slot, item: int, bit: int = -1) -> bool:
+        """Whether a client may write ``item`` of ``slot`` (its ``bit`` in a
+        Logix app's B file, whose BOOL tags share words)."""
+        if self.tags_open is None:
+            return self.opens(slot.name, item // slot.per)
+        unit = item * 16 + bit if slot.letter == "B" and bit >= 0 else item
+        inside = lambda ranges: any(lo <= unit < hi for lo, hi in ranges.get(slot.name, ()))  # noqa: E731
+        return inside(self.tags_open) and not inside(self.tags_closed)
 
     @property
     def image_bytes(self) -> int:
@@ -141,16 +154,22 @@ def _element_text(a) -> str:
     return f"{a.type_letter}:{a.element}" if a.type_letter in ("O", "I", "S") else f"{a.file_name()}:{a.element}"
 
 
-def build_space(table, app: str, config, symbols: dict | None = None, directory=None, comments=None) -> Space:
+def build_space(table, app: str, config, symbols: dict | None = None, directory=None, comments=None,
+                tag_ranges=None) -> Space:
     """The address space of ``table``: ``symbols`` (a program's, name ->
     declaration) and the data files as ``config`` exposes them, and the
     PLC's mode, fault code and scan time always; for a Studio 5000 export,
     its tag ``directory``'s tags in place of the symbols and the files.
     ``comments``: each element's rung comment (``rung_comments``), which
-    its nodes' Descriptions say."""
+    its nodes' Descriptions say; ``tag_ranges``: the export's (open, closed)
+    storage, by file (enips/logixconfig.py)."""
     comments = comments or {}
     space = Space(app)
+    if directory is not None:
+        space.tags_open, space.tags_closed = tag_ranges or ({}, {})
     for w in getattr(config, "writable", ()):
+        if w.address is None:
+            continue
         space.open.setdefault(w.file, []).append((w.address.element, w.last + 1))
     offset = 0
     for f in table.files():

@@ -50,7 +50,7 @@ def apply(space: Space, payload: bytes, table) -> str:
     writable again (the server checked it against the same space)."""
     k, item, bit = _HEAD.unpack_from(payload)
     slot = space.slots[k]
-    if not space.opens(slot.name, item // slot.per):
+    if not space.may_write(slot, item, bit):
         return REFUSED
     data = table.file(slot.name).data
     rest = payload[_HEAD.size:]
