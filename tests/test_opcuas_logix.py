@@ -22,9 +22,9 @@ pytestmark = pytest.mark.xdist_group("opcuas_logix")  # one server for the modul
 
 NS = "urn:softplc-lite:opcuas"
 # A DINT tag, a REAL tag, a whole array element (Tanks[1]: its BOOL and REAL members), a UDT member, a
-# STRING; Tanks[0].Setpoint, SettleTimer.PRE and Running stay closed. The line stays stopped (Start is
-# never pressed), so no rung writes what the tests write.
-WRITABLE = ("Active", "FillRate", "Tanks[1]", "Tanks[0].Level", "Banner")
+# whole structure (Batches: every member), a STRING; Tanks[0].Setpoint, SettleTimer.PRE and Running stay
+# closed. The line stays stopped (Start is never pressed), so no rung writes what the tests write.
+WRITABLE = ("Active", "FillRate", "Tanks[1]", "Tanks[0].Level", "Batches", "Banner")
 
 
 def _config(tmp_path, body: str = "") -> str:
@@ -88,22 +88,28 @@ def test_tags_browse_and_read_by_their_paths(line):
 def test_writable_tags_are_written_through_the_scan(line):
     V = ua.VariantType
     writes = {"Active": (1, V.Int32), "FillRate": (2.5, V.Float), "Tanks[1].Fill": (True, V.Boolean),
-              "Tanks[1].Level": (12.25, V.Float), "Tanks[0].Level": (3.5, V.Float), "Banner": ("filling", V.String)}
+              "Tanks[1].Level": (12.25, V.Float), "Tanks[0].Level": (3.5, V.Float), "Batches.PRE": (7, V.Int32),
+              "Banner": ("filling", V.String)}
+    shown = ("Active", "Tanks[1].Drain", "Batches.DN", "Tanks[1].Fills", "Tanks[0].Setpoint", "SettleTimer.PRE")
 
     async def work(client):
         ns = await client.get_namespace_index(NS)
         codes = {t: await _write(client, t, v, kind) for t, (v, kind) in writes.items()}
         back = {t: await client.get_node(f"ns={ns};s={t}").read_value() for t in writes}
+        in_table = {t: value(line, t) for t in ("Active", "FillRate", "Tanks[1].Level", "Batches.PRE", "Banner")}
         access = {t: await client.get_node(f"ns={ns};s={t}").read_attribute(ua.AttributeIds.AccessLevel)
-                  for t in ("Active", "Tanks[1].Drain", "Tanks[0].Setpoint")}
-        return codes, back, {t: bool(a.Value.Value & ua.AccessLevel.CurrentWrite.mask) for t, a in access.items()}
+                  for t in shown}
+        restored = await _write(client, "Banner", "idle", V.String)  # the browse test reads the export's text
+        return codes, back, in_table, {t: bool(a.Value.Value & ua.AccessLevel.CurrentWrite.mask)
+                                       for t, a in access.items()}, restored
 
-    codes, back, access = client_run(line.port, work, secure=True)
-    assert codes == {t: "Good" for t in writes}
+    codes, back, in_table, access, restored = client_run(line.port, work, secure=True)
+    assert codes == {t: "Good" for t in writes} and restored == "Good"
     assert back == {t: v for t, (v, _) in writes.items()}  # answered once applied: the read sees it
-    assert {t: value(line, t) for t in ("Active", "FillRate", "Tanks[1].Level", "Banner")} == \
-        {"Active": 1, "FillRate": 2.5, "Tanks[1].Level": 12.25, "Banner": "filling"}
-    assert access == {"Active": True, "Tanks[1].Drain": True, "Tanks[0].Setpoint": False}
+    assert in_table == {"Active": 1, "FillRate": 2.5, "Tanks[1].Level": 12.25, "Batches.PRE": 7, "Banner": "filling"}
+    assert access == {"Active": True, "Tanks[1].Drain": True, "Batches.DN": True, "Tanks[1].Fills": False,
+                      "Tanks[0].Setpoint": False, "SettleTimer.PRE": False}
+    assert value(line, "Banner") == "idle"
 
 
 def test_tags_not_opened_and_bad_values_are_refused(line):
