@@ -22,9 +22,10 @@ pytestmark = pytest.mark.xdist_group("opcuas_logix")  # one server for the modul
 
 NS = "urn:softplc-lite:opcuas"
 # A DINT tag, a REAL tag, a whole array element (Tanks[1]: its BOOL and REAL members), a UDT member, a
+# BOOL member (Tanks[0].Fill, whose neighbour Drain shares its storage and stays closed), a
 # whole structure (Batches: every member), a STRING; Tanks[0].Setpoint, SettleTimer.PRE and Running stay
 # closed. The line stays stopped (Start is never pressed), so no rung writes what the tests write.
-WRITABLE = ("Active", "FillRate", "Tanks[1]", "Tanks[0].Level", "Batches", "Banner")
+WRITABLE = ("Active", "FillRate", "Tanks[1]", "Tanks[0].Level", "Tanks[0].Fill", "Batches", "Banner")
 
 
 def _config(tmp_path, body: str = "") -> str:
@@ -90,7 +91,8 @@ def test_writable_tags_are_written_through_the_scan(line):
     writes = {"Active": (1, V.Int32), "FillRate": (2.5, V.Float), "Tanks[1].Fill": (True, V.Boolean),
               "Tanks[1].Level": (12.25, V.Float), "Tanks[0].Level": (3.5, V.Float), "Batches.PRE": (7, V.Int32),
               "Banner": ("filling", V.String)}
-    shown = ("Active", "Tanks[1].Drain", "Batches.DN", "Tanks[1].Fills", "Tanks[0].Setpoint", "SettleTimer.PRE")
+    shown = ("Active", "Tanks[1].Drain", "Batches.DN", "Tanks[1].Fills", "Tanks[0].Setpoint", "SettleTimer.PRE",
+             "Tanks[0].Fill", "Tanks[0].Drain")
 
     async def work(client):
         ns = await client.get_namespace_index(NS)
@@ -108,7 +110,8 @@ def test_writable_tags_are_written_through_the_scan(line):
     assert back == {t: v for t, (v, _) in writes.items()}  # answered once applied: the read sees it
     assert in_table == {"Active": 1, "FillRate": 2.5, "Tanks[1].Level": 12.25, "Batches.PRE": 7, "Banner": "filling"}
     assert access == {"Active": True, "Tanks[1].Drain": True, "Batches.DN": True, "Tanks[1].Fills": False,
-                      "Tanks[0].Setpoint": False, "SettleTimer.PRE": False}
+                      "Tanks[0].Setpoint": False, "SettleTimer.PRE": False, "Tanks[0].Fill": True,
+                      "Tanks[0].Drain": False}
     assert value(line, "Banner") == "idle"
 
 
@@ -119,13 +122,15 @@ def test_tags_not_opened_and_bad_values_are_refused(line):
         return {
             "closed": await _write(client, "Tanks[0].Setpoint", 1.0, V.Float),  # no <Writable> names it
             "timer": await _write(client, "SettleTimer.PRE", 5, V.Int32),
+            "neighbour": await _write(client, "Tanks[0].Drain", True, V.Boolean),  # beside the opened Fill
             "read only": await _write(client, "Tanks[1].Fills", 5, V.Int32),  # inside Tanks[1]; the export's Read Only
             "long": await _write(client, "Banner", "x" * 83, V.String),  # a STRING holds 82 characters
             "type": await _write(client, "Active", 1.0, V.Float),  # a DINT written as a Float
         }
 
     codes = client_run(line.port, work, secure=True)
-    assert codes == {"closed": "BadNotWritable", "timer": "BadNotWritable", "read only": "BadNotWritable",
+    assert codes == {"closed": "BadNotWritable", "timer": "BadNotWritable", "neighbour": "BadNotWritable",
+                     "read only": "BadNotWritable",
                      "long": "BadOutOfRange", "type": "BadTypeMismatch"}
     assert (value(line, "Tanks[0].Setpoint"), value(line, "SettleTimer.PRE")) == (40.0, 2000)
     anonymous = client_run(line.port, lambda client: _write(client, "FillRate", 9.0, V.Float))

@@ -8,9 +8,9 @@ DINT Int32, LINT Int64, REAL Float, a string String. A BOOL member kept in a
 bit of a hidden host is a variable over that bit; hidden members are not
 shown. A tag's External Access None keeps it out; program tags are under an
 object ``Program:NAME``. A variable is writable where a ``<Writable tag>``
-opens its storage and the export's External Access leaves it Read/Write
-(``Space.may_write``, the ranges ENIPS's checks give: enips/logixconfig.py);
-every other is read-only.
+names it (``Space.names_opened``) and the export's External Access leaves
+its storage Read/Write (``Space.may_write``, the ranges ENIPS's checks
+give: enips/logixconfig.py); every other is read-only.
 """
 
 from __future__ import annotations
@@ -82,16 +82,16 @@ def _atomic(space, by_name, leaf, flat, node, shown, parent, description, bit=No
     if string:
         item = (leaf.first + flat) * slot.per
         space.variables.append(Var(node, shown, parent, "String", slot.offset + item * slot.itemsize, k,
-                                   size=slot.per * 2, description=description, writable=space.may_write(slot, item)))
+                                   size=slot.per * 2, description=description, writable=space.may_write(slot, item) and space.names_opened(node)))
         return
     if leaf.letter == "B":  # a BOOL tag: a bit of a B file, whose leaves count bits
         word, b = divmod(leaf.first + flat, 16)
         space.variables.append(Var(node, shown, parent, "Boolean", slot.offset + word * 2, k, bit=b,
-                                   description=description, writable=space.may_write(slot, word, b)))
+                                   description=description, writable=space.may_write(slot, word, b) and space.names_opened(node)))
         return
     item = leaf.first + flat
     offset = slot.offset + item * slot.itemsize
-    w = space.may_write(slot, item)
+    w = space.may_write(slot, item) and space.names_opened(node)
     if bit is not None:
         space.variables.append(Var(node, shown, parent, "Boolean", offset, k, bit=bit, size=slot.itemsize,
                                    description=description, writable=w))

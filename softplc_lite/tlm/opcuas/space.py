@@ -82,6 +82,18 @@ class Space:
     # (enips/logixconfig.py), file -> [first item, end), bits in a B file
     tags_open: dict[str, list[tuple[int, int]]] | None = None
     tags_closed: dict[str, list[tuple[int, int]]] = field(default_factory=dict)
+    tag_paths: tuple[str, ...] = ()  # the paths its <Writable tag>s name, upper case, no spaces
+
+    def names_opened(self, node: str) -> bool:
+        """Whether a <Writable tag> names the variable ``node`` (a tag path):
+        it, or a tag, element or structure holding it, or a bit of it (an
+        integer's bit: the integer is what a client writes). A BOOL member
+        shares its storage with its neighbours, which the ranges cannot
+        tell apart; the path can, so an opened ``Tanks[0].Fill`` leaves
+        ``Tanks[0].Drain`` read-only."""
+        n = node.upper()
+        return any(n == p or n.startswith((p + ".", p + "[")) or (p.startswith(n + ".") and p[len(n) + 1:].isdigit())
+                   for p in self.tag_paths)
 
     def opens(self, file: str, element: int) -> bool:
         """Whether a <Writable> covers the element."""
@@ -167,6 +179,8 @@ def build_space(table, app: str, config, symbols: dict | None = None, directory=
     space = Space(app)
     if directory is not None:
         space.tags_open, space.tags_closed = tag_ranges or ({}, {})
+        space.tag_paths = tuple(w.tag.upper().replace(" ", "") for w in getattr(config, "writable", ())
+                                if getattr(w, "tag", None))
     for w in getattr(config, "writable", ()):
         if w.address is None:
             continue
