@@ -146,3 +146,16 @@ def test_a_bad_configuration_beside_an_export_is_located(tmp_path):
     with pytest.raises(AppError) as info:
         load_app(export)
     assert f"{tmp_path / 'tank_line.opcuas.xml'}:1:14: port='99999'" in str(info.value)
+
+
+def test_an_address_beside_an_export_is_a_located_warning(tmp_path):
+    """<Writable address> beside an export opens nothing a client sees: check says so, at the element."""
+    from helpers.cli import softplc_here
+
+    export = tmp_path / "tank_line.L5X"
+    shutil.copy(PROGRAMS / "logix" / "tank_line.L5X", export)
+    config = tmp_path / "tank_line.OPCUAS.XML"
+    config.write_text(_config(tmp_path, '  <Writable address="N7:0"/>\n'))
+    r = softplc_here("check", str(export))
+    assert r.returncode == 0, r.stderr
+    assert f"{config}:3:3: <Writable address=N7:0> opens nothing a client sees" in r.stderr

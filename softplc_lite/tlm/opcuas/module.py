@@ -70,7 +70,10 @@ class OpcUaServer(NetServerModule):
             raise ModuleErrors(problems)
         self.tag_ranges = (opened, closed_ranges(view))
         check_certificate(self.config)
-        return list(self.config.warnings)
+        unseen = [f"{config_path}:{w.line}:{w.column}: <Writable address={w.address}> opens nothing a client "
+                  "sees beside an export (its address space holds tags, not data files): open a tag with "
+                  "<Writable tag=...>" for w in self.config.writable if w.address is not None]
+        return list(self.config.warnings) + unseen
 
     def config_references(self) -> list:
         return config_references(self.config)
