@@ -337,8 +337,9 @@ class Listener:
     async def refresh(self) -> None:
         """Take the latest whole scan from the image, if it is new, and give
         asyncua the values it changed. The scans published since the last
-        one taken, before this one, are counted skipped: their values
-        reached no client (a server that falls behind the scan)."""
+        one taken, before this one, are counted skipped while a client is
+        subscribed: their changes reached no subscriber (a server that
+        falls behind the scan)."""
         image, space = self.plc_server.image, self.space
         if self._by_slot is None:
             self._by_slot = [[] for _ in space.slots]
@@ -353,8 +354,10 @@ class Listener:
                 break
             await asyncio.sleep(0)  # the scan is publishing: a few microseconds
         last_seq = self._last_seq
-        if last_seq is not None and seq > last_seq + 2:  # each scan's publication moves the sequence by 2
-            self.plc_server.image.add(SKIPPED_SCANS, (seq - last_seq) // 2 - 1)  # never given to a client
+        if last_seq is not None and seq > last_seq + 2 and self.ua.iserver.subscription_service.subscriptions:
+            # each scan's publication moves the sequence by 2; counted while a subscription waits for
+            # changes (a Read takes the newest scan whatever came between: nothing is missed)
+            self.plc_server.image.add(SKIPPED_SCANS, (seq - last_seq) // 2 - 1)
         raw, last_raw, values = raws[0], self._last_raw, self._values
         aspace = self.ua.iserver.aspace
         now = datetime.now(timezone.utc)
