@@ -16,6 +16,7 @@ def test_an_empty_root_takes_the_defaults():
     c = parse_config(b"<OpcUaServer/>")
     assert (c.host, c.port, c.symbols, c.data_files, c.tags) == ("127.0.0.1", 4840, True, True, True)
     assert (c.max_sessions, c.max_subscriptions, c.max_monitored_items, c.status) == (10, 100, 10_000, None)
+    assert c.idle_timeout_ms == 5_000
     assert (c.allow_none, c.allow_sign, c.anonymous, c.trusted_clients_only) == (False, False, True, False)
     assert c.warnings == []
 
@@ -33,10 +34,12 @@ def test_the_security_attributes_are_read_and_checked():
 
 def test_every_attribute_is_read():
     c = parse_config(b'<OpcUaServer address="::1" port="4841" symbols="no" dataFiles="yes" tags="no" '
-                     b'maxSessions="2" maxSubscriptions="3" maxMonitoredItems="4" status="N40:0" debug="1"/>')
+                     b'maxSessions="2" maxSubscriptions="3" maxMonitoredItems="4" status="N40:0" debug="1" '
+                     b'idleTimeout="1500"/>')
     assert (c.host, c.port, c.symbols, c.data_files, c.tags) == ("::1", 4841, False, True, False)
     assert (c.max_sessions, c.max_subscriptions, c.max_monitored_items, str(c.status), c.debug) == \
         (2, 3, 4, "N40:0", 1)
+    assert c.idle_timeout_ms == 1500
 
 
 def test_every_problem_is_located_at_once():

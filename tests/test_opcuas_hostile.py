@@ -151,7 +151,7 @@ def apps(tmp_path):
 @pytest.mark.alone  # counts late real-time scans (docs/testing.md)
 def test_garbage_and_floods_are_refused_and_a_good_client_is_served_with_no_late_scan(apps):
     # the good client holds one session of maxSessions, the subscription flood another
-    xml = opcuas_xml(maxSessions=SESSIONS, maxSubscriptions=SUBSCRIPTIONS)
+    xml = opcuas_xml(maxSessions=SESSIONS, maxSubscriptions=SUBSCRIPTIONS, idleTimeout=1000)  # idle closed in 1 s
     r = apps.start(xml, ladder="SYMBOL Count N7:5\nADD N7:5 1 N7:5\nMOV N7:5 N7:6\n", scan_ms=10)
     r.wait_for(lambda: r.engine.scans > 20, "scans running")
     late_before = r.runner.late_scans

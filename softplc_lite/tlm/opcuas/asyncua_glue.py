@@ -94,9 +94,6 @@ BAD_NODE_UNKNOWN = ua.StatusCodes.BadNodeIdUnknown
 BAD_TOO_MANY_ITEMS = ua.StatusCodes.BadTooManyMonitoredItems
 
 
-PENDING_SESSION_S = 5.0
-
-
 async def end_clock(server) -> None:
     """Stop the task asyncua's InternalServer keeps ServerStatus.CurrentTime
     with: it sleeps a second between updates and ``Server.stop`` awaits it,
@@ -266,10 +263,9 @@ class Listener:
         self.ns = await server.register_namespace(NAMESPACE)
         iserver = server.iserver
         iserver.max_connections = self.config.max_sessions
-        # A connection that opens no session within this many seconds is closed (asyncua waits 30):
-        # garbage on a socket, or a client stalled before its session, holds a slot of maxSessions
-        # only this long (a choice; an OPC UA client activates its session within a second).
-        iserver.max_pending_activation_seconds = PENDING_SESSION_S
+        # A connection that opens no session within idleTimeout is closed (asyncua waits 30 s):
+        # config.py says why.
+        iserver.max_pending_activation_seconds = self.config.idle_timeout_ms / 1000
         iserver.max_subscriptions = self.config.max_subscriptions
         iserver.allow_remote_admin = False  # a client calling itself "admin" gets no more than another
         results = iserver.node_mgt_service.add_nodes(_add_items(self.space, self.ns))

@@ -39,6 +39,7 @@ ATTRIBUTES: dict[str, tuple[Attr, ...]] = {
            Attr("maxSessions", 1, 1000, default=10),
            Attr("maxSubscriptions", 1, 10_000, default=100),
            Attr("maxMonitoredItems", 1, 1_000_000, default=10_000),
+           Attr("idleTimeout", 100, 3_600_000, default=5_000),
            Attr("status", text=True, what=f"a word address of an N or B file, the first of {STATUS_WORDS} "
                                            "status words (N40:0)"),
            Attr("debug", 0, 2, default=0),
@@ -72,11 +73,14 @@ class ServerConfig:
     line: int = 0  # the root element's, where a security problem is located
     warnings: list[str] = field(default_factory=list)
 
+    # a connection with no session activated this long after it opened is closed, counted idle
+    # (asyncua_glue.py): garbage, or a client stalled before its session, holds a slot of maxSessions
+    # only this long; an OPC UA client activates its session within a second (a choice)
+    idle_timeout_ms: int = 5_000
     # what the network-server layer's Settings take (tlm/netmodule.settings_of); asyncua accepts the
-    # connections and answers the requests, so the layer's allow-list, rate and idle rules are not consulted
+    # connections and answers the requests, so the layer's allow-list and rate rules are not consulted
     allow: tuple = LOOPBACK
     max_requests_per_second: int = 100_000
-    idle_timeout_ms: int = 3_600_000
 
     @property
     def max_connections(self) -> int:
@@ -108,6 +112,7 @@ def parse_config(data: bytes, path: str = CONFIG_FILE) -> ServerConfig:
                         data_files=a.get("dataFiles") == "yes", tags=a.get("tags") == "yes",
                         max_sessions=a.get("maxSessions", 10), max_subscriptions=a.get("maxSubscriptions", 100),
                         max_monitored_items=a.get("maxMonitoredItems", 10_000), status=status,
+                        idle_timeout_ms=a.get("idleTimeout", 5_000),
                         debug=a.get("debug", 0), writable=tuple(writable), warnings=warnings,
                         allow_none=a.get("securityNone") == "yes", allow_sign=a.get("securitySign") == "yes",
                         anonymous=a.get("anonymous", "yes") == "yes",
