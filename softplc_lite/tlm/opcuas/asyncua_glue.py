@@ -21,14 +21,11 @@ relies on these internals:
   ``subscriptions[..].monitored_item_srv._monitored_items``, to hold the
   monitored items to the configured limit and keep each one's sampling
   interval;
-- ``MonitoredItemService.datachange_callback`` (and its
-  ``_monitored_datachange``, ``_monitored_items``), taken over by
-  ``sample_items``: asyncua queues every change of a value whatever the
-  item's sampling interval, where OPC 10000-4 5.12.1.2 samples at it;
 - ``Server.bserver._server`` (the asyncio server), for the port bound, and
   ``bserver.clients``, the connections open;
 - the patches of asyncua's classes in asyncua_patches.py (installed once
-  a process: on a connection, a session request, a password), whose
+  a process: on a connection, a session request, a password, a monitored
+  item's data change), whose
   docstring lists the internals they rely on.
 
 Nothing else in OPCUAS imports asyncua (asyncua_patches.py only through
@@ -69,7 +66,8 @@ from .security import CertPaths, SecuritySettings, apply_security, role_of, user
 from .users import FILE_NAME as USERS_FILE, Users  # noqa: E402
 from .space import NAMESPACE, Space, decode  # noqa: E402
 from .status import IDLE, MALFORMED, REFUSED_LIMIT, SKIPPED_SCANS  # noqa: E402
-from .asyncua_patches import ASIDE, COUNT, check_passwords_aside, check_transport, refuse_unoffered  # noqa: E402
+from .asyncua_patches import (ASIDE, COUNT, Sampler, check_passwords_aside, check_transport,  # noqa: E402
+                               refuse_unoffered, sample_items)
 
 _NEEDED = (
     (Server, ("init", "set_endpoint", "set_security_policy", "register_namespace", "start", "stop")),
@@ -118,51 +116,6 @@ def sampling_s(requested_ms: float, publishing_ms: float) -> float:
     every scan (the fastest the values change). 0.0: every scan."""
     ms = publishing_ms if requested_ms < 0 else requested_ms
     return ms / 1000.0 if ms / 1000.0 > POLL_S else 0.0
-
-
-class Sampler:
-    """A monitored item's sampling: its interval (s), when its next sample
-    is due (the event loop's time) and the newest change held until then.
-    One attribute of asyncua's item holds it (``sampler``): slots keep it
-    small, 56 bytes an item where three attributes of their own cost 365."""
-
-    __slots__ = ("interval", "due", "held")
-
-    def __init__(self, interval: float, due: float = 0.0) -> None:
-        self.interval, self.due, self.held = interval, due, None
-
-
-def sample_items() -> None:
-    """Make asyncua's monitored items sample at their sampling interval: a
-    change that comes sooner than an interval after the last one sampled is
-    held, and the newest held is sampled when the interval is up (one
-    notification an interval at most, the value current then). Items
-    without a ``sampler`` get every scan's change."""
-    original = MonitoredItemService.datachange_callback
-    if getattr(original, "samples", False):
-        return
-
-    async def datachange_callback(self, handle, value, error=None):
-        if error is None:
-            sampler = getattr(self._monitored_items.get(self._monitored_datachange.get(handle)), "sampler", None)
-            if sampler is not None:
-                loop = asyncio.get_running_loop()
-                now = loop.time()
-                if now < sampler.due:
-                    if sampler.held is None:
-                        loop.call_at(sampler.due, lambda: loop.create_task(release(self, handle, sampler)))
-                    sampler.held = value
-                    return
-                sampler.due = now + sampler.interval
-        await original(self, handle, value, error)
-
-    async def release(service, handle, sampler: Sampler) -> None:
-        value, sampler.held = sampler.held, None
-        if value is not None and handle in service._monitored_datachange:  # not deleted since
-            sampler.due = asyncio.get_running_loop().time() + sampler.interval
-            await original(service, handle, value)
-    datachange_callback.samples = True
-    MonitoredItemService.datachange_callback = datachange_callback
 
 
 def _keep_sampling(subs, subscription_id: int, items, created: bool = True) -> None:
@@ -436,14 +389,10 @@ class Listener:
             held = sum(len(s.monitored_item_srv._monitored_items) for s in subs.subscriptions.values())
             room = max(0, limit - held)
             asked = list(params.ItemsToCreate)
-            if len(asked) <= room:
-                results = await original_items(params)
-                _keep_sampling(subs, params.SubscriptionId,
-                               [(r.MonitoredItemId, a.RequestedParameters, r) for a, r in zip(asked, results)])
-                return results
-            taken = params.__class__(SubscriptionId=params.SubscriptionId,
-                                     TimestampsToReturn=params.TimestampsToReturn, ItemsToCreate=asked[:room])
-            results = await original_items(taken) if room else []
+            if len(asked) > room:  # asyncua makes the ones there is room for; the rest refused below
+                params = params.__class__(SubscriptionId=params.SubscriptionId,
+                                          TimestampsToReturn=params.TimestampsToReturn, ItemsToCreate=asked[:room])
+            results = await original_items(params) if room or not asked else []
             _keep_sampling(subs, params.SubscriptionId,
                            [(r.MonitoredItemId, a.RequestedParameters, r) for a, r in zip(asked, results)])
             for _ in asked[room:]:

@@ -25,7 +25,12 @@ Written against asyncua >=2.1,<2.2, as asyncua_glue.py is (its
   ``processor.session`` is not ``is_activated()``, counted idle); ``check_transport``
   answers a chunk that is not OPC UA, or that asyncua fails to process,
   with an Error message and closes the connection (OPC 10000-6 7.1.5),
-  where asyncua would log it and keep the connection.
+  where asyncua would log it and keep the connection;
+- ``MonitoredItemService.datachange_callback`` (and its
+  ``_monitored_datachange``, ``_monitored_items``), taken over by
+  ``sample_items``: asyncua queues every change of a value whatever the
+  item's sampling interval, where OPC 10000-4 5.12.1.2 samples at it; the
+  glue gives each item its ``sampler``.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ import struct
 
 from asyncua import ua
 from asyncua.server.binary_server_asyncio import OPCUAProtocol
+from asyncua.server.monitored_item_service import MonitoredItemService
 from asyncua.server.uaprocessor import UaProcessor
 from asyncua.ua.ua_binary import struct_from_binary, uatcp_to_binary
 
@@ -42,6 +48,15 @@ from asyncua.ua.ua_binary import struct_from_binary, uatcp_to_binary
 # channel), "limit", "malformed", "idle"; each takes the message to log.
 # One server a process: the patches below are installed once and count here.
 COUNT: dict = {}
+_INSTALLED: set = set()  # the patches installed in this process, by name
+
+
+def _first(name: str) -> bool:
+    """True the first time a patch is installed in this process, then False."""
+    if name in _INSTALLED:
+        return False
+    _INSTALLED.add(name)
+    return True
 
 
 def _count(kind: str, message: str) -> None:
@@ -58,9 +73,9 @@ def refuse_unoffered() -> None:
     """Make asyncua refuse a session (BadSecurityPolicyRejected) on a channel
     whose policy and mode no endpoint offers: a None channel serves
     discovery only, unless the config allows None."""
-    original = UaProcessor._process_message
-    if getattr(original, "refuses_unoffered", False):
+    if not _first("unoffered"):
         return
+    original = UaProcessor._process_message
 
     async def _process_message(self, typeid, requesthdr, seqhdr, body):
         if typeid.Identifier in _SESSION_REQUESTS and typeid.NamespaceIndex == 0:  # every request passes here
@@ -70,7 +85,6 @@ def refuse_unoffered() -> None:
                 _count("channel", f"session refused: {policy.URI.rsplit('#', 1)[-1]} is not offered")
                 raise ua.UaStatusCodeError(ua.StatusCodes.BadSecurityPolicyRejected)
         return await original(self, typeid, requesthdr, seqhdr, body)
-    _process_message.refuses_unoffered = True
     UaProcessor._process_message = _process_message
 
 
@@ -118,7 +132,7 @@ def check_transport() -> None:
     ``max_pending_activation_seconds`` is closed and counted (idle). A
     client that only asks for the endpoints and closes is counted as
     nothing."""
-    if getattr(OPCUAProtocol.connection_made, "counts", False):
+    if not _first("transport"):
         return
     original_made, original_received = OPCUAProtocol.connection_made, OPCUAProtocol.data_received
     original_one = OPCUAProtocol._process_one_msg
@@ -170,7 +184,6 @@ def check_transport() -> None:
                            f"{self.iserver.max_pending_activation_seconds:g} s")
             self.transport.close()
 
-    connection_made.counts = True
     OPCUAProtocol.connection_made = connection_made
     OPCUAProtocol.data_received = data_received
     OPCUAProtocol._process_one_msg = _process_one_msg
@@ -178,7 +191,6 @@ def check_transport() -> None:
 
 
 ASIDE: dict = {}  # "manager": the Listener's UserManager, whose password checks run in a thread
-_INSTALLED: set = set()  # the patches installed in this process, by name
 _ACTIVATE = ua.ObjectIds.ActivateSessionRequest_Encoding_DefaultBinary
 
 
@@ -191,9 +203,8 @@ def check_passwords_aside() -> None:
     docs/opcuas.md). The
     token is read and decrypted as asyncua will read it; a token that fails
     to is left to asyncua to refuse."""
-    if "aside" in _INSTALLED:
+    if not _first("aside"):
         return
-    _INSTALLED.add("aside")
     original = UaProcessor._process_message
 
     async def _process_message(self, typeid, requesthdr, seqhdr, body):
@@ -213,3 +224,47 @@ def check_passwords_aside() -> None:
         finally:
             manager.forget(key)
     UaProcessor._process_message = _process_message
+
+
+class Sampler:
+    """A monitored item's sampling: its interval (s), when its next sample
+    is due (the event loop's time) and the newest change held until then.
+    One attribute of asyncua's item holds it (``sampler``): slots keep it
+    small, 56 bytes an item where three attributes of their own cost 365."""
+
+    __slots__ = ("interval", "due", "held")
+
+    def __init__(self, interval: float, due: float = 0.0) -> None:
+        self.interval, self.due, self.held = interval, due, None
+
+
+def sample_items() -> None:
+    """Make asyncua's monitored items sample at their sampling interval: a
+    change that comes sooner than an interval after the last one sampled is
+    held, and the newest held is sampled when the interval is up (one
+    notification an interval at most, the value current then). Items
+    without a ``sampler`` get every scan's change."""
+    if not _first("sample"):
+        return
+    original = MonitoredItemService.datachange_callback
+
+    async def datachange_callback(self, handle, value, error=None):
+        if error is None:
+            sampler = getattr(self._monitored_items.get(self._monitored_datachange.get(handle)), "sampler", None)
+            if sampler is not None:
+                loop = asyncio.get_running_loop()
+                now = loop.time()
+                if now < sampler.due:
+                    if sampler.held is None:
+                        loop.call_at(sampler.due, lambda: loop.create_task(release(self, handle, sampler)))
+                    sampler.held = value
+                    return
+                sampler.due = now + sampler.interval
+        await original(self, handle, value, error)
+
+    async def release(service, handle, sampler: Sampler) -> None:
+        value, sampler.held = sampler.held, None
+        if value is not None and handle in service._monitored_datachange:  # not deleted since
+            sampler.due = asyncio.get_running_loop().time() + sampler.interval
+            await original(service, handle, value)
+    MonitoredItemService.datachange_callback = datachange_callback
