@@ -224,6 +224,22 @@ def check_writable(c: XmlChecker, node: XmlNode, status: Address | None, status_
     return None if found is None else Writable(found[0], found[1], node.line, node.column)
 
 
+def status_references(status: Address | None, words: int) -> list[Address]:
+    """The first and last word of a status block of ``words`` words (none
+    without one), so that the engine creates them before the first scan."""
+    return [] if status is None else [status, status.with_element(status.element + words - 1)]
+
+
+def element_references(config, status_words: int) -> list[Address]:
+    """The first and last element of every ``<Writable address>`` region and
+    of the status block (ENIPS's and OPCUAS's), created before the first scan."""
+    found: list[Address] = []
+    for w in config.writable:
+        if w.address is not None:
+            found += [w.address, w.address.with_element(w.last)]
+    return found + status_references(config.status, status_words)
+
+
 def refuse_tags(config) -> None:
     """ModuleErrors for each ``<Writable tag=...>`` of an app directory's
     configuration: its data table has no tags."""

@@ -20,8 +20,8 @@ from ...datatable.address import Address
 from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
-from ..netconfig import (ALLOW, Writable, check_allow, check_host, check_status, check_writable, listen_attributes,
-                         listen_warning, writable_attributes)
+from ..netconfig import (ALLOW, Writable, check_allow, check_host, check_status, check_writable, element_references,
+                         listen_attributes, listen_warning, writable_attributes)
 from ..xmlcheck import MANY, Attr, XmlChecker
 
 CONFIG_FILE = "ENIPS.XML"
@@ -93,12 +93,5 @@ def load_config(app_dir: Path) -> ServerConfig:
 
 
 def config_references(config: ServerConfig) -> list[Address]:
-    """The first and last element of every writable region and of the
-    status block, so that the engine creates them before the first scan."""
-    found: list[Address] = []
-    for w in config.writable:
-        if w.address is not None:
-            found += [w.address, w.address.with_element(w.last)]
-    if config.status is not None:
-        found += [config.status, config.status.with_element(config.status.element + STATUS_WORDS - 1)]
-    return found
+    """What the engine creates before the first scan (netconfig.element_references)."""
+    return element_references(config, STATUS_WORDS)

@@ -29,7 +29,7 @@ from ...textfile import read_bytes
 from ..api import find_file
 from ..errors import ModuleError, ModuleErrors
 from ..netconfig import (ALLOW, check_allow, check_host, check_status, listen_attributes,
-                         listen_warning)
+                         listen_warning, status_references)
 from ..xmlcheck import MANY, Attr, XmlChecker, parse_integer
 from ..xmlreader import XmlNode
 
@@ -345,7 +345,4 @@ def config_references(config: ServerConfig) -> list[Address]:
         for region in unit.regions:
             found.append(region.address)
             found.append(item_address(region, region.count - 1))
-    if config.status is not None:
-        found.append(config.status)
-        found.append(config.status.with_element(config.status.element + STATUS_WORDS - 1))
-    return found
+    return found + status_references(config.status, STATUS_WORDS)
