@@ -13,7 +13,7 @@ the scan.
 
 from __future__ import annotations
 
-from ..errors import ModuleError
+from ..errors import ModuleError, ModuleErrors
 from ...cip.status import PRIVILEGE_VIOLATION
 from .config import ServerConfig
 from .logixtags import LogixCatalogue, StructTarget, _segments
@@ -52,6 +52,16 @@ def tag_ranges(view: LogixView, config: ServerConfig) -> tuple[Ranges, list[Modu
         for file, lo, hi in _spans(cat, target, one):
             ranges.setdefault(file, []).append((lo, hi))
     return ranges, problems
+
+
+def export_ranges(view: LogixView, config: ServerConfig) -> tuple[Ranges, Ranges]:
+    """(what the config's <Writable tag>s open, what the export keeps
+    closed), as ENIPS and OPCUAS both hold an export's tags to them;
+    ModuleErrors listing every path the export does not open."""
+    opened, problems = tag_ranges(view, config)
+    if problems:
+        raise ModuleErrors(problems)
+    return opened, closed_ranges(view)
 
 
 def _spans(cat: LogixCatalogue, target, one: bool):

@@ -22,13 +22,13 @@ from pathlib import Path
 from typing import Mapping
 
 from ...textfile import read_bytes
-from ..errors import ModuleError, ModuleErrors
+from ..errors import ModuleError
 from ..netconfig import refuse_tags
 from ..netmodule import NetServerModule
 from . import status as S
 from .config import CONFIG_FILE, ServerConfig, config_references, load_config, parse_config
 from .identity import Identity
-from .logixconfig import closed_ranges, tag_ranges
+from .logixconfig import export_ranges
 from .logixview import build_view
 from .protocol import EnipProtocol, build_slots
 from .tagnames import symbol_addresses
@@ -70,10 +70,7 @@ class EnipServer(NetServerModule):
         self.config = parse_config(data, str(config_path))
         self.app_name = app_name
         self.logix = build_view(directory, programs)
-        self.open_ranges, problems = tag_ranges(self.logix, self.config)
-        if problems:
-            raise ModuleErrors(problems)
-        self.closed = closed_ranges(self.logix)
+        self.open_ranges, self.closed = export_ranges(self.logix, self.config)
         return list(self.config.warnings) + [f"{config_path}: tag {why}: not served to clients"
                                              for why in self.logix.skipped]
 

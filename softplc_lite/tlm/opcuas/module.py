@@ -18,9 +18,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Mapping
 
-from ..enips.logixconfig import closed_ranges, tag_ranges
+from ..enips.logixconfig import export_ranges
 from ..enips.logixview import build_view
-from ..errors import ModuleError, ModuleErrors
+from ..errors import ModuleError
 from ..netconfig import refuse_tags
 from ..netmodule import NetServerModule
 from . import status as S
@@ -64,11 +64,7 @@ class OpcUaServer(NetServerModule):
         self.config = read_config(Path(config_path))
         self.app_name = app_name
         self.directory = directory
-        view = build_view(directory, programs)
-        opened, problems = tag_ranges(view, self.config)
-        if problems:
-            raise ModuleErrors(problems)
-        self.tag_ranges = (opened, closed_ranges(view))
+        self.tag_ranges = export_ranges(build_view(directory, programs), self.config)
         check_certificate(self.config)
         unseen = [f"{config_path}:{w.line}:{w.column}: <Writable address={w.address}> opens nothing a client "
                   "sees beside an export (its address space holds tags, not data files): open a tag with "
