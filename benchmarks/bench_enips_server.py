@@ -44,8 +44,8 @@ import time
 from pathlib import Path
 
 import _common as C
-from bench_modbus_server import (RUNTIME, START_LIMIT_S, CheckFailed, Child, client_results, finish, ladder, scans_in,
-                                 server_xml, span)
+from bench_modbus_server import (RUNTIME, START_LIMIT_S, CheckFailed, Child, client_results, finish, idle_window,
+                                 ladder, scans_in, server_xml, span)
 
 from helpers.modbus_peer import free_tcp_port
 
@@ -122,18 +122,13 @@ def run(cfg: dict, work: Path) -> dict:
               f"{100 * (used or 0) / seconds:.0f} %", flush=True)
 
     try:
-        time.sleep(1.0)
-        t0 = time.monotonic()
-        time.sleep(cfg["idle_s"])
-        quiet = {"start": t0, "end": time.monotonic()}
+        quiet = idle_window(cfg["idle_s"], settle_s=1.0)
         for rnd in range(cfg["rounds"]):
             for k in CLIENT_COUNTS:
                 for j in range(len(KINDS)):
                     window(KINDS[(rnd + j) % len(KINDS)], k, rnd, cfg["window_s"])
         window("raw", BUSY_CLIENTS, 0, cfg["busy_s"])
-        t1 = time.monotonic()
-        time.sleep(cfg["idle_s"])
-        after_busy = {"start": t1, "end": time.monotonic()}
+        after_busy = idle_window(cfg["idle_s"])
     finally:
         runtime.stop()
     if not records_path.exists():

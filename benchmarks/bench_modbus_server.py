@@ -188,6 +188,16 @@ class Child:
         self.proc.stdout.close()
 
 
+def idle_window(seconds: float, settle_s: float = 0.0) -> dict:
+    """A window of ``seconds`` with no client, after ``settle_s`` (the
+    runtime's first scans and the baseline's start behind us): its start
+    and end, to find the scans in it (scans_in)."""
+    time.sleep(settle_s)
+    start = time.monotonic()
+    time.sleep(seconds)
+    return {"start": start, "end": time.monotonic()}
+
+
 def stop_all(children: list[Child]) -> None:
     """Stop children side by side: each is told first, then each awaited."""
     for child in children:
@@ -318,10 +328,7 @@ def run(cfg: dict, work: Path) -> dict:
               f"runtime {w['cpu_percent']['runtime']:.0f}", flush=True)
 
     try:
-        time.sleep(1.0)  # the runtime's first scans and the baseline's start behind us
-        t0 = time.monotonic()
-        time.sleep(cfg["idle_s"])
-        quiet = {"start": t0, "end": time.monotonic()}
+        quiet = idle_window(cfg["idle_s"], settle_s=1.0)
         for rnd in range(cfg["rounds"]):
             for j, (kind, k, procs) in enumerate(PLAN):
                 order = ["modbtcps", "pymodbus"] if (rnd + j) % 2 == 0 else ["pymodbus", "modbtcps"]

@@ -54,12 +54,11 @@ import json
 import os
 import statistics
 import sys
-import time
 from pathlib import Path
 
 import _common as C
 import opcuas_load as L
-from bench_modbus_server import RUNTIME, CheckFailed, Child, finish, ladder, scans_in, span, stop_all
+from bench_modbus_server import RUNTIME, CheckFailed, Child, finish, idle_window, ladder, scans_in, span, stop_all
 
 from helpers.modbus_peer import free_tcp_port
 
@@ -183,10 +182,7 @@ def run(cfg: dict, work: Path) -> dict:
 
     try:
         L.quiet_asyncua()
-        time.sleep(1.0)
-        t0 = time.monotonic()
-        time.sleep(cfg["idle_s"])
-        quiet = {"start": t0, "end": time.monotonic()}
+        quiet = idle_window(cfg["idle_s"], settle_s=1.0)
         for rnd in range(cfg["rounds"]):
             for kind in KINDS:
                 order = ("opcuas", "asyncua") if rnd % 2 == 0 else ("asyncua", "opcuas")
